@@ -1,0 +1,1 @@
+# gateway/: the programs. Each program is one .c file; shared code in modules.

@@ -1,0 +1,761 @@
+/* urrt: RealTime interface decoder. See urrt.h for the API, docs/ for the
+ * wire format and the security model. */
+#include "urrt.h"
+
+/* C99 has no _Static_assert; a negative array size stops the build. */
+#define URRT_STATIC_ASSERT(name, cond) typedef char urrt_assert_##name[(cond) ? 1 : -1]
+
+URRT_STATIC_ASSERT(double_is_ieee754_binary64, sizeof(double) == 8);
+URRT_STATIC_ASSERT(max_doubles_holds_newest_layout, URRT_MAX_DOUBLES >= URRT_WIRE_COLUMNS);
+URRT_STATIC_ASSERT(max_doubles_fits_int, URRT_MAX_DOUBLES <= 0x0FFFFFFF);
+URRT_STATIC_ASSERT(fields_fit_presence_mask, URRT_FIELD_COUNT <= 64);
+
+/* The decoder fills the 3.x/5.x grid in one pass, so each grid field must
+ * sit at its column's offset from the start of the struct. */
+#define URRT_X_GRID_CHECK(ID, name, count, c1, c3, unit, since, desc) \
+    URRT_STATIC_ASSERT(grid_##name, (c3) == 0 || offsetof(urrt_state, name) == ((c3) - 1) * sizeof(double));
+URRT_FIELDS(URRT_X_GRID_CHECK)
+#undef URRT_X_GRID_CHECK
+URRT_STATIC_ASSERT(grid_is_152_columns,
+                   offsetof(urrt_state, unused_53) == URRT_WIRE_COLUMNS * sizeof(double));
+
+#define URRT_X_COUNT_CHECK(ID, name, count, c1, c3, unit, since, desc) \
+    URRT_STATIC_ASSERT(count_##name, (count) <= URRT_FIELD_COUNT_MAX);
+URRT_FIELDS(URRT_X_COUNT_CHECK)
+#undef URRT_X_COUNT_CHECK
+
+#define URRT_NAN_BITS UINT64_C(0x7FF8000000000000)
+#define URRT_1X_MAX_DOUBLES 101u
+#define URRT_3X_MIN_DOUBLES 130u
+/* 1.5 sent columns 50-52 without the accelerometer (protocol-facts.md). */
+#define URRT_1X_ACCELEROMETER_MIN_DOUBLES 95u
+
+static const urrt_field_info field_table[URRT_FIELD_COUNT] = {
+#define URRT_X_INFO(ID, name, count, c1, c3, unit, since, desc) \
+    {#name, unit, since, desc, count, c1, c3},
+    URRT_FIELDS(URRT_X_INFO)
+#undef URRT_X_INFO
+};
+
+/* ---- bytes and bits ---------------------------------------------------- */
+
+static uint32_t load_be32(const uint8_t *p)
+{
+    return ((uint32_t)p[0] << 24) | ((uint32_t)p[1] << 16) | ((uint32_t)p[2] << 8) | (uint32_t)p[3];
+}
+
+static uint64_t load_be64(const uint8_t *p)
+{
+    return ((uint64_t)load_be32(p) << 32) | (uint64_t)load_be32(p + 4);
+}
+
+static void store_be64(uint8_t *p, uint64_t v)
+{
+    unsigned i;
+    for (i = 0; i < 8; i++) {
+        p[i] = (uint8_t)(v >> (56 - 8 * i));
+    }
+}
+
+/* Reading a union member other than the one last written reinterprets the
+ * bytes (C99 TC3 6.5.2.3): the portable way to move bits without memcpy. */
+typedef union {
+    uint64_t u;
+    double d;
+} urrt_bits;
+
+static double double_from_bits(uint64_t u)
+{
+    urrt_bits b;
+    b.u = u;
+    return b.d;
+}
+
+static uint64_t bits_from_double(double d)
+{
+    urrt_bits b;
+    b.d = d;
+    return b.u;
+}
+
+/*
+ * An integral double's value, worked out on the bits so that the library
+ * needs no floating-point arithmetic (a Cortex-M without an FPU would pull in
+ * soft-float routines for a single comparison). False for NaN, infinities,
+ * fractions and magnitudes past 2^53.
+ */
+static bool integral_from_bits(uint64_t u, bool *negative, uint64_t *magnitude)
+{
+    const uint64_t mantissa_mask = (UINT64_C(1) << 52) - 1;
+    unsigned exponent = (unsigned)((u >> 52) & 0x7FFu);
+    uint64_t mantissa = u & mantissa_mask;
+
+    *negative = (u >> 63) != 0;
+    if (exponent == 0) {
+        *magnitude = 0;
+        return mantissa == 0; /* zero, or a subnormal fraction */
+    }
+    if (exponent == 0x7FFu || exponent < 1023u || exponent > 1023u + 53u) {
+        return false;
+    }
+    mantissa |= UINT64_C(1) << 52;
+    if (exponent >= 1075u) {
+        *magnitude = mantissa << (exponent - 1075u);
+        return true;
+    }
+    {
+        unsigned shift = 1075u - exponent;
+        if ((mantissa & ((UINT64_C(1) << shift) - 1)) != 0) {
+            return false;
+        }
+        *magnitude = mantissa >> shift;
+    }
+    return true;
+}
+
+/* ---- results and metadata ----------------------------------------------- */
+
+const char *urrt_strerror(int result)
+{
+    switch (result) {
+    case URRT_E_ARG: return "invalid argument";
+    case URRT_E_TRUNCATED: return "fewer bytes than the packet declares";
+    case URRT_E_SIZE_SMALL: return "declared size below the minimum packet";
+    case URRT_E_SIZE_ALIGN: return "declared size is not 4 + 8n";
+    case URRT_E_SIZE_LARGE: return "declared size past the largest packet accepted";
+    case URRT_E_ABSENT: return "field not present in a packet of this length";
+    case URRT_E_RANGE: return "index out of range";
+    case URRT_E_NOT_BITMASK: return "value is not a bit mask";
+    case URRT_E_NO_SPACE: return "output buffer too small";
+    case URRT_E_UNKNOWN_FIELD: return "no field of that name";
+    default: return result >= 0 ? "ok" : "unknown error";
+    }
+}
+
+const urrt_field_info *urrt_field(urrt_field_id id)
+{
+    if ((unsigned)id >= (unsigned)URRT_FIELD_COUNT) {
+        return NULL;
+    }
+    return &field_table[id];
+}
+
+int urrt_field_find(const char *name, size_t name_len)
+{
+    unsigned id;
+    if (name == NULL) {
+        return URRT_E_ARG;
+    }
+    for (id = 0; id < (unsigned)URRT_FIELD_COUNT; id++) {
+        const char *candidate = field_table[id].name;
+        size_t i = 0;
+        while (i < name_len && candidate[i] != '\0' && candidate[i] == name[i]) {
+            i++;
+        }
+        if (i == name_len && candidate[i] == '\0') {
+            return (int)id;
+        }
+    }
+    return URRT_E_UNKNOWN_FIELD;
+}
+
+unsigned urrt_field_column(urrt_field_id id, urrt_generation gen)
+{
+    const urrt_field_info *f = urrt_field(id);
+    if (f == NULL) {
+        return 0;
+    }
+    switch (gen) {
+    case URRT_GEN_1X: return f->col_1x;
+    case URRT_GEN_3X: return f->col_3x;
+    case URRT_GEN_UNKNOWN: return f->col_1x == f->col_3x ? f->col_1x : 0u;
+    default: return 0;
+    }
+}
+
+/* ---- lengths ------------------------------------------------------------ */
+
+static bool plausible_length(uint32_t size)
+{
+    return size >= URRT_PACKET_MIN && size <= URRT_PACKET_MAX && (size - URRT_HEADER_SIZE) % 8u == 0;
+}
+
+const char *urrt_versions_of(uint32_t length)
+{
+    switch (length) {
+    case 540:
+    case 692: return "early 1.x (before 1.5)";
+    case 756: return "1.5-1.6";
+    case 764: return "1.6-1.7";
+    case 812: return "1.8";
+    case 1044: return "3.0-3.1";
+    case 1060: return "3.2-3.4";
+    case 1108: return "3.5-3.9, 5.0-5.3";
+    case 1116: return "3.10-3.13, 5.4-5.8";
+    case 1140: return "3.14-3.15, 5.9";
+    case 1220: return "5.10 or later";
+    default: return NULL;
+    }
+}
+
+urrt_generation urrt_generation_of(uint32_t length)
+{
+    uint32_t doubles;
+    if (!plausible_length(length)) {
+        return URRT_GEN_UNKNOWN;
+    }
+    doubles = (length - URRT_HEADER_SIZE) / 8u;
+    if (doubles <= URRT_1X_MAX_DOUBLES) {
+        return URRT_GEN_1X;
+    }
+    if (doubles >= URRT_3X_MIN_DOUBLES) {
+        return URRT_GEN_3X;
+    }
+    return URRT_GEN_UNKNOWN;
+}
+
+int urrt_packet_length(const uint8_t *buf, size_t len)
+{
+    int32_t declared;
+    uint32_t raw;
+    if (buf == NULL) {
+        return URRT_E_ARG;
+    }
+    if (len < URRT_HEADER_SIZE) {
+        return URRT_E_TRUNCATED;
+    }
+    raw = load_be32(buf);
+    declared = raw > 0x7FFFFFFFu ? -1 : (int32_t)raw;
+    if (declared < (int32_t)URRT_PACKET_MIN) {
+        return URRT_E_SIZE_SMALL;
+    }
+    if ((raw - URRT_HEADER_SIZE) % 8u != 0) {
+        return URRT_E_SIZE_ALIGN;
+    }
+    if (raw > URRT_PACKET_MAX) {
+        return URRT_E_SIZE_LARGE;
+    }
+    if (raw > len) {
+        return URRT_E_TRUNCATED;
+    }
+    return (int)raw;
+}
+
+/* ---- decoding ----------------------------------------------------------- */
+
+static bool field_fits(const urrt_field_info *f, unsigned column, unsigned doubles, urrt_generation gen)
+{
+    if (column == 0 || column + f->count - 1u > doubles) {
+        return false;
+    }
+    if (gen == URRT_GEN_1X && f == &field_table[URRT_F_TOOL_ACCELEROMETER]) {
+        return doubles >= URRT_1X_ACCELEROMETER_MIN_DOUBLES;
+    }
+    return true;
+}
+
+/* Column c of the 3.x/5.x grid, as a place in the struct (see the static
+ * assertions above: the grid members are laid out in column order). */
+static double *grid_slot(urrt_state *st, unsigned column)
+{
+    return (double *)(void *)((unsigned char *)st + (column - 1u) * sizeof(double));
+}
+
+static const double *grid_slot_const(const urrt_state *st, unsigned column)
+{
+    return (const double *)(const void *)((const unsigned char *)st + (column - 1u) * sizeof(double));
+}
+
+static const uint16_t field_offsets[URRT_FIELD_COUNT] = {
+#define URRT_X_OFFSET(ID, name, count, c1, c3, unit, since, desc) (uint16_t)offsetof(urrt_state, name),
+    URRT_FIELDS(URRT_X_OFFSET)
+#undef URRT_X_OFFSET
+};
+
+static double *field_slot(urrt_state *st, unsigned id)
+{
+    return (double *)(void *)((unsigned char *)st + field_offsets[id]);
+}
+
+static const double *field_slot_const(const urrt_state *st, unsigned id)
+{
+    return (const double *)(const void *)((const unsigned char *)st + field_offsets[id]);
+}
+
+static void fill_nan(double *p, unsigned count)
+{
+    double nan = double_from_bits(URRT_NAN_BITS);
+    unsigned i;
+    for (i = 0; i < count; i++) {
+        p[i] = nan;
+    }
+}
+
+void urrt_state_clear(urrt_state *st)
+{
+    unsigned id;
+    if (st == NULL) {
+        return;
+    }
+    for (id = 0; id < (unsigned)URRT_FIELD_COUNT; id++) {
+        fill_nan(field_slot(st, id), field_table[id].count);
+    }
+    st->present = 0;
+    st->length = 0;
+    st->doubles = 0;
+    st->extra_columns = 0;
+    st->generation = URRT_GEN_UNKNOWN;
+}
+
+/* The hot path (e-series at 500 Hz): one pass over the grid. */
+static void decode_3x(const uint8_t *body, unsigned doubles, urrt_state *st)
+{
+    unsigned known = doubles < URRT_WIRE_COLUMNS ? doubles : URRT_WIRE_COLUMNS;
+    unsigned col;
+    unsigned id;
+    uint64_t present = 0;
+
+    for (col = 1; col <= known; col++) {
+        *grid_slot(st, col) = double_from_bits(load_be64(body + 8u * (col - 1u)));
+    }
+    /* Grid fields are in column order, so the present ones are a prefix. */
+    for (id = 0; id < (unsigned)URRT_FIELD_COUNT && field_table[id].col_3x != 0; id++) {
+        const urrt_field_info *f = &field_table[id];
+        if (!field_fits(f, f->col_3x, doubles, URRT_GEN_3X)) {
+            fill_nan(grid_slot(st, f->col_3x), URRT_WIRE_COLUMNS + 1u - f->col_3x);
+            break;
+        }
+        present |= UINT64_C(1) << id;
+    }
+    fill_nan(st->unused_53, 15);
+    fill_nan(st->tool_vector, 6);
+    fill_nan(st->tcp_speed, 6);
+    st->present = present;
+    st->extra_columns = (uint16_t)(doubles - known);
+}
+
+/* 1.x and the ambiguous lengths: field by field from the table. */
+static void decode_by_table(const uint8_t *body, unsigned doubles, urrt_generation gen, urrt_state *st)
+{
+    unsigned id;
+    urrt_state_clear(st);
+    for (id = 0; id < (unsigned)URRT_FIELD_COUNT; id++) {
+        const urrt_field_info *f = &field_table[id];
+        unsigned column = urrt_field_column((urrt_field_id)id, gen);
+        double *slot = field_slot(st, id);
+        unsigned i;
+        if (!field_fits(f, column, doubles, gen)) {
+            continue;
+        }
+        for (i = 0; i < f->count; i++) {
+            slot[i] = double_from_bits(load_be64(body + 8u * (column - 1u + i)));
+        }
+        st->present |= UINT64_C(1) << id;
+    }
+}
+
+int urrt_decode(const uint8_t *buf, size_t len, urrt_state *st)
+{
+    int size;
+    unsigned doubles;
+    urrt_generation gen;
+
+    if (st == NULL) {
+        return URRT_E_ARG;
+    }
+    size = urrt_packet_length(buf, len);
+    if (size < 0) {
+        urrt_state_clear(st);
+        return size;
+    }
+    doubles = ((unsigned)size - URRT_HEADER_SIZE) / 8u;
+    gen = urrt_generation_of((uint32_t)size);
+    if (gen == URRT_GEN_3X) {
+        decode_3x(buf + URRT_HEADER_SIZE, doubles, st);
+    } else {
+        decode_by_table(buf + URRT_HEADER_SIZE, doubles, gen, st);
+    }
+    st->length = (uint32_t)size;
+    st->doubles = (uint16_t)doubles;
+    st->generation = gen;
+    return size;
+}
+
+int urrt_read_column_bits(const uint8_t *buf, size_t len, unsigned column, uint64_t *out)
+{
+    int size = urrt_packet_length(buf, len);
+    if (size < 0) {
+        return size;
+    }
+    if (out == NULL) {
+        return URRT_E_ARG;
+    }
+    if (column == 0 || column > ((unsigned)size - URRT_HEADER_SIZE) / 8u) {
+        return URRT_E_RANGE;
+    }
+    *out = load_be64(buf + URRT_HEADER_SIZE + 8u * (column - 1u));
+    return URRT_OK;
+}
+
+int urrt_read_column(const uint8_t *buf, size_t len, unsigned column, double *out)
+{
+    uint64_t bits;
+    int r;
+    if (out == NULL) {
+        return URRT_E_ARG;
+    }
+    r = urrt_read_column_bits(buf, len, column, &bits);
+    if (r == URRT_OK) {
+        *out = double_from_bits(bits);
+    }
+    return r;
+}
+
+int urrt_read(const uint8_t *buf, size_t len, urrt_field_id id, unsigned elem, double *out)
+{
+    const urrt_field_info *f = urrt_field(id);
+    int size = urrt_packet_length(buf, len);
+    unsigned doubles;
+    urrt_generation gen;
+    unsigned column;
+
+    if (size < 0) {
+        return size;
+    }
+    if (f == NULL || out == NULL) {
+        return URRT_E_ARG;
+    }
+    if (elem >= f->count) {
+        return URRT_E_RANGE;
+    }
+    doubles = ((unsigned)size - URRT_HEADER_SIZE) / 8u;
+    gen = urrt_generation_of((uint32_t)size);
+    column = urrt_field_column(id, gen);
+    if (!field_fits(f, column, doubles, gen)) {
+        return URRT_E_ABSENT;
+    }
+    return urrt_read_column(buf, len, column + elem, out);
+}
+
+/* ---- encoding ----------------------------------------------------------- */
+
+int urrt_encode(const urrt_state *st, uint32_t length, uint8_t *out, size_t out_size)
+{
+    unsigned doubles;
+    unsigned col;
+    unsigned id;
+    urrt_generation gen;
+
+    if (st == NULL || out == NULL) {
+        return URRT_E_ARG;
+    }
+    if (length < URRT_PACKET_MIN || length > 0x7FFFFFFFu) {
+        return URRT_E_SIZE_SMALL;
+    }
+    if ((length - URRT_HEADER_SIZE) % 8u != 0) {
+        return URRT_E_SIZE_ALIGN;
+    }
+    if (length > URRT_PACKET_MAX) {
+        return URRT_E_SIZE_LARGE;
+    }
+    if (out_size < length) {
+        return URRT_E_NO_SPACE;
+    }
+    doubles = (length - URRT_HEADER_SIZE) / 8u;
+    gen = doubles <= URRT_1X_MAX_DOUBLES ? URRT_GEN_1X : URRT_GEN_3X;
+
+    out[0] = (uint8_t)(length >> 24);
+    out[1] = (uint8_t)(length >> 16);
+    out[2] = (uint8_t)(length >> 8);
+    out[3] = (uint8_t)length;
+    if (gen == URRT_GEN_3X) {
+        unsigned known = doubles < URRT_WIRE_COLUMNS ? doubles : URRT_WIRE_COLUMNS;
+        for (col = 1; col <= known; col++) {
+            store_be64(out + URRT_HEADER_SIZE + 8u * (col - 1u), bits_from_double(*grid_slot_const(st, col)));
+        }
+        for (; col <= doubles; col++) {
+            store_be64(out + URRT_HEADER_SIZE + 8u * (col - 1u), 0);
+        }
+        return (int)length;
+    }
+    for (col = 1; col <= doubles; col++) {
+        store_be64(out + URRT_HEADER_SIZE + 8u * (col - 1u), 0);
+    }
+    for (id = 0; id < (unsigned)URRT_FIELD_COUNT; id++) {
+        const urrt_field_info *f = &field_table[id];
+        const double *slot = field_slot_const(st, id);
+        unsigned i;
+        if (f->col_1x == 0) {
+            continue;
+        }
+        for (i = 0; i < f->count && f->col_1x + i <= doubles; i++) {
+            store_be64(out + URRT_HEADER_SIZE + 8u * (f->col_1x - 1u + i), bits_from_double(slot[i]));
+        }
+    }
+    return (int)length;
+}
+
+/* ---- bit masks and enumerations ------------------------------------------ */
+
+int urrt_bitmask(double value, uint64_t *mask)
+{
+    uint64_t u = bits_from_double(value);
+    uint64_t magnitude;
+    bool negative;
+
+    if (mask == NULL) {
+        return URRT_E_ARG;
+    }
+    if ((u >> 52) == 0) {
+        /* Sign and exponent clear: zero, or a raw int64 read as a double. */
+        *mask = u;
+        return URRT_OK;
+    }
+    if (!integral_from_bits(u, &negative, &magnitude) || (negative && magnitude != 0) ||
+        magnitude > (UINT64_C(1) << 53)) {
+        return URRT_E_NOT_BITMASK;
+    }
+    *mask = magnitude;
+    return URRT_OK;
+}
+
+static const urrt_enum_entry robot_modes[] = {
+    {-1, "NO_CONTROLLER"}, {0, "DISCONNECTED"}, {1, "CONFIRM_SAFETY"}, {2, "BOOTING"},
+    {3, "POWER_OFF"}, {4, "POWER_ON"}, {5, "IDLE"}, {6, "BACKDRIVE"},
+    {7, "RUNNING"}, {8, "UPDATING_FIRMWARE"},
+};
+
+static const urrt_enum_entry robot_modes_1x[] = {
+    {0, "RUNNING"}, {1, "FREEDRIVE"}, {2, "READY"}, {3, "INITIALIZING"},
+    {4, "SECURITY_STOPPED"}, {5, "EMERGENCY_STOPPED"}, {6, "FATAL_ERROR"}, {7, "NO_POWER"},
+    {8, "NOT_CONNECTED"}, {9, "SHUTDOWN"}, {10, "SAFEGUARD_STOP"},
+};
+
+static const urrt_enum_entry joint_modes[] = {
+    {235, "RESET"}, {236, "SHUTTING_DOWN"}, {237, "PART_D_CALIBRATION"}, {238, "BACKDRIVE"},
+    {239, "POWER_OFF"}, {240, "READY_FOR_POWER_OFF"}, {241, "CALVAL_INITIALIZATION"}, {242, "ERROR"},
+    {243, "FREEDRIVE"}, {244, "SIMULATED"}, {245, "NOT_RESPONDING"}, {246, "MOTOR_INITIALISATION"},
+    {247, "BOOTING"}, {248, "PART_D_CALIBRATION_ERROR"}, {249, "BOOTLOADER"}, {250, "CALIBRATION"},
+    {251, "VIOLATION"}, {252, "FAULT"}, {253, "RUNNING"}, {254, "INITIALISATION"},
+    {255, "IDLE"},
+};
+
+static const urrt_enum_entry safety_modes[] = {
+    {1, "NORMAL"}, {2, "REDUCED"}, {3, "PROTECTIVE_STOP"}, {4, "RECOVERY"},
+    {5, "SAFEGUARD_STOP"}, {6, "SYSTEM_EMERGENCY_STOP"}, {7, "ROBOT_EMERGENCY_STOP"}, {8, "VIOLATION"},
+    {9, "FAULT"}, {10, "VALIDATE_JOINT_ID"}, {11, "UNDEFINED_SAFETY_MODE"},
+};
+
+static const urrt_enum_entry safety_statuses[] = {
+    {1, "NORMAL"}, {2, "REDUCED"}, {3, "PROTECTIVE_STOP"}, {4, "RECOVERY"},
+    {5, "SAFEGUARD_STOP"}, {6, "SYSTEM_EMERGENCY_STOP"}, {7, "ROBOT_EMERGENCY_STOP"}, {8, "VIOLATION"},
+    {9, "FAULT"}, {10, "VALIDATE_JOINT_ID"}, {11, "UNDEFINED_SAFETY_MODE"},
+    {12, "AUTOMATIC_MODE_SAFEGUARD_STOP"}, {13, "SYSTEM_THREE_POSITION_ENABLING_STOP"},
+};
+
+static const urrt_enum_entry program_states[] = {
+    {0, "STOPPING"}, {1, "STOPPED"}, {2, "PLAYING"}, {3, "PAUSING"}, {4, "PAUSED"}, {5, "RESUMING"},
+};
+
+#define URRT_ENTRIES(table) (*count = sizeof(table) / sizeof(table[0]), table)
+
+const urrt_enum_entry *urrt_enum_entries(urrt_enum_kind kind, size_t *count)
+{
+    size_t ignored;
+    if (count == NULL) {
+        count = &ignored;
+    }
+    switch (kind) {
+    case URRT_ENUM_ROBOT_MODE: return URRT_ENTRIES(robot_modes);
+    case URRT_ENUM_ROBOT_MODE_1X: return URRT_ENTRIES(robot_modes_1x);
+    case URRT_ENUM_JOINT_MODE: return URRT_ENTRIES(joint_modes);
+    case URRT_ENUM_SAFETY_MODE: return URRT_ENTRIES(safety_modes);
+    case URRT_ENUM_SAFETY_STATUS: return URRT_ENTRIES(safety_statuses);
+    case URRT_ENUM_PROGRAM_STATE: return URRT_ENTRIES(program_states);
+    case URRT_ENUM_NONE:
+    default: *count = 0; return NULL;
+    }
+}
+
+const char *urrt_enum_name(urrt_enum_kind kind, double value)
+{
+    size_t count;
+    size_t i;
+    const urrt_enum_entry *entries = urrt_enum_entries(kind, &count);
+    uint64_t magnitude;
+    bool negative;
+
+    if (entries == NULL || !integral_from_bits(bits_from_double(value), &negative, &magnitude) ||
+        magnitude > 0x7FFFu) {
+        return URRT_UNKNOWN_NAME;
+    }
+    for (i = 0; i < count; i++) {
+        int v = negative ? -(int)magnitude : (int)magnitude;
+        if (entries[i].value == v) {
+            return entries[i].name;
+        }
+    }
+    return URRT_UNKNOWN_NAME;
+}
+
+urrt_enum_kind urrt_field_enum(urrt_field_id id, urrt_generation gen)
+{
+    switch (id) {
+    case URRT_F_ROBOT_MODE:
+        return gen == URRT_GEN_1X ? URRT_ENUM_ROBOT_MODE_1X
+             : gen == URRT_GEN_3X ? URRT_ENUM_ROBOT_MODE : URRT_ENUM_NONE;
+    case URRT_F_JOINT_MODES: return URRT_ENUM_JOINT_MODE;
+    case URRT_F_SAFETY_MODE: return URRT_ENUM_SAFETY_MODE;
+    case URRT_F_SAFETY_STATUS: return URRT_ENUM_SAFETY_STATUS;
+    case URRT_F_PROGRAM_STATE: return URRT_ENUM_PROGRAM_STATE;
+    default: return URRT_ENUM_NONE;
+    }
+}
+
+/* ---- framing ------------------------------------------------------------ */
+
+void urrt_framer_init(urrt_framer *fr)
+{
+    if (fr == NULL) {
+        return;
+    }
+    fr->stats.bytes = 0;
+    fr->stats.packets = 0;
+    fr->stats.resyncs = 0;
+    fr->stats.skipped = 0;
+    urrt_framer_reset(fr);
+}
+
+void urrt_framer_reset(urrt_framer *fr)
+{
+    if (fr == NULL) {
+        return;
+    }
+    fr->have = 0;
+    fr->need = 0;
+    fr->last_length = 0;
+    fr->out_of_sync = false;
+    fr->packet = NULL;
+    fr->packet_length = 0;
+}
+
+static bool header_acceptable(const urrt_framer *fr, uint32_t size)
+{
+    if (!plausible_length(size)) {
+        return false;
+    }
+    return fr->last_length == 0 || size == fr->last_length || urrt_versions_of(size) != NULL;
+}
+
+static void reject_byte(urrt_framer *fr)
+{
+    if (!fr->out_of_sync) {
+        fr->out_of_sync = true;
+        fr->stats.resyncs++;
+    }
+    fr->stats.skipped++;
+}
+
+static void accept_header(urrt_framer *fr, uint32_t size)
+{
+    fr->need = size;
+    fr->last_length = size;
+    fr->out_of_sync = false;
+}
+
+int urrt_framer_feed(urrt_framer *fr, const uint8_t *data, size_t len, size_t *used_out)
+{
+    size_t used = 0;
+
+    if (fr == NULL || used_out == NULL || (data == NULL && len != 0)) {
+        return URRT_E_ARG;
+    }
+    fr->packet = NULL;
+    fr->packet_length = 0;
+    while (used < len) {
+        if (fr->need == 0 && fr->have == 0 && len - used >= URRT_HEADER_SIZE) {
+            /* Header straight from the caller's bytes: no copy for whole packets. */
+            uint32_t size = load_be32(data + used);
+            if (!header_acceptable(fr, size)) {
+                reject_byte(fr);
+                used++;
+                continue;
+            }
+            accept_header(fr, size);
+            if (len - used >= size) {
+                fr->packet = data + used;
+                fr->packet_length = size;
+                fr->need = 0;
+                used += size;
+                break;
+            }
+        } else if (fr->need == 0) {
+            uint32_t size;
+            fr->buf[fr->have++] = data[used++];
+            if (fr->have < URRT_HEADER_SIZE) {
+                continue;
+            }
+            size = load_be32(fr->buf);
+            if (!header_acceptable(fr, size)) {
+                reject_byte(fr);
+                fr->buf[0] = fr->buf[1];
+                fr->buf[1] = fr->buf[2];
+                fr->buf[2] = fr->buf[3];
+                fr->have = URRT_HEADER_SIZE - 1u;
+                continue;
+            }
+            accept_header(fr, size);
+        }
+        {
+            size_t take = fr->need - fr->have;
+            size_t i;
+            if (take > len - used) {
+                take = len - used;
+            }
+            for (i = 0; i < take; i++) {
+                fr->buf[fr->have + i] = data[used + i];
+            }
+            fr->have += (uint32_t)take;
+            used += take;
+        }
+        if (fr->have == fr->need) {
+            fr->packet = fr->buf;
+            fr->packet_length = fr->need;
+            fr->have = 0;
+            fr->need = 0;
+            break;
+        }
+    }
+    fr->stats.bytes += used;
+    *used_out = used;
+    if (fr->packet != NULL) {
+        fr->stats.packets++;
+        return 1;
+    }
+    return 0;
+}
+
+const uint8_t *urrt_framer_packet(const urrt_framer *fr, size_t *len)
+{
+    if (fr == NULL || fr->packet == NULL) {
+        if (len != NULL) {
+            *len = 0;
+        }
+        return NULL;
+    }
+    if (len != NULL) {
+        *len = fr->packet_length;
+    }
+    return fr->packet;
+}
+
+size_t urrt_framer_finish(urrt_framer *fr)
+{
+    size_t pending;
+    if (fr == NULL) {
+        return 0;
+    }
+    pending = fr->have;
+    urrt_framer_reset(fr);
+    return pending;
+}
