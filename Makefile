@@ -32,7 +32,7 @@ all:
 
 include lib/lib.mk
 include port/port.mk
-include gateway/gateway.mk
+include $(sort $(wildcard gateway/*.mk))
 include $(sort $(wildcard tests/*.mk))
 
 all: $(PROGRAMS)

@@ -126,6 +126,69 @@ void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void
 urrt_link_state urrt_link_get_state(const urrt_link *link);
 const urrt_link_stats *urrt_link_get_stats(const urrt_link *link);
 
+/* ---- CAN link ---------------------------------------------------------------- */
+
+/*
+ * A transmit-mostly CAN link: a SocketCAN raw socket on POSIX, or a file in
+ * candump's log format (replayable with canplayer) for boxes without a CAN
+ * interface. Sending never blocks the loop: a frame the driver cannot take
+ * (ENOBUFS) waits in a one-deep slot per CAN ID, and a newer frame for that
+ * ID replaces it and counts a drop, so an outage never replays a backlog. An
+ * interface that goes down is reported and reopened. Error frames (bus-off,
+ * restarted, ...) are received and counted.
+ */
+#define URRT_CAN_MAX_DATA 64
+
+typedef struct urrt_can_frame {
+    uint32_t id;    /* 11-bit, or 29-bit when extended */
+    bool extended;
+    bool fd;        /* CAN FD: len 0-8, 12, 16, 20, 24, 32, 48 or 64 */
+    uint8_t len;
+    uint8_t data[URRT_CAN_MAX_DATA];
+} urrt_can_frame;
+
+typedef struct urrt_can_config {
+    const char *interface;     /* "can0", or "log:PATH" ("log:-" is stdout) */
+    bool fd;                   /* FD frames allowed: needs an interface with the FD MTU */
+    uint32_t reopen_interval_ms;
+} urrt_can_config;
+
+void urrt_can_config_defaults(urrt_can_config *cfg);
+
+typedef enum urrt_can_state {
+    URRT_CAN_DOWN = 0,         /* not open, or the interface is down; reopening */
+    URRT_CAN_UP
+} urrt_can_state;
+
+typedef struct urrt_can_stats {
+    uint64_t sent;
+    uint64_t dropped;          /* values replaced before they could be sent, or discarded by an outage */
+    uint64_t send_errors;
+    uint64_t opens;
+    uint64_t down_events;
+    uint64_t error_frames;
+    uint64_t bus_off;
+    uint64_t restarts;
+    uint32_t last_error_class; /* CAN_ERR_* bits of the last error frame */
+} urrt_can_stats;
+
+typedef struct urrt_can urrt_can;
+
+/* NULL with a logged reason when the configuration cannot work (an FD link
+ * on an interface without the FD MTU, say). */
+urrt_can *urrt_can_new(const urrt_can_config *cfg);
+void urrt_can_free(urrt_can *can);
+
+/* Queue a frame for sending now; never blocks. Negative on a frame the link
+ * can never send (FD frame on a classic link, bad length). */
+int urrt_can_send(urrt_can *can, const urrt_can_frame *frame, uint64_t now_us);
+
+int urrt_can_poll_fd(const urrt_can *can, short *events);
+uint64_t urrt_can_deadline(const urrt_can *can);
+void urrt_can_service(urrt_can *can, uint64_t now_us);
+urrt_can_state urrt_can_get_state(const urrt_can *can);
+const urrt_can_stats *urrt_can_get_stats(const urrt_can *can);
+
 #ifdef __cplusplus
 }
 #endif
