@@ -51,6 +51,18 @@ void urrt_log(urrt_log_level level, const char *fmt, ...)
 #endif
     ;
 
+/* Change the threshold after init (a --verbose option, say). */
+void urrt_log_set_level(urrt_log_level max_level);
+urrt_log_level urrt_log_get_level(void);
+/* "error", "warning", "notice", "info", "debug". */
+const char *urrt_log_level_name(urrt_log_level level);
+
+/* Route messages (without prefix or newline) to fn instead of stderr, or
+ * back to stderr with NULL: for tests, and for firmware that keeps a log
+ * ring. Messages above the threshold are still dropped first. */
+typedef void (*urrt_log_sink_fn)(void *ctx, urrt_log_level level, const char *message);
+void urrt_log_set_sink(urrt_log_sink_fn fn, void *ctx);
+
 /* ---- robot link ------------------------------------------------------------ */
 
 /*
@@ -66,7 +78,7 @@ typedef struct urrt_link_config {
     const char *host;            /* host name, IPv4 or IPv6 literal */
     uint16_t port;               /* URRT_LINK_PORT_RW or URRT_LINK_PORT_RO */
     uint32_t connect_timeout_ms;
-    uint32_t silence_timeout_ms;
+    uint32_t silence_timeout_ms; /* 0: never treat silence as a lost link */
     uint32_t backoff_initial_ms;
     uint32_t backoff_max_ms;
 } urrt_link_config;
@@ -98,6 +110,8 @@ typedef struct urrt_link_stats {
     uint64_t skipped;        /* bytes dropped while resynchronising */
     uint64_t partial_drops;  /* incomplete packets dropped when a connection ended */
     uint64_t last_packet_us; /* monotonic time of the last packet, 0 if none */
+    uint64_t partial_bytes;  /* bytes of those incomplete packets */
+    uint32_t last_length;    /* size of the last packet, 0 if none */
 } urrt_link_stats;
 
 typedef struct urrt_link urrt_link;
@@ -126,16 +140,45 @@ void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void
 urrt_link_state urrt_link_get_state(const urrt_link *link);
 const urrt_link_stats *urrt_link_get_stats(const urrt_link *link);
 
+/* "host:port" as log lines name the robot ("[::1]:30003" for IPv6). */
+const char *urrt_link_peer(const urrt_link *link);
+
 /* ---- CAN link ---------------------------------------------------------------- */
 
 /*
  * A transmit-mostly CAN link: a SocketCAN raw socket on POSIX, or a file in
  * candump's log format (replayable with canplayer) for boxes without a CAN
- * interface. Sending never blocks the loop: a frame the driver cannot take
- * (ENOBUFS) waits in a one-deep slot per CAN ID, and a newer frame for that
- * ID replaces it and counts a drop, so an outage never replays a backlog. An
- * interface that goes down is reported and reopened. Error frames (bus-off,
- * restarted, ...) are received and counted.
+ * interface.
+ *
+ * Sending never blocks the loop. A frame the driver cannot take (ENOBUFS
+ * from a full transmit queue, EAGAIN from a full socket buffer) waits in a
+ * one-deep slot per CAN ID; a newer frame for that ID replaces it and counts
+ * a drop, and a held frame older than hold_max_ms is discarded and counted,
+ * so an outage never replays a backlog of stale values. Held frames are
+ * retried at the next send, when the socket is writable again (EAGAIN) and
+ * every retry_interval_ms (ENOBUFS: the socket reports writable while the
+ * queue is full, so waiting for POLLOUT alone would spin).
+ *
+ * An interface that goes down (or is removed) is reported once, its held
+ * frames are discarded and counted as dropped, frames sent meanwhile are
+ * dropped and counted, and it is reopened every reopen_interval_ms until it
+ * is up again, which is reported once too. Error frames (bus-off,
+ * restarted, controller problems, ...) are received and counted; data frames
+ * from other nodes are not received at all.
+ *
+ * The interface string:
+ *   "can0"                      a SocketCAN interface: it must exist when the
+ *                               link is created (it may be down); with fd set
+ *                               its MTU must be the FD MTU (72):
+ *                               `ip link set can0 mtu 72`
+ *   "log:PATH"                  candump -l format into PATH (created or
+ *                               truncated); "log:-" is stdout
+ *   "log:PATH,ifname=NAME"      the same, with NAME as the interface column
+ *                               (default "can0"), so that `canplayer -I PATH`
+ *                               replays onto NAME without a mapping
+ * Log lines are "(SEC.USEC) IFNAME ID#DATA" for classic frames and
+ * "(SEC.USEC) IFNAME ID##FDATA" for FD frames (F: flags nibble, 1 with bit
+ * rate switch), ID in 3 hex digits (11-bit) or 8 (29-bit), wall-clock time.
  */
 #define URRT_CAN_MAX_DATA 64
 
@@ -148,11 +191,15 @@ typedef struct urrt_can_frame {
 } urrt_can_frame;
 
 typedef struct urrt_can_config {
-    const char *interface;     /* "can0", or "log:PATH" ("log:-" is stdout) */
+    const char *interface;     /* "can0", or "log:PATH[,ifname=NAME]" ("log:-" is stdout) */
     bool fd;                   /* FD frames allowed: needs an interface with the FD MTU */
+    bool fd_brs;               /* FD frames use the bit rate switch (data phase bitrate) */
     uint32_t reopen_interval_ms;
+    uint32_t retry_interval_ms; /* held frames retried at least this often */
+    uint32_t hold_max_ms;       /* a held frame older than this is stale: dropped */
 } urrt_can_config;
 
+/* Defaults: no FD, reopen every 1000 ms, retry every 5 ms, hold 100 ms. */
 void urrt_can_config_defaults(urrt_can_config *cfg);
 
 typedef enum urrt_can_state {
@@ -160,32 +207,51 @@ typedef enum urrt_can_state {
     URRT_CAN_UP
 } urrt_can_state;
 
+const char *urrt_can_state_name(urrt_can_state state);
+
 typedef struct urrt_can_stats {
-    uint64_t sent;
-    uint64_t dropped;          /* values replaced before they could be sent, or discarded by an outage */
-    uint64_t send_errors;
-    uint64_t opens;
+    uint64_t sent;             /* frames the driver (or the log file) took */
+    uint64_t dropped;          /* values replaced before they could be sent, too old, or discarded by an outage */
+    uint64_t send_errors;      /* frames lost to an unexpected error (logged) */
+    uint64_t busy;             /* times the driver refused a frame (ENOBUFS, EAGAIN) */
+    uint64_t opens;            /* sockets opened: 1 + reopens */
     uint64_t down_events;
     uint64_t error_frames;
     uint64_t bus_off;
     uint64_t restarts;
-    uint32_t last_error_class; /* CAN_ERR_* bits of the last error frame */
+    uint32_t last_error_class; /* CAN_ERR_* class bits of the last error frame */
+    uint32_t pending;          /* frames held for a retry right now */
 } urrt_can_stats;
 
 typedef struct urrt_can urrt_can;
 
-/* NULL with a logged reason when the configuration cannot work (an FD link
- * on an interface without the FD MTU, say). */
+/* NULL with a logged reason when the configuration cannot work: no such
+ * interface, not a CAN interface, an FD link on an interface without the FD
+ * MTU, a log file that cannot be created. An interface that exists but is
+ * down gives a link in URRT_CAN_DOWN that opens when the interface comes up. */
 urrt_can *urrt_can_new(const urrt_can_config *cfg);
 void urrt_can_free(urrt_can *can);
 
-/* Queue a frame for sending now; never blocks. Negative on a frame the link
- * can never send (FD frame on a classic link, bad length). */
+/* Sends a frame now, never blocking. 1: the driver (or the log) took it;
+ * 0: held for a retry, or dropped and counted because the link is down;
+ * URRT_E_ARG for a frame the link can never send (FD frame on a classic
+ * link, a length FD does not have, an ID out of range). */
 int urrt_can_send(urrt_can *can, const urrt_can_frame *frame, uint64_t now_us);
 
+/* The descriptor to wait on and the events (POLLIN, plus POLLOUT while
+ * frames wait for socket buffer space), or -1 when there is none (down, or
+ * a log file). It changes across reopens: ask again before each wait. */
 int urrt_can_poll_fd(const urrt_can *can, short *events);
+
+/* Monotonic time by which urrt_can_service must run again at the latest
+ * (UINT64_MAX when nothing is due). */
 uint64_t urrt_can_deadline(const urrt_can *can);
+
+/* Does what is due: reads error frames (bounded per call), notices the
+ * interface going down, retries and expires held frames, reopens. Never
+ * blocks. */
 void urrt_can_service(urrt_can *can, uint64_t now_us);
+
 urrt_can_state urrt_can_get_state(const urrt_can *can);
 const urrt_can_stats *urrt_can_get_stats(const urrt_can *can);
 

@@ -1,0 +1,506 @@
+/*
+ * link.c: the read-only robot link on POSIX sockets.
+ *
+ * One state machine per robot, driven by urrt_link_service from the
+ * program's poll loop:
+ *
+ *   IDLE --(backoff over)--> CONNECTING --(connected)--> UP
+ *     ^                          |                        |
+ *     +---(failed, timed out)----+----(closed, reset, silent)
+ *
+ * Name resolution uses getaddrinfo, which blocks while a DNS server answers:
+ * acceptable once per attempt (controllers are usually addressed by IP
+ * literal, and a literal is parsed with AI_NUMERICHOST, so it never waits
+ * for DNS). Everything after that is non-blocking.
+ *
+ * The link never sends: no write, no send, no shutdown. Closing the socket
+ * is the only thing it does to the peer.
+ */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <inttypes.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "port.h"
+
+/* One recv per chunk, and at most this many bytes per service call, so that
+ * one busy link cannot starve the others in the same loop (about 58
+ * packets of 1116 bytes, several periods' worth even at 500 Hz). */
+#define LINK_READ_CHUNK 16384
+#define LINK_READ_BUDGET (4 * LINK_READ_CHUNK)
+/* Connect failures are logged at the first one and then when their count
+ * reaches 10, 100, 1000, ...: the log grows with the logarithm of an outage. */
+#define LINK_FAILURE_REPORT_BASE 10
+
+struct urrt_link {
+    urrt_link_config cfg;
+    char *name;
+    char *host;
+    char peer[300];
+    urrt_link_state state;
+    int fd;
+    struct addrinfo *addrs;
+    struct addrinfo *next_addr;
+    uint64_t deadline_us;     /* IDLE: next attempt; CONNECTING: connect timeout */
+    uint64_t last_rx_us;      /* UP: last bytes received (or the connect) */
+    uint64_t backoff_ms;      /* wait before the next attempt after a failure */
+    bool more_to_read;        /* the read budget ran out with bytes left */
+    bool announced;           /* "connecting" logged */
+    bool lost_logged;         /* a loss was logged: the first failed retry needs no line */
+    uint64_t failed_attempts; /* since packets last flowed */
+    uint64_t next_report;     /* failure count at which to log again */
+    int last_errno;
+    uint64_t conn_packets;    /* on the current connection */
+    urrt_framer framer;
+    urrt_link_stats stats;
+};
+
+void urrt_link_config_defaults(urrt_link_config *cfg)
+{
+    if (cfg == NULL) {
+        return;
+    }
+    cfg->name = NULL;
+    cfg->host = NULL;
+    cfg->port = URRT_LINK_PORT_RW;
+    cfg->connect_timeout_ms = 2000;
+    cfg->silence_timeout_ms = 100;
+    cfg->backoff_initial_ms = 100;
+    cfg->backoff_max_ms = 5000;
+}
+
+const char *urrt_link_state_name(urrt_link_state state)
+{
+    switch (state) {
+    case URRT_LINK_IDLE: return "idle";
+    case URRT_LINK_CONNECTING: return "connecting";
+    case URRT_LINK_UP: return "up";
+    default: return "unknown";
+    }
+}
+
+urrt_link *urrt_link_new(const urrt_link_config *cfg)
+{
+    urrt_link *link;
+    const char *why = NULL;
+
+    if (cfg == NULL) {
+        urrt_log(URRT_LOG_ERR, "robot link: no configuration");
+        return NULL;
+    }
+    if (cfg->host == NULL || cfg->host[0] == '\0') {
+        why = "no host given";
+    } else if (strlen(cfg->host) > 255) {
+        why = "host name longer than 255 characters";
+    } else if (cfg->port == 0) {
+        why = "port 0 (use 30003, or 30013 for the read-only port)";
+    } else if (cfg->connect_timeout_ms == 0) {
+        why = "connect timeout is 0";
+    } else if (cfg->backoff_initial_ms == 0) {
+        why = "initial backoff is 0 (would retry in a busy loop)";
+    } else if (cfg->backoff_max_ms < cfg->backoff_initial_ms) {
+        why = "maximum backoff is below the initial backoff";
+    }
+    if (why != NULL) {
+        urrt_log(URRT_LOG_ERR, "robot %s: unusable link configuration: %s",
+                 cfg->name != NULL ? cfg->name : "?", why);
+        return NULL;
+    }
+    link = calloc(1, sizeof *link);
+    if (link == NULL) {
+        urrt_log(URRT_LOG_ERR, "robot %s: out of memory", cfg->name != NULL ? cfg->name : cfg->host);
+        return NULL;
+    }
+    link->cfg = *cfg;
+    link->name = strdup(cfg->name != NULL && cfg->name[0] != '\0' ? cfg->name : cfg->host);
+    link->host = strdup(cfg->host);
+    if (link->name == NULL || link->host == NULL) {
+        urrt_log(URRT_LOG_ERR, "robot %s: out of memory", cfg->host);
+        urrt_link_free(link);
+        return NULL;
+    }
+    link->cfg.name = link->name;
+    link->cfg.host = link->host;
+    snprintf(link->peer, sizeof link->peer, strchr(link->host, ':') != NULL ? "[%s]:%u" : "%s:%u",
+             link->host, (unsigned)cfg->port);
+    link->fd = -1;
+    link->state = URRT_LINK_IDLE;
+    link->deadline_us = 0;
+    link->backoff_ms = cfg->backoff_initial_ms;
+    link->next_report = 1;
+    urrt_framer_init(&link->framer);
+    return link;
+}
+
+static void close_socket(urrt_link *link)
+{
+    if (link->fd >= 0) {
+        close(link->fd);
+        link->fd = -1;
+    }
+}
+
+static void forget_addresses(urrt_link *link)
+{
+    if (link->addrs != NULL) {
+        freeaddrinfo(link->addrs);
+        link->addrs = NULL;
+    }
+    link->next_addr = NULL;
+}
+
+void urrt_link_free(urrt_link *link)
+{
+    if (link == NULL) {
+        return;
+    }
+    close_socket(link);
+    forget_addresses(link);
+    free(link->name);
+    free(link->host);
+    free(link);
+}
+
+int urrt_link_poll_fd(const urrt_link *link, short *events)
+{
+    if (link == NULL || link->fd < 0 || link->state == URRT_LINK_IDLE) {
+        if (events != NULL) {
+            *events = 0;
+        }
+        return -1;
+    }
+    if (events != NULL) {
+        *events = link->state == URRT_LINK_CONNECTING ? POLLOUT : POLLIN;
+    }
+    return link->fd;
+}
+
+uint64_t urrt_link_deadline(const urrt_link *link)
+{
+    if (link == NULL) {
+        return UINT64_MAX;
+    }
+    switch (link->state) {
+    case URRT_LINK_UP:
+        if (link->more_to_read) {
+            return 0;
+        }
+        if (link->cfg.silence_timeout_ms == 0) {
+            return UINT64_MAX;
+        }
+        return link->last_rx_us + (uint64_t)link->cfg.silence_timeout_ms * 1000u;
+    default:
+        return link->deadline_us;
+    }
+}
+
+urrt_link_state urrt_link_get_state(const urrt_link *link)
+{
+    return link != NULL ? link->state : URRT_LINK_IDLE;
+}
+
+const urrt_link_stats *urrt_link_get_stats(const urrt_link *link)
+{
+    return link != NULL ? &link->stats : NULL;
+}
+
+const char *urrt_link_peer(const urrt_link *link)
+{
+    return link != NULL ? link->peer : "";
+}
+
+/* The wait before the next attempt; doubles up to the cap. */
+static void schedule_retry(urrt_link *link, uint64_t now_us)
+{
+    link->state = URRT_LINK_IDLE;
+    link->deadline_us = now_us + link->backoff_ms * 1000u;
+    link->backoff_ms *= 2;
+    if (link->backoff_ms > link->cfg.backoff_max_ms) {
+        link->backoff_ms = link->cfg.backoff_max_ms;
+    }
+}
+
+static const char *errno_text(int err)
+{
+    switch (err) {
+    case ECONNREFUSED: return "connection refused: nothing listens on that port";
+    case ETIMEDOUT: return "timed out";
+    case ECONNRESET: return "reset by peer";
+    case EHOSTUNREACH: return "host unreachable";
+    case ENETUNREACH: return "network unreachable";
+    default: return strerror(err);
+    }
+}
+
+/* A connect attempt failed (every address of the host tried). */
+static void attempt_failed(urrt_link *link, uint64_t now_us, const char *reason)
+{
+    close_socket(link);
+    forget_addresses(link);
+    link->stats.connect_failures++;
+    link->failed_attempts++;
+    if (link->failed_attempts >= link->next_report) {
+        /* The first failure after a logged loss was announced by "reconnecting". */
+        if (link->failed_attempts == 1 && !link->lost_logged) {
+            urrt_log(URRT_LOG_WARNING, "robot %s: cannot connect to %s (%s); retrying with backoff up to %" PRIu32 " ms",
+                     link->name, link->peer, reason, link->cfg.backoff_max_ms);
+        } else if (link->failed_attempts > 1) {
+            urrt_log(URRT_LOG_WARNING, "robot %s: still cannot connect to %s after %" PRIu64 " attempts (%s)",
+                     link->name, link->peer, link->failed_attempts, reason);
+        }
+        link->next_report = link->failed_attempts == 1 ? LINK_FAILURE_REPORT_BASE
+                                                       : link->next_report * LINK_FAILURE_REPORT_BASE;
+    }
+    schedule_retry(link, now_us);
+}
+
+static void became_up(urrt_link *link, uint64_t now_us)
+{
+    forget_addresses(link);
+    link->state = URRT_LINK_UP;
+    link->last_rx_us = now_us;
+    link->more_to_read = false;
+    link->conn_packets = 0;
+    link->stats.connects++;
+    if (link->stats.disconnects > 0) {
+        link->stats.reconnects++;
+    }
+    urrt_framer_reset(&link->framer);
+    urrt_log(URRT_LOG_DEBUG, "robot %s: TCP connection to %s established", link->name, link->peer);
+}
+
+/* An established connection ended. A connection that never delivered a
+ * packet counts as a failed attempt too, so that a peer accepting and closing
+ * at once is logged like a refusal: once, not once per attempt. */
+static void connection_lost(urrt_link *link, uint64_t now_us, const char *reason, bool silent)
+{
+    size_t partial = urrt_framer_finish(&link->framer);
+    link->stats.disconnects++;
+    if (silent) {
+        link->stats.silences++;
+    }
+    if (partial > 0) {
+        link->stats.partial_drops++;
+        link->stats.partial_bytes += partial;
+    }
+    link->more_to_read = false;
+    if (link->conn_packets == 0) {
+        attempt_failed(link, now_us, reason);
+        return;
+    }
+    close_socket(link);
+    urrt_log(URRT_LOG_WARNING, "robot %s: connection to %s lost (%s); reconnecting", link->name, link->peer, reason);
+    link->lost_logged = true;
+    /* It worked until now: start again from the short wait. */
+    link->backoff_ms = link->cfg.backoff_initial_ms;
+    link->failed_attempts = 0;
+    link->next_report = LINK_FAILURE_REPORT_BASE;
+    schedule_retry(link, now_us);
+}
+
+static void set_keepalive(int fd)
+{
+    int on = 1;
+    /* Failure only loses the kernel's own dead-peer detection; the silence
+     * timeout still covers a half-open link. */
+    (void)setsockopt(fd, SOL_SOCKET, SO_KEEPALIVE, &on, sizeof on);
+#ifdef TCP_KEEPIDLE
+    {
+        int idle = 1, interval = 1, count = 3;
+        (void)setsockopt(fd, IPPROTO_TCP, TCP_KEEPIDLE, &idle, sizeof idle);
+        (void)setsockopt(fd, IPPROTO_TCP, TCP_KEEPINTVL, &interval, sizeof interval);
+        (void)setsockopt(fd, IPPROTO_TCP, TCP_KEEPCNT, &count, sizeof count);
+    }
+#endif
+}
+
+/* Starts a non-blocking connect to the next address; returns when one is in
+ * progress or established, or every address failed. */
+static void try_next_address(urrt_link *link, uint64_t now_us)
+{
+    while (link->next_addr != NULL) {
+        struct addrinfo *ai = link->next_addr;
+        link->next_addr = ai->ai_next;
+        link->fd = socket(ai->ai_family, ai->ai_socktype | SOCK_NONBLOCK | SOCK_CLOEXEC, ai->ai_protocol);
+        if (link->fd < 0) {
+            link->last_errno = errno;
+            continue;
+        }
+        set_keepalive(link->fd);
+        if (connect(link->fd, ai->ai_addr, ai->ai_addrlen) == 0) {
+            became_up(link, now_us);
+            return;
+        }
+        if (errno == EINPROGRESS) {
+            link->state = URRT_LINK_CONNECTING;
+            link->deadline_us = now_us + (uint64_t)link->cfg.connect_timeout_ms * 1000u;
+            return;
+        }
+        link->last_errno = errno;
+        close_socket(link);
+    }
+    attempt_failed(link, now_us, errno_text(link->last_errno));
+}
+
+static void start_attempt(urrt_link *link, uint64_t now_us)
+{
+    struct addrinfo hints;
+    char service[8];
+    int rc;
+
+    if (!link->announced) {
+        urrt_log(URRT_LOG_INFO, "robot %s: connecting to %s", link->name, link->peer);
+        link->announced = true;
+    }
+    forget_addresses(link);
+    memset(&hints, 0, sizeof hints);
+    hints.ai_family = AF_UNSPEC;
+    hints.ai_socktype = SOCK_STREAM;
+    hints.ai_flags = AI_NUMERICHOST | AI_NUMERICSERV;
+    snprintf(service, sizeof service, "%u", (unsigned)link->cfg.port);
+    rc = getaddrinfo(link->host, service, &hints, &link->addrs);
+    if (rc == EAI_NONAME) {
+        /* Not a literal: a name, and this may wait for DNS. */
+        hints.ai_flags = AI_NUMERICSERV;
+        rc = getaddrinfo(link->host, service, &hints, &link->addrs);
+    }
+    if (rc != 0) {
+        char reason[200];
+        link->addrs = NULL;
+        snprintf(reason, sizeof reason, "cannot resolve \"%s\": %s", link->host,
+                 rc == EAI_SYSTEM ? strerror(errno) : gai_strerror(rc));
+        attempt_failed(link, now_us, reason);
+        return;
+    }
+    link->next_addr = link->addrs;
+    link->last_errno = EHOSTUNREACH;
+    try_next_address(link, now_us);
+}
+
+static void check_connect(urrt_link *link, uint64_t now_us)
+{
+    struct pollfd pfd = {.fd = link->fd, .events = POLLOUT};
+    int rc = poll(&pfd, 1, 0);
+    if (rc > 0) {
+        int err = 0;
+        socklen_t len = sizeof err;
+        if (getsockopt(link->fd, SOL_SOCKET, SO_ERROR, &err, &len) != 0) {
+            err = errno;
+        }
+        if (err == 0) {
+            became_up(link, now_us);
+            return;
+        }
+        link->last_errno = err;
+    } else if (now_us >= link->deadline_us) {
+        link->last_errno = ETIMEDOUT;
+    } else {
+        return;
+    }
+    close_socket(link);
+    try_next_address(link, now_us);
+}
+
+static void deliver(urrt_link *link, const uint8_t *data, size_t len, uint64_t now_us, urrt_packet_fn fn, void *ctx)
+{
+    while (len > 0) {
+        size_t used = 0;
+        if (urrt_framer_feed(&link->framer, data, len, &used) == 1) {
+            size_t plen = 0;
+            const uint8_t *packet = urrt_framer_packet(&link->framer, &plen);
+            link->stats.packets++;
+            link->stats.last_packet_us = now_us;
+            link->stats.last_length = (uint32_t)plen;
+            if (link->conn_packets++ == 0) {
+                const char *versions = urrt_versions_of((uint32_t)plen);
+                char after[64] = "";
+                if (link->failed_attempts > 1) {
+                    snprintf(after, sizeof after, " after %" PRIu64 " failed attempts", link->failed_attempts);
+                }
+                urrt_log(URRT_LOG_NOTICE, "robot %s: connected to %s%s: %zu-byte packets (%s)", link->name,
+                         link->peer, after, plen,
+                         versions != NULL ? versions : "a length no known controller sends");
+                link->failed_attempts = 0;
+                link->next_report = 1;
+                link->backoff_ms = link->cfg.backoff_initial_ms;
+                link->lost_logged = false;
+            }
+            if (fn != NULL) {
+                fn(ctx, packet, plen, now_us);
+            }
+        }
+        data += used;
+        len -= used;
+    }
+    link->stats.bytes = link->framer.stats.bytes;
+    link->stats.resyncs = link->framer.stats.resyncs;
+    link->stats.skipped = link->framer.stats.skipped;
+}
+
+static void read_available(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void *ctx)
+{
+    uint8_t buf[LINK_READ_CHUNK];
+    size_t budget = LINK_READ_BUDGET;
+
+    link->more_to_read = false;
+    while (link->state == URRT_LINK_UP) {
+        ssize_t n = recv(link->fd, buf, sizeof buf, MSG_DONTWAIT);
+        if (n > 0) {
+            link->last_rx_us = now_us;
+            deliver(link, buf, (size_t)n, now_us, fn, ctx);
+            if ((size_t)n >= budget) {
+                link->more_to_read = true;
+                return;
+            }
+            budget -= (size_t)n;
+            if ((size_t)n < sizeof buf) {
+                return; /* drained, most likely: poll says when there is more */
+            }
+        } else if (n == 0) {
+            connection_lost(link, now_us, "closed by peer", false);
+        } else if (errno == EINTR) {
+            continue;
+        } else if (errno == EAGAIN || errno == EWOULDBLOCK) {
+            return;
+        } else {
+            connection_lost(link, now_us, errno_text(errno), false);
+        }
+    }
+}
+
+void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void *ctx)
+{
+    if (link == NULL) {
+        return;
+    }
+    switch (link->state) {
+    case URRT_LINK_IDLE:
+        if (now_us >= link->deadline_us) {
+            start_attempt(link, now_us);
+        }
+        break;
+    case URRT_LINK_CONNECTING:
+        check_connect(link, now_us);
+        break;
+    case URRT_LINK_UP:
+        break;
+    }
+    if (link->state != URRT_LINK_UP) {
+        return;
+    }
+    read_available(link, now_us, fn, ctx);
+    if (link->state == URRT_LINK_UP && !link->more_to_read && link->cfg.silence_timeout_ms != 0 &&
+        now_us > link->last_rx_us && now_us - link->last_rx_us >= (uint64_t)link->cfg.silence_timeout_ms * 1000u) {
+        char reason[64];
+        snprintf(reason, sizeof reason, "no data for %" PRIu32 " ms", link->cfg.silence_timeout_ms);
+        connection_lost(link, now_us, reason, true);
+    }
+}
