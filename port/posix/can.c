@@ -1,0 +1,724 @@
+/*
+ * can.c: the CAN link of port.h on Linux SocketCAN, and its candump-log
+ * alternative.
+ *
+ * Why it is shaped this way:
+ * - A raw socket bound to one interface, non-blocking, with no data filter
+ *   (we only transmit) and the error mask fully open, so that bus-off and
+ *   restarts wake the loop.
+ * - A CAN driver that cannot take a frame makes the qdisc drop it and the
+ *   socket return ENOBUFS, while poll() still reports POLLOUT (the socket
+ *   buffer is not full). So a refused frame waits in a one-deep slot per ID
+ *   and is retried at the next send (the cheapest probe that the queue has
+ *   room again) or after retry_interval_ms; only EAGAIN (socket buffer full)
+ *   is worth a POLLOUT wait.
+ * - The interface going down reaches the socket as a pending error
+ *   (ENETDOWN; ENODEV when it is removed) that makes poll() return POLLERR,
+ *   so the loop notices even when it sends nothing.
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <net/if.h>
+#include <net/if_arp.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <linux/can.h>
+#include <linux/can/error.h>
+#include <linux/can/raw.h>
+
+#include "port.h"
+
+#define LOG_PREFIX "log:"
+#define LOG_IFNAME_OPT ",ifname="
+#define LOG_IFNAME_DEFAULT "can0"
+/* A link serving more distinct IDs than this has a configuration problem;
+ * the bound keeps a bug from turning into unbounded memory. */
+#define MAX_HELD_IDS 4096
+/* Error frames read per service call: a babbling bus cannot starve the loop. */
+#define MAX_READS_PER_SERVICE 64
+
+/* Outage reasons: compared by address to log a change of reason once. */
+static const char REASON_DOWN[] = "interface went down";
+static const char REASON_IS_DOWN[] = "interface is down";
+static const char REASON_REMOVED[] = "interface removed";
+static const char REASON_MTU[] = "FD frames configured but the MTU is no longer 72";
+static const char REASON_REOPEN[] = "reopen failed";
+
+typedef struct held_frame {
+    urrt_can_frame frame;
+    uint64_t since_us;   /* when the value was first held (replacement keeps it fresh) */
+} held_frame;
+
+struct urrt_can {
+    urrt_can_config cfg;
+    char ifname[IFNAMSIZ];       /* SocketCAN interface, or the log's IFNAME column */
+    char *log_path;              /* NULL for a socket link */
+    int fd;                      /* socket or log file; -1 when closed */
+    bool log_is_stdout;
+    urrt_can_state state;
+    bool reported_down;          /* the current outage has been logged */
+    const char *down_reason;     /* last reason logged, to log a change once */
+    uint64_t down_since_us;
+    uint64_t dropped_at_down;
+    uint64_t reopen_at_us;
+    bool busy;                   /* the driver is refusing frames */
+    bool wait_writable;          /* the last refusal was EAGAIN: POLLOUT helps */
+    uint64_t dropped_at_busy;
+    uint64_t retry_at_us;
+    int last_send_errno;         /* logged once until it changes */
+    held_frame *held;            /* insertion order = retry order */
+    size_t n_held, cap_held;
+    urrt_can_stats stats;
+};
+
+void urrt_can_config_defaults(urrt_can_config *cfg)
+{
+    memset(cfg, 0, sizeof(*cfg));
+    cfg->interface = "can0";
+    cfg->fd = false;
+    cfg->fd_brs = false;
+    cfg->reopen_interval_ms = 1000;
+    cfg->retry_interval_ms = 5;
+    cfg->hold_max_ms = 100;
+}
+
+const char *urrt_can_state_name(urrt_can_state state)
+{
+    switch (state) {
+    case URRT_CAN_DOWN: return "down";
+    case URRT_CAN_UP: return "up";
+    }
+    return "?";
+}
+
+/* ---- frames ---------------------------------------------------------------- */
+
+static bool fd_length_valid(uint8_t len)
+{
+    static const uint8_t lengths[] = { 12, 16, 20, 24, 32, 48, 64 };
+    if (len <= 8)
+        return true;
+    for (size_t i = 0; i < sizeof(lengths); i++)
+        if (len == lengths[i])
+            return true;
+    return false;
+}
+
+static bool frame_valid(const urrt_can *can, const urrt_can_frame *f)
+{
+    if (f->extended ? f->id > CAN_EFF_MASK : f->id > CAN_SFF_MASK)
+        return false;
+    if (f->fd)
+        return can->cfg.fd && fd_length_valid(f->len);
+    return f->len <= CAN_MAX_DLEN;
+}
+
+static bool same_id(const urrt_can_frame *a, const urrt_can_frame *b)
+{
+    return a->id == b->id && a->extended == b->extended;
+}
+
+static canid_t kernel_id(const urrt_can_frame *f)
+{
+    return f->extended ? (f->id | CAN_EFF_FLAG) : f->id;
+}
+
+/* ---- the candump log --------------------------------------------------------- */
+
+static const char hex_upper[] = "0123456789ABCDEF";
+
+/* One line exactly as candump -l writes it (can-utils lib.c sprint_canframe
+ * with no separator, after "(%010lu.%06lu) %s "). */
+static size_t format_log_line(char *out, size_t size, const char *ifname, uint64_t wall_us,
+                              const urrt_can_frame *f, bool brs)
+{
+    int n = snprintf(out, size, "(%010llu.%06llu) %s ", (unsigned long long)(wall_us / 1000000u),
+                     (unsigned long long)(wall_us % 1000000u), ifname);
+    size_t pos = (size_t)n;
+    pos += (size_t)snprintf(out + pos, size - pos, f->extended ? "%08X#" : "%03X#", (unsigned)f->id);
+    if (f->fd) {
+        out[pos++] = '#';
+        out[pos++] = hex_upper[brs ? CANFD_BRS : 0];
+    }
+    for (unsigned i = 0; i < f->len; i++) {
+        out[pos++] = hex_upper[f->data[i] >> 4];
+        out[pos++] = hex_upper[f->data[i] & 0xF];
+    }
+    out[pos++] = '\n';
+    return pos;
+}
+
+static int log_write(urrt_can *can, const urrt_can_frame *f)
+{
+    /* "(" 10 "." 6 ") " IFNAMSIZ " " 8 "##" 1 128 "\n" */
+    char line[32 + IFNAMSIZ + 16 + 2 * URRT_CAN_MAX_DATA];
+    size_t len = format_log_line(line, sizeof(line), can->ifname, urrt_port_realtime_us(), f,
+                                 can->cfg.fd_brs);
+    size_t done = 0;
+    while (done < len) {
+        ssize_t w = write(can->fd, line + done, len - done);
+        if (w < 0) {
+            if (errno == EINTR)
+                continue;
+            can->stats.send_errors++;
+            if (errno != can->last_send_errno)
+                urrt_log(URRT_LOG_ERR, "CAN log %s: write failed: %s; frames are lost until it works again",
+                         can->log_path, strerror(errno));
+            can->last_send_errno = errno;
+            return 0;
+        }
+        done += (size_t)w;
+    }
+    if (can->last_send_errno != 0)
+        urrt_log(URRT_LOG_NOTICE, "CAN log %s: writing again", can->log_path);
+    can->last_send_errno = 0;
+    can->stats.sent++;
+    return 1;
+}
+
+/* "log:PATH[,ifname=NAME]" */
+static bool parse_log_interface(urrt_can *can, const char *spec)
+{
+    const char *path = spec + strlen(LOG_PREFIX);
+    const char *opt = strstr(path, LOG_IFNAME_OPT);
+    size_t path_len = opt ? (size_t)(opt - path) : strlen(path);
+    const char *ifname = opt ? opt + strlen(LOG_IFNAME_OPT) : LOG_IFNAME_DEFAULT;
+
+    if (path_len == 0) {
+        urrt_log(URRT_LOG_ERR, "CAN interface \"%s\": no path after \"log:\" (use log:FILE or log:- for stdout)",
+                 spec);
+        return false;
+    }
+    size_t name_len = strlen(ifname);
+    if (name_len == 0 || name_len >= IFNAMSIZ || strpbrk(ifname, " \t\n()#,") != NULL) {
+        urrt_log(URRT_LOG_ERR,
+                 "CAN interface \"%s\": ifname must be 1 to %d characters without blanks, '#', '(', ')' or ','",
+                 spec, IFNAMSIZ - 1);
+        return false;
+    }
+    memcpy(can->ifname, ifname, name_len + 1);
+    can->log_path = strndup(path, path_len);
+    return can->log_path != NULL;
+}
+
+static bool open_log(urrt_can *can)
+{
+    if (strcmp(can->log_path, "-") == 0) {
+        can->fd = STDOUT_FILENO;
+        can->log_is_stdout = true;
+    } else {
+        can->fd = open(can->log_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (can->fd < 0) {
+            urrt_log(URRT_LOG_ERR, "CAN log %s: cannot create it: %s", can->log_path, strerror(errno));
+            return false;
+        }
+    }
+    can->state = URRT_CAN_UP;
+    can->stats.opens++;
+    return true;
+}
+
+/* ---- held frames --------------------------------------------------------------- */
+
+static held_frame *find_held(urrt_can *can, const urrt_can_frame *f)
+{
+    for (size_t i = 0; i < can->n_held; i++)
+        if (same_id(&can->held[i].frame, f))
+            return &can->held[i];
+    return NULL;
+}
+
+static void remove_held(urrt_can *can, size_t i)
+{
+    memmove(&can->held[i], &can->held[i + 1], (can->n_held - i - 1) * sizeof(can->held[0]));
+    can->n_held--;
+    can->stats.pending = (uint32_t)can->n_held;
+}
+
+static void hold(urrt_can *can, const urrt_can_frame *f, uint64_t now_us)
+{
+    held_frame *h = find_held(can, f);
+    if (h != NULL) {
+        h->frame = *f;
+        h->since_us = now_us;
+        can->stats.dropped++;
+        return;
+    }
+    if (can->n_held == can->cap_held) {
+        size_t cap = can->cap_held ? can->cap_held * 2 : 16;
+        held_frame *grown = cap <= MAX_HELD_IDS ? realloc(can->held, cap * sizeof(*grown)) : NULL;
+        if (grown == NULL) {
+            can->stats.dropped++;
+            return;
+        }
+        can->held = grown;
+        can->cap_held = cap;
+    }
+    can->held[can->n_held].frame = *f;
+    can->held[can->n_held].since_us = now_us;
+    can->n_held++;
+    can->stats.pending = (uint32_t)can->n_held;
+}
+
+static void discard_held(urrt_can *can)
+{
+    can->stats.dropped += can->n_held;
+    can->n_held = 0;
+    can->stats.pending = 0;
+}
+
+static void expire_held(urrt_can *can, uint64_t now_us)
+{
+    uint64_t max_us = (uint64_t)can->cfg.hold_max_ms * 1000u;
+    size_t kept = 0;
+    for (size_t i = 0; i < can->n_held; i++) {
+        if (now_us > can->held[i].since_us && now_us - can->held[i].since_us > max_us)
+            can->stats.dropped++;
+        else
+            can->held[kept++] = can->held[i];
+    }
+    can->n_held = kept;
+    can->stats.pending = (uint32_t)kept;
+}
+
+/* ---- the socket ---------------------------------------------------------------- */
+
+static void log_down(urrt_can *can, urrt_log_level level, const char *reason, const char *detail)
+{
+    if (can->reported_down && can->down_reason == reason)
+        return;
+    if (!can->reported_down)
+        urrt_log(level, "CAN %s: down (%s%s%s); reopening every %u ms", can->ifname, reason,
+                 detail ? ": " : "", detail ? detail : "", (unsigned)can->cfg.reopen_interval_ms);
+    else
+        urrt_log(level, "CAN %s: still down (%s%s%s)", can->ifname, reason, detail ? ": " : "",
+                 detail ? detail : "");
+    can->reported_down = true;
+    can->down_reason = reason;
+}
+
+static void close_socket(urrt_can *can)
+{
+    if (can->fd >= 0)
+        close(can->fd);
+    can->fd = -1;
+}
+
+static void go_down(urrt_can *can, uint64_t now_us, const char *reason, int err)
+{
+    close_socket(can);
+    if (can->state == URRT_CAN_UP) {
+        can->stats.down_events++;
+        can->down_since_us = now_us;
+        can->dropped_at_down = can->stats.dropped;
+    }
+    can->state = URRT_CAN_DOWN;
+    discard_held(can);
+    can->busy = false;
+    can->wait_writable = false;
+    can->reopen_at_us = now_us + (uint64_t)can->cfg.reopen_interval_ms * 1000u;
+    log_down(can, URRT_LOG_WARNING, reason, err ? strerror(err) : NULL);
+}
+
+static bool is_down_errno(int err)
+{
+    return err == ENETDOWN || err == ENXIO || err == ENODEV || err == ENETUNREACH;
+}
+
+/* The interface facts that decide whether a socket can work. With
+ * log_config_errors, a missing or unsuitable interface is an error (at
+ * creation); later it is an outage. Returns 1 when usable and up, 0 when
+ * usable but down, -1 when unusable. */
+static int check_interface(urrt_can *can, int sock, bool at_creation, unsigned *ifindex)
+{
+    struct ifreq ifr;
+    memset(&ifr, 0, sizeof(ifr));
+    memcpy(ifr.ifr_name, can->ifname, sizeof(ifr.ifr_name));
+
+    *ifindex = if_nametoindex(can->ifname);
+    if (*ifindex == 0) {
+        if (at_creation)
+            urrt_log(URRT_LOG_ERR,
+                     "CAN interface %s: no such interface (check `ip link show type can`; "
+                     "a test bus: `ip link add dev %s type vcan`)",
+                     can->ifname, can->ifname);
+        else
+            log_down(can, URRT_LOG_WARNING, REASON_REMOVED, NULL);
+        return at_creation ? -1 : 0;
+    }
+    if (ioctl(sock, SIOCGIFHWADDR, &ifr) == 0 && ifr.ifr_hwaddr.sa_family != ARPHRD_CAN) {
+        urrt_log(URRT_LOG_ERR, "CAN interface %s: not a CAN interface (link type %u)", can->ifname,
+                 (unsigned)ifr.ifr_hwaddr.sa_family);
+        return -1;
+    }
+    if (ioctl(sock, SIOCGIFMTU, &ifr) < 0) {
+        urrt_log(URRT_LOG_ERR, "CAN interface %s: cannot read its MTU: %s", can->ifname, strerror(errno));
+        return at_creation ? -1 : 0;
+    }
+    if (can->cfg.fd && ifr.ifr_mtu != (int)CANFD_MTU) {
+        if (at_creation) {
+            urrt_log(URRT_LOG_ERR,
+                     "CAN interface %s: CAN FD frames are configured but its MTU is %d, not the FD MTU %d; "
+                     "enable FD on it (`ip link set %s mtu %d`, or for a controller `ip link set %s type can "
+                     "bitrate B dbitrate D fd on`) or configure classic frames only",
+                     can->ifname, ifr.ifr_mtu, (int)CANFD_MTU, can->ifname, (int)CANFD_MTU, can->ifname);
+            return -1;
+        }
+        char fix[64];
+        snprintf(fix, sizeof(fix), "set it back with `ip link set %s mtu 72`", can->ifname);
+        log_down(can, URRT_LOG_ERR, REASON_MTU, fix);
+        return 0;
+    }
+    if (ioctl(sock, SIOCGIFFLAGS, &ifr) < 0)
+        return at_creation ? -1 : 0;
+    return (ifr.ifr_flags & IFF_UP) ? 1 : 0;
+}
+
+/* Opens and binds the socket when the interface is up. Returns as
+ * check_interface does. */
+static int open_socket(urrt_can *can, uint64_t now_us, bool at_creation)
+{
+    int sock = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+    if (sock < 0) {
+        int err = errno;
+        urrt_log(URRT_LOG_ERR, "CAN %s: cannot create a CAN socket: %s%s", can->ifname, strerror(err),
+                 err == EAFNOSUPPORT || err == EPROTONOSUPPORT
+                     ? " (this kernel has no CAN support: `modprobe can-raw`)" : "");
+        return at_creation ? -1 : 0;
+    }
+    unsigned ifindex;
+    int usable = check_interface(can, sock, at_creation, &ifindex);
+    if (usable <= 0) {
+        close(sock);
+        if (usable == 0 && at_creation)
+            log_down(can, URRT_LOG_WARNING, REASON_IS_DOWN, NULL);
+        return usable;
+    }
+
+    /* No data frames wanted: an empty filter list receives none. */
+    setsockopt(sock, SOL_CAN_RAW, CAN_RAW_FILTER, NULL, 0);
+    can_err_mask_t err_mask = CAN_ERR_MASK;
+    const char *failed = NULL;
+    if (setsockopt(sock, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &err_mask, sizeof(err_mask)) < 0)
+        failed = "subscribe to error frames";
+    int on = 1;
+    if (failed == NULL && can->cfg.fd &&
+        setsockopt(sock, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof(on)) < 0)
+        failed = "enable CAN FD frames";
+    struct sockaddr_can addr;
+    memset(&addr, 0, sizeof(addr));
+    addr.can_family = AF_CAN;
+    addr.can_ifindex = (int)ifindex;
+    if (failed == NULL && bind(sock, (struct sockaddr *)&addr, sizeof(addr)) < 0)
+        failed = "bind";
+    if (failed != NULL) {
+        int err = errno;
+        close(sock);
+        if (at_creation) {
+            urrt_log(URRT_LOG_ERR, "CAN %s: cannot %s: %s", can->ifname, failed, strerror(err));
+            return -1;
+        }
+        log_down(can, URRT_LOG_WARNING, REASON_REOPEN, strerror(err));
+        return 0;
+    }
+
+    can->fd = sock;
+    can->state = URRT_CAN_UP;
+    can->stats.opens++;
+    if (can->reported_down && !at_creation)
+        urrt_log(URRT_LOG_NOTICE, "CAN %s: up again after %.1f s; %llu frames dropped meanwhile",
+                 can->ifname, (double)(now_us - can->down_since_us) / 1e6,
+                 (unsigned long long)(can->stats.dropped - can->dropped_at_down));
+    else if (can->reported_down)
+        urrt_log(URRT_LOG_NOTICE, "CAN %s: up", can->ifname);
+    can->reported_down = false;
+    can->down_reason = NULL;
+    return 1;
+}
+
+static void reopen(urrt_can *can, uint64_t now_us)
+{
+    if (open_socket(can, now_us, false) <= 0)
+        can->reopen_at_us = now_us + (uint64_t)can->cfg.reopen_interval_ms * 1000u;
+}
+
+/* 1 written; 0 refused for now (held by the caller); -1 the link went down or
+ * the frame was lost to an unexpected error. */
+static int write_frame(urrt_can *can, const urrt_can_frame *f, uint64_t now_us)
+{
+    union {
+        struct can_frame cc;
+        struct canfd_frame fd;
+    } k;
+    size_t size;
+    memset(&k, 0, sizeof(k));
+    if (f->fd) {
+        k.fd.can_id = kernel_id(f);
+        k.fd.len = f->len;
+        k.fd.flags = can->cfg.fd_brs ? CANFD_BRS : 0;
+        memcpy(k.fd.data, f->data, f->len);
+        size = sizeof(k.fd);
+    } else {
+        k.cc.can_id = kernel_id(f);
+        k.cc.can_dlc = f->len;
+        memcpy(k.cc.data, f->data, f->len);
+        size = sizeof(k.cc);
+    }
+    for (;;) {
+        ssize_t w = send(can->fd, &k, size, MSG_DONTWAIT);
+        if (w == (ssize_t)size) {
+            can->stats.sent++;
+            can->last_send_errno = 0;
+            return 1;
+        }
+        int err = w < 0 ? errno : EIO;
+        if (err == EINTR)
+            continue;
+        if (err == ENOBUFS || err == EAGAIN) {
+            can->stats.busy++;
+            if (!can->busy) {
+                urrt_log(URRT_LOG_WARNING,
+                         "CAN %s: transmit queue full (%s); holding the newest frame per ID, counting drops",
+                         can->ifname, strerror(err));
+                can->busy = true;
+                can->dropped_at_busy = can->stats.dropped;
+            }
+            can->wait_writable = err == EAGAIN;
+            can->retry_at_us = now_us + (uint64_t)can->cfg.retry_interval_ms * 1000u;
+            return 0;
+        }
+        if (is_down_errno(err)) {
+            go_down(can, now_us, REASON_DOWN, err);
+            return -1;
+        }
+        can->stats.send_errors++;
+        if (err != can->last_send_errno)
+            urrt_log(URRT_LOG_ERR, "CAN %s: send of ID %X failed: %s; frame lost", can->ifname,
+                     (unsigned)f->id, strerror(err));
+        can->last_send_errno = err;
+        return -1;
+    }
+}
+
+/* A write went through with nothing left held: the end of a busy spell. */
+static void note_accepting(urrt_can *can)
+{
+    if (!can->busy)
+        return;
+    urrt_log(URRT_LOG_NOTICE, "CAN %s: transmit queue takes frames again; %llu dropped meanwhile",
+             can->ifname, (unsigned long long)(can->stats.dropped - can->dropped_at_busy));
+    can->busy = false;
+    can->wait_writable = false;
+}
+
+/* Sends held frames in the order they were first held, until the driver
+ * refuses one. */
+static void flush_held(urrt_can *can, uint64_t now_us)
+{
+    while (can->n_held > 0 && can->state == URRT_CAN_UP) {
+        urrt_can_frame f = can->held[0].frame;
+        int r = write_frame(can, &f, now_us);
+        if (r == 0)
+            return;
+        if (can->state != URRT_CAN_UP)
+            return; /* went down: held frames already discarded */
+        remove_held(can, 0);
+        if (r > 0 && can->n_held == 0)
+            note_accepting(can);
+    }
+}
+
+static void note_error_frame(urrt_can *can, const struct can_frame *cf)
+{
+    uint32_t class = cf->can_id & CAN_ERR_MASK;
+    can->stats.error_frames++;
+    can->stats.last_error_class = class;
+    if (class & CAN_ERR_BUSOFF) {
+        can->stats.bus_off++;
+        urrt_log(URRT_LOG_ERR, "CAN %s: bus-off (the controller stopped; it restarts if restart-ms is set: "
+                 "`ip link set %s type can restart-ms 100`)", can->ifname, can->ifname);
+    }
+    if (class & CAN_ERR_RESTARTED) {
+        can->stats.restarts++;
+        urrt_log(URRT_LOG_NOTICE, "CAN %s: controller restarted after bus-off", can->ifname);
+    }
+    if (class & ~(uint32_t)(CAN_ERR_BUSOFF | CAN_ERR_RESTARTED))
+        urrt_log(URRT_LOG_DEBUG, "CAN %s: error frame class 0x%X data %02X %02X %02X %02X", can->ifname,
+                 (unsigned)class, cf->data[0], cf->data[1], cf->data[2], cf->data[3]);
+}
+
+static void read_socket(urrt_can *can, uint64_t now_us)
+{
+    for (int i = 0; i < MAX_READS_PER_SERVICE && can->state == URRT_CAN_UP; i++) {
+        struct canfd_frame buf;
+        ssize_t r = recv(can->fd, &buf, sizeof(buf), MSG_DONTWAIT);
+        if (r < 0) {
+            int err = errno;
+            if (err == EAGAIN || err == EINTR)
+                return;
+            if (is_down_errno(err))
+                go_down(can, now_us, err == ENODEV ? REASON_REMOVED : REASON_DOWN, err);
+            else
+                urrt_log(URRT_LOG_WARNING, "CAN %s: receive failed: %s", can->ifname, strerror(err));
+            return;
+        }
+        if ((size_t)r >= sizeof(struct can_frame) && (buf.can_id & CAN_ERR_FLAG))
+            note_error_frame(can, (const struct can_frame *)&buf);
+    }
+}
+
+/* ---- the API ------------------------------------------------------------------- */
+
+urrt_can *urrt_can_new(const urrt_can_config *cfg)
+{
+    if (cfg == NULL || cfg->interface == NULL || cfg->interface[0] == '\0') {
+        urrt_log(URRT_LOG_ERR, "CAN link: no interface configured");
+        return NULL;
+    }
+    urrt_can *can = calloc(1, sizeof(*can));
+    if (can == NULL)
+        return NULL;
+    can->cfg = *cfg;
+    can->cfg.interface = NULL; /* not owned; ifname/log_path hold what we need */
+    can->fd = -1;
+    can->state = URRT_CAN_DOWN;
+
+    if (strncmp(cfg->interface, LOG_PREFIX, strlen(LOG_PREFIX)) == 0) {
+        if (!parse_log_interface(can, cfg->interface) || !open_log(can)) {
+            urrt_can_free(can);
+            return NULL;
+        }
+        return can;
+    }
+
+    if (strlen(cfg->interface) >= IFNAMSIZ) {
+        urrt_log(URRT_LOG_ERR, "CAN interface \"%s\": name longer than %d characters", cfg->interface,
+                 IFNAMSIZ - 1);
+        free(can);
+        return NULL;
+    }
+    memcpy(can->ifname, cfg->interface, strlen(cfg->interface) + 1);
+    uint64_t now_us = urrt_port_monotonic_us();
+    int r = open_socket(can, now_us, true);
+    if (r < 0) {
+        free(can);
+        return NULL;
+    }
+    if (r == 0) {
+        can->down_since_us = now_us;
+        can->reopen_at_us = now_us + (uint64_t)can->cfg.reopen_interval_ms * 1000u;
+    }
+    return can;
+}
+
+void urrt_can_free(urrt_can *can)
+{
+    if (can == NULL)
+        return;
+    if (can->log_path != NULL) {
+        if (!can->log_is_stdout && can->fd >= 0)
+            close(can->fd);
+    } else {
+        close_socket(can);
+    }
+    free(can->log_path);
+    free(can->held);
+    free(can);
+}
+
+int urrt_can_send(urrt_can *can, const urrt_can_frame *frame, uint64_t now_us)
+{
+    if (can == NULL || frame == NULL || !frame_valid(can, frame))
+        return URRT_E_ARG;
+    if (can->log_path != NULL)
+        return log_write(can, frame);
+    if (can->state != URRT_CAN_UP) {
+        can->stats.dropped++;
+        return 0;
+    }
+    held_frame *h = find_held(can, frame);
+    if (h != NULL) {
+        /* The older value of this ID is still waiting: the new one takes its
+         * place (and its turn), then everything waiting gets a chance. */
+        hold(can, frame, now_us);
+        flush_held(can, now_us);
+        return find_held(can, frame) == NULL && can->state == URRT_CAN_UP ? 1 : 0;
+    }
+    int r = write_frame(can, frame, now_us);
+    if (r == 0) {
+        hold(can, frame, now_us);
+        return 0;
+    }
+    if (r < 0) {
+        if (can->state != URRT_CAN_UP)
+            can->stats.dropped++;
+        return 0;
+    }
+    if (can->n_held > 0)
+        flush_held(can, now_us); /* the queue took a frame: it has room again */
+    else
+        note_accepting(can);
+    return 1;
+}
+
+int urrt_can_poll_fd(const urrt_can *can, short *events)
+{
+    if (events != NULL)
+        *events = 0;
+    if (can == NULL || can->log_path != NULL || can->state != URRT_CAN_UP)
+        return -1;
+    if (events != NULL)
+        *events = (short)(POLLIN | (can->n_held > 0 && can->wait_writable ? POLLOUT : 0));
+    return can->fd;
+}
+
+uint64_t urrt_can_deadline(const urrt_can *can)
+{
+    if (can == NULL || can->log_path != NULL)
+        return UINT64_MAX;
+    if (can->state != URRT_CAN_UP)
+        return can->reopen_at_us;
+    if (can->n_held == 0)
+        return UINT64_MAX;
+    uint64_t deadline = can->retry_at_us;
+    uint64_t max_us = (uint64_t)can->cfg.hold_max_ms * 1000u;
+    for (size_t i = 0; i < can->n_held; i++) {
+        uint64_t expiry = can->held[i].since_us + max_us + 1;
+        if (expiry < deadline)
+            deadline = expiry;
+    }
+    return deadline;
+}
+
+void urrt_can_service(urrt_can *can, uint64_t now_us)
+{
+    if (can == NULL || can->log_path != NULL)
+        return;
+    if (can->state != URRT_CAN_UP) {
+        if (now_us >= can->reopen_at_us)
+            reopen(can, now_us);
+        return;
+    }
+    read_socket(can, now_us);
+    if (can->state != URRT_CAN_UP || can->n_held == 0)
+        return;
+    expire_held(can, now_us);
+    if (can->n_held > 0 && (now_us >= can->retry_at_us || can->wait_writable))
+        flush_held(can, now_us);
+}
+
+urrt_can_state urrt_can_get_state(const urrt_can *can)
+{
+    return can->state;
+}
+
+const urrt_can_stats *urrt_can_get_stats(const urrt_can *can)
+{
+    return &can->stats;
+}
