@@ -1,0 +1,50 @@
+# tests/lib.mk: proof that lib/ is right and freestanding.
+#   check-lib       black-box tests against the independent Python reference
+#   check-lib-san   the same tests under ASan + UBSan
+#   check-fuzz-lib  the libFuzzer harness, briefly (make fuzz FUZZ_SECONDS=N for longer)
+#   check-cross     every lib/*.c alone for Cortex-M4, linked -nostdlib; footprint vs README
+#   check-docs      docs/protocol.md's generated tables are current (make docs rewrites them)
+#   bench-lib       ns/packet beside memcpy of the same bytes
+# Every lib-level rule takes lib/*.c by wildcard (LIB_SRCS), so new modules are covered.
+
+LIBT := $(BUILD)/tests/lib
+LIB_VECTORS := $(LIBT)/vectors.txt
+LIB_CORPUS := $(LIBT)/corpus
+LIB_TEST_CFLAGS := $(PROG_WARN) $(CPPFLAGS) -Itests
+
+CHECKS += check-lib check-lib-san check-fuzz-lib check-cross check-docs
+BENCHES += bench-lib
+
+.PHONY: check-lib check-lib-san check-fuzz-lib check-cross check-docs bench-lib fuzz-lib docs
+
+# $(call lib_suite,NAME,COMMAND): runs COMMAND, shows its output and keeps its
+# last line ("N passed, N failed") as the suite's result.
+define lib_suite
+	@mkdir -p $(BUILD)/results
+	@$(2) > $(BUILD)/results/$(1).log 2>&1; rc=$$?; cat $(BUILD)/results/$(1).log; \
+	  tail -n 1 $(BUILD)/results/$(1).log > $(BUILD)/results/$(1).result; \
+	  grep -q '^[0-9]* passed, 0 failed$$' $(BUILD)/results/$(1).result || rc=1; exit $$rc
+endef
+
+# Vectors and the fuzz seed corpus come from the reference, at test time.
+$(LIB_VECTORS): tests/ref/urrt_ref.py
+	@mkdir -p $(@D)
+	rm -rf $(LIB_CORPUS)
+	$(PYTHON) tests/ref/urrt_ref.py --out $@ --corpus $(LIB_CORPUS)
+
+# ---- unit tests --------------------------------------------------------------
+
+$(LIBT)/test_lib: tests/lib/test_lib.c tests/check.h $(LIBURRT) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LIB_TEST_CFLAGS) $(OPT) $< $(LIBURRT) -lm -o $@
+
+# The sanitizer build compiles lib/ itself with the sanitizers too.
+$(LIBT)/test_lib_san: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LIB_TEST_CFLAGS) -O1 -g $(SAN_FLAGS) $< $(LIB_SRCS) -lm -o $@
+
+check-lib: $(LIBT)/test_lib $(LIB_VECTORS)
+	$(call lib_suite,check-lib,$(LIBT)/test_lib $(LIB_VECTORS))
+
+check-lib-san: $(LIBT)/test_lib_san $(LIB_VECTORS)
+	$(call lib_suite,check-lib-san,ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $(LIBT)/test_lib_san $(LIB_VECTORS))
