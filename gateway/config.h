@@ -1,0 +1,125 @@
+/*
+ * config.h: the urrt-gateway configuration file.
+ *
+ * An INI file read with libinih. Sections are dispatched through a table of
+ * section handlers (config.c: config_sections), so an output such as CAN adds
+ * its sections ("[can]", "[frame NAME]") with one table entry and a member of
+ * gw_config for its values. Every error is reported as "FILE:LINE: reason";
+ * an unknown section or key is an error, because a typo must not be
+ * silently ignored. Parsing allocates; nothing after startup does.
+ */
+#ifndef URRT_GATEWAY_CONFIG_H
+#define URRT_GATEWAY_CONFIG_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "port.h"
+
+/* The LCM messages, one channel each per robot: "NAME.SUFFIX". */
+typedef enum gw_kind {
+    GW_KIND_STATE = 0, /* urrt.state_t: every field of the packet */
+    GW_KIND_JOINTS,    /* urrt.joints_t */
+    GW_KIND_TOOL,      /* urrt.tool_t */
+    GW_KIND_STATUS,    /* urrt.status_t */
+    GW_KIND_GATEWAY,   /* urrt.gateway_t: the gateway's view of the robot */
+    GW_KIND_COUNT
+} gw_kind;
+
+/* "state", "joints", ...: the key prefix in [lcm]. */
+const char *gw_kind_name(gw_kind kind);
+
+typedef enum gw_rate_mode {
+    GW_RATE_OFF = 0,
+    GW_RATE_EVERY, /* every packet */
+    GW_RATE_HZ     /* decimated to hz, on the controller's clock */
+} gw_rate_mode;
+
+typedef struct gw_rate {
+    gw_rate_mode mode;
+    double hz;
+} gw_rate;
+
+typedef struct gw_lcm_config {
+    char *url;
+    int url_line;
+    char *channel[GW_KIND_COUNT]; /* suffix after "NAME." */
+    int channel_line[GW_KIND_COUNT];
+    gw_rate rate[GW_KIND_COUNT];
+    int rate_line[GW_KIND_COUNT];
+} gw_lcm_config;
+
+typedef struct gw_robot_config {
+    char *name;            /* channel prefix */
+    int line;              /* of the section header */
+    char *host;
+    int host_line;
+    uint16_t port;
+    uint32_t expected_length; /* 0: auto, any length is accepted */
+    char *expected;        /* "auto", or the version/length as written */
+    unsigned max_rate_hz;  /* 125 for a 1.x/3.x version, else 500 */
+    int version_line;
+    urrt_link_config link; /* timeouts and backoff; name/host/port filled in */
+} gw_robot_config;
+
+#define GW_DEFAULT_LCM_URL "udpm://239.255.76.67:7667?ttl=0"
+#define GW_MAX_ROBOTS 64
+/* The fastest controllers send 500 packets per second (e-series). */
+#define GW_ROBOT_MAX_RATE_HZ 500u
+
+typedef struct gw_config {
+    const char *path;
+    urrt_log_level log_level;
+    bool summary;          /* one line per second on stdout */
+    gw_lcm_config lcm;
+    gw_robot_config *robots;
+    unsigned robot_count;
+} gw_config;
+
+/* Parse a file. Returns the number of errors (0: *cfg is complete and
+ * valid), each written to err as "FILE:LINE: reason". */
+int gw_config_load(gw_config *cfg, const char *path, FILE *err);
+void gw_config_free(gw_config *cfg);
+
+/* Writes the file grammar, for --help. */
+void gw_config_usage(FILE *out);
+
+/* Parses a log level name ("err", "warning", "notice", "info", "debug"). */
+bool gw_parse_log_level(const char *text, urrt_log_level *level);
+
+/*
+ * For section handlers. A handler reports a problem with config_error() and
+ * returns false; the parser goes on, so that one run shows every error.
+ */
+typedef struct config_ctx config_ctx;
+
+typedef struct config_section {
+    const char *kind;   /* "robot" matches "[robot NAME]" */
+    bool named;         /* the header carries a NAME */
+    bool repeatable;    /* may appear more than once (with different names) */
+    /* A section header; name is NULL for unnamed sections. */
+    bool (*begin)(config_ctx *ctx, gw_config *cfg, const char *name);
+    bool (*key)(config_ctx *ctx, gw_config *cfg, const char *key, const char *value);
+    /* After the whole file: defaults and checks across sections. May be NULL. */
+    void (*finish)(config_ctx *ctx, gw_config *cfg);
+} config_section;
+
+int config_line(const config_ctx *ctx);
+void config_error(config_ctx *ctx, int line, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* Value parsers: false (after reporting the error at the current line) when
+ * the value is not valid. what names the key in the message. */
+bool config_uint(config_ctx *ctx, const char *what, const char *value, unsigned long min,
+                 unsigned long max, unsigned long *out);
+/* "250 ms", "2 s", "1.5s": a unit is required. */
+bool config_duration_ms(config_ctx *ctx, const char *what, const char *value, uint32_t min_ms,
+                        uint32_t max_ms, uint32_t *out);
+/* "every", "off" or "N Hz". */
+bool config_rate(config_ctx *ctx, const char *what, const char *value, gw_rate *out);
+bool config_bool(config_ctx *ctx, const char *what, const char *value, bool *out);
+/* Letters, digits, '_' and '-' (and '.' when dots is true), 1..64 chars. */
+bool config_identifier(config_ctx *ctx, const char *what, const char *value, bool dots);
+
+#endif

@@ -1,0 +1,269 @@
+/* gateway.c: robots, outputs and the poll loop of urrt-gateway (gateway.h). */
+#define _GNU_SOURCE
+#include "gateway.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A wrong-length stream is logged at once, then at most this often. */
+#define GW_MISMATCH_LOG_US (10u * 1000000u)
+
+bool gw_robot_fresh(const gw_robot *robot, uint64_t now_us)
+{
+    uint64_t timeout_us = (uint64_t)robot->cfg->link.silence_timeout_ms * 1000u;
+    if (urrt_link_get_state(robot->link) != URRT_LINK_UP || robot->last_rx_us == 0 || robot->mismatch) {
+        return false;
+    }
+    /* A connection made after the last packet has sent nothing yet. */
+    if (urrt_link_get_stats(robot->link)->connects != robot->connects_seen) {
+        return false;
+    }
+    return timeout_us == 0 || now_us < robot->last_rx_us + timeout_us;
+}
+
+int64_t gw_robot_data_age_us(const gw_robot *robot, uint64_t now_us)
+{
+    if (robot->last_any_rx_us == 0) {
+        return -1;
+    }
+    return now_us > robot->last_any_rx_us ? (int64_t)(now_us - robot->last_any_rx_us) : 0;
+}
+
+unsigned gw_counters(const gateway *gw, const gw_robot *robot, gw_counter *out, unsigned max)
+{
+    unsigned n = 0;
+    for (unsigned i = 0; i < gw->output_count && n < max; i++) {
+        if (gw->outputs[i].counters != NULL) {
+            n += gw->outputs[i].counters(gw->outputs[i].ctx, robot, out + n, max - n);
+        }
+    }
+    return n;
+}
+
+static void on_mismatch(gw_robot *robot, size_t length, uint64_t rx_us)
+{
+    const char *versions = urrt_versions_of((uint32_t)length);
+    robot->mismatches++;
+    robot->mismatch = true;
+    snprintf(robot->last_error, sizeof robot->last_error,
+             "%zu-byte packets (%s), expected %" PRIu32 " (version %s)", length,
+             versions != NULL ? versions : "no known controller", robot->cfg->expected_length,
+             robot->cfg->expected);
+    if (robot->mismatches_logged == 0 || rx_us >= robot->mismatch_logged_us + GW_MISMATCH_LOG_US) {
+        urrt_log(URRT_LOG_WARNING,
+                 "robot %s: %s: %" PRIu64 " packets not published so far; fix \"version\" in the "
+                 "configuration (or set it to auto)",
+                 robot->cfg->name, robot->last_error, robot->mismatches);
+        robot->mismatch_logged_us = rx_us;
+        robot->mismatches_logged = robot->mismatches;
+    }
+}
+
+/* The one per-packet path: check, decode once, hand to every output. */
+static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t rx_us)
+{
+    gw_robot *robot = ctx;
+    gateway *gw = robot->gw;
+    gw_packet pkt;
+    int r;
+
+    robot->last_any_rx_us = rx_us;
+    robot->connects_seen = urrt_link_get_stats(robot->link)->connects;
+    if (robot->cfg->expected_length != 0 && length != robot->cfg->expected_length) {
+        on_mismatch(robot, length, rx_us);
+        return;
+    }
+    if (robot->mismatch) {
+        urrt_log(URRT_LOG_NOTICE, "robot %s: %zu-byte packets again, as expected", robot->cfg->name, length);
+        robot->mismatch = false;
+        robot->mismatches_logged = 0;
+    }
+    r = urrt_decode(bytes, length, &robot->state);
+    if (r < 0) {
+        /* The framer only yields plausible packets: this is a bug if seen. */
+        robot->decode_errors++;
+        snprintf(robot->last_error, sizeof robot->last_error, "decode: %s", urrt_strerror(r));
+        return;
+    }
+    robot->last_rx_us = rx_us;
+    robot->sequence++;
+    pkt.bytes = bytes;
+    pkt.length = length;
+    pkt.state = &robot->state;
+    pkt.rx_us = rx_us;
+    /* The wall clock of the instant the bytes were read. */
+    {
+        uint64_t mono = urrt_port_monotonic_us();
+        uint64_t wall = urrt_port_realtime_us();
+        pkt.rx_wall_us = wall - (mono > rx_us ? mono - rx_us : 0);
+    }
+    pkt.sequence = robot->sequence;
+    for (unsigned i = 0; i < gw->output_count; i++) {
+        gw->outputs[i].packet(gw->outputs[i].ctx, robot, &pkt);
+    }
+}
+
+bool gw_init(gateway *gw, const gw_config *cfg)
+{
+    memset(gw, 0, sizeof *gw);
+    gw->cfg = cfg;
+    gw->summary = cfg->summary;
+    gw->robots = calloc(cfg->robot_count, sizeof *gw->robots);
+    if (gw->robots == NULL) {
+        urrt_log(URRT_LOG_ERR, "out of memory");
+        return false;
+    }
+    gw->robot_count = cfg->robot_count;
+    for (unsigned i = 0; i < cfg->robot_count; i++) {
+        gw_robot *robot = &gw->robots[i];
+        robot->gw = gw;
+        robot->index = i;
+        robot->cfg = &cfg->robots[i];
+        urrt_state_clear(&robot->state);
+        robot->link = urrt_link_new(&robot->cfg->link);
+        if (robot->link == NULL) {
+            gw_close(gw);
+            return false;
+        }
+    }
+    return true;
+}
+
+bool gw_add_output(gateway *gw, const gw_output *output)
+{
+    if (gw->output_count == GW_MAX_OUTPUTS || output->packet == NULL || output->tick == NULL) {
+        urrt_log(URRT_LOG_ERR, "output %s cannot be added", output->name);
+        return false;
+    }
+    gw->outputs[gw->output_count++] = *output;
+    return true;
+}
+
+static void print_summary(gateway *gw, uint64_t now_us)
+{
+    char line[1024];
+    for (unsigned i = 0; i < gw->robot_count; i++) {
+        const gw_robot *robot = &gw->robots[i];
+        const urrt_link_stats *ls = urrt_link_get_stats(robot->link);
+        int64_t age = gw_robot_data_age_us(robot, now_us);
+        char age_text[32];
+        int n;
+        if (age < 0) {
+            snprintf(age_text, sizeof age_text, "-");
+        } else if (age < 10000) {
+            snprintf(age_text, sizeof age_text, "%.2f ms", (double)age / 1000.0);
+        } else {
+            snprintf(age_text, sizeof age_text, "%.1f s", (double)age / 1e6);
+        }
+        n = snprintf(line, sizeof line, "%s %s%s age %s reconnects %" PRIu64 " resyncs %" PRIu64
+                     " mismatches %" PRIu64 " |",
+                     robot->cfg->name, urrt_link_state_name(urrt_link_get_state(robot->link)),
+                     gw_robot_fresh(robot, now_us) ? "" : " (no data)", age_text, ls->reconnects,
+                     ls->resyncs, robot->mismatches);
+        for (unsigned o = 0; o < gw->output_count && n > 0 && (size_t)n < sizeof line; o++) {
+            if (gw->outputs[o].summary != NULL) {
+                n += gw->outputs[o].summary(gw->outputs[o].ctx, robot, now_us, line + n, sizeof line - (size_t)n);
+            }
+        }
+        puts(line);
+    }
+    fflush(stdout);
+}
+
+void gw_run(gateway *gw, volatile sig_atomic_t *running)
+{
+    struct pollfd fds[GW_MAX_POLL];
+    unsigned link_fd[GW_MAX_ROBOTS];
+    unsigned output_first[GW_MAX_OUTPUTS], output_count[GW_MAX_OUTPUTS];
+    uint64_t now = urrt_port_monotonic_us();
+
+    gw->next_summary_us = now + 1000000u;
+    while (*running) {
+        unsigned nfds = 0;
+        uint64_t deadline = now + GW_TICK_MAX_US;
+        int timeout_ms, ready;
+
+        for (unsigned i = 0; i < gw->robot_count; i++) {
+            short events = 0;
+            int fd = urrt_link_poll_fd(gw->robots[i].link, &events);
+            uint64_t d = urrt_link_deadline(gw->robots[i].link);
+            link_fd[i] = UINT32_MAX;
+            if (fd >= 0 && nfds < GW_MAX_POLL) {
+                link_fd[i] = nfds;
+                fds[nfds++] = (struct pollfd){.fd = fd, .events = events};
+            }
+            if (d < deadline) {
+                deadline = d;
+            }
+        }
+        for (unsigned o = 0; o < gw->output_count; o++) {
+            const gw_output *out = &gw->outputs[o];
+            output_first[o] = nfds;
+            output_count[o] = out->poll_fds != NULL ? out->poll_fds(out->ctx, fds + nfds, GW_MAX_POLL - nfds) : 0;
+            nfds += output_count[o];
+            if (out->deadline != NULL) {
+                uint64_t d = out->deadline(out->ctx);
+                if (d < deadline) {
+                    deadline = d;
+                }
+            }
+        }
+        if (gw->summary && gw->next_summary_us < deadline) {
+            deadline = gw->next_summary_us;
+        }
+        /* Round up: waking a little late is harmless, early wakes spin. */
+        timeout_ms = deadline <= now ? 0 : (int)((deadline - now + 999u) / 1000u);
+        ready = poll(fds, nfds, timeout_ms);
+        if (ready < 0 && errno != EINTR) {
+            urrt_log(URRT_LOG_ERR, "poll: %s", strerror(errno));
+        }
+        now = urrt_port_monotonic_us();
+        if (ready < 0) {
+            for (unsigned i = 0; i < nfds; i++) {
+                fds[i].revents = 0;
+            }
+        }
+        for (unsigned i = 0; i < gw->robot_count; i++) {
+            gw_robot *robot = &gw->robots[i];
+            bool signalled = link_fd[i] != UINT32_MAX && fds[link_fd[i]].revents != 0;
+            if (signalled || urrt_link_deadline(robot->link) <= now ||
+                urrt_link_get_state(robot->link) != URRT_LINK_UP) {
+                urrt_link_service(robot->link, now, on_packet, robot);
+            }
+        }
+        for (unsigned o = 0; o < gw->output_count; o++) {
+            const gw_output *out = &gw->outputs[o];
+            if (out->service != NULL) {
+                out->service(out->ctx, fds + output_first[o], output_count[o], now);
+            }
+            out->tick(out->ctx, now);
+        }
+        if (gw->summary && now >= gw->next_summary_us) {
+            print_summary(gw, now);
+            gw->next_summary_us += 1000000u;
+            if (gw->next_summary_us <= now) {
+                gw->next_summary_us = now + 1000000u;
+            }
+        }
+        gw->loops++;
+    }
+}
+
+void gw_close(gateway *gw)
+{
+    for (unsigned o = 0; o < gw->output_count; o++) {
+        if (gw->outputs[o].close != NULL) {
+            gw->outputs[o].close(gw->outputs[o].ctx);
+        }
+    }
+    gw->output_count = 0;
+    for (unsigned i = 0; i < gw->robot_count; i++) {
+        urrt_link_free(gw->robots[i].link);
+    }
+    free(gw->robots);
+    gw->robots = NULL;
+    gw->robot_count = 0;
+}

@@ -1,0 +1,116 @@
+/*
+ * gateway.h: the core of urrt-gateway: robots, outputs, one poll loop.
+ *
+ * Each robot has a link (port.h). Every complete packet of the expected
+ * length is decoded once and handed to every output through one dispatch
+ * (gw_output.packet); every output also gets a periodic tick, may add
+ * descriptors to the poll set and counters to each robot's status. LCM is
+ * one output (lcm_out.h); CAN is meant to be another, registered with
+ * gw_add_output() next to it.
+ *
+ * Nothing here allocates after gw_init(): the per-packet path only reads
+ * and writes memory the gateway already owns.
+ */
+#ifndef URRT_GATEWAY_H
+#define URRT_GATEWAY_H
+
+#include <poll.h>
+#include <signal.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "config.h"
+#include "port.h"
+#include "urrt.h"
+
+#define GW_MAX_OUTPUTS 8
+#define GW_MAX_POLL 256
+/* An output's tick runs at least this often, and whenever its deadline has
+ * passed. */
+#define GW_TICK_MAX_US 100000u
+
+typedef struct gateway gateway;
+
+typedef struct gw_robot {
+    gateway *gw;
+    unsigned index;
+    const gw_robot_config *cfg;
+    urrt_link *link;
+    urrt_state state;          /* the last packet decoded */
+    uint64_t sequence;         /* packets dispatched to the outputs */
+    uint64_t mismatches;       /* packets not of the expected length */
+    uint64_t decode_errors;
+    uint64_t last_rx_us;       /* monotonic time of the last dispatched packet, 0: none */
+    uint64_t last_any_rx_us;   /* of the last packet, dispatched or not */
+    uint64_t connects_seen;    /* link connects when the last packet came */
+    uint64_t mismatch_logged_us;
+    uint64_t mismatches_logged;
+    bool mismatch;             /* the last packet had the wrong length */
+    char last_error[160];
+} gw_robot;
+
+/* One packet, as every output receives it. */
+typedef struct gw_packet {
+    const uint8_t *bytes;      /* valid during the call only */
+    size_t length;
+    const urrt_state *state;   /* decoded */
+    uint64_t rx_us;            /* monotonic time the bytes were read */
+    uint64_t rx_wall_us;       /* the same instant on the wall clock (utime) */
+    uint64_t sequence;         /* robot->sequence for this packet */
+} gw_packet;
+
+/* A named counter an output adds to each robot's status. */
+typedef struct gw_counter {
+    const char *name;
+    uint64_t value;
+} gw_counter;
+
+typedef struct gw_output {
+    const char *name;
+    void *ctx;
+    /* Every packet of every robot, in order. Must not block or allocate. */
+    void (*packet)(void *ctx, gw_robot *robot, const gw_packet *pkt);
+    /* Periodic work (status reports, retries); now is monotonic. */
+    void (*tick)(void *ctx, uint64_t now_us);
+    /* Optional: descriptors to wait on (at most max), their number. */
+    unsigned (*poll_fds)(void *ctx, struct pollfd *fds, unsigned max);
+    /* Optional: after the wait, with the descriptors it gave (revents set). */
+    void (*service)(void *ctx, const struct pollfd *fds, unsigned count, uint64_t now_us);
+    /* Optional: monotonic time its tick is due at the latest. */
+    uint64_t (*deadline)(void *ctx);
+    /* Optional: counters for a robot's status (at most max), their number. */
+    unsigned (*counters)(void *ctx, const gw_robot *robot, gw_counter *out, unsigned max);
+    /* Optional: appends to a robot's one-line summary; returns chars written. */
+    int (*summary)(void *ctx, const gw_robot *robot, uint64_t now_us, char *buf, size_t size);
+    /* Optional: at exit. */
+    void (*close)(void *ctx);
+} gw_output;
+
+struct gateway {
+    const gw_config *cfg;
+    gw_robot *robots;
+    unsigned robot_count;
+    gw_output outputs[GW_MAX_OUTPUTS];
+    unsigned output_count;
+    bool summary;              /* print one line per robot each second on stdout */
+    uint64_t next_summary_us;
+    uint64_t loops;
+};
+
+/* Creates a link per robot. False (logged) when one cannot be created. */
+bool gw_init(gateway *gw, const gw_config *cfg);
+bool gw_add_output(gateway *gw, const gw_output *output);
+/* Runs until *running is cleared. */
+void gw_run(gateway *gw, volatile sig_atomic_t *running);
+void gw_close(gateway *gw);
+
+/* Packets arrive, have the expected length, and the last one is younger
+ * than the silence timeout: only then may state be published. */
+bool gw_robot_fresh(const gw_robot *robot, uint64_t now_us);
+/* Microseconds since the last packet was read, -1 before the first. */
+int64_t gw_robot_data_age_us(const gw_robot *robot, uint64_t now_us);
+/* Every output's counters for a robot. */
+unsigned gw_counters(const gateway *gw, const gw_robot *robot, gw_counter *out, unsigned max);
+
+#endif

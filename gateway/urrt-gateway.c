@@ -1,0 +1,181 @@
+/*
+ * urrt-gateway: reads the RealTime stream of one or more Universal Robots
+ * controllers and publishes it on LCM (see docs/gateway.md).
+ */
+#define _GNU_SOURCE
+#include <getopt.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "config.h"
+#include "gateway.h"
+#include "lcm_out.h"
+#include "port.h"
+#include "urrt.h"
+
+static volatile sig_atomic_t running = 1;
+
+static void usage(FILE *out)
+{
+    fputs(
+        "Usage: urrt-gateway [options] CONFIG\n"
+        "       urrt-gateway --check-config CONFIG\n"
+        "\n"
+        "Reads the RealTime interface (TCP 30003/30013) of the robots in CONFIG and\n"
+        "publishes each one's packets on LCM: NAME.STATE (urrt.state_t, every field),\n"
+        "NAME.JOINTS, NAME.TOOL, NAME.STATUS, and NAME.GATEWAY (urrt.gateway_t: link\n"
+        "state and counters, once per second even while the robot is unreachable).\n"
+        "Never writes to a robot. Stops on SIGINT or SIGTERM.\n"
+        "\n"
+        "Options:\n"
+        "  -c, --check-config     validate CONFIG, print what would run, exit\n"
+        "  -s, --summary          one line per robot each second on stdout\n"
+        "                         (state, data age, reconnects, messages/s per channel)\n"
+        "  -u, --lcm-url URL      publish on URL instead of [lcm] url\n"
+        "  -l, --log-level LEVEL  err, warning, notice, info or debug (overrides [gateway])\n"
+        "  -h, --help             this text\n"
+        "  -V, --version          program, library and wire format versions\n"
+        "\n",
+        out);
+    gw_config_usage(out);
+    fputs(
+        "\n"
+        "Example CONFIG:\n"
+        "  [lcm]\n"
+        "  url = udpm://239.255.76.67:7667?ttl=0   # ttl=1 to reach the LAN\n"
+        "  state_rate = every\n"
+        "  tool_rate = 50 Hz\n"
+        "\n"
+        "  [robot arm1]\n"
+        "  host = 192.168.1.10\n"
+        "  port = 30013\n"
+        "  version = 5.10\n"
+        "\n"
+        "Examples:\n"
+        "  urrt-gateway --check-config /etc/urrt/gateway.ini\n"
+        "  urrt-gateway --summary /etc/urrt/gateway.ini\n"
+        "  urrt-gateway -u 'udpm://239.255.76.67:7667?ttl=1' -l info gateway.ini\n"
+        "\n"
+        "Exit status: 0 stopped by a signal (or the configuration is valid),\n"
+        "1 runtime failure, 2 bad command line or configuration.\n",
+        out);
+}
+
+static void print_plan(const gw_config *cfg, const char *url)
+{
+    printf("%s: valid\n", cfg->path);
+    printf("lcm %s\n", url);
+    for (unsigned i = 0; i < cfg->robot_count; i++) {
+        const gw_robot_config *r = &cfg->robots[i];
+        char peer[300];
+        cli_format_host_port(r->host, r->port, peer, sizeof peer);
+        printf("robot %s: %s, version %s, connect %u ms, silence %u ms, backoff %u..%u ms\n", r->name, peer,
+               r->expected, (unsigned)r->link.connect_timeout_ms, (unsigned)r->link.silence_timeout_ms,
+               (unsigned)r->link.backoff_initial_ms, (unsigned)r->link.backoff_max_ms);
+        for (unsigned k = 0; k < GW_KIND_COUNT; k++) {
+            const gw_rate *rate = &cfg->lcm.rate[k];
+            printf("  %s.%s: ", r->name, cfg->lcm.channel[k]);
+            if (rate->mode == GW_RATE_OFF) {
+                printf("off\n");
+            } else if (rate->mode == GW_RATE_EVERY) {
+                printf("every packet\n");
+            } else {
+                printf("%g Hz\n", rate->hz);
+            }
+        }
+    }
+}
+
+int main(int argc, char **argv)
+{
+    static const struct option options[] = {
+        {"check-config", no_argument, NULL, 'c'},
+        {"summary", no_argument, NULL, 's'},
+        {"lcm-url", required_argument, NULL, 'u'},
+        {"log-level", required_argument, NULL, 'l'},
+        {"help", no_argument, NULL, 'h'},
+        {"version", no_argument, NULL, 'V'},
+        {NULL, 0, NULL, 0},
+    };
+    bool check_only = false, summary = false;
+    const char *url_override = NULL;
+    urrt_log_level level = URRT_LOG_NOTICE;
+    bool level_given = false;
+    gw_config cfg;
+    gateway gw;
+    lcm_out *lcm;
+    gw_output output;
+    int opt;
+
+    urrt_log_init(argv[0], URRT_LOG_NOTICE);
+    while ((opt = getopt_long(argc, argv, "csu:l:hV", options, NULL)) != -1) {
+        switch (opt) {
+        case 'c': check_only = true; break;
+        case 's': summary = true; break;
+        case 'u': url_override = optarg; break;
+        case 'l':
+            if (!gw_parse_log_level(optarg, &level)) {
+                fprintf(stderr, "urrt-gateway: --log-level %s: use err, warning, notice, info or debug\n", optarg);
+                return CLI_EXIT_USAGE;
+            }
+            level_given = true;
+            break;
+        case 'h': usage(stdout); return CLI_EXIT_OK;
+        case 'V':
+            printf("urrt-gateway %s (wire format up to %d, %d columns)\n", URRT_VERSION_STRING,
+                   URRT_WIRE_VERSION, URRT_WIRE_COLUMNS);
+            return CLI_EXIT_OK;
+        default:
+            fprintf(stderr, "Try 'urrt-gateway --help'.\n");
+            return CLI_EXIT_USAGE;
+        }
+    }
+    if (optind != argc - 1) {
+        fprintf(stderr, "urrt-gateway: %s\nTry 'urrt-gateway --help'.\n",
+                optind == argc ? "no CONFIG file given" : "only one CONFIG file is read");
+        return CLI_EXIT_USAGE;
+    }
+    if (gw_config_load(&cfg, argv[optind], stderr) != 0) {
+        fprintf(stderr, "urrt-gateway: %s is not valid; see `urrt-gateway --help` for the grammar\n", argv[optind]);
+        gw_config_free(&cfg);
+        return CLI_EXIT_USAGE;
+    }
+    if (url_override != NULL) {
+        free(cfg.lcm.url);
+        cfg.lcm.url = strdup(url_override);
+    }
+    if (check_only) {
+        print_plan(&cfg, cfg.lcm.url);
+        gw_config_free(&cfg);
+        return CLI_EXIT_OK;
+    }
+    urrt_log_set_level(level_given ? level : cfg.log_level);
+    cli_handle_signals(&running);
+
+    if (!gw_init(&gw, &cfg)) {
+        gw_config_free(&cfg);
+        return CLI_EXIT_RUNTIME;
+    }
+    gw.summary = gw.summary || summary;
+    lcm = lcm_out_new(&gw, &cfg.lcm);
+    if (lcm == NULL) {
+        urrt_log(URRT_LOG_ERR, "out of memory");
+        gw_close(&gw);
+        gw_config_free(&cfg);
+        return CLI_EXIT_RUNTIME;
+    }
+    output = lcm_out_output(lcm);
+    gw_add_output(&gw, &output);
+    urrt_log(URRT_LOG_NOTICE, "started: %u robot%s, LCM %s", cfg.robot_count, cfg.robot_count == 1 ? "" : "s",
+             cfg.lcm.url);
+
+    gw_run(&gw, &running);
+
+    urrt_log(URRT_LOG_NOTICE, "stopping (signal %d)", cli_stop_signal());
+    gw_close(&gw);
+    gw_config_free(&cfg);
+    return CLI_EXIT_OK;
+}
