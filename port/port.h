@@ -177,8 +177,10 @@ const char *urrt_link_peer(const urrt_link *link);
  *                               (default "can0"), so that `canplayer -I PATH`
  *                               replays onto NAME without a mapping
  * Log lines are "(SEC.USEC) IFNAME ID#DATA" for classic frames and
- * "(SEC.USEC) IFNAME ID##FDATA" for FD frames (F: flags nibble, 1 with bit
- * rate switch), ID in 3 hex digits (11-bit) or 8 (29-bit), wall-clock time.
+ * "(SEC.USEC) IFNAME ID##FDATA" for FD frames (F: the flags nibble, 4, or 5
+ * with the bit rate switch, as candump shows FD frames on current kernels),
+ * ID in 3 hex digits (11-bit) or 8 (29-bit), DATA in upper-case hex,
+ * wall-clock time.
  */
 #define URRT_CAN_MAX_DATA 64
 

@@ -34,6 +34,10 @@
 
 #include "port.h"
 
+#ifndef CANFD_FDF
+#define CANFD_FDF 0x04 /* kernels since 6.2 (and 6.1 stable) mark FD frames with it */
+#endif
+
 #define LOG_PREFIX "log:"
 #define LOG_IFNAME_OPT ",ifname="
 #define LOG_IFNAME_DEFAULT "can0"
@@ -124,6 +128,11 @@ static bool same_id(const urrt_can_frame *a, const urrt_can_frame *b)
     return a->id == b->id && a->extended == b->extended;
 }
 
+static uint8_t fd_flags(bool brs)
+{
+    return (uint8_t)(CANFD_FDF | (brs ? CANFD_BRS : 0));
+}
+
 static canid_t kernel_id(const urrt_can_frame *f)
 {
     return f->extended ? (f->id | CAN_EFF_FLAG) : f->id;
@@ -134,7 +143,9 @@ static canid_t kernel_id(const urrt_can_frame *f)
 static const char hex_upper[] = "0123456789ABCDEF";
 
 /* One line exactly as candump -l writes it (can-utils lib.c sprint_canframe
- * with no separator, after "(%010lu.%06lu) %s "). */
+ * with no separator, after "(%010lu.%06lu) %s "). The FD flags nibble is what
+ * candump shows for the frame received back from a current kernel, which
+ * sets CANFD_FDF on every FD frame: 4, or 5 with the bit rate switch. */
 static size_t format_log_line(char *out, size_t size, const char *ifname, uint64_t wall_us,
                               const urrt_can_frame *f, bool brs)
 {
@@ -144,7 +155,7 @@ static size_t format_log_line(char *out, size_t size, const char *ifname, uint64
     pos += (size_t)snprintf(out + pos, size - pos, f->extended ? "%08X#" : "%03X#", (unsigned)f->id);
     if (f->fd) {
         out[pos++] = '#';
-        out[pos++] = hex_upper[brs ? CANFD_BRS : 0];
+        out[pos++] = hex_upper[fd_flags(brs)];
     }
     for (unsigned i = 0; i < f->len; i++) {
         out[pos++] = hex_upper[f->data[i] >> 4];
@@ -461,7 +472,7 @@ static int write_frame(urrt_can *can, const urrt_can_frame *f, uint64_t now_us)
     if (f->fd) {
         k.fd.can_id = kernel_id(f);
         k.fd.len = f->len;
-        k.fd.flags = can->cfg.fd_brs ? CANFD_BRS : 0;
+        k.fd.flags = fd_flags(can->cfg.fd_brs);
         memcpy(k.fd.data, f->data, f->len);
         size = sizeof(k.fd);
     } else {
