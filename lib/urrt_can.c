@@ -1,0 +1,641 @@
+/* urrt_can: signal packing for CAN payloads. See urrt_can.h for the API and
+ * the bit numbering, docs/can.md for the gateway built on it. */
+#include "urrt_can.h"
+
+#include <float.h>
+
+#include "urrt.h"
+
+#define URRT_CAN_STATIC_ASSERT(name, cond) typedef char urrt_can_assert_##name[(cond) ? 1 : -1]
+
+URRT_CAN_STATIC_ASSERT(double_is_binary64, sizeof(double) == 8 && DBL_MANT_DIG == 53);
+URRT_CAN_STATIC_ASSERT(float_is_binary32, sizeof(float) == 4 && FLT_MANT_DIG == 24);
+URRT_CAN_STATIC_ASSERT(errors_apart_from_urrt, (int)URRT_CAN_E_SIGNAL < (int)URRT_E_UNKNOWN_FIELD);
+
+#define PAYLOAD_BITS (8u * URRT_CAN_MAX_LEN)
+#define TWO_POW_52 4503599627370496.0
+#define TWO_POW_64 18446744073709551616.0
+#define FLOAT32_QUIET_NAN UINT64_C(0x7FC00000)
+#define FLOAT64_QUIET_NAN UINT64_C(0x7FF8000000000000)
+
+const char *urrt_can_strerror(int result)
+{
+    switch (result) {
+    case URRT_CAN_E_SIGNAL: return "invalid signal descriptor";
+    case URRT_CAN_E_PAST_END: return "signal reaches past the frame's length";
+    case URRT_CAN_E_OVERLAP: return "signals overlap";
+    case URRT_CAN_E_FRAME_LENGTH: return "invalid frame length";
+    case URRT_CAN_E_ID: return "CAN id out of range";
+    default: return urrt_strerror(result);
+    }
+}
+
+/* ---- frames ---------------------------------------------------------------- */
+
+static const uint8_t dlc_lengths[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64};
+
+uint8_t urrt_can_len_to_dlc(unsigned len)
+{
+    uint8_t dlc;
+    for (dlc = 0; dlc < 16u; dlc++) {
+        if (dlc_lengths[dlc] == len) {
+            return dlc;
+        }
+    }
+    return 0xFF;
+}
+
+unsigned urrt_can_dlc_to_len(uint8_t dlc)
+{
+    return dlc < 16u ? dlc_lengths[dlc] : 0u;
+}
+
+bool urrt_can_length_valid(unsigned len, bool fd)
+{
+    if (!fd) {
+        return len <= URRT_CAN_CLASSIC_MAX_LEN;
+    }
+    return urrt_can_len_to_dlc(len) != 0xFF;
+}
+
+unsigned urrt_can_fd_length_round_up(unsigned len)
+{
+    uint8_t dlc;
+    for (dlc = 0; dlc < 16u; dlc++) {
+        if (dlc_lengths[dlc] >= len) {
+            return dlc_lengths[dlc];
+        }
+    }
+    return URRT_CAN_MAX_LEN;
+}
+
+bool urrt_can_id_valid(uint32_t id, bool extended)
+{
+    return id <= (extended ? URRT_CAN_EFF_MAX : URRT_CAN_SFF_MAX);
+}
+
+void urrt_can_frame_bits(unsigned len, bool extended, bool fd, unsigned *nominal_bits, unsigned *data_bits)
+{
+    unsigned nominal;
+    unsigned data;
+    if (!fd) {
+        unsigned g = extended ? 54u : 34u;
+        unsigned s = len < URRT_CAN_CLASSIC_MAX_LEN ? len : URRT_CAN_CLASSIC_MAX_LEN;
+        nominal = g + 8u * s + 13u + (g + 8u * s - 1u) / 4u;
+        data = 0;
+    } else {
+        /* SOF, id, (SRR, IDE, id extension,) RRS, IDE/FDF, res, BRS. */
+        unsigned arbitration = extended ? 36u : 17u;
+        unsigned s = urrt_can_fd_length_round_up(len);
+        unsigned stuffed = 5u + 8u * s; /* ESI, DLC, data */
+        nominal = arbitration + (arbitration - 1u) / 4u + 13u;
+        data = stuffed + (stuffed + 3u) / 4u + (s <= 16u ? 4u + 17u + 6u : 4u + 21u + 7u);
+    }
+    if (nominal_bits != NULL) {
+        *nominal_bits = nominal;
+    }
+    if (data_bits != NULL) {
+        *data_bits = data;
+    }
+}
+
+/* ---- descriptors ------------------------------------------------------------- */
+
+static uint64_t low_mask(unsigned length)
+{
+    return length >= 64u ? ~UINT64_C(0) : (UINT64_C(1) << length) - 1u;
+}
+
+static bool is_finite(double x)
+{
+    return x == x && x <= DBL_MAX && x >= -DBL_MAX;
+}
+
+static bool descriptor_valid(const urrt_can_signal *sig)
+{
+    if (sig->length < 1u || sig->length > 64u || sig->byte_order > (uint8_t)URRT_CAN_MOTOROLA) {
+        return false;
+    }
+    switch ((urrt_can_value_type)sig->type) {
+    case URRT_CAN_UNSIGNED:
+    case URRT_CAN_SIGNED: break;
+    case URRT_CAN_FLOAT32:
+        if (sig->length != 32u) {
+            return false;
+        }
+        break;
+    case URRT_CAN_FLOAT64:
+        if (sig->length != 64u) {
+            return false;
+        }
+        break;
+    default: return false;
+    }
+    if (!is_finite(sig->factor) || sig->factor == 0.0 || !is_finite(sig->offset) || !is_finite(sig->min) ||
+        !is_finite(sig->max) || !(sig->min <= sig->max)) {
+        return false;
+    }
+    if ((sig->flags & ~URRT_CAN_SIG_INVALID_RAW) != 0u) {
+        return false;
+    }
+    if ((sig->flags & URRT_CAN_SIG_INVALID_RAW) != 0u && (sig->invalid_raw & ~low_mask(sig->length)) != 0u) {
+        return false;
+    }
+    return true;
+}
+
+/* Motorola bits counted from the most significant bit of byte 0 downwards
+ * ("big-endian linear"): a Motorola signal is a contiguous run there. */
+static unsigned motorola_linear(unsigned dbc_bit)
+{
+    return (dbc_bit / 8u) * 8u + (7u - dbc_bit % 8u);
+}
+
+/* Where the signal's least significant bit sits: byte and bit in it, and
+ * the direction towards the more significant bytes. */
+static void lsb_position(const urrt_can_signal *sig, unsigned *byte, unsigned *bit, int *step)
+{
+    if (sig->byte_order == (uint8_t)URRT_CAN_INTEL) {
+        *byte = sig->start / 8u;
+        *bit = sig->start % 8u;
+        *step = 1;
+    } else {
+        unsigned lsb_linear = motorola_linear(sig->start) + sig->length - 1u;
+        *byte = lsb_linear / 8u;
+        *bit = 7u - lsb_linear % 8u;
+        *step = -1;
+    }
+}
+
+int urrt_can_signal_span(const urrt_can_signal *sig, unsigned *lsb, unsigned *msb, unsigned *bytes_needed)
+{
+    unsigned lo;
+    unsigned hi;
+    unsigned bytes;
+    if (sig == NULL) {
+        return URRT_E_ARG;
+    }
+    if (sig->length < 1u || sig->length > 64u || sig->start >= PAYLOAD_BITS) {
+        return URRT_CAN_E_SIGNAL;
+    }
+    if (sig->byte_order == (uint8_t)URRT_CAN_INTEL) {
+        lo = sig->start;
+        hi = sig->start + sig->length - 1u;
+        bytes = (hi + 8u) / 8u;
+    } else {
+        unsigned last = motorola_linear(sig->start) + sig->length - 1u;
+        hi = sig->start;
+        lo = (last / 8u) * 8u + (7u - last % 8u);
+        bytes = last / 8u + 1u;
+    }
+    if (lsb != NULL) {
+        *lsb = lo;
+    }
+    if (msb != NULL) {
+        *msb = hi;
+    }
+    if (bytes_needed != NULL) {
+        *bytes_needed = bytes;
+    }
+    return 0;
+}
+
+int urrt_can_signal_check(const urrt_can_signal *sig, unsigned frame_len)
+{
+    unsigned bytes;
+    int rc;
+    if (sig == NULL) {
+        return URRT_E_ARG;
+    }
+    if (!descriptor_valid(sig)) {
+        return URRT_CAN_E_SIGNAL;
+    }
+    rc = urrt_can_signal_span(sig, NULL, NULL, &bytes);
+    if (rc < 0) {
+        return sig->start >= PAYLOAD_BITS ? URRT_CAN_E_PAST_END : rc;
+    }
+    return bytes > frame_len ? URRT_CAN_E_PAST_END : 0;
+}
+
+int urrt_can_signal_range(const urrt_can_signal *sig, double *lo, double *hi)
+{
+    double raw_lo;
+    double raw_hi;
+    double a;
+    double b;
+    if (sig == NULL || lo == NULL || hi == NULL) {
+        return URRT_E_ARG;
+    }
+    if (!descriptor_valid(sig)) {
+        return URRT_CAN_E_SIGNAL;
+    }
+    switch ((urrt_can_value_type)sig->type) {
+    case URRT_CAN_UNSIGNED:
+        raw_lo = 0.0;
+        raw_hi = (double)low_mask(sig->length);
+        break;
+    case URRT_CAN_SIGNED:
+        raw_hi = (double)(low_mask(sig->length) >> 1);
+        raw_lo = -raw_hi - 1.0;
+        break;
+    case URRT_CAN_FLOAT32:
+        raw_lo = -(double)FLT_MAX;
+        raw_hi = (double)FLT_MAX;
+        break;
+    default:
+        raw_lo = -DBL_MAX;
+        raw_hi = DBL_MAX;
+        break;
+    }
+    a = raw_lo * sig->factor + sig->offset;
+    b = raw_hi * sig->factor + sig->offset;
+    if (a > b) {
+        double t = a;
+        a = b;
+        b = t;
+    }
+    /* Scaling a float64 range overflows to infinity (defined in IEEE-754);
+     * limits stay finite. */
+    *lo = a < -DBL_MAX ? -DBL_MAX : a;
+    *hi = b > DBL_MAX ? DBL_MAX : b;
+    return 0;
+}
+
+/* ---- bits ---------------------------------------------------------------------- */
+
+/* Writes (or with `write` false, reads) the signal's bits chunk by chunk
+ * from its least significant bit. The descriptor's span is checked. */
+static uint64_t move_bits(const urrt_can_signal *sig, uint8_t *data, uint64_t raw, bool write)
+{
+    unsigned byte;
+    unsigned bit;
+    int step;
+    unsigned done = 0;
+    uint64_t out = 0;
+
+    lsb_position(sig, &byte, &bit, &step);
+    while (done < sig->length) {
+        unsigned room = 8u - bit;
+        unsigned n = sig->length - done < room ? sig->length - done : room;
+        unsigned chunk_mask = ((1u << n) - 1u) << bit;
+        if (write) {
+            unsigned chunk = (unsigned)((raw >> done) & ((1u << n) - 1u)) << bit;
+            data[byte] = (uint8_t)((data[byte] & ~chunk_mask) | chunk);
+        } else {
+            out |= (uint64_t)((data[byte] & chunk_mask) >> bit) << done;
+        }
+        done += n;
+        bit = 0;
+        byte = step > 0 ? byte + 1u : byte - 1u;
+    }
+    return out;
+}
+
+static int check_placement(const urrt_can_signal *sig, const void *data, unsigned frame_len)
+{
+    if (sig == NULL || data == NULL) {
+        return URRT_E_ARG;
+    }
+    return urrt_can_signal_check(sig, frame_len);
+}
+
+int urrt_can_put_raw(const urrt_can_signal *sig, uint64_t raw, uint8_t *data, unsigned frame_len)
+{
+    int rc = check_placement(sig, data, frame_len);
+    if (rc < 0) {
+        return rc;
+    }
+    (void)move_bits(sig, data, raw, true);
+    return 0;
+}
+
+int urrt_can_get_raw(const urrt_can_signal *sig, const uint8_t *data, unsigned frame_len, uint64_t *raw)
+{
+    int rc = check_placement(sig, data, frame_len);
+    if (rc < 0) {
+        return rc;
+    }
+    if (raw == NULL) {
+        return URRT_E_ARG;
+    }
+    /* move_bits only reads when write is false. */
+    *raw = move_bits(sig, (uint8_t *)(uintptr_t)data, 0, false);
+    return 0;
+}
+
+static void mark_bits(const urrt_can_signal *sig, uint8_t *mask)
+{
+    (void)move_bits(sig, mask, ~UINT64_C(0), true);
+}
+
+static bool masks_overlap(const uint8_t *a, const uint8_t *b, unsigned len)
+{
+    unsigned i;
+    for (i = 0; i < len; i++) {
+        if ((a[i] & b[i]) != 0u) {
+            return true;
+        }
+    }
+    return false;
+}
+
+int urrt_can_layout_check(const urrt_can_signal *sigs, size_t count, unsigned frame_len, size_t *first,
+                          size_t *second)
+{
+    uint8_t occupied[URRT_CAN_MAX_LEN];
+    uint8_t mine[URRT_CAN_MAX_LEN];
+    size_t i;
+    size_t j;
+    unsigned k;
+
+    if (sigs == NULL && count > 0) {
+        return URRT_E_ARG;
+    }
+    if (frame_len > URRT_CAN_MAX_LEN) {
+        return URRT_CAN_E_FRAME_LENGTH;
+    }
+    for (k = 0; k < URRT_CAN_MAX_LEN; k++) {
+        occupied[k] = 0;
+    }
+    for (i = 0; i < count; i++) {
+        int rc = urrt_can_signal_check(&sigs[i], frame_len);
+        if (rc < 0) {
+            if (first != NULL) {
+                *first = i;
+            }
+            return rc;
+        }
+        for (k = 0; k < URRT_CAN_MAX_LEN; k++) {
+            mine[k] = 0;
+        }
+        mark_bits(&sigs[i], mine);
+        if (masks_overlap(occupied, mine, frame_len)) {
+            /* Which earlier signal: rebuild their masks one at a time. */
+            for (j = 0; j < i; j++) {
+                uint8_t theirs[URRT_CAN_MAX_LEN];
+                for (k = 0; k < URRT_CAN_MAX_LEN; k++) {
+                    theirs[k] = 0;
+                }
+                mark_bits(&sigs[j], theirs);
+                if (masks_overlap(theirs, mine, frame_len)) {
+                    break;
+                }
+            }
+            if (first != NULL) {
+                *first = i;
+            }
+            if (second != NULL) {
+                *second = j;
+            }
+            return URRT_CAN_E_OVERLAP;
+        }
+        for (k = 0; k < frame_len; k++) {
+            occupied[k] = (uint8_t)(occupied[k] | mine[k]);
+        }
+    }
+    return 0;
+}
+
+/* ---- values ------------------------------------------------------------------------ */
+
+typedef union {
+    float f;
+    uint32_t u;
+} float_bits;
+
+typedef union {
+    double d;
+    uint64_t u;
+} double_bits;
+
+/* Round half away from zero, for finite x. Past 2^52 every double is an
+ * integer; below it the truncation through int64_t is exact and defined. */
+static double round_half_away(double x)
+{
+    double t;
+    if (!(x > -TWO_POW_52 && x < TWO_POW_52)) {
+        return x;
+    }
+    t = (double)(int64_t)x;
+    if (x - t >= 0.5) {
+        t += 1.0;
+    } else if (x - t <= -0.5) {
+        t -= 1.0;
+    }
+    return t;
+}
+
+/* Scaled value to an integer raw: range checked in floating point first,
+ * so that the conversion below always has a value it can represent. */
+static int integer_raw(const urrt_can_signal *sig, double scaled, uint64_t *raw)
+{
+    uint64_t mask = low_mask(sig->length);
+    double r = round_half_away(scaled); /* +-inf pass through */
+
+    if (sig->type == (uint8_t)URRT_CAN_UNSIGNED) {
+        double limit = sig->length >= 64u ? TWO_POW_64 : (double)(mask + 1u);
+        if (r >= limit) {
+            *raw = mask;
+            return URRT_CAN_PACK_SATURATED;
+        }
+        if (r < 0.0) {
+            *raw = 0;
+            return URRT_CAN_PACK_SATURATED;
+        }
+        *raw = (uint64_t)r;
+        return URRT_CAN_PACK_OK;
+    } else {
+        uint64_t top = mask >> 1; /* 2^(length-1) - 1 */
+        double limit = (double)top + 1.0; /* exact: a power of two */
+        if (r >= limit) {
+            *raw = top;
+            return URRT_CAN_PACK_SATURATED;
+        }
+        if (r < -limit) {
+            *raw = (top + 1u) & mask; /* the most negative value */
+            return URRT_CAN_PACK_SATURATED;
+        }
+        if (r < 0.0) {
+            /* Two's complement without relying on the implementation-defined
+             * conversion of an out-of-range unsigned value. */
+            uint64_t magnitude = (uint64_t)(-r);
+            *raw = (~magnitude + 1u) & mask;
+        } else {
+            *raw = (uint64_t)r;
+        }
+        return URRT_CAN_PACK_OK;
+    }
+}
+
+static int clamp_to_limits(const urrt_can_signal *sig, double *value)
+{
+    if (*value < sig->min) {
+        *value = sig->min;
+        return URRT_CAN_PACK_SATURATED;
+    }
+    if (*value > sig->max) {
+        *value = sig->max;
+        return URRT_CAN_PACK_SATURATED;
+    }
+    return URRT_CAN_PACK_OK;
+}
+
+/* A finite value within [min, max] to raw. */
+static int finite_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
+{
+    double scaled = (value - sig->offset) / sig->factor; /* may overflow to +-inf: defined */
+
+    switch ((urrt_can_value_type)sig->type) {
+    case URRT_CAN_FLOAT32: {
+        float_bits b;
+        int outcome = URRT_CAN_PACK_OK;
+        if (scaled > (double)FLT_MAX) {
+            scaled = (double)FLT_MAX;
+            outcome = URRT_CAN_PACK_SATURATED;
+        } else if (scaled < -(double)FLT_MAX) {
+            scaled = -(double)FLT_MAX;
+            outcome = URRT_CAN_PACK_SATURATED;
+        }
+        b.f = (float)scaled;
+        *raw = b.u;
+        return outcome;
+    }
+    case URRT_CAN_FLOAT64: {
+        double_bits b;
+        int outcome = URRT_CAN_PACK_OK;
+        if (scaled > DBL_MAX) {
+            scaled = DBL_MAX;
+            outcome = URRT_CAN_PACK_SATURATED;
+        } else if (scaled < -DBL_MAX) {
+            scaled = -DBL_MAX;
+            outcome = URRT_CAN_PACK_SATURATED;
+        }
+        b.d = scaled;
+        *raw = b.u;
+        return outcome;
+    }
+    default: return integer_raw(sig, scaled, raw);
+    }
+}
+
+int urrt_can_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
+{
+    int outcome;
+    int raw_outcome;
+    if (sig == NULL || raw == NULL) {
+        return URRT_E_ARG;
+    }
+    if (!descriptor_valid(sig)) {
+        return URRT_CAN_E_SIGNAL;
+    }
+    if (value != value) {
+        if ((sig->flags & URRT_CAN_SIG_INVALID_RAW) != 0u) {
+            *raw = sig->invalid_raw;
+        } else if (sig->type == (uint8_t)URRT_CAN_FLOAT32) {
+            *raw = FLOAT32_QUIET_NAN;
+        } else if (sig->type == (uint8_t)URRT_CAN_FLOAT64) {
+            *raw = FLOAT64_QUIET_NAN;
+        } else {
+            double neutral = 0.0;
+            (void)clamp_to_limits(sig, &neutral);
+            (void)finite_to_raw(sig, neutral, raw);
+        }
+        return URRT_CAN_PACK_NAN;
+    }
+    outcome = clamp_to_limits(sig, &value); /* infinities end here too */
+    raw_outcome = finite_to_raw(sig, value, raw);
+    return outcome > raw_outcome ? outcome : raw_outcome;
+}
+
+double urrt_can_from_raw(const urrt_can_signal *sig, uint64_t raw)
+{
+    uint64_t mask;
+    double r;
+    if (sig == NULL || sig->length < 1u || sig->length > 64u) {
+        double_bits nan;
+        nan.u = FLOAT64_QUIET_NAN;
+        return nan.d;
+    }
+    mask = low_mask(sig->length);
+    raw &= mask;
+    switch ((urrt_can_value_type)sig->type) {
+    case URRT_CAN_FLOAT32: {
+        float_bits b;
+        b.u = (uint32_t)raw;
+        r = (double)b.f;
+        break;
+    }
+    case URRT_CAN_FLOAT64: {
+        double_bits b;
+        b.u = raw;
+        r = b.d;
+        break;
+    }
+    case URRT_CAN_SIGNED: {
+        if (((raw >> (sig->length - 1u)) & 1u) != 0u) {
+            /* -(magnitude): magnitude = two's complement of raw in length bits. */
+            uint64_t magnitude = (~raw + 1u) & mask;
+            r = -(double)magnitude;
+        } else {
+            r = (double)raw;
+        }
+        break;
+    }
+    default: r = (double)raw; break;
+    }
+    return r * sig->factor + sig->offset;
+}
+
+int urrt_can_pack(const urrt_can_signal *sig, double value, uint8_t *data, unsigned frame_len)
+{
+    uint64_t raw;
+    int outcome;
+    int rc = check_placement(sig, data, frame_len);
+    if (rc < 0) {
+        return rc;
+    }
+    outcome = urrt_can_to_raw(sig, value, &raw);
+    if (outcome < 0) {
+        return outcome;
+    }
+    (void)move_bits(sig, data, raw, true);
+    return outcome;
+}
+
+int urrt_can_unpack(const urrt_can_signal *sig, const uint8_t *data, unsigned frame_len, double *value)
+{
+    uint64_t raw;
+    int rc;
+    if (value == NULL) {
+        return URRT_E_ARG;
+    }
+    rc = urrt_can_get_raw(sig, data, frame_len, &raw);
+    if (rc < 0) {
+        return rc;
+    }
+    *value = urrt_can_from_raw(sig, raw);
+    return 0;
+}
+
+int urrt_can_pack_frame(const urrt_can_signal *sigs, const double *values, size_t count, uint8_t *data,
+                        unsigned frame_len, uint8_t *outcomes)
+{
+    size_t i;
+    int worst = URRT_CAN_PACK_OK;
+    if ((sigs == NULL || values == NULL) && count > 0) {
+        return URRT_E_ARG;
+    }
+    for (i = 0; i < count; i++) {
+        int outcome = urrt_can_pack(&sigs[i], values[i], data, frame_len);
+        if (outcome < 0) {
+            return outcome;
+        }
+        if (outcomes != NULL) {
+            outcomes[i] = (uint8_t)outcome;
+        }
+        if (outcome > worst) {
+            worst = outcome;
+        }
+    }
+    return worst;
+}
