@@ -48,3 +48,45 @@ check-lib: $(LIBT)/test_lib $(LIB_VECTORS)
 
 check-lib-san: $(LIBT)/test_lib_san $(LIB_VECTORS)
 	$(call lib_suite,check-lib-san,ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $(LIBT)/test_lib_san $(LIB_VECTORS))
+
+# ---- freestanding proof -------------------------------------------------------
+
+check-cross: $(LIB_SRCS) $(LIB_HDRS) $(wildcard tests/cross/*)
+	@mkdir -p $(BUILD)/results
+	@RESULT=$(BUILD)/results/check-cross.result sh tests/cross/check.sh $(BUILD)/cross README.md "$(LIB_WARN)" $(LIB_SRCS)
+
+# ---- docs/protocol.md tables from the field table ----------------------------
+
+$(LIBT)/doc_table: tests/lib/doc_table.c $(LIBURRT) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LIB_TEST_CFLAGS) $(OPT) $< $(LIBURRT) -o $@
+
+docs: $(LIBT)/doc_table
+	sh tests/lib/docs.sh $(LIBT)/doc_table docs/protocol.md
+
+check-docs: $(LIBT)/doc_table
+	@mkdir -p $(BUILD)/results
+	@RESULT=$(BUILD)/results/check-docs.result sh tests/lib/docs.sh $(LIBT)/doc_table docs/protocol.md --check
+
+# ---- fuzzing -------------------------------------------------------------------
+
+FUZZ_CC ?= clang
+FUZZ_SECONDS ?= 300
+# Seconds of fuzzing inside make check.
+FUZZ_CHECK_SECONDS ?= 15
+
+$(LIBT)/fuzz_lib: tests/lib/fuzz_lib.c $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) -std=c99 -Wall -Wextra -Werror -g -O1 -fsanitize=fuzzer,address,undefined \
+	  -fno-sanitize-recover=all $(CPPFLAGS) $< $(LIB_SRCS) -o $@
+
+check-fuzz-lib: $(LIBT)/fuzz_lib $(LIB_VECTORS)
+	@mkdir -p $(BUILD)/results
+	@RESULT=$(BUILD)/results/check-fuzz-lib.result sh tests/lib/fuzz.sh $(LIBT)/fuzz_lib $(LIB_CORPUS) \
+	  $(LIBT)/fuzz-check $(FUZZ_CHECK_SECONDS) --check
+
+# make fuzz FUZZ_SECONDS=N: as long as asked; the corpus grows in $(LIBT)/fuzz.
+fuzz-lib: $(LIBT)/fuzz_lib $(LIB_VECTORS)
+	sh tests/lib/fuzz.sh $(LIBT)/fuzz_lib $(LIB_CORPUS) $(LIBT)/fuzz $(FUZZ_SECONDS)
+
+fuzz: fuzz-lib

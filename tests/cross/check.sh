@@ -1,0 +1,127 @@
+#!/bin/sh
+# Proof that lib/ is freestanding: every lib/*.c compiled alone for a
+# Cortex-M4 under the library's strict warnings, linked with -nostdlib into a
+# small image (tests/cross/startup.c), and the footprint compared with the
+# figures README.md states.
+#
+# usage: check.sh OUTDIR README "LIB_WARN flags" lib/a.c lib/b.c ...
+# Needs arm-none-eabi-gcc, -nm and -size. RESULT (if set) receives the
+# closing "N passed, N failed" line.
+set -u
+out=$1; readme=$2; warn=$3; shift 3
+. "$(dirname "$0")/../lib.sh"
+
+CROSS=arm-none-eabi-
+ARCH="-mcpu=cortex-m4 -mthumb"
+CFLAGS="$ARCH -ffreestanding -Os $warn -ffunction-sections -fdata-sections -Ilib"
+LDFLAGS="$ARCH -nostdlib -Wl,--gc-sections -T tests/cross/link.ld"
+# Percentage by which a measured text size may differ from README's.
+TOLERANCE=10
+
+mkdir -p "$out"
+rm -f "$out"/*.o "$out"/*.elf
+
+if ! command -v ${CROSS}gcc >/dev/null; then
+  fail "arm-none-eabi-gcc not found: install gcc-arm-none-eabi (make deps)"
+  finish; exit 1
+fi
+echo "cross: $(${CROSS}gcc --version | head -n 1)"
+
+objs=""
+for src in "$@"; do
+  obj="$out/$(basename "$src" .c).o"
+  if ${CROSS}gcc $CFLAGS -c "$src" -o "$obj"; then
+    ok "$src compiles alone for Cortex-M4 (-ffreestanding -Os, strict warnings)"
+    objs="$objs $obj"
+  else
+    fail "$src does not compile for Cortex-M4 under the library's warnings"
+  fi
+done
+check "startup compiles" ${CROSS}gcc $CFLAGS -c tests/cross/startup.c -o "$out/startup.o"
+check "size probe compiles" ${CROSS}gcc $CFLAGS -c tests/cross/probe.c -o "$out/probe.o"
+
+# Undefined references of a -nostdlib link without libgcc: what lib/ needs
+# from outside, (a) for framer + decode + random access, (b) with every
+# global function of lib/ kept as a root.
+roots=$(${CROSS}nm -g --defined-only $objs | awk 'NF == 3 && $2 ~ /[TDRB]/ { printf " -Wl,-u,%s", $3 }')
+undefined() {
+  ${CROSS}gcc $LDFLAGS "$@" -o "$out/probe-link.elf" 2>&1 |
+    sed -n "s/.*undefined reference to \`\([^']*\)'.*/\1/p"
+}
+needed=$( { undefined "$out/startup.o" $objs; undefined "$out/startup.o" $objs $roots; } | sort -u)
+listed=$(sed -n '/<!-- cross-symbols:begin/,/<!-- cross-symbols:end/p' "$readme" |
+         sed -n 's/^| *`\([A-Za-z_][A-Za-z0-9_]*\)`.*/\1/p' | sort -u)
+echo "cross: symbols lib/ needs from the toolchain: $(echo $needed)"
+for sym in $needed; do
+  if echo "$listed" | grep -qx "$sym"; then
+    ok "needed symbol $sym is listed in README.md"
+  else
+    fail "lib/ needs $sym, which README.md's cross-symbols table does not list and justify"
+  fi
+done
+for sym in $listed; do
+  echo "$needed" | grep -qx "$sym" || fail "README.md lists $sym, which lib/ no longer needs: remove it"
+done
+
+# The real images: libgcc supplies what the table lists, nothing else links in.
+check "image (framer + decode + random access) links with -nostdlib" \
+  ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs -o "$out/image-min.elf"
+check "image (every lib/ function) links with -nostdlib -lgcc" \
+  ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $roots -lgcc -o "$out/image-all.elf"
+
+# Footprint.
+row() { # name text data bss
+  printf '| %s | %s | %s | %s |\n' "$1" "$2" "$3" "$4"
+}
+measured="$out/footprint.md"
+: > "$measured"
+for obj in $objs; do
+  set -- $(${CROSS}size "$obj" | awk 'NR == 2 { print $1, $2, $3 }')
+  row "lib/$(basename "$obj" .o).c (every function)" "$1" "$2" "$3" >> "$measured"
+  [ "$2" = 0 ] && [ "$3" = 0 ] && ok "$(basename "$obj" .o).c has no globals (data and bss are 0)" ||
+    fail "$(basename "$obj" .o).c has data $2 / bss $3: lib/ must keep no state of its own"
+done
+for img in min all; do
+  [ -f "$out/image-$img.elf" ] || continue
+  set -- $(${CROSS}size "$out/image-$img.elf" | awk 'NR == 2 { print $1, $2, $3 }')
+  case $img in
+    min) name="image: framer + decode + random access (tests/cross)" ;;
+    all) name="image: every lib/ function (tests/cross)" ;;
+  esac
+  row "$name" "$1" "$2" "$3" >> "$measured"
+done
+symbol_size() {
+  hex=$(${CROSS}nm -S "$out/probe.o" | awk -v s="$1" '$4 == s { print $2 }')
+  [ -n "$hex" ] && echo $((0x$hex))
+}
+state=$(symbol_size urrt_probe_state)
+framer=$(symbol_size urrt_probe_framer)
+printf '| sizeof(urrt_state) | %s |\n| sizeof(urrt_framer) | %s |\n' "$state" "$framer" >> "$measured"
+echo "cross: footprint (arm-none-eabi-size; bytes):"
+sed 's/^/cross:   /' "$measured"
+
+# README must state the same figures: text within TOLERANCE %, the rest exact.
+stated=$(sed -n '/<!-- footprint:begin/,/<!-- footprint:end/p' "$readme")
+while IFS= read -r line; do
+  name=$(echo "$line" | awk -F'|' '{ gsub(/^ +| +$/, "", $2); print $2 }')
+  want=$(echo "$stated" | awk -F'|' -v n="$name" '{ k = $2; gsub(/^ +| +$/, "", k) } k == n { print; exit }')
+  if [ -z "$want" ]; then
+    fail "README.md footprint table has no row \"$name\": add it with the measured figures"
+    continue
+  fi
+  m=$(echo "$line" | awk -F'|' '{ for (i = 3; i < NF; i++) { v = $i; gsub(/[ ,]/, "", v); printf "%s ", v } }')
+  s=$(echo "$want" | awk -F'|' '{ for (i = 3; i < NF; i++) { v = $i; gsub(/[ ,]/, "", v); printf "%s ", v } }')
+  if echo "$m|$s" | awk -F'|' -v tol="$TOLERANCE" '{
+        n = split($1, m, " "); k = split($2, s, " ");
+        if (n != k) exit 1;
+        if (n == 1) exit (m[1] == s[1]) ? 0 : 1;      # sizeof rows: exact
+        d = m[1] - s[1]; if (d < 0) d = -d;
+        if (s[1] == 0 || d * 100 > tol * s[1]) exit 1; # text: within tolerance
+        for (i = 2; i <= n; i++) if (m[i] != s[i]) exit 1;
+        exit 0 }'; then
+    ok "README.md states \"$name\" ($s; measured $m)"
+  else
+    fail "README.md says \"$name\" is $s, measured $m: update the footprint table"
+  fi
+done < "$measured"
+finish

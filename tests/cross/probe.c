@@ -1,0 +1,6 @@
+/* Sizes of the caller-owned structs on the target: each array's size is
+ * read back from the symbol table (arm-none-eabi-nm -S). */
+#include "urrt.h"
+
+char urrt_probe_state[sizeof(urrt_state)];
+char urrt_probe_framer[sizeof(urrt_framer)];
