@@ -587,7 +587,7 @@ static bool robot_key(config_ctx *ctx, gw_config *cfg, const char *key, const ch
 static void robot_finish(config_ctx *ctx, gw_config *cfg)
 {
     if (cfg->robot_count == 0) {
-        config_error(ctx, 0, "no robot: add a section such as\n  [robot arm1]\n  host = 192.168.1.10");
+        config_error(ctx, 0, "no robot: add a section \"[robot NAME]\" with \"host = ADDRESS\"");
     }
     for (unsigned i = 0; i < cfg->robot_count; i++) {
         gw_robot_config *robot = &cfg->robots[i];

@@ -38,7 +38,7 @@ $(LCMTYPES_JAR): $(LCMTYPES)
 
 # ---- urrt-gateway ------------------------------------------------------------------
 GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o config.o lcm_out.o) \
-                $(BUILD)/gateway/urrt-gateway/cli.o $(LCMTYPES_OBJS)
+                $(BUILD)/gateway/cli.o $(LCMTYPES_OBJS)
 # Other fragments append their objects (the CAN output, say); read at link time.
 GATEWAY_EXTRA_OBJS ?=
 GATEWAY_HDRS := gateway/config.h gateway/gateway.h gateway/lcm_out.h gateway/cli.h port/port.h $(LIB_HDRS)
@@ -49,11 +49,7 @@ $(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o config.o lcm_out.o): \
 	@mkdir -p $(@D)
 	$(CC) $(PROG_WARN) $(OPT) $(CPPFLAGS) -Igateway -I$(LCMGEN) -c $< -o $@
 
-# The programs' shared helpers (gateway/cli.c), as an object of our own so
-# that no other fragment's rule for it can collide with this one.
-$(BUILD)/gateway/urrt-gateway/cli.o: gateway/cli.c gateway/cli.h
-	@mkdir -p $(@D)
-	$(CC) $(PROG_WARN) $(OPT) $(CPPFLAGS) -Igateway -c $< -o $@
+# $(BUILD)/gateway/cli.o (the programs' shared helpers) is built by tools.mk.
 
 .SECONDEXPANSION:
 $(BUILD)/bin/urrt-gateway: $(GATEWAY_OBJS) $$(GATEWAY_EXTRA_OBJS) $(LIBPORT) $(LIBURRT)
@@ -88,7 +84,7 @@ install-gateway: $(BUILD)/bin/urrt-gateway $(LCMTYPES_JAR)
 	  install -m 0644 gateway/urrt-gateway.example.ini $(DESTDIR)$(SYSCONFDIR)/urrt/gateway.ini
 
 # ---- make demo ---------------------------------------------------------------------------
-# urrt-sim at 500 Hz on 127.0.0.1:$(DEMO_PORT) and urrt-gateway publishing on
+# urrt-sim (e-series 5.10 layout) at 500 Hz on 127.0.0.1:$(DEMO_PORT) and urrt-gateway publishing on
 # $(DEMO_LCM_URL), one summary line per second, until Ctrl-C or DEMO_SECONDS.
 demo: deps all
 	@set -u; dir=$$(mktemp -d); sim=; gw=; \
@@ -99,6 +95,6 @@ demo: deps all
 	  '$(DEMO_LCM_URL)' '$(DEMO_PORT)' > "$$dir/demo.ini"; \
 	echo "demo: urrt-sim at 500 Hz on 127.0.0.1:$(DEMO_PORT), urrt-gateway on $(DEMO_LCM_URL)"; \
 	echo "demo: watch it with 'make spy' in another terminal; Ctrl-C stops$(if $(filter-out 0,$(DEMO_SECONDS)), (or after $(DEMO_SECONDS) s))"; \
-	$(BUILD)/bin/urrt-sim --listen 127.0.0.1:$(DEMO_PORT) --rate 500 & sim=$$!; \
+	$(BUILD)/bin/urrt-sim --listen 127.0.0.1:$(DEMO_PORT) --version 5.10 --rate 500 & sim=$$!; \
 	$(BUILD)/bin/urrt-gateway --summary "$$dir/demo.ini" & gw=$$!; \
 	if [ '$(DEMO_SECONDS)' != 0 ]; then sleep '$(DEMO_SECONDS)'; else wait $$gw; fi

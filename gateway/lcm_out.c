@@ -42,6 +42,7 @@ typedef struct lcm_robot {
     uint64_t report_due_us;
     uint64_t report_us;
     uint64_t report_packets;
+    double packet_rate;
     bool reported_fresh;
 } lcm_robot;
 
@@ -363,9 +364,17 @@ static void report(lcm_out *out, gw_robot *robot, uint64_t now_us)
     msg->length = (int32_t)ls->last_length;
     msg->versions = (char *)(versions != NULL ? versions : "");
     msg->generation = (int8_t)(ls->last_length != 0 ? urrt_generation_of(ls->last_length) : URRT_GEN_UNKNOWN);
-    msg->packet_rate = lr->report_us != 0 && now_us > lr->report_us
-                           ? (double)(ls->packets - lr->report_packets) * 1e6 / (double)(now_us - lr->report_us)
-                           : 0.0;
+    /* Over at least half a second: reports sent early, when the data starts
+     * or stops, would give a rate of a few packets in a few microseconds. */
+    if (lr->report_us == 0) {
+        lr->report_us = now_us;
+        lr->report_packets = ls->packets;
+    } else if (now_us - lr->report_us >= 500000u) {
+        lr->packet_rate = (double)(ls->packets - lr->report_packets) * 1e6 / (double)(now_us - lr->report_us);
+        lr->report_us = now_us;
+        lr->report_packets = ls->packets;
+    }
+    msg->packet_rate = lr->packet_rate;
     msg->packets = (int64_t)ls->packets;
     msg->bytes = (int64_t)ls->bytes;
     msg->connects = (int64_t)ls->connects;
@@ -388,8 +397,6 @@ static void report(lcm_out *out, gw_robot *robot, uint64_t now_us)
     msg->n_counters = (int16_t)n;
     msg->counter_names = out->counter_names;
     msg->counter_values = out->counter_values;
-    lr->report_us = now_us;
-    lr->report_packets = ls->packets;
     lr->reported_fresh = msg->data_fresh;
     publish(out, robot, GW_KIND_GATEWAY, urrt_gateway_t_encode(out->buf, 0, LCM_OUT_BUFFER, msg), now_us);
 }
@@ -522,6 +529,9 @@ lcm_out *lcm_out_new(gateway *gw, const gw_lcm_config *cfg)
         }
     }
     out->retry_ms = LCM_OUT_RETRY_MIN_MS;
+    for (unsigned i = 0; i < gw->robot_count; i++) {
+        out->robots[i].summary_us = urrt_port_monotonic_us();
+    }
     try_open(out, urrt_port_monotonic_us());
     return out;
 }

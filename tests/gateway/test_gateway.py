@@ -1,0 +1,638 @@
+#!/usr/bin/python3
+"""check-gateway: urrt-gateway against urrt-sim, seen through LCM.
+
+The subscriber (lcm_sub) decodes every message with the generated C types
+and prints it as JSON; the expectations come from the simulator's --record
+capture decoded here with the independent reference (tests/ref/urrt_ref.py),
+matched by controller time. Every wait is bounded; every process started is
+stopped. Robot names (channel prefixes) carry the PID, so that concurrent
+runs do not see each other's messages.
+
+Usage: test_gateway.py --build DIR [--result FILE] [--port-base N] [--only NAME]
+"""
+import argparse
+import json
+import math
+import os
+import re
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "ref"))
+import urrt_ref as ref  # noqa: E402
+
+URL = "udpm://239.255.76.67:7667?ttl=0"
+KINDS = ("STATE", "JOINTS", "TOOL", "STATUS", "GATEWAY")
+PASSED = 0
+FAILED = 0
+
+
+def check(cond, what):
+    global PASSED, FAILED
+    if cond:
+        PASSED += 1
+        print("ok: " + what)
+    else:
+        FAILED += 1
+        print("FAIL: " + what, file=sys.stderr)
+    return cond
+
+
+class Run:
+    """Processes and files of one test; stop() ends everything it started."""
+
+    def __init__(self, args, name):
+        self.args = args
+        self.dir = tempfile.mkdtemp(prefix="gw-%s-" % name, dir=args.tmp)
+        self.procs = []
+        self.prefix = "t%d%s" % (os.getpid(), name.replace("_", ""))
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def start(self, argv, log, env=None):
+        e = dict(os.environ)
+        e.update(env or {})
+        p = subprocess.Popen(argv, stdout=open(self.path(log), "w"), stderr=subprocess.STDOUT
+                             if log.endswith(".log") else open(self.path(log + ".err"), "w"), env=e)
+        self.procs.append(p)
+        return p
+
+    def sim(self, port, *extra, log="sim.log"):
+        return self.start([self.args.sim, "--listen", "127.0.0.1:%d" % port, "-q"] + list(extra), log)
+
+    def sub(self, seconds, regex=None):
+        ready = self.path("sub.ready")
+        p = self.start([self.args.sub, URL, regex or (re.escape(self.prefix) + r".*\..*"), str(seconds), ready],
+                       "sub.jsonl")
+        wait_for(lambda: os.path.exists(ready), 5)
+        return p
+
+    def gateway(self, ini_text, env=None, log="gw.log"):
+        ini = self.path("gw.ini")
+        with open(ini, "w") as f:
+            f.write(ini_text)
+        return self.start([self.args.gateway, ini], log, env)
+
+    def stop(self):
+        for p in reversed(self.procs):
+            if p.poll() is None:
+                p.send_signal(signal.SIGTERM)
+        for p in self.procs:
+            try:
+                p.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+
+    def messages(self):
+        out = []
+        with open(self.path("sub.jsonl")) as f:
+            for line in f:
+                if line.strip():
+                    out.append(json.loads(line))
+        return out
+
+    def log(self, name="gw.log"):
+        with open(self.path(name)) as f:
+            return f.read()
+
+
+def wait_for(pred, seconds, step=0.02):
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if pred():
+            return True
+        time.sleep(step)
+    return pred()
+
+
+def robot_ini(name, port, extra=""):
+    return "[robot %s]\nhost = 127.0.0.1\nport = %d\n%s\n" % (name, port, extra)
+
+
+def lcm_ini(**rates):
+    text = "[lcm]\nurl = %s\n" % URL
+    for k, v in rates.items():
+        text += "%s = %s\n" % (k, v)
+    return text
+
+
+def read_capture(path):
+    """Packets of a raw capture, framed by their size header."""
+    data = open(path, "rb").read()
+    packets, i = [], 0
+    while i + 4 <= len(data):
+        (n,) = struct.unpack(">i", data[i:i + 4])
+        if n < 12 or i + n > len(data):
+            break
+        cols = [struct.unpack(">Q", data[j:j + 8])[0] for j in range(i + 4, i + n, 8)]
+        packets.append((n, cols))
+        i += n
+    return packets
+
+
+def same(a, b):
+    """Equal as doubles, NaN equal to NaN (JSON carries no NaN payload)."""
+    if isinstance(a, float) and math.isnan(a):
+        return isinstance(b, float) and math.isnan(b)
+    return float(a) == float(b)
+
+
+def field_values(cols, lay, name):
+    count, first = lay[name]
+    return [ref.double_of(cols[first - 1 + i]) for i in range(count)]
+
+
+def by_channel(msgs, prefix):
+    out = {k: [] for k in KINDS}
+    for m in msgs:
+        ch = m["ch"]
+        if ch.startswith(prefix + "."):
+            out.setdefault(ch[len(prefix) + 1:], []).append(m)
+    return out
+
+
+# ---- the tests ------------------------------------------------------------------------
+
+def t_values(args, version, port, count):
+    """Every message decodes and equals the packet the simulator sent."""
+    r = Run(args, "v" + version.replace(".", ""))
+    try:
+        rate = 500 if version.startswith("5") else 125
+        r.sub(count / rate + 4)
+        sim = r.sim(port, "--version", version, "--start-on-connect", "-n", str(count), "-w", r.path("rec.bin"),
+                    "--clients", "1")
+        r.gateway(lcm_ini(status_rate="every") + robot_ini(r.prefix, port))
+        # The simulator ends the connection after count packets and exits.
+        wait_for(lambda: sim.poll() is not None, count / rate + 5)
+        time.sleep(0.3)
+    finally:
+        r.stop()
+    msgs = r.messages()
+    packets = read_capture(r.path("rec.bin"))
+    check(len(packets) == count, "%s: simulator recorded %d packets (%d)" % (version, count, len(packets)))
+    check(all(m["type"] is not None for m in msgs), "%s: every one of %d messages decodes" % (version, len(msgs)))
+    ch = by_channel(msgs, r.prefix)
+    by_time = {p[1][0]: p for p in packets}
+    length, doubles = packets[0][0], (packets[0][0] - 4) // 8
+    lay = ref.layout(doubles)
+    gen = ref.generation(doubles)
+    for kind in ("STATE", "JOINTS", "TOOL", "STATUS"):
+        n = len(ch[kind])
+        check(n >= 0.98 * count, "%s: %s messages for %d of %d packets" % (version, kind, n, count))
+    # STATE: every field, bit by bit where JSON keeps bits.
+    bad, first_bad = 0, None
+    for m in ch["STATE"]:
+        p = by_time.get(ref.bits_of(m["time"]))
+        if p is None:
+            bad += 1
+            first_bad = first_bad or "no packet with time %r" % m["time"]
+            continue
+        cols = p[1]
+        problems = []
+        if m["length"] != length or m["doubles"] != doubles or m["generation"] != gen:
+            problems.append("length/doubles/generation")
+        if m["versions"] != ref.VERSIONS.get(length, ""):
+            problems.append("versions %r" % m["versions"])
+        for i, name in enumerate(ref.ALL_NAMES):
+            present = bool(m["present"] >> i & 1)
+            v = m[name] if isinstance(m[name], list) else [m[name]]
+            if name in lay:
+                want = field_values(cols, lay, name)
+                if not present or len(v) != len(want) or not all(same(a, b) for a, b in zip(v, want)):
+                    problems.append(name)
+            elif present or not all(math.isnan(x) for x in v):
+                problems.append(name + " (absent)")
+        if problems:
+            bad += 1
+            first_bad = first_bad or "t=%r: %s" % (m["time"], ", ".join(problems))
+    check(bad == 0, "%s: all %d STATE messages equal their packets%s" %
+          (version, len(ch["STATE"]), "" if bad == 0 else " (%d differ; first: %s)" % (bad, first_bad)))
+    # Focused messages: the same values under their names.
+    for kind in ("JOINTS", "TOOL"):
+        bad, first_bad = 0, None
+        for m in ch[kind]:
+            p = by_time.get(ref.bits_of(m["controller_time"]))
+            if p is None:
+                bad += 1
+                continue
+            for name, v in m.items():
+                if name in ("ch", "recv_utime", "size", "type", "utime", "controller_time", "sequence"):
+                    continue
+                v = v if isinstance(v, list) else [v]
+                want = field_values(p[1], lay, name) if name in lay else [float("nan")] * len(v)
+                if not all(same(a, b) for a, b in zip(v, want)) or len(v) != len(want):
+                    bad += 1
+                    first_bad = first_bad or "%s t=%r" % (name, m["controller_time"])
+                    break
+        check(bad == 0, "%s: all %d %s messages equal their packets%s" %
+              (version, len(ch[kind]), kind, "" if bad == 0 else " (%d differ; first %s)" % (bad, first_bad)))
+    bad, first_bad = 0, None
+    for m in ch["STATUS"]:
+        p = by_time.get(ref.bits_of(m["controller_time"]))
+        if p is None:
+            bad += 1
+            continue
+        cols = p[1]
+        problems = []
+        for name in ("robot_mode", "safety_mode", "safety_status", "program_state"):
+            if name in lay:
+                bits = cols[lay[name][1] - 1]
+                x = ref.double_of(bits)
+                if m[name] != int(x) or m[name + "_name"] != ref.expected_enum(name, gen, bits):
+                    problems.append(name)
+            elif m[name] != -32768 or m[name + "_name"] != "":
+                problems.append(name + " (absent)")
+        if "joint_modes" in lay:
+            for j in range(6):
+                bits = cols[lay["joint_modes"][1] - 1 + j]
+                if m["joint_modes"][j] != int(ref.double_of(bits)) or \
+                        m["joint_mode_names"][j] != ref.expected_enum("joint_modes", gen, bits):
+                    problems.append("joint_modes")
+        for name, key in (("digital_input_bits", "digital_inputs"), ("digital_outputs", "digital_outputs")):
+            want = ref.expected_mask(cols[lay[name][1] - 1]) if name in lay else None
+            if m[key] != (-1 if want is None else want):
+                problems.append(key)
+        for name in ("speed_scaling", "v_main", "v_robot", "i_robot", "linear_momentum_norm", "controller_timer"):
+            want = field_values(cols, lay, name)[0] if name in lay else float("nan")
+            if not same(m[name], want):
+                problems.append(name)
+        if problems:
+            bad += 1
+            first_bad = first_bad or "t=%r: %s" % (m["controller_time"], problems)
+    check(bad == 0, "%s: all %d STATUS messages (numbers, names, bits) equal their packets%s" %
+          (version, len(ch["STATUS"]), "" if bad == 0 else " (%d differ; first %s)" % (bad, first_bad)))
+    # One packet, one sequence number, one receive time across the kinds.
+    seq = {}
+    consistent = True
+    for kind in ("STATE", "JOINTS", "TOOL", "STATUS"):
+        for m in ch[kind]:
+            t = m["time"] if kind == "STATE" else m["controller_time"]
+            if seq.setdefault(t, (m["sequence"], m["utime"])) != (m["sequence"], m["utime"]):
+                consistent = False
+    check(consistent, "%s: sequence and utime agree across the messages of a packet" % version)
+    ages = [m["recv_utime"] - m["utime"] for m in ch["STATE"]]
+    check(ages and 0 <= min(ages) and max(ages) < 100000,
+          "%s: utime is the host receive time (receive - utime %s..%s us)" %
+          (version, min(ages) if ages else "-", max(ages) if ages else "-"))
+    g = ch["GATEWAY"]
+    check(len(g) >= 1 and g[0]["robot"] == r.prefix and g[0]["port"] == port and g[0]["host"] == "127.0.0.1",
+          "%s: GATEWAY names the robot, host and port" % version)
+    up = [x for x in g if x["data_fresh"]]
+    check(bool(up) and up[-1]["length"] == length and up[-1]["versions"] == ref.VERSIONS.get(length, "") and
+          up[-1]["link_state_name"] == "up", "%s: GATEWAY reports the link up with %d-byte packets" % (version, length))
+
+
+def t_decimation(args, port):
+    r = Run(args, "dec")
+    seconds = 4
+    try:
+        r.sub(seconds + 2)
+        r.sim(port, "--version", "5.10", "--rate", "500")
+        r.gateway(lcm_ini(state_rate="off", joints_rate="50 Hz", tool_rate="30 Hz", status_rate="10 Hz",
+                          gateway_rate="2 Hz") + robot_ini(r.prefix, port))
+        time.sleep(seconds)
+    finally:
+        r.stop()
+    ch = by_channel(r.messages(), r.prefix)
+    check(len(ch["STATE"]) == 0, "decimation: state_rate = off publishes nothing (%d)" % len(ch["STATE"]))
+    for kind, hz in (("JOINTS", 50), ("TOOL", 30), ("STATUS", 10)):
+        t = [m["controller_time"] for m in ch[kind]]
+        if not check(len(t) > 5, "decimation: %s has messages (%d)" % (kind, len(t))):
+            continue
+        rate = (len(t) - 1) / (t[-1] - t[0])
+        gaps = [b - a for a, b in zip(t, t[1:])]
+        check(abs(rate - hz) <= 0.01 * hz, "decimation: %s at %.3f Hz on the controller clock (configured %d)" %
+              (kind, rate, hz))
+        # 500 Hz packets: each gap is the period rounded to a packet (2 ms).
+        lo, hi = math.floor(500.0 / hz) * 0.002 - 1e-6, math.ceil(500.0 / hz) * 0.002 + 1e-6
+        check(all(lo <= gp <= hi for gp in gaps), "decimation: every %s gap within %.3f..%.3f s (%.4f..%.4f)" %
+              (kind, lo, hi, min(gaps), max(gaps)))
+    g = ch["GATEWAY"]
+    t = [m["utime"] / 1e6 for m in g]
+    rate = (len(t) - 1) / (t[-1] - t[0]) if len(t) > 2 else 0
+    check(abs(rate - 2) < 0.2, "decimation: GATEWAY at %.2f Hz (configured 2 Hz)" % rate)
+
+
+def t_two_robots(args, port):
+    r = Run(args, "two")
+    a, b = r.prefix + "a", r.prefix + "b"
+    try:
+        r.sub(5, re.escape(r.prefix) + r"[ab]\..*")
+        r.sim(port, "--version", "5.10", "--seed", "7", log="sim_a.log")
+        r.sim(port + 1, "--version", "3.10", "--seed", "8", log="sim_b.log")
+        r.gateway(lcm_ini() + robot_ini(a, port, "version = 5.10") + robot_ini(b, port + 1, "version = 3.10"))
+        time.sleep(3)
+    finally:
+        r.stop()
+    msgs = r.messages()
+    ca, cb = by_channel(msgs, a), by_channel(msgs, b)
+    check(len(ca["STATE"]) > 800 and len(cb["STATE"]) > 200,
+          "two robots: both publish (%d and %d STATE)" % (len(ca["STATE"]), len(cb["STATE"])))
+    check(all(m["length"] == 1220 for m in ca["STATE"]) and all(m["length"] == 1116 for m in cb["STATE"]),
+          "two robots: each channel carries its own robot's packets (1220 / 1116 bytes)")
+    ta = set(m["time"] for m in ca["STATE"])
+    tb = set(m["time"] for m in cb["STATE"])
+    ga, gb = ca["GATEWAY"], cb["GATEWAY"]
+    check(ga and gb and all(m["robot"] == a and m["port"] == port for m in ga) and
+          all(m["robot"] == b and m["port"] == port + 1 for m in gb),
+          "two robots: each GATEWAY channel reports its own robot")
+    check(all(m["ch"].split(".")[0] in (a, b) for m in msgs) and len(ta) > 0 and len(tb) > 0,
+          "two robots: no other channels, no mixing")
+    rates = [m["packet_rate"] for m in ga[1:]] or [0]
+    check(abs(sorted(rates)[len(rates) // 2] - 500) < 25,
+          "two robots: %s reports ~500 packets/s (%.1f)" % (a, sorted(rates)[len(rates) // 2]))
+
+
+def t_restart(args, port):
+    """Kill the simulator, restart it: disconnected, no stale state, then recovery."""
+    r = Run(args, "rst")
+    try:
+        r.sub(7)
+        sim = r.sim(port, "--version", "5.10", log="sim1.log")
+        r.gateway(lcm_ini(gateway_rate="10 Hz") + robot_ini(r.prefix, port, "silence_timeout = 100 ms\n"
+                                                                          "backoff_initial = 100 ms\nbackoff_max = 200 ms"))
+        time.sleep(1.5)
+        killed = time.time()
+        sim.kill()
+        sim.wait()
+        time.sleep(2)
+        restarted = time.time()
+        r.sim(port, "--version", "5.10", log="sim2.log")
+        time.sleep(2)
+        # A stall: the connection stays open, the data stops.
+    finally:
+        r.stop()
+    ch = by_channel(r.messages(), r.prefix)
+    state = [m for k in ("STATE", "JOINTS", "TOOL", "STATUS") for m in ch[k]]
+    gap = [m for m in state if killed + 0.05 < m["recv_utime"] / 1e6 < restarted]
+    check(len(gap) == 0, "restart: no state message between the kill and the restart (%d)" % len(gap))
+    down = [m for m in ch["GATEWAY"] if killed + 0.3 < m["utime"] / 1e6 < restarted]
+    check(len(down) >= 10 and all(not m["data_fresh"] and m["link_state_name"] != "up" for m in down),
+          "restart: %d GATEWAY reports while down, all saying no data and link not up" % len(down))
+    after = [m for m in ch["STATE"] if m["recv_utime"] / 1e6 > restarted]
+    check(len(after) > 500, "restart: state flows again after the restart (%d STATE)" % len(after))
+    last = ch["GATEWAY"][-1] if ch["GATEWAY"] else {}
+    check(last.get("data_fresh") and last.get("reconnects", 0) >= 1 and last.get("disconnects", 0) >= 1,
+          "restart: the last GATEWAY says fresh again, reconnects %s, disconnects %s" %
+          (last.get("reconnects"), last.get("disconnects")))
+    stale = [m for m in state if m["recv_utime"] - m["utime"] > 100000]
+    check(not stale, "restart: no state message older than the silence timeout when received (%d)" % len(stale))
+
+
+def t_stall(args, port):
+    """A half-open link: the simulator keeps the connection but stops sending."""
+    r = Run(args, "stall")
+    try:
+        r.sub(4)
+        r.sim(port, "--version", "5.10", "--fault", "stall-after=500,for=1500")
+        start = time.time()
+        r.gateway(lcm_ini(gateway_rate="10 Hz") + robot_ini(r.prefix, port, "silence_timeout = 100 ms"))
+        time.sleep(3.5)
+    finally:
+        r.stop()
+    ch = by_channel(r.messages(), r.prefix)
+    g = ch["GATEWAY"]
+    stale = [m for m in g if not m["data_fresh"] and m["utime"] / 1e6 > start + 0.5]
+    check(len(stale) >= 3, "stall: GATEWAY says no data during the stall (%d reports)" % len(stale))
+    check(any(m["silences"] >= 1 for m in g), "stall: the silence is counted")
+    if stale:
+        t0 = stale[0]["utime"]
+        late = [m for m in ch["STATE"] if t0 < m["recv_utime"] and m["recv_utime"] - m["utime"] > 100000]
+        check(not late, "stall: no stale STATE after the silence (%d)" % len(late))
+
+
+def t_mismatch(args, port):
+    r = Run(args, "mis")
+    try:
+        r.sub(3)
+        r.sim(port, "--version", "3.10")
+        r.gateway(lcm_ini() + robot_ini(r.prefix, port, "version = 5.10"))
+        time.sleep(2)
+    finally:
+        r.stop()
+    ch = by_channel(r.messages(), r.prefix)
+    check(sum(len(ch[k]) for k in ("STATE", "JOINTS", "TOOL", "STATUS")) == 0,
+          "version mismatch: no state published")
+    g = ch["GATEWAY"]
+    check(g and g[-1]["version_mismatches"] > 100 and not g[-1]["data_fresh"] and "1116" in g[-1]["last_error"],
+          "version mismatch: GATEWAY counts %s mismatches: %r" %
+          (g[-1]["version_mismatches"] if g else "?", g[-1]["last_error"] if g else ""))
+    check("1116-byte packets" in r.log() and "expected 1220" in r.log(), "version mismatch: logged with both lengths")
+
+
+def t_allocations(args, port):
+    """Zero allocations per packet in steady state, publish included."""
+    r = Run(args, "alloc")
+    report = r.path("alloc.txt")
+    warm, window = 4000, 20000
+    env = {"LD_PRELOAD": args.shim, "ALLOC_SHIM_OUT": report, "ALLOC_SHIM_WARMUP": str(warm),
+           "ALLOC_SHIM_WINDOW": str(window)}
+    try:
+        r.sim(port, "--version", "5.10", "--rate", "2500")
+        r.gateway(lcm_ini(status_rate="every") + robot_ini(r.prefix, port), env=env)
+        wait_for(lambda: os.path.exists(report) and os.path.getsize(report) > 0, 20)
+    finally:
+        r.stop()
+    text = open(report).read() if os.path.exists(report) else ""
+    m = re.match(r"publishes (\d+) allocs (\d+) in_publish (\d+) outside (\d+)", text)
+    if not check(m is not None, "allocations: the shim reported (%r)" % text.strip()):
+        return
+    pubs, total, inside, outside = map(int, m.groups())
+    print("allocations: %d publishes (%d packets): %d allocations, %d inside lcm_publish" %
+          (pubs, pubs // 4, total, inside))
+    check(outside == 0, "allocations: the gateway's own per-packet path allocates nothing (%d)" % outside)
+    check(inside == 0, "allocations: lcm_publish allocates nothing either (%d)" % inside)
+
+
+def t_publish_errors(args, port):
+    r = Run(args, "perr")
+    env = {"LD_PRELOAD": args.shim, "ALLOC_SHIM_FAIL_FROM": "2000", "ALLOC_SHIM_FAIL_COUNT": "1000"}
+    try:
+        r.sub(5)
+        r.sim(port, "--version", "5.10")
+        gw = r.gateway(lcm_ini(status_rate="every") + robot_ini(r.prefix, port), env=env)
+        time.sleep(3.5)
+        alive = gw.poll() is None
+    finally:
+        r.stop()
+    check(alive, "publish errors: the gateway keeps running")
+    ch = by_channel(r.messages(), r.prefix)
+    g = ch["GATEWAY"]
+    check(g and g[-1]["publish_errors"] == 1000, "publish errors: GATEWAY counts exactly the 1000 lost (%s)" %
+          (g[-1]["publish_errors"] if g else "?"))
+    seq = [m["sequence"] for m in ch["STATE"]]
+    check(len(seq) > 1000 and seq[-1] - seq[0] + 1 > len(seq) and seq == sorted(seq),
+          "publish errors: STATE has a hole where publishing failed and carries on after it")
+    check("publishing" in r.log() and "failed" in r.log(), "publish errors: logged")
+
+
+def t_jar(args):
+    jar = args.jar
+    names = sorted(os.path.basename(p)[:-4] for p in os.listdir(os.path.join(HERE, "..", "..", "gateway", "lcmtypes"))
+                   if p.endswith(".lcm"))
+    listing = subprocess.run(["jar", "tf", jar], capture_output=True, text=True, timeout=60).stdout.split()
+    check(all("urrt/%s.class" % n in listing for n in names), "jar: holds urrt/%s.class" % ", urrt/".join(names))
+    src = os.path.join(args.tmp, "Fingerprints.java")
+    with open(src, "w") as f:
+        f.write("public class Fingerprints { public static void main(String[] a) throws Exception {\n"
+                "  for (String n : a) System.out.println(n + \" \" + Long.toHexString("
+                "Class.forName(\"urrt.\" + n).getField(\"LCM_FINGERPRINT\").getLong(null))); } }\n")
+    cp = "%s:%s:%s" % (args.lcm_jar, jar, args.tmp)
+    subprocess.run(["javac", "-cp", cp, "-d", args.tmp, src], check=True, timeout=120)
+    java = subprocess.run(["java", "-cp", cp, "Fingerprints"] + names, capture_output=True, text=True,
+                          timeout=60).stdout.split()
+    c = subprocess.run([args.sub, "--fingerprints"], capture_output=True, text=True, timeout=10).stdout.split()
+    jfp = dict(zip(java[0::2], java[1::2]))
+    cfp = dict(zip(c[0::2], c[1::2]))
+    for n in names:
+        check(n in jfp and jfp.get(n) == cfp.get(n),
+              "jar: %s fingerprint Java %s == C %s" % (n, jfp.get(n), cfp.get(n)))
+
+
+BAD_CONFIGS = [
+    # (name, text, line, reason pattern)
+    ("unknown section", "[robots arm]\nhost = a\n", 1, r"unknown section \[robots arm\]"),
+    ("unknown key", "[robot a]\nhost = h\nhots = x\n", 3, r'unknown key "hots" in \[robot a\]'),
+    ("unknown lcm key", "[lcm]\nchannel = X\n[robot a]\nhost = h\n", 2, r'unknown key "channel" in \[lcm\]'),
+    ("unknown gateway key", "[gateway]\nverbose = 1\n[robot a]\nhost = h\n", 2, r'unknown key "verbose"'),
+    ("key outside a section", "host = h\n[robot a]\nhost = h\n", 1, r"outside of any section"),
+    ("robot without name", "[robot]\nhost = h\n", 1, r"needs a name"),
+    ("name with a dot", "[robot a.b]\nhost = h\n", 1, r'robot name "a.b"'),
+    ("duplicate robot", "[robot a]\nhost = h\n\n[robot a]\nhost = i\n", 4, r'"a" is already defined at line 1'),
+    ("duplicate section", "[lcm]\n[robot a]\nhost = h\n[lcm]\n", 4, r"\[lcm\] appears again \(first at line 1\)"),
+    ("duplicate key", "[robot a]\nhost = h\nport = 1\nport = 2\n", 4, r"port is set again \(first at line 3\)"),
+    ("no host", "[gateway]\n[robot a]\nport = 30013\n", 2, r"has no host"),
+    ("bad host", "[robot a]\nhost = bad host!\n", 2, r"not a host name"),
+    ("port 0", "[robot a]\nhost = h\nport = 0\n", 3, r"port must be a whole number from 1 to 65535"),
+    ("port text", "[robot a]\nhost = h\nport = 30k\n", 3, r"port must be a whole number"),
+    ("version 1.6", "[robot a]\nhost = h\nversion = 1.6\n", 3, r"756 or 764"),
+    ("unknown version", "[robot a]\nhost = h\nversion = 4.2\n", 3, r"no known controller version"),
+    ("bad length", "[robot a]\nhost = h\nversion = 1117\n", 3, r"4 \+ 8n"),
+    ("duration without unit", "[robot a]\nhost = h\nsilence_timeout = 50\n", 3, r"with a unit"),
+    ("duration too short", "[robot a]\nhost = h\nsilence_timeout = 5 ms\n", 3, r"from 20 ms"),
+    ("backoff order", "[robot a]\nhost = h\nbackoff_initial = 2 s\nbackoff_max = 1 s\n", 1, r"backoff_max"),
+    ("log level", "[gateway]\nlog_level = loud\n[robot a]\nhost = h\n", 2, r"log_level must be"),
+    ("summary", "[gateway]\nsummary = maybe\n[robot a]\nhost = h\n", 2, r"summary must be yes or no"),
+    ("url not a URL", "[lcm]\nurl = 239.255.76.67\n[robot a]\nhost = h\n", 2, r"not an LCM URL"),
+    ("url provider", "[lcm]\nurl = udp://1.2.3.4:5\n[robot a]\nhost = h\n", 2, r'unknown LCM provider "udp"'),
+    ("url not multicast", "[lcm]\nurl = udpm://10.1.2.3:7667\n[robot a]\nhost = h\n", 2, r"not a multicast group"),
+    ("url ttl", "[lcm]\nurl = udpm://239.255.76.67:7667?ttl=300\n[robot a]\nhost = h\n", 2, r"ttl must be 0 to 255"),
+    ("url option", "[lcm]\nurl = udpm://239.255.76.67:7667?tll=0\n[robot a]\nhost = h\n", 2, r'unknown udpm option "tll"'),
+    ("rate syntax", "[lcm]\njoints_rate = 50\n[robot a]\nhost = h\n", 2, r'"every", "off" or a rate'),
+    ("rate range", "[lcm]\njoints_rate = 501 Hz\n[robot a]\nhost = h\n", 2, r"out of range"),
+    ("rate above robot", "[lcm]\ntool_rate = 200 Hz\n\n[robot a]\nhost = h\nversion = 3.10\n", 2,
+     r'above the 125 Hz robot "a" sends \(version 3.10, line 6\)'),
+    ("gateway every", "[lcm]\ngateway_rate = every\n[robot a]\nhost = h\n", 2, r"not \"every\""),
+    ("channel syntax", "[lcm]\nstate_channel = ST ATE\n[robot a]\nhost = h\n", 2, r"state_channel \"ST ATE\""),
+    ("channel twice", "[lcm]\ntool_channel = STATE\n[robot a]\nhost = h\n", 2,
+     r'tool_channel "STATE" is also the channel of state'),
+    ("empty value", "[robot a]\nhost =\n", 2, r"host has no value"),
+    ("syntax", "[robot a]\nhost = h\njust words\n", 3, r'expected "\[section\]" or "key = value"'),
+    ("header", "[robot a\nhost = h\n", 1, r"without '\]'"),
+    ("long line", "[robot a]\nhost = h\n# " + "x" * 300 + "\n", 3, r"line longer than"),
+    ("no robot", "[lcm]\n", 0, r"no robot"),
+]
+
+
+def t_configs(args):
+    d = tempfile.mkdtemp(prefix="gw-cfg-", dir=args.tmp)
+    for i, (name, text, line, pattern) in enumerate(BAD_CONFIGS):
+        path = os.path.join(d, "bad%02d.ini" % i)
+        with open(path, "w") as f:
+            f.write(text)
+        p = subprocess.run([args.gateway, "--check-config", path], capture_output=True, text=True, timeout=10)
+        where = "%s:%d: " % (path, line) if line else "%s: " % path
+        hit = [l for l in p.stderr.splitlines() if l.startswith(where) and re.search(pattern, l)]
+        check(p.returncode == 2 and hit, "config %s: exit 2 and \"%s.../%s\" (got %d: %s)" %
+              (name, where.split("/")[-1], pattern, p.returncode, p.stderr.strip().splitlines()[:1]))
+    p = subprocess.run([args.gateway, "--check-config", os.path.join(d, "missing.ini")], capture_output=True,
+                       text=True, timeout=10)
+    check(p.returncode == 2 and "missing.ini: cannot open" in p.stderr, "config: a missing file is named")
+    example = os.path.join(HERE, "..", "..", "gateway", "urrt-gateway.example.ini")
+    p = subprocess.run([args.gateway, "--check-config", example], capture_output=True, text=True, timeout=10)
+    check(p.returncode == 0 and "arm1.STATE: every packet" in p.stdout and "arm1.STATUS: 10 Hz" in p.stdout,
+          "config: the example configuration is valid and its plan printed")
+    good = os.path.join(d, "good.ini")
+    with open(good, "w") as f:
+        f.write("; comment\n[robot a]\nhost = ::1  # inline comment\nversion = 1.8\nconnect_timeout = 1.5 s\n"
+                "[lcm]\njoints_rate = 125 Hz\n[robot b]\nhost = robot-b.local\nversion = 1220\n")
+    p = subprocess.run([args.gateway, "--check-config", good], capture_output=True, text=True, timeout=10)
+    check(p.returncode == 0 and "robot a: [::1]:30003, version 1.8, connect 1500 ms" in p.stdout and
+          "b.JOINTS: 125 Hz" in p.stdout, "config: comments, IPv6, versions, lengths and durations accepted")
+    many = os.path.join(d, "many.ini")
+    with open(many, "w") as f:
+        f.write("[robot a]\nhost = h\nport = 0\nversion = x\n[nope]\n")
+    p = subprocess.run([args.gateway, "--check-config", many], capture_output=True, text=True, timeout=10)
+    lines = [int(l.split(":")[1]) for l in p.stderr.splitlines() if l.startswith(many + ":")]
+    check(lines == [3, 4, 5], "config: every error reported, in line order (%s)" % lines)
+
+
+def t_cli(args):
+    h = subprocess.run([args.gateway, "--help"], capture_output=True, text=True, timeout=10)
+    check(h.returncode == 0 and "--check-config" in h.stdout and "[robot NAME]" in h.stdout and
+          "KIND_rate = every | N Hz | off" in h.stdout and "Examples:" in h.stdout,
+          "--help documents options, the file grammar and examples")
+    v = subprocess.run([args.gateway, "--version"], capture_output=True, text=True, timeout=10)
+    check(v.returncode == 0 and v.stdout.startswith("urrt-gateway "), "--version")
+    u = subprocess.run([args.gateway], capture_output=True, text=True, timeout=10)
+    check(u.returncode == 2 and "no CONFIG" in u.stderr, "no CONFIG: usage error")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", required=True)
+    ap.add_argument("--result")
+    ap.add_argument("--port-base", type=int, default=41000)
+    ap.add_argument("--only")
+    args = ap.parse_args()
+    b = args.build
+    args.gateway = os.path.join(b, "bin", "urrt-gateway")
+    args.sim = os.path.join(b, "bin", "urrt-sim")
+    args.sub = os.path.join(b, "tests", "gateway", "lcm_sub")
+    args.shim = os.path.abspath(os.path.join(b, "tests", "gateway", "alloc_shim.so"))
+    args.jar = os.path.join(b, "urrt_lcmtypes.jar")
+    args.lcm_jar = "/usr/share/java/lcm.jar"
+    args.tmp = tempfile.mkdtemp(prefix="check-gateway-")
+    port = args.port_base
+    tests = [
+        ("cli", lambda: t_cli(args)),
+        ("configs", lambda: t_configs(args)),
+        ("jar", lambda: t_jar(args)),
+        ("values510", lambda: t_values(args, "5.10", port + 1, 1500)),
+        ("values310", lambda: t_values(args, "3.10", port + 2, 300)),
+        ("values18", lambda: t_values(args, "1.8", port + 3, 300)),
+        ("decimation", lambda: t_decimation(args, port + 4)),
+        ("two", lambda: t_two_robots(args, port + 5)),
+        ("restart", lambda: t_restart(args, port + 7)),
+        ("stall", lambda: t_stall(args, port + 8)),
+        ("mismatch", lambda: t_mismatch(args, port + 9)),
+        ("alloc", lambda: t_allocations(args, port + 10)),
+        ("publish_errors", lambda: t_publish_errors(args, port + 11)),
+    ]
+    for name, fn in tests:
+        if args.only and not re.search(args.only, name):
+            continue
+        t0 = time.monotonic()
+        try:
+            fn()
+        except Exception as e:  # a crashed test is a failure, the others still run
+            check(False, "%s: raised %r" % (name, e))
+        print("-- %s: %.1f s" % (name, time.monotonic() - t0))
+    line = "%d passed, %d failed" % (PASSED, FAILED)
+    print(line)
+    if args.result:
+        with open(args.result, "w") as f:
+            f.write(line + "\n")
+    subprocess.run(["rm", "-rf", args.tmp])
+    return 0 if FAILED == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
