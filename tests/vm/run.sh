@@ -119,7 +119,9 @@ add_file() {  # SRC DESTDIR
   [ -e "$src" ] || die "no such file: $src"
   cp -rL "$src" "$dst/" || die "cannot copy $src"
   local f
-  while IFS= read -r f; do is_elf "$f" && copy_libs "$f"; done < <(find "$dst/$(basename "$src")" -type f)
+  while IFS= read -r f; do
+    if is_elf "$f"; then copy_libs "$f"; fi
+  done < <(find "$dst/$(basename "$src")" -type f)
 }
 
 cp /bin/busybox "$stage/bin/busybox"
