@@ -778,8 +778,12 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
     if (type == URRT_CAN_FLOAT64 && length != 64) {
         return fail(err, errlen, loc, "signal: float64 needs length 64, not %u", length);
     }
-    if (urrt_can_signal_range(&sig, &lo, &hi) < 0) {
-        return fail(err, errlen, loc, "signal: invalid scaling");
+    {
+        urrt_can_signal bare = sig;
+        bare.min = bare.max = 0;
+        if (urrt_can_signal_range(&bare, &lo, &hi) < 0) {
+            return fail(err, errlen, loc, "signal: invalid scaling");
+        }
     }
     {
         /* Half a raw step of slack, so that min=-3276.8 passes for a signed
@@ -1228,12 +1232,10 @@ static void check_frame(struct can_map *map, struct can_map_frame *f, char *err,
                 const struct can_map_signal *b = &f->meta[index[second]];
                 PROBLEM(a->loc, "%s signal '%s' overlaps signal '%s' (line %d)", what, a->name, b->name, b->loc.line);
             } else if (rc == URRT_CAN_E_PAST_END) {
-                unsigned lsb = 0;
-                unsigned msb = 0;
                 unsigned need = 0;
-                urrt_can_signal_span(&work[first], &lsb, &msb, &need);
-                PROBLEM(a->loc, "%s signal '%s' (bits %u..%u) reaches byte %u, past the frame's length %u", what,
-                        a->name, lsb < msb ? lsb : msb, lsb < msb ? msb : lsb, need - 1, (unsigned)f->len);
+                urrt_can_signal_span(&work[first], NULL, NULL, &need);
+                PROBLEM(a->loc, "%s signal '%s' (@%u|%u) reaches byte %u, past the frame's length %u", what, a->name,
+                        (unsigned)work[first].start, (unsigned)work[first].length, need - 1, (unsigned)f->len);
             } else {
                 PROBLEM(a->loc, "%s signal '%s': %s", what, a->name, urrt_can_strerror(rc));
             }

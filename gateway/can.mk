@@ -1,0 +1,11 @@
+# gateway/can.mk: the CAN side of urrt-gateway: the mapping configuration and
+# frame scheduling (can_map) and the DBC writer (dbc). The gateway links them
+# through GATEWAY_EXTRA_OBJS; tests/can.mk tests them.
+
+CAN_GATEWAY_OBJS := $(BUILD)/gateway/can_map.o $(BUILD)/gateway/dbc.o
+CAN_GATEWAY_HDRS := gateway/can_map.h gateway/dbc.h port/port.h $(LIB_HDRS)
+GATEWAY_EXTRA_OBJS += $(CAN_GATEWAY_OBJS)
+
+$(CAN_GATEWAY_OBJS): $(BUILD)/gateway/%.o: gateway/%.c $(CAN_GATEWAY_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(PROG_WARN) $(OPT) $(CPPFLAGS) -Igateway -c $< -o $@

@@ -1,0 +1,44 @@
+# tests/can.mk: the CAN mapping, packing and DBC.
+#   check-can      lib/urrt_can and gateway/can_map unit tests (hand vectors, saturation,
+#                  config rejections with FILE:LINE, bus load, scheduling on a fake clock)
+#   check-can-san  the same under ASan + UBSan (float-cast-overflow included: no float to
+#                  integer conversion may be undefined), lib/ and gateway/ compiled with them
+#   check-can-dbc  DBCs and payloads against python3-canmatrix and an independent
+#                  Python reference; the example configurations in docs/examples/
+
+CANT := $(BUILD)/tests/can
+CAN_TEST_SRCS := gateway/can_map.c gateway/dbc.c
+CAN_TEST_CFLAGS := $(PROG_WARN) $(CPPFLAGS) -Igateway -Itests
+
+CHECKS += check-can check-can-san check-can-dbc
+.PHONY: check-can check-can-san check-can-dbc
+
+# $(call can_suite,NAME,COMMAND): runs COMMAND, shows its output and keeps its
+# last line ("N passed, N failed") as the suite's result.
+define can_suite
+	@mkdir -p $(BUILD)/results
+	@$(2) > $(BUILD)/results/$(1).log 2>&1; rc=$$?; cat $(BUILD)/results/$(1).log; \
+	  tail -n 1 $(BUILD)/results/$(1).log > $(BUILD)/results/$(1).result; \
+	  grep -q '^[0-9]* passed, 0 failed$$' $(BUILD)/results/$(1).result || rc=1; exit $$rc
+endef
+
+$(CANT)/test_can: tests/can/test_can.c tests/check.h $(CAN_GATEWAY_OBJS) $(LIBURRT)
+	@mkdir -p $(@D)
+	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_GATEWAY_OBJS) $(LIBURRT) -linih -lm -o $@
+
+$(CANT)/test_can_san: tests/can/test_can.c tests/check.h $(CAN_TEST_SRCS) $(CAN_GATEWAY_HDRS) $(LIB_SRCS)
+	@mkdir -p $(@D)
+	$(CC) $(CAN_TEST_CFLAGS) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $< $(CAN_TEST_SRCS) $(LIB_SRCS) -linih -lm -o $@
+
+$(CANT)/can_tool: tests/can/can_tool.c $(CAN_GATEWAY_OBJS) $(LIBURRT)
+	@mkdir -p $(@D)
+	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_GATEWAY_OBJS) $(LIBURRT) -linih -lm -o $@
+
+check-can: $(CANT)/test_can
+	$(call can_suite,check-can,$(CANT)/test_can)
+
+check-can-san: $(CANT)/test_can_san
+	$(call can_suite,check-can-san,ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $(CANT)/test_can_san)
+
+check-can-dbc: $(CANT)/can_tool
+	$(call can_suite,check-can-dbc,$(PYTHON) tests/can/test_dbc.py --tool $(CANT)/can_tool --work $(CANT)/work)

@@ -1,0 +1,1263 @@
+/*
+ * check-can: lib/urrt_can (bit placement by hand-worked vectors, rounding,
+ * saturation, NaN, layout checks, frame bit lengths) and gateway/can_map
+ * (configuration and its rejections with FILE:LINE, bus load against
+ * hand-computed figures, scheduling, staleness, alive counters and the
+ * heartbeat on a fake clock). The DBC and bulk packing are checked against
+ * python3-canmatrix by test_dbc.py (check-can-dbc).
+ */
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <ini.h>
+
+#include "can_map.h"
+#include "check.h"
+#include "dbc.h"
+#include "urrt_can.h"
+
+/* ---- helpers ----------------------------------------------------------------- */
+
+static urrt_can_signal sig_make(unsigned start, unsigned length, urrt_can_byte_order order, urrt_can_value_type type,
+                                double factor, double offset)
+{
+    urrt_can_signal s;
+    memset(&s, 0, sizeof s);
+    s.start = (uint16_t)start;
+    s.length = (uint8_t)length;
+    s.byte_order = (uint8_t)order;
+    s.type = (uint8_t)type;
+    s.factor = factor;
+    s.offset = offset;
+    if (urrt_can_signal_range(&s, &s.min, &s.max) < 0) {
+        s.min = s.max = 0;
+    }
+    return s;
+}
+
+static uint64_t to_raw(const urrt_can_signal *s, double v, int *outcome)
+{
+    uint64_t raw = 0xDEADBEEF;
+    *outcome = urrt_can_to_raw(s, v, &raw);
+    return raw;
+}
+
+#define CHECK_RAW(sig, value, want_raw, want_outcome)                                                  \
+    do {                                                                                              \
+        int outcome_;                                                                                 \
+        uint64_t raw_ = to_raw(&(sig), (value), &outcome_);                                           \
+        CHECK(raw_ == (uint64_t)(want_raw) && outcome_ == (want_outcome),                             \
+              "value %.17g: raw 0x%llX outcome %d, want 0x%llX outcome %d", (double)(value),          \
+              (unsigned long long)raw_, outcome_, (unsigned long long)(uint64_t)(want_raw), (want_outcome)); \
+    } while (0)
+
+static bool bytes_are(const uint8_t *data, const uint8_t *want, unsigned len)
+{
+    return memcmp(data, want, len) == 0;
+}
+
+static void hex(const uint8_t *d, unsigned len, char *out)
+{
+    unsigned i;
+    for (i = 0; i < len; i++) {
+        sprintf(out + 2 * i, "%02X", d[i]);
+    }
+    out[2 * len] = '\0';
+}
+
+/* Deterministic pseudo-random numbers (the tests must not flake). */
+static uint64_t rng_state = 0x9E3779B97F4A7C15u;
+static uint64_t rnd(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return rng_state;
+}
+
+/* ---- lib: bit placement ------------------------------------------------------- */
+
+static void test_placement(void)
+{
+    uint8_t d[64];
+    char h[130];
+    uint64_t raw;
+
+    /* The pictures in urrt_can.h: 0xABC as 12 bits at start 12. */
+    {
+        urrt_can_signal intel = sig_make(12, 12, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+        urrt_can_signal moto = sig_make(12, 12, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+        const uint8_t want_intel[8] = {0x00, 0xC0, 0xAB, 0, 0, 0, 0, 0};
+        const uint8_t want_moto[8] = {0x00, 0x15, 0x78, 0, 0, 0, 0, 0};
+        unsigned lsb, msb, need;
+        memset(d, 0, sizeof d);
+        CHECK_EQ_INT(urrt_can_put_raw(&intel, 0xABC, d, 8), 0);
+        hex(d, 8, h);
+        CHECK(bytes_are(d, want_intel, 8), "intel 0xABC@12: %s", h);
+        memset(d, 0, sizeof d);
+        CHECK_EQ_INT(urrt_can_put_raw(&moto, 0xABC, d, 8), 0);
+        hex(d, 8, h);
+        CHECK(bytes_are(d, want_moto, 8), "motorola 0xABC@12: %s", h);
+        CHECK_EQ_INT(urrt_can_get_raw(&moto, d, 8, &raw), 0);
+        CHECK_EQ_INT(raw, 0xABC);
+        CHECK_EQ_INT(urrt_can_signal_span(&intel, &lsb, &msb, &need), 0);
+        CHECK(lsb == 12 && msb == 23 && need == 3, "intel span %u %u %u", lsb, msb, need);
+        CHECK_EQ_INT(urrt_can_signal_span(&moto, &lsb, &msb, &need), 0);
+        CHECK(lsb == 17 && msb == 12 && need == 3, "motorola span %u %u %u", lsb, msb, need);
+    }
+    /* Whole bytes: 16 bits in bytes 2-3, both orders. */
+    {
+        urrt_can_signal moto = sig_make(23, 16, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+        urrt_can_signal intel = sig_make(16, 16, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+        memset(d, 0, sizeof d);
+        urrt_can_put_raw(&moto, 0x1234, d, 8);
+        CHECK(d[2] == 0x12 && d[3] == 0x34 && d[1] == 0 && d[4] == 0, "motorola 16@23: %02X %02X", d[2], d[3]);
+        memset(d, 0, sizeof d);
+        urrt_can_put_raw(&intel, 0x1234, d, 8);
+        CHECK(d[2] == 0x34 && d[3] == 0x12 && d[1] == 0 && d[4] == 0, "intel 16@16: %02X %02X", d[2], d[3]);
+    }
+    /* 64 bits: the whole classic payload. */
+    {
+        urrt_can_signal moto = sig_make(7, 64, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+        urrt_can_signal intel = sig_make(0, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+        const uint8_t be[8] = {0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF};
+        const uint8_t le[8] = {0xEF, 0xCD, 0xAB, 0x89, 0x67, 0x45, 0x23, 0x01};
+        memset(d, 0, sizeof d);
+        urrt_can_put_raw(&moto, UINT64_C(0x0123456789ABCDEF), d, 8);
+        hex(d, 8, h);
+        CHECK(bytes_are(d, be, 8), "motorola 64@7: %s", h);
+        memset(d, 0, sizeof d);
+        urrt_can_put_raw(&intel, UINT64_C(0x0123456789ABCDEF), d, 8);
+        hex(d, 8, h);
+        CHECK(bytes_are(d, le, 8), "intel 64@0: %s", h);
+        CHECK_EQ_INT(urrt_can_get_raw(&intel, le, 8, &raw), 0);
+        CHECK(raw == UINT64_C(0x0123456789ABCDEF), "intel 64 read back %llX", (unsigned long long)raw);
+        /* 64 bits at the end of an FD frame, unaligned for Intel. */
+        urrt_can_signal tail = sig_make(8 * 56 + 0, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+        CHECK_EQ_INT(urrt_can_signal_check(&tail, 64), 0);
+        CHECK_EQ_INT(urrt_can_signal_check(&tail, 48), URRT_CAN_E_PAST_END);
+        urrt_can_signal odd = sig_make(3, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+        CHECK_EQ_INT(urrt_can_signal_check(&odd, 8), URRT_CAN_E_PAST_END);
+        CHECK_EQ_INT(urrt_can_signal_check(&odd, 9), 0);
+        memset(d, 0, sizeof d);
+        urrt_can_put_raw(&odd, ~UINT64_C(0), d, 9);
+        CHECK(d[0] == 0xF8 && d[7] == 0xFF && d[8] == 0x07, "intel 64@3: %02X..%02X %02X", d[0], d[7], d[8]);
+    }
+    /* Single bits and short Motorola runs across a byte boundary. */
+    {
+        urrt_can_signal bit63i = sig_make(63, 1, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+        urrt_can_signal bit63m = sig_make(63, 1, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+        urrt_can_signal m10 = sig_make(1, 10, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+        urrt_can_signal m4 = sig_make(3, 4, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+        memset(d, 0, sizeof d);
+        urrt_can_put_raw(&bit63i, 1, d, 8);
+        CHECK(d[7] == 0x80, "bit 63 intel: %02X", d[7]);
+        memset(d, 0, sizeof d);
+        urrt_can_put_raw(&bit63m, 1, d, 8);
+        CHECK(d[7] == 0x80, "bit 63 motorola: %02X", d[7]);
+        memset(d, 0, sizeof d);
+        urrt_can_put_raw(&m10, 0x2AA, d, 8); /* 10 1010 1010 */
+        CHECK(d[0] == 0x02 && d[1] == 0xAA, "motorola 10@1: %02X %02X", d[0], d[1]);
+        memset(d, 0, sizeof d);
+        urrt_can_put_raw(&m4, 0xF, d, 8);
+        CHECK(d[0] == 0x0F && d[1] == 0, "motorola 4@3: %02X", d[0]);
+    }
+    /* Bits outside the signal are left alone. */
+    {
+        urrt_can_signal moto = sig_make(12, 12, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+        memset(d, 0xFF, sizeof d);
+        urrt_can_put_raw(&moto, 0, d, 8);
+        CHECK(d[0] == 0xFF && d[1] == 0xE0 && d[2] == 0x01 && d[3] == 0xFF, "clear motorola 12@12: %02X %02X %02X",
+              d[0], d[1], d[2]);
+    }
+    /* Signed read-back is sign-extended. */
+    {
+        urrt_can_signal s = sig_make(4, 12, URRT_CAN_INTEL, URRT_CAN_SIGNED, 0.5, 10);
+        double v;
+        memset(d, 0, sizeof d);
+        CHECK_EQ_INT(urrt_can_pack(&s, -10.0, d, 8), URRT_CAN_PACK_OK); /* raw -40 */
+        CHECK_EQ_INT(urrt_can_get_raw(&s, d, 8, &raw), 0);
+        CHECK(raw == 0xFD8, "raw -40 in 12 bits: %llX", (unsigned long long)raw);
+        CHECK_EQ_INT(urrt_can_unpack(&s, d, 8, &v), 0);
+        CHECK(v == -10.0, "unpack %g", v);
+        CHECK(urrt_can_from_raw(&s, 0x800) == -2048 * 0.5 + 10, "most negative %g", urrt_can_from_raw(&s, 0x800));
+    }
+}
+
+/* ---- lib: values ------------------------------------------------------------------ */
+
+static void test_values(void)
+{
+    urrt_can_signal u8 = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    urrt_can_signal s8 = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_SIGNED, 1, 0);
+    int outcome;
+
+    CHECK(u8.min == 0 && u8.max == 255, "u8 range %g %g", u8.min, u8.max);
+    CHECK(s8.min == -128 && s8.max == 127, "s8 range %g %g", s8.min, s8.max);
+    /* Round half away from zero, never through value + 0.5. */
+    CHECK_RAW(u8, 2.5, 3, URRT_CAN_PACK_OK);
+    CHECK_RAW(u8, 2.4999999999999996, 2, URRT_CAN_PACK_OK);
+    CHECK_RAW(u8, 0.49999999999999994, 0, URRT_CAN_PACK_OK);
+    CHECK_RAW(u8, -0.4, 0, URRT_CAN_PACK_SATURATED); /* below min: saturated though it rounds to 0 */
+    CHECK_RAW(u8, 255.0, 255, URRT_CAN_PACK_OK);
+    CHECK_RAW(s8, -2.5, 0xFD, URRT_CAN_PACK_OK);
+    CHECK_RAW(s8, 127.0, 0x7F, URRT_CAN_PACK_OK);
+    CHECK_RAW(s8, -128.0, 0x80, URRT_CAN_PACK_OK);
+    /* Out of range: clamped to the limits, outcome saturated. */
+    CHECK_RAW(u8, 255.5, 255, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(u8, -0.6, 0, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(u8, 1e300, 255, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(u8, INFINITY, 255, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(u8, -INFINITY, 0, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(s8, 128.0, 0x7F, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(s8, -128.6, 0x80, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(s8, -1e308, 0x80, URRT_CAN_PACK_SATURATED);
+    /* The raw type's range applies even where min/max are wider than it
+     * (a descriptor built by hand, not by the configuration). */
+    {
+        urrt_can_signal wide = u8;
+        wide.min = -1e9;
+        wide.max = 1e9;
+        CHECK_RAW(wide, 300, 255, URRT_CAN_PACK_SATURATED);
+        CHECK_RAW(wide, -3, 0, URRT_CAN_PACK_SATURATED);
+    }
+    /* Physical limits inside the raw range. */
+    {
+        urrt_can_signal pct = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 0.5, 0);
+        pct.min = 0;
+        pct.max = 100;
+        CHECK_RAW(pct, 150, 200, URRT_CAN_PACK_SATURATED);
+        CHECK_RAW(pct, 99.74, 199, URRT_CAN_PACK_OK); /* 199.48 rounds to 199 */
+        CHECK_RAW(pct, 99.75, 200, URRT_CAN_PACK_OK); /* 199.5 rounds away from zero */
+    }
+    /* Scaling: factor 0.01, offset -40 (a temperature byte pair). */
+    {
+        urrt_can_signal t = sig_make(0, 16, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 0.01, -40);
+        CHECK_RAW(t, 25.0, 6500, URRT_CAN_PACK_OK);
+        CHECK_RAW(t, -40.0, 0, URRT_CAN_PACK_OK);
+        CHECK_RAW(t, -41.0, 0, URRT_CAN_PACK_SATURATED);
+        CHECK(fabs(t.max - 615.35) < 1e-9, "max %.17g", t.max);
+    }
+    /* Negative factor: the range is ordered, the sign flips. */
+    {
+        urrt_can_signal n = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_SIGNED, -0.5, 0);
+        CHECK(n.min == -63.5 && n.max == 64, "negative factor range %g %g", n.min, n.max);
+        CHECK_RAW(n, 10, 0xEC, URRT_CAN_PACK_OK); /* raw -20 */
+        CHECK_RAW(n, 64, 0x80, URRT_CAN_PACK_OK);
+    }
+    /* NaN: outcome NAN; integers carry physical 0 clamped into [min, max],
+     * or the configured invalid raw. */
+    {
+        urrt_can_signal t = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, -40);
+        CHECK_RAW(t, NAN, 40, URRT_CAN_PACK_NAN);
+        t.min = 10;
+        CHECK_RAW(t, NAN, 50, URRT_CAN_PACK_NAN);
+        t.flags = URRT_CAN_SIG_INVALID_RAW;
+        t.invalid_raw = 0xFF;
+        CHECK_RAW(t, NAN, 0xFF, URRT_CAN_PACK_NAN);
+        CHECK_RAW(t, -NAN, 0xFF, URRT_CAN_PACK_NAN);
+        t.invalid_raw = 0x1FF; /* does not fit 8 bits */
+        CHECK_EQ_INT(urrt_can_to_raw(&t, 1, &(uint64_t){0}), URRT_CAN_E_SIGNAL);
+    }
+    /* 64-bit integers at the edges of what a double holds. */
+    {
+        urrt_can_signal u64 = sig_make(0, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+        urrt_can_signal s64 = sig_make(0, 64, URRT_CAN_INTEL, URRT_CAN_SIGNED, 1, 0);
+        CHECK_RAW(u64, 18446744073709549568.0, UINT64_C(0xFFFFFFFFFFFFF800), URRT_CAN_PACK_OK);
+        CHECK_RAW(u64, 18446744073709551616.0, UINT64_MAX, URRT_CAN_PACK_SATURATED);
+        CHECK_RAW(u64, 1e19 * 10, UINT64_MAX, URRT_CAN_PACK_SATURATED);
+        CHECK_RAW(s64, -9223372036854775808.0, UINT64_C(0x8000000000000000), URRT_CAN_PACK_OK);
+        CHECK_RAW(s64, 9223372036854775808.0, UINT64_C(0x7FFFFFFFFFFFFFFF), URRT_CAN_PACK_SATURATED);
+        CHECK_RAW(s64, -9223372036854777856.0, UINT64_C(0x8000000000000000), URRT_CAN_PACK_SATURATED);
+        CHECK_RAW(s64, -1.0, UINT64_MAX, URRT_CAN_PACK_OK);
+        CHECK(urrt_can_from_raw(&s64, UINT64_C(0x8000000000000000)) == -9223372036854775808.0, "s64 min");
+        CHECK(urrt_can_from_raw(&s64, UINT64_MAX) == -1.0, "s64 -1");
+        CHECK(urrt_can_from_raw(&u64, UINT64_MAX) == 18446744073709551616.0, "u64 max");
+    }
+    /* Tiny factors: the scaled value overflows to infinity, which saturates. */
+    {
+        urrt_can_signal tiny = sig_make(0, 32, URRT_CAN_INTEL, URRT_CAN_SIGNED, 1e-300, 0);
+        tiny.min = -DBL_MAX;
+        tiny.max = DBL_MAX;
+        CHECK_RAW(tiny, 1e300, 0x7FFFFFFF, URRT_CAN_PACK_SATURATED);
+        CHECK_RAW(tiny, -1e300, 0x80000000, URRT_CAN_PACK_SATURATED);
+        CHECK_RAW(tiny, 5e-300, 5, URRT_CAN_PACK_OK);
+    }
+    /* float32: IEEE bits, out of range clamped to FLT_MAX (never an
+     * undefined double-to-float conversion), NaN stays NaN. */
+    {
+        urrt_can_signal f = sig_make(0, 32, URRT_CAN_INTEL, URRT_CAN_FLOAT32, 1, 0);
+        urrt_can_signal g = sig_make(0, 32, URRT_CAN_INTEL, URRT_CAN_FLOAT32, 2, 1);
+        CHECK(f.max == (double)FLT_MAX && f.min == -(double)FLT_MAX, "float32 range %g", f.max);
+        CHECK_RAW(f, 1.5, 0x3FC00000, URRT_CAN_PACK_OK);
+        CHECK_RAW(f, -2.0, 0xC0000000, URRT_CAN_PACK_OK);
+        CHECK_RAW(f, 1e39, 0x7F7FFFFF, URRT_CAN_PACK_SATURATED);
+        CHECK_RAW(f, -INFINITY, 0xFF7FFFFF, URRT_CAN_PACK_SATURATED);
+        CHECK_RAW(f, NAN, 0x7FC00000, URRT_CAN_PACK_NAN);
+        CHECK_RAW(f, 1e-50, 0, URRT_CAN_PACK_OK); /* underflows to +0 */
+        CHECK_RAW(g, 4.0, 0x3FC00000, URRT_CAN_PACK_OK);
+        CHECK(urrt_can_from_raw(&g, 0x3FC00000) == 4.0, "float32 scaled read-back");
+        f.max = 10;
+        CHECK_RAW(f, 11, 0x41200000, URRT_CAN_PACK_SATURATED);
+    }
+    {
+        urrt_can_signal d = sig_make(0, 64, URRT_CAN_MOTOROLA, URRT_CAN_FLOAT64, 1, 0);
+        uint8_t buf[8] = {0};
+        const uint8_t want[8] = {0x3F, 0xF8, 0, 0, 0, 0, 0, 0};
+        d.start = 7;
+        CHECK_RAW(d, 1.5, UINT64_C(0x3FF8000000000000), URRT_CAN_PACK_OK);
+        CHECK_RAW(d, INFINITY, UINT64_C(0x7FEFFFFFFFFFFFFF), URRT_CAN_PACK_SATURATED);
+        CHECK_RAW(d, NAN, UINT64_C(0x7FF8000000000000), URRT_CAN_PACK_NAN);
+        CHECK_EQ_INT(urrt_can_pack(&d, 1.5, buf, 8), URRT_CAN_PACK_OK);
+        CHECK(bytes_are(buf, want, 8), "float64 motorola is the big-endian double");
+    }
+    /* Descriptors out of their domain. */
+    {
+        urrt_can_signal bad = u8;
+        uint64_t r;
+        bad.factor = 0;
+        CHECK_EQ_INT(urrt_can_to_raw(&bad, 1, &r), URRT_CAN_E_SIGNAL);
+        bad = u8;
+        bad.factor = NAN;
+        CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+        bad = u8;
+        bad.min = 5;
+        bad.max = 4;
+        CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+        bad = u8;
+        bad.length = 0;
+        CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+        bad.length = 65;
+        CHECK_EQ_INT(urrt_can_signal_check(&bad, 64), URRT_CAN_E_SIGNAL);
+        bad = sig_make(0, 16, URRT_CAN_INTEL, URRT_CAN_FLOAT32, 1, 0);
+        CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+        bad = u8;
+        bad.type = 9;
+        CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+        bad = u8;
+        bad.start = 600;
+        CHECK_EQ_INT(urrt_can_signal_check(&bad, 64), URRT_CAN_E_PAST_END);
+        CHECK_EQ_INT(urrt_can_pack(NULL, 1, (uint8_t[8]){0}, 8), URRT_E_ARG);
+        CHECK_EQ_INT(urrt_can_pack(&u8, 1, NULL, 8), URRT_E_ARG);
+        CHECK_EQ_STR(urrt_can_strerror(URRT_CAN_E_OVERLAP), "signals overlap");
+        CHECK_EQ_STR(urrt_can_strerror(URRT_E_ARG), "invalid argument");
+        CHECK(isnan(urrt_can_from_raw(NULL, 0)), "from_raw(NULL) is NaN");
+        outcome = urrt_can_pack(&bad, 1, (uint8_t[64]){0}, 64);
+        CHECK_EQ_INT(outcome, URRT_CAN_E_PAST_END);
+    }
+}
+
+/* Random descriptors: pack, unpack, compare within half a raw step; and
+ * every bit outside the signal is kept. */
+static void test_round_trip(void)
+{
+    int n;
+    int bad_value = 0;
+    int bad_bits = 0;
+    for (n = 0; n < 20000; n++) {
+        urrt_can_signal s;
+        uint8_t data[64];
+        uint8_t before[64];
+        uint8_t mask[64] = {0};
+        unsigned len = (unsigned)(rnd() % 64) + 1;
+        unsigned type = (unsigned)(rnd() % 4);
+        unsigned frame_len = 64;
+        double factor;
+        double v;
+        double back;
+        int outcome;
+        unsigned i;
+        if (type == URRT_CAN_FLOAT32) {
+            len = 32;
+        } else if (type == URRT_CAN_FLOAT64) {
+            len = 64;
+        }
+        factor = type >= URRT_CAN_FLOAT32 ? 1.0 : ldexp(1.0 + (double)(rnd() % 1000) / 1000.0, (int)(rnd() % 20) - 10);
+        if (rnd() % 4 == 0) {
+            factor = -factor;
+        }
+        s = sig_make(0, len, rnd() % 2 ? URRT_CAN_MOTOROLA : URRT_CAN_INTEL, (urrt_can_value_type)type, factor,
+                     (double)((int)(rnd() % 200) - 100));
+        /* A start bit that fits. */
+        do {
+            s.start = (uint16_t)(rnd() % (8 * frame_len));
+        } while (urrt_can_signal_check(&s, frame_len) != 0);
+        for (i = 0; i < 64; i++) {
+            before[i] = data[i] = (uint8_t)rnd();
+        }
+        urrt_can_put_raw(&s, ~UINT64_C(0), mask, frame_len);
+        v = s.min + (s.max - s.min) * (double)(rnd() % 1000001) / 1000000.0;
+        if (type >= URRT_CAN_FLOAT32) {
+            v = (double)((int64_t)(rnd() % 2000001) - 1000000) / 64.0;
+        }
+        outcome = urrt_can_pack(&s, v, data, frame_len);
+        urrt_can_unpack(&s, data, frame_len, &back);
+        if (outcome != URRT_CAN_PACK_OK || !(fabs(back - v) <= fabs(factor) * 0.5000001 + fabs(v) * 1e-15)) {
+            if (bad_value++ < 5) {
+                fprintf(stderr, "round trip: len %u type %u start %u factor %g: %.17g -> %.17g (outcome %d)\n", len,
+                        type, s.start, factor, v, back, outcome);
+            }
+        }
+        for (i = 0; i < 64; i++) {
+            if (((data[i] ^ before[i]) & ~mask[i]) != 0) {
+                bad_bits++;
+                break;
+            }
+        }
+    }
+    CHECK(bad_value == 0, "%d of 20000 random values did not round-trip", bad_value);
+    CHECK(bad_bits == 0, "%d of 20000 packs changed bits outside the signal", bad_bits);
+}
+
+/* ---- lib: layout, lengths, ids, bits on the wire --------------------------------- */
+
+static void test_layout(void)
+{
+    urrt_can_signal sigs[4];
+    size_t a = 99;
+    size_t b = 99;
+    sigs[0] = sig_make(0, 16, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    sigs[1] = sig_make(23, 16, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0); /* bytes 2-3 */
+    sigs[2] = sig_make(32, 4, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    sigs[3] = sig_make(63, 1, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    CHECK_EQ_INT(urrt_can_layout_check(sigs, 4, 8, &a, &b), 0);
+    /* A Motorola signal whose MSB is bit 16 (byte 2's low bit) runs into byte 3. */
+    sigs[2] = sig_make(16, 2, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+    CHECK_EQ_INT(urrt_can_layout_check(sigs, 4, 8, &a, &b), URRT_CAN_E_OVERLAP);
+    CHECK(a == 2 && b == 1, "overlap reported %zu with %zu", a, b);
+    sigs[2] = sig_make(15, 1, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    CHECK_EQ_INT(urrt_can_layout_check(sigs, 4, 8, &a, &b), URRT_CAN_E_OVERLAP);
+    CHECK(a == 2 && b == 0, "overlap reported %zu with %zu", a, b);
+    sigs[2] = sig_make(32, 4, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    CHECK_EQ_INT(urrt_can_layout_check(sigs, 4, 7, &a, &b), URRT_CAN_E_PAST_END);
+    CHECK_EQ_INT(a, 3);
+    CHECK_EQ_INT(urrt_can_layout_check(sigs, 0, 8, NULL, NULL), 0);
+    CHECK_EQ_INT(urrt_can_layout_check(sigs, 4, 65, NULL, NULL), URRT_CAN_E_FRAME_LENGTH);
+
+    CHECK(urrt_can_length_valid(8, false) && !urrt_can_length_valid(9, false), "classic lengths");
+    CHECK(urrt_can_length_valid(12, true) && urrt_can_length_valid(64, true) && !urrt_can_length_valid(10, true) &&
+              !urrt_can_length_valid(65, true),
+          "FD lengths");
+    CHECK_EQ_INT(urrt_can_len_to_dlc(48), 14);
+    CHECK_EQ_INT(urrt_can_len_to_dlc(13), 0xFF);
+    CHECK_EQ_INT(urrt_can_dlc_to_len(9), 12);
+    CHECK_EQ_INT(urrt_can_dlc_to_len(16), 0);
+    CHECK_EQ_INT(urrt_can_fd_length_round_up(9), 12);
+    CHECK_EQ_INT(urrt_can_fd_length_round_up(33), 48);
+    CHECK(urrt_can_id_valid(0x7FF, false) && !urrt_can_id_valid(0x800, false), "11-bit ids");
+    CHECK(urrt_can_id_valid(0x1FFFFFFF, true) && !urrt_can_id_valid(0x20000000, true), "29-bit ids");
+}
+
+static void test_frame_bits(void)
+{
+    unsigned nominal;
+    unsigned data;
+    /* Classic, worked by hand from Davis et al.: g + 8s + 13 + floor((g + 8s - 1) / 4). */
+    urrt_can_frame_bits(8, false, false, &nominal, &data);
+    CHECK(nominal == 135 && data == 0, "11-bit 8 bytes: %u", nominal); /* 34+64+13+24 */
+    urrt_can_frame_bits(8, true, false, &nominal, &data);
+    CHECK_EQ_INT(nominal, 160); /* 54+64+13+29 */
+    urrt_can_frame_bits(0, false, false, &nominal, &data);
+    CHECK_EQ_INT(nominal, 55); /* 34+0+13+8 */
+    urrt_can_frame_bits(0, true, false, &nominal, &data);
+    CHECK_EQ_INT(nominal, 80); /* 54+0+13+13 */
+    urrt_can_frame_bits(1, false, false, &nominal, &data);
+    CHECK_EQ_INT(nominal, 65); /* 34+8+13+10 */
+    /* FD, 64 bytes, 11-bit id: arbitration 17 + 4 stuff + 13 tail = 34;
+     * data phase 5 + 512 = 517, + ceil(517/4) = 130 stuff, + 4 + 21 + 7 = 679. */
+    urrt_can_frame_bits(64, false, true, &nominal, &data);
+    CHECK(nominal == 34 && data == 679, "FD 64: %u + %u", nominal, data);
+    /* FD, 8 bytes, 29-bit id: 36 + 8 + 13 = 57; 69 + 18 + 27 = 114. */
+    urrt_can_frame_bits(8, true, true, &nominal, &data);
+    CHECK(nominal == 57 && data == 114, "FD 8 ext: %u + %u", nominal, data);
+    /* FD, 20 bytes: CRC-21. 5 + 160 = 165 + 42 + 32 = 239. */
+    urrt_can_frame_bits(20, false, true, &nominal, &data);
+    CHECK(nominal == 34 && data == 239, "FD 20: %u + %u", nominal, data);
+    /* An invalid FD length counts as the next valid one. */
+    urrt_can_frame_bits(10, false, true, &nominal, &data);
+    CHECK_EQ_INT(data, 5 + 96 + 26 + 27);
+}
+
+/* ---- can_map: configuration ---------------------------------------------------------- */
+
+struct text_reader {
+    const char *p;
+    int line;
+    struct can_map *map;
+    char err[1024];
+    int errors;
+};
+
+static char *text_read(char *str, int num, void *stream)
+{
+    struct text_reader *r = stream;
+    int n = 0;
+    if (*r->p == '\0') {
+        return NULL;
+    }
+    while (*r->p != '\0' && n < num - 1) {
+        char c = *r->p++;
+        str[n++] = c;
+        if (c == '\n') {
+            break;
+        }
+    }
+    str[n] = '\0';
+    r->line++;
+    return str;
+}
+
+static int text_key(void *user, const char *section, const char *key, const char *value)
+{
+    struct text_reader *r = user;
+    char err[512];
+    int rc = can_map_ini(r->map, section, key, value, "t.ini", r->line, err, sizeof err);
+    if (rc < 0 && r->errors++ == 0) {
+        snprintf(r->err, sizeof r->err, "%s", err);
+    }
+    if (rc == 0 && r->errors++ == 0) {
+        snprintf(r->err, sizeof r->err, "t.ini:%d: section [%s] not handled", r->line, section);
+    }
+    return 1;
+}
+
+static const struct can_map_robot one_robot[] = {{"arm", 8000}};
+
+/* Parses text and finishes the map: 0, or -1 with the first error in err. */
+static int load(struct can_map *map, const char *text, const struct can_map_robot *robots, size_t n, char *err,
+                size_t errlen)
+{
+    struct text_reader r;
+    memset(&r, 0, sizeof r);
+    r.p = text;
+    r.map = map;
+    can_map_init(map);
+    ini_parse_stream(text_read, &r, text_key, &r);
+    if (r.errors > 0) {
+        snprintf(err, errlen, "%s", r.err);
+        return -1;
+    }
+    return can_map_finish(map, robots, n, err, errlen);
+}
+
+#define CAN_HEAD "[can]\ninterface = vcan0\nheartbeat_id = 0x701\n"
+
+static const char *const good_config =
+    "; a comment\n"
+    "[can]\n"
+    "interface = vcan0\n"
+    "bitrate = 500000\n"
+    "heartbeat_id = 0x701\n"
+    "\n"
+    "[frame joints]\n"
+    "id = 0x181\n"
+    "period_ms = 10\n"
+    "signal = q_actual[0] @0|16 intel signed factor=0.0001 unit=rad\n"
+    "signal = q_actual[1] @16|16 intel signed factor=0.0001\n"
+    "signal = tool_vector_actual[4] @39|16 motorola signed factor=0.0001 name=rx\n"
+    "alive_counter = 56\n"
+    "validity_bit = 63\n"
+    "\n"
+    "[frame status]\n"
+    "id = 0x18FF0080\n"
+    "extended = yes\n"
+    "period_ms = every\n"
+    "length = 4\n"
+    "signal = robot_mode @0|8 intel signed\n"
+    "signal = digital_input_bits @8|18 intel unsigned\n"
+    "signal = v_robot @26|6 intel unsigned factor=2 offset=0 min=0 max=60 unit=\"V DC\"\n";
+
+static void test_config_good(void)
+{
+    struct can_map map;
+    char err[2048] = "";
+    int rc = load(&map, good_config, one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "good config rejected: %s", err);
+    if (rc != 0) {
+        can_map_free(&map);
+        return;
+    }
+    CHECK(can_map_enabled(&map), "enabled");
+    CHECK_EQ_STR(map.interface, "vcan0");
+    CHECK_EQ_INT(map.frame_count, 2);
+    CHECK_EQ_INT(map.hb_id, 0x701);
+    {
+        const struct can_map_frame *j = &map.frames[0];
+        CHECK_EQ_STR(j->name, "joints");
+        CHECK(j->id == 0x181 && !j->extended && !j->fd && j->len == 8 && j->period_ms == 10 && !j->every, "joints");
+        CHECK_EQ_INT(j->count, 5);
+        CHECK_EQ_STR(j->meta[0].name, "q_actual_0");
+        CHECK_EQ_STR(j->meta[0].unit, "rad");
+        CHECK_EQ_STR(j->meta[1].unit, "rad"); /* from the field table */
+        CHECK_EQ_STR(j->meta[2].name, "rx");
+        CHECK_EQ_STR(j->meta[2].unit, "rad"); /* "m, rad": element 4 is a rotation */
+        CHECK(j->sigs[0].min == -3.2768 && j->sigs[0].max == 3.2767, "q range %.17g %.17g", j->sigs[0].min,
+              j->sigs[0].max);
+        CHECK(j->sigs[2].byte_order == URRT_CAN_MOTOROLA && j->sigs[2].start == 39, "motorola parsed");
+        CHECK(j->alive_index == 3 && j->valid_index == 4, "alive %d valid %d", j->alive_index, j->valid_index);
+        CHECK_EQ_INT(j->stale_after_ms, CAN_MAP_DEFAULT_STALE_MS);
+        CHECK(j->stale_policy == CAN_MAP_STALE_STOP, "default policy stop");
+        CHECK_EQ_INT(j->key_loc[CAN_MAP_FK_ID].line, 8);
+    }
+    {
+        const struct can_map_frame *s = &map.frames[1];
+        CHECK(s->id == 0x18FF0080 && s->extended && s->every && s->len == 4, "status frame");
+        CHECK_EQ_STR(s->meta[0].unit, "");
+        CHECK(s->meta[1].bitmask, "digital inputs are a bit mask");
+        CHECK_EQ_STR(s->meta[2].unit, "V DC");
+        CHECK(s->sigs[2].min == 0 && s->sigs[2].max == 60, "v_robot limits");
+    }
+    can_map_free(&map);
+
+    /* No CAN configuration at all: finishes, stays disabled. */
+    rc = load(&map, "[other]\nkey = 1\n", one_robot, 1, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, "not handled") != NULL, "[other] is not the CAN map's: %s", err);
+    can_map_free(&map);
+    can_map_init(&map);
+    CHECK_EQ_INT(can_map_finish(&map, one_robot, 1, err, sizeof err), 0);
+    CHECK(!can_map_enabled(&map), "no CAN sections: disabled");
+    can_map_free(&map);
+}
+
+struct rejection {
+    const char *config;
+    const char *expect; /* the first error begins with this */
+};
+
+static const struct rejection rejections[] = {
+    /* Syntax of keys and values (can_map_ini). */
+    {CAN_HEAD "bogus = 1\n", "t.ini:4: unknown key 'bogus' in [can]"},
+    {CAN_HEAD "interface = can1\n", "t.ini:4: [can] interface given twice (first at line 2)"},
+    {CAN_HEAD "heartbeat_period_ms = 1001\n", "t.ini:4: heartbeat_period_ms = '1001': give 10..1000"},
+    {CAN_HEAD "bitrate = fast\n", "t.ini:4: bitrate = 'fast': give bits per second"},
+    {CAN_HEAD "[frame 9lives]\nid = 1\n", "t.ini:5: [frame 9lives]: the frame name is its DBC name"},
+    {CAN_HEAD "[frame urrt_heartbeat]\nid = 1\n", "t.ini:5: [frame urrt_heartbeat]: that name is the heartbeat's"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nid = 0x101\n", "t.ini:6: [frame a] id given twice (first at line 5)"},
+    {CAN_HEAD "[frame a]\ncolour = red\n", "t.ini:5: unknown key 'colour' in [frame a]"},
+    {CAN_HEAD "[frame a]\nperiod_ms = sometimes\n", "t.ini:5: period_ms = 'sometimes'"},
+    {CAN_HEAD "[frame a]\nstale_policy = ignore\n", "t.ini:5: stale_policy = 'ignore': use stop or invalid"},
+    {CAN_HEAD "[frame a]\nsignal = q_actual[0] @0|16 intel\n", "t.ini:5: signal = 'q_actual[0] @0|16 intel': expected"},
+    {CAN_HEAD "[frame a]\nsignal = q_actual[6] @0|16 intel signed\n",
+     "t.ini:5: signal: q_actual has 6 elements: q_actual[6] is out of range (0..5)"},
+    {CAN_HEAD "[frame a]\nsignal = q_actual @0|16 intel signed\n",
+     "t.ini:5: signal: q_actual has 6 elements: write q_actual[0] .. q_actual[5]"},
+    {CAN_HEAD "[frame a]\nsignal = q_wrong[0] @0|16 intel signed\n", "t.ini:5: signal: no field 'q_wrong'"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|65 intel unsigned\n", "t.ini:5: signal: length 65: give 1..64 bits"},
+    {CAN_HEAD "[frame a]\nsignal = time @512|8 intel unsigned\n", "t.ini:5: signal: start bit 512"},
+    {CAN_HEAD "[frame a]\nsignal = time 0|8 intel unsigned\n", "t.ini:5: signal: '0|8': expected @START|LENGTH"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|16 intel float32\n", "t.ini:5: signal: float32 needs length 32, not 16"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 unsigned factor=1\n", "t.ini:5: signal: byte order missing"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel\n", "t.ini:5: signal = 'time @0|8 intel': expected"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned big\n", "t.ini:5: signal: unknown word 'big'"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel intel unsigned\n", "t.ini:5: signal: 'intel': byte order given twice"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned factor=0\n", "t.ini:5: signal: factor must not be 0"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned factor=x\n", "t.ini:5: signal: factor = 'x' is not a finite number"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned max=256\n",
+     "t.ini:5: signal: max=256 is above what the signal can carry (255)"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel signed min=-200\n",
+     "t.ini:5: signal: min=-200 is below what the signal can carry (-128)"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned min=10 max=5\n", "t.ini:5: signal: min=10 is above max=5"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned invalid=256\n", "t.ini:5: signal: invalid=256 does not fit 8 bits"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned invalid=-1\n", "t.ini:5: signal: invalid=-1 does not fit 8 unsigned bits"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|32 intel float32 invalid=0\n", "t.ini:5: signal: invalid= applies to integer signals"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned name=1x\n", "t.ini:5: signal: name '1x'"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned colour=red\n", "t.ini:5: signal: unknown option 'colour='"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned unit=\"a\n", "t.ini:5: signal: unbalanced quotes"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned\nsignal = time @8|8 intel unsigned\n",
+     "t.ini:6: signal name 'time' already used in [frame a] (line 5): add name=OTHER"},
+    {CAN_HEAD "[frame a]\nalive_counter = 99 big\n", "t.ini:5: alive_counter: byte order 'big'"},
+    {CAN_HEAD "[frame a]\nvalidity_bit = 600\n", "t.ini:5: validity_bit = 600: give a bit number 0..511"},
+    /* Whole-file checks (can_map_finish). */
+    {"[frame a]\nid = 1\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:2: CAN frames need a [can] section"},
+    {"[can]\nheartbeat_id = 0x700\n[frame a]\nid = 1\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:2: [can] has no interface"},
+    {"[can]\ninterface = can0\n[frame a]\nid = 1\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:2: [can] has no heartbeat_id"},
+    {CAN_HEAD, "t.ini:2: [can] without any [frame NAME] section"},
+    {CAN_HEAD "[frame a]\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n", "t.ini:5: [frame a] has no id"},
+    {CAN_HEAD "[frame a]\nid = 0x800\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:5: [frame a] id 0x800 is past 0x7FF, the largest 11-bit id: set extended = yes"},
+    {CAN_HEAD "[frame a]\nid = 0x20000000\nextended = yes\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:5: [frame a] id 0x20000000 is past 0x1FFFFFFF, the largest 29-bit id"},
+    {CAN_HEAD "heartbeat_extended = no\n[frame a]\nid = 0x701\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:3: the heartbeat id 0x701 is already used by [frame a] (line 6)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n"
+              "[frame b]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:9: [frame b] id 0x100 is already used by [frame a] (line 5)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nlength = 12\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:6: [frame a] length 12: a classic CAN frame carries at most 8 bytes"},
+    {CAN_HEAD "fd = yes\n[frame a]\nid = 0x100\nfd = yes\nlength = 10\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:8: [frame a] length 10 is not a CAN FD length (0-8, 12, 16, 20, 24, 32, 48, 64): use 12"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nfd = yes\nlength = 12\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:6: [frame a] is a CAN FD frame but [can] fd is not yes"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|16 intel unsigned\n"
+              "signal = robot_mode @8|8 intel signed\n",
+     "t.ini:8: [frame a] signal 'robot_mode' overlaps signal 'time' (line 7)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|16 intel unsigned\nalive_counter = 12\n",
+     "t.ini:8: [frame a] signal 'alive_counter' overlaps signal 'time' (line 7)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nvalidity_bit = 7\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:8: [frame a] signal 'time' overlaps signal 'valid' (line 7)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nlength = 2\nperiod_ms = 10\nsignal = time @8|16 intel unsigned\n",
+     "t.ini:8: [frame a] signal 'time' (@8|16) reaches byte 2, past the frame's length 2"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nlength = 2\nperiod_ms = 10\nsignal = time @15|16 motorola unsigned\n",
+     "t.ini:8: [frame a] signal 'time' (@15|16) reaches byte 2, past the frame's length 2"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 5\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:6: [frame a] period_ms = 5 is faster than robot arm sends (every 8 ms, 125 Hz): use period_ms >= 8 or every"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nrobot = bob\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:6: [frame a]: unknown robot 'bob' (robots: arm)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:5: [frame a] has no period_ms"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\n", "t.ini:5: [frame a] has no signal"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nstale_policy = invalid\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:7: [frame a] stale_policy = invalid needs a validity_bit"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = every\nvalidity_bit = 63\nstale_policy = invalid\n"
+              "signal = time @0|8 intel unsigned\n",
+     "t.ini:8: [frame a]: a period_ms = every frame stops with the packets"},
+    {CAN_HEAD "data_bitrate = 2000000\n[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:4: data_bitrate is for CAN FD"},
+    {CAN_HEAD "max_bus_load = 5\n[frame a]\nid = 0x100\nperiod_ms = 1\nperiod_ms = 2\n", "t.ini:8: [frame a] period_ms given twice"},
+};
+
+static void test_config_rejections(void)
+{
+    size_t i;
+    for (i = 0; i < sizeof rejections / sizeof rejections[0]; i++) {
+        struct can_map map;
+        char err[4096] = "";
+        const struct can_map_robot robots[] = {{"arm", 8000}};
+        int rc = load(&map, rejections[i].config, robots, 1, err, sizeof err);
+        CHECK(rc == -1 && strncmp(err, rejections[i].expect, strlen(rejections[i].expect)) == 0,
+              "rejection %zu:\n  got:  %s\n  want: %s", i, err, rejections[i].expect);
+        can_map_free(&map);
+    }
+}
+
+static void test_config_robots(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    const struct can_map_robot two[] = {{"left", 2000}, {"right", 8000}};
+    const char *cfg = CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n";
+    int rc = load(&map, cfg, two, 2, err, sizeof err);
+    CHECK(rc == -1, "several robots need robot = NAME");
+    CHECK(strstr(err, "t.ini:2: heartbeat: the gateway has 2 robots (left, right): say which with heartbeat_robot = NAME") != NULL,
+          "heartbeat robot: %s", err);
+    CHECK(strstr(err, "t.ini:5: [frame a]: the gateway has 2 robots (left, right): say which with robot = NAME") != NULL,
+          "frame robot: %s", err);
+    can_map_free(&map);
+    rc = load(&map,
+              CAN_HEAD "heartbeat_robot = right\n[frame a]\nid = 0x100\nrobot = left\nperiod_ms = 2\n"
+                       "signal = time @0|8 intel unsigned\n",
+              two, 2, err, sizeof err);
+    CHECK(rc == 0, "two robots: %s", err);
+    if (rc == 0) {
+        CHECK(map.frames[0].robot_index == 0 && map.hb_robot_index == 1, "robots resolved");
+    }
+    can_map_free(&map);
+    /* Every error is reported, one per line. */
+    rc = load(&map,
+              CAN_HEAD "[frame a]\nid = 0x900\nperiod_ms = 10\nsignal = time @0|16 intel unsigned\n"
+                       "signal = robot_mode @8|8 intel signed\n",
+              one_robot, 1, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, "t.ini:5: [frame a] id 0x900") == err &&
+              strstr(err, "\nt.ini:8: [frame a] signal 'robot_mode' overlaps") != NULL,
+          "two errors: %s", err);
+    can_map_free(&map);
+}
+
+/* ---- can_map: bus load ---------------------------------------------------------------- */
+
+static void test_bus_load(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    int rc;
+    /* 500 kbit/s, 2 us per bit. 11-bit, 8 bytes: 135 bits = 270 us; every
+     * 10 ms is 2.7 %. The heartbeat (11-bit, 8 bytes, 100 ms) is 0.27 %. */
+    rc = load(&map, CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n", one_robot,
+              1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    CHECK(fabs(map.frames[0].load - 0.027) < 1e-12, "load %.6f", map.frames[0].load);
+    CHECK(fabs(map.load - 0.0297) < 1e-12, "total %.6f", map.load);
+    CHECK(fabs(can_map_frame_time_us(&map, 8, true, false) - 320.0) < 1e-9, "29-bit 8 bytes: 160 bits");
+    can_map_free(&map);
+    /* every packet at 125 Hz: 270 us / 8 ms = 3.375 %; 29-bit 8 bytes at
+     * 250 kbit/s: 160 bits = 640 us, every 20 ms = 3.2 %; heartbeat at 1000
+     * ms on 250 kbit/s: 540 us / 1 s = 0.054 %. */
+    rc = load(&map,
+              CAN_HEAD "bitrate = 250000\nheartbeat_period_ms = 1000\n[frame a]\nid = 0x100\nperiod_ms = every\n"
+                       "signal = time @0|8 intel unsigned\n[frame b]\nid = 0x100\nextended = yes\nperiod_ms = 20\n"
+                       "signal = time @0|8 intel unsigned\n",
+              one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    CHECK(fabs(map.frames[0].load - 0.0675) < 1e-12, "every at 125 Hz, 250k: %.6f", map.frames[0].load);
+    CHECK(fabs(map.frames[1].load - 0.032) < 1e-12, "29-bit at 20 ms: %.6f", map.frames[1].load);
+    CHECK(fabs(map.hb_load - 0.00054) < 1e-12, "heartbeat: %.6f", map.hb_load);
+    can_map_free(&map);
+    /* FD, 64 bytes, 500k/2M: 34 bits at 2 us + 679 bits at 0.5 us = 407.5 us;
+     * every 10 ms: 4.075 %. */
+    rc = load(&map,
+              CAN_HEAD "fd = yes\ndata_bitrate = 2000000\n[frame a]\nid = 0x100\nfd = yes\nlength = 64\n"
+                       "period_ms = 10\nsignal = time @0|8 intel unsigned\n",
+              one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    CHECK(fabs(map.frames[0].load - 0.04075) < 1e-12, "FD 64: %.6f", map.frames[0].load);
+    can_map_free(&map);
+    /* Over the threshold: 10 frames every 1 ms... at 125 Hz the robot
+     * limits periods, so use an e-series robot: 2 ms. 4 frames of 270 us
+     * every 2 ms = 54 % + heartbeat 0.27 % = 54.27 % over 50 %. */
+    {
+        const struct can_map_robot fast[] = {{"arm", 2000}};
+        char cfg[2048];
+        int n = snprintf(cfg, sizeof cfg, "%s", CAN_HEAD);
+        int k;
+        for (k = 0; k < 4; k++) {
+            n += snprintf(cfg + n, sizeof cfg - (size_t)n,
+                          "[frame f%d]\nid = 0x%x\nperiod_ms = 2\nsignal = time @0|8 intel unsigned\n", k, 0x100 + k);
+        }
+        rc = load(&map, cfg, fast, 1, err, sizeof err);
+        CHECK(rc == -1 && strstr(err, "t.ini:2: worst-case bus load 54.3% at 500000 bit/s is over max_bus_load = 50% "
+                                      "(heaviest: f0 13.5%, f1 13.5%, f2 13.5%)") == err,
+              "bus load rejection: %s", err);
+        can_map_free(&map);
+        /* The same at max_bus_load = 60 passes, and the message points at
+         * max_bus_load when it is given. */
+        snprintf(cfg + strlen(CAN_HEAD), sizeof cfg - strlen(CAN_HEAD), "max_bus_load = 54\n%s", "");
+        n = (int)strlen(cfg);
+        for (k = 0; k < 4; k++) {
+            n += snprintf(cfg + n, sizeof cfg - (size_t)n,
+                          "[frame f%d]\nid = 0x%x\nperiod_ms = 2\nsignal = time @0|8 intel unsigned\n", k, 0x100 + k);
+        }
+        rc = load(&map, cfg, fast, 1, err, sizeof err);
+        CHECK(rc == -1 && strncmp(err, "t.ini:4: worst-case bus load 54.3%", 34) == 0, "at max_bus_load: %s", err);
+        can_map_free(&map);
+    }
+}
+
+/* ---- can_map: run time on a fake clock --------------------------------------------------- */
+
+#define MAX_SENT 4096
+struct sent {
+    uint64_t t;
+    urrt_can_frame f;
+};
+struct capture {
+    uint64_t now;
+    size_t n;
+    struct sent s[MAX_SENT];
+};
+
+static void capture_frame(void *ctx, const urrt_can_frame *f)
+{
+    struct capture *c = ctx;
+    if (c->n < MAX_SENT) {
+        c->s[c->n].t = c->now;
+        c->s[c->n].f = *f;
+        c->n++;
+    }
+}
+
+static double hb_value(const urrt_can_frame *f, enum can_map_hb_signal_id k)
+{
+    double v = NAN;
+    urrt_can_unpack(&can_map_heartbeat_layout[k].sig, f->data, f->len, &v);
+    return v;
+}
+
+static uint64_t bits_of(const urrt_can_frame *f, unsigned start, unsigned length)
+{
+    urrt_can_signal s = sig_make(start, length, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    uint64_t raw = 0;
+    urrt_can_get_raw(&s, f->data, f->len, &raw);
+    return raw;
+}
+
+static void packet(struct can_map *map, uint64_t t, double q0, double mode, bool with_q)
+{
+    urrt_state st;
+    urrt_state_clear(&st);
+    st.generation = URRT_GEN_3X;
+    st.time[0] = (double)t / 1e6;
+    st.robot_mode[0] = mode;
+    st.safety_mode[0] = 1;
+    st.q_actual[0] = q0;
+    st.present = (UINT64_C(1) << URRT_F_TIME) | (UINT64_C(1) << URRT_F_ROBOT_MODE) |
+                 (UINT64_C(1) << URRT_F_SAFETY_MODE) | (with_q ? UINT64_C(1) << URRT_F_Q_ACTUAL : 0);
+    can_map_on_packet(map, 0, &st, t);
+}
+
+static const char *const sched_config =
+    "[can]\n"
+    "interface = log:-\n"
+    "heartbeat_id = 0x701\n"
+    "heartbeat_period_ms = 100\n"
+    "stale_after_ms = 50\n"
+    "[frame fast]\n"
+    "id = 0x181\n"
+    "period_ms = 10\n"
+    "alive_counter = 60\n"
+    "validity_bit = 59\n"
+    "stale_policy = invalid\n"
+    "signal = q_actual[0] @0|16 intel signed factor=0.001\n"
+    "[frame slow]\n"
+    "id = 0x281\n"
+    "period_ms = 20\n"
+    "stale_after_ms = 30\n"
+    "signal = robot_mode @0|8 intel signed\n"
+    "[frame each]\n"
+    "id = 0x381\n"
+    "period_ms = every\n"
+    "signal = time @0|32 intel unsigned factor=0.001\n";
+
+static struct capture cap;
+
+static void test_schedule(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    uint64_t t;
+    uint64_t last_packet = 0;
+    size_t i;
+    size_t fast = 0, slow = 0, each = 0, hb = 0;
+    int packets = 0;
+    bool ok_valid = true, ok_alive = true, ok_fast_t = true, ok_q = true, ok_each = true;
+    int rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "schedule config: %s", err);
+    if (rc != 0) {
+        return;
+    }
+    memset(&cap, 0, sizeof cap);
+    CHECK(can_map_deadline(&map) == CAN_MAP_NOT_SCHEDULED, "no deadline before start");
+    can_map_start(&map, 0);
+    /* Packets every 8 ms from 1 ms to 97 ms; due() every millisecond to 300 ms. */
+    for (t = 0; t < 300000; t += 1000) {
+        cap.now = t;
+        if (t % 8000 == 1000 && t < 100000) {
+            packet(&map, t, 1.234, 7, true);
+            last_packet = t;
+            packets++;
+        }
+        can_map_due(&map, t, NULL, capture_frame, &cap);
+        if (t == 50000) {
+            /* Next: fast at 60, slow at 61 (started at the first packet, 1 ms), heartbeat at 100. */
+            CHECK_EQ_INT(can_map_deadline(&map), 60000);
+        }
+    }
+    (void)last_packet;
+    for (i = 0; i < cap.n; i++) {
+        const struct sent *s = &cap.s[i];
+        switch (s->f.id) {
+        case 0x181: {
+            bool has = s->t >= 1000;
+            uint64_t age = has ? s->t - (s->t >= 97000 ? 97000 : ((s->t - 1000) / 8000) * 8000 + 1000) : 0;
+            bool want_valid = has && age <= 50000;
+            ok_fast_t &= s->t == fast * 10000;
+            ok_alive &= bits_of(&s->f, 60, 4) == fast % 16;
+            ok_valid &= bits_of(&s->f, 59, 1) == (want_valid ? 1u : 0u);
+            /* Before data: NaN packs physical 0; after: 1.234 -> 1234. */
+            ok_q &= bits_of(&s->f, 0, 16) == (has ? 1234u : 0u);
+            fast++;
+            break;
+        }
+        case 0x281:
+            /* Started by the first packet at 1 ms; every 20 ms; stops once
+             * the data is older than 30 ms: the last packet is at 97 ms, so
+             * 121 (age 24) is sent and 141 (age 44) is not. */
+            CHECK(s->t == 1000 + slow * 20000, "slow frame %zu at %llu", slow, (unsigned long long)s->t);
+            CHECK(s->f.data[0] == 7 && s->f.len == 8, "slow frame carries robot mode 7");
+            slow++;
+            break;
+        case 0x381:
+            ok_each &= s->t % 8000 == 1000 && bits_of(&s->f, 0, 32) == s->t / 1000;
+            each++;
+            break;
+        case 0x701:
+            CHECK(s->t == hb * 100000, "heartbeat %zu at %llu", hb, (unsigned long long)s->t);
+            CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_ALIVE), hb);
+            if (hb == 0) {
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_STATE), CAN_MAP_STATE_STARTING);
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_ROBOT_MODE), CAN_MAP_HB_ROBOT_MODE_NA);
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_SAFETY_MODE), CAN_MAP_HB_SAFETY_MODE_NA);
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_DATA_AGE), 65535);
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_GENERATION), 0);
+            } else if (hb == 1) {
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_STATE), CAN_MAP_STATE_OK);
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_ROBOT_MODE), 7);
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_SAFETY_MODE), 1);
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_DATA_AGE), 3); /* last packet at 97 ms */
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_GENERATION), 3);
+            } else {
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_STATE), CAN_MAP_STATE_DATA_STALE);
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_DATA_AGE), 103);
+            }
+            CHECK(s->f.len == 8 && !s->f.fd && !s->f.extended, "heartbeat frame shape");
+            hb++;
+            break;
+        default: CHECK(false, "unexpected id 0x%X", (unsigned)s->f.id);
+        }
+    }
+    CHECK_EQ_INT(fast, 30);
+    CHECK(ok_fast_t, "fast frames every 10 ms from 0");
+    CHECK(ok_alive, "alive counter 0..15, 0, ...");
+    CHECK(ok_valid, "validity bit follows data age (50 ms) and data presence");
+    CHECK(ok_q, "fast frame payload");
+    CHECK_EQ_INT(slow, 7); /* 1, 21, 41, 61, 81, 101, 121 */
+    CHECK_EQ_INT(each, packets);
+    CHECK(ok_each, "every-packet frames at the packets, with their time");
+    CHECK_EQ_INT(hb, 3);
+
+    /* Data comes back: the slow frame resumes at once, then every 20 ms. */
+    cap.n = 0;
+    for (t = 300000; t < 345000; t += 1000) {
+        cap.now = t;
+        if (t == 305000) {
+            packet(&map, t, -1.0, 5, true);
+        }
+        can_map_due(&map, t, NULL, capture_frame, &cap);
+    }
+    {
+        uint64_t slow_at[8];
+        size_t ns = 0;
+        for (i = 0; i < cap.n; i++) {
+            if (cap.s[i].f.id == 0x281 && ns < 8) {
+                slow_at[ns++] = cap.s[i].t;
+            }
+        }
+        CHECK(ns == 2 && slow_at[0] == 305000 && slow_at[1] == 325000, "slow resumes: %zu frames, first at %llu", ns,
+              ns ? (unsigned long long)slow_at[0] : 0ull);
+        /* 345: the 325 one was the last within 30 ms of data at 305 (age 20) */
+    }
+    /* A stalled loop: one frame per frame, not a burst of the missed slots. */
+    cap.n = 0;
+    cap.now = 1000000;
+    can_map_due(&map, 1000000, NULL, capture_frame, &cap);
+    {
+        size_t nfast = 0, nhb = 0;
+        for (i = 0; i < cap.n; i++) {
+            nfast += cap.s[i].f.id == 0x181;
+            nhb += cap.s[i].f.id == 0x701;
+        }
+        CHECK(nfast == 1 && nhb == 1 && cap.n == 2, "after a stall: %zu fast, %zu heartbeats, %zu frames", nfast, nhb,
+              cap.n);
+        CHECK_EQ_INT(can_map_deadline(&map), 1010000);
+    }
+    can_map_free(&map);
+}
+
+/* Saturation, NaN and link statistics in the frames and the heartbeat. */
+static void test_validity_and_heartbeat(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    urrt_can_stats stats;
+    size_t i;
+    int rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    if (rc != 0) {
+        return;
+    }
+    memset(&stats, 0, sizeof stats);
+    memset(&cap, 0, sizeof cap);
+    can_map_start(&map, 0);
+    /* In range: valid. */
+    packet(&map, 1000, 2.0, 7, true);
+    cap.now = 1000;
+    can_map_due(&map, 1000, &stats, capture_frame, &cap);
+    /* 40.0 rad does not fit 16 signed bits at 0.001: saturated, invalid. */
+    packet(&map, 9000, 40.0, 7, true);
+    cap.now = 10000;
+    can_map_due(&map, 10000, &stats, capture_frame, &cap);
+    /* q absent from the packet (NaN): invalid, payload carries physical 0. */
+    packet(&map, 17000, 0, 7, false);
+    cap.now = 20000;
+    can_map_due(&map, 20000, &stats, capture_frame, &cap);
+    /* In range again: valid. */
+    packet(&map, 25000, -2.0, 7, true);
+    cap.now = 30000;
+    can_map_due(&map, 30000, &stats, capture_frame, &cap);
+    {
+        int k = 0;
+        const uint64_t want_q[] = {2000, 32767, 0, (uint64_t)(65536 - 2000)};
+        const unsigned want_valid[] = {1, 0, 0, 1};
+        for (i = 0; i < cap.n; i++) {
+            if (cap.s[i].f.id != 0x181 || cap.s[i].t == 0) {
+                continue;
+            }
+            if (k < 4) {
+                CHECK(bits_of(&cap.s[i].f, 0, 16) == want_q[k] && bits_of(&cap.s[i].f, 59, 1) == want_valid[k],
+                      "frame %d: q raw %llu valid %llu", k, (unsigned long long)bits_of(&cap.s[i].f, 0, 16),
+                      (unsigned long long)bits_of(&cap.s[i].f, 59, 1));
+            }
+            k++;
+        }
+        CHECK_EQ_INT(k, 4);
+    }
+    /* Heartbeat flags say "since the previous heartbeat". */
+    stats.dropped = 70000;
+    stats.bus_off = 1;
+    cap.n = 0;
+    cap.now = 100000;
+    packet(&map, 99000, 1, 7, true);
+    can_map_due(&map, 100000, &stats, capture_frame, &cap);
+    for (i = 0; i < cap.n && cap.s[i].f.id != 0x701; i++) {
+    }
+    CHECK(i < cap.n, "heartbeat at 100 ms");
+    if (i < cap.n) {
+        const urrt_can_frame *f = &cap.s[i].f;
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_DROPS), 70000 % 65536);
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_TX_DROPPED), 1);
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_BUS_OFF), 1);
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_CAN_ERRORS), 0);
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_CLAMPED), 1); /* 40 rad and NaN since start */
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_DATA_AGE), 1);
+    }
+    stats.error_frames = 3;
+    stats.down_events = 1;
+    stats.send_errors = 2;
+    cap.n = 0;
+    cap.now = 200000;
+    packet(&map, 199000, 1, 7, true);
+    can_map_due(&map, 200000, &stats, capture_frame, &cap);
+    for (i = 0; i < cap.n && cap.s[i].f.id != 0x701; i++) {
+    }
+    if (i < cap.n) {
+        const urrt_can_frame *f = &cap.s[i].f;
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_DROPS), 70000 % 65536);
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_TX_DROPPED), 0);
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_BUS_OFF), 0);
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_CAN_ERRORS), 1);
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_CAN_DOWN), 1);
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_SEND_ERRORS), 1);
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_CLAMPED), 0);
+        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_STATE), CAN_MAP_STATE_OK);
+    } else {
+        CHECK(false, "heartbeat at 200 ms");
+    }
+    /* The link goes down: disconnected, whatever the age. */
+    can_map_robot_link(&map, 0, false);
+    CHECK_EQ_INT(can_map_state(&map, 200500), CAN_MAP_STATE_DISCONNECTED);
+    {
+        urrt_can_frame f;
+        can_map_heartbeat_frame(&map, 200500, &stats, &f);
+        CHECK_EQ_INT(hb_value(&f, CAN_MAP_HB_STATE), CAN_MAP_STATE_DISCONNECTED);
+        CHECK(f.id == 0x701 && f.len == 8, "heartbeat_frame id and length");
+    }
+    /* Data age saturates at 65534 ms. */
+    CHECK_EQ_INT(can_map_state(&map, 100000000), CAN_MAP_STATE_DISCONNECTED);
+    {
+        urrt_can_frame f;
+        can_map_heartbeat_frame(&map, 100000000, &stats, &f);
+        CHECK_EQ_INT(hb_value(&f, CAN_MAP_HB_DATA_AGE), 65534);
+    }
+    can_map_free(&map);
+
+    /* Starting: at most CAN_MAP_STARTUP_MS without data, then disconnected
+     * (link not up) or stale (link up but silent). */
+    rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
+    can_map_start(&map, 1000);
+    CHECK_EQ_INT(can_map_state(&map, 1000 + 4999000), CAN_MAP_STATE_STARTING);
+    CHECK_EQ_INT(can_map_state(&map, 1000 + 5000000), CAN_MAP_STATE_DISCONNECTED);
+    can_map_robot_link(&map, 0, true);
+    CHECK_EQ_INT(can_map_state(&map, 1000 + 5000000), CAN_MAP_STATE_DATA_STALE);
+    can_map_free(&map);
+}
+
+/* The heartbeat goes at least once a second, whatever the loop's rhythm. */
+static void test_heartbeat_rate(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    uint64_t t;
+    uint64_t prev = 0;
+    uint64_t worst_gap = 0;
+    size_t i;
+    int n = 0;
+    int rc = load(&map,
+                  CAN_HEAD "heartbeat_period_ms = 1000\n[frame a]\nid = 0x100\nperiod_ms = 500\n"
+                           "signal = time @0|8 intel unsigned\n",
+                  one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    memset(&cap, 0, sizeof cap);
+    /* The loop wakes at the map's deadline, a little late each time. */
+    t = 5000;
+    for (i = 0; i < 200 && t < 20000000; i++) {
+        uint64_t d;
+        cap.now = t;
+        can_map_due(&map, t, NULL, capture_frame, &cap);
+        d = can_map_deadline(&map);
+        CHECK(d > t && d != CAN_MAP_NOT_SCHEDULED, "deadline %llu after %llu", (unsigned long long)d,
+              (unsigned long long)t);
+        t = d + 700; /* late by 0.7 ms */
+    }
+    for (i = 0; i < cap.n; i++) {
+        if (cap.s[i].f.id == 0x701) {
+            if (n > 0 && cap.s[i].t - prev > worst_gap) {
+                worst_gap = cap.s[i].t - prev;
+            }
+            prev = cap.s[i].t;
+            n++;
+        }
+    }
+    CHECK(n >= 19, "%d heartbeats in 20 s", n);
+    CHECK(worst_gap <= 1000700, "largest gap between heartbeats %llu us", (unsigned long long)worst_gap);
+    can_map_free(&map);
+}
+
+/* DBC text spot checks (the full comparison is check-can-dbc). */
+static void test_dbc_text(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    char *text = NULL;
+    size_t size = 0;
+    FILE *f;
+    char num[40];
+    int rc = load(&map, good_config, one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    f = open_memstream(&text, &size);
+    CHECK_EQ_INT(dbc_write(f, &map, "t.ini"), 0);
+    fclose(f);
+    CHECK(strstr(text, "BO_ 385 joints: 8 URRT_GATEWAY\n") != NULL, "joints BO_");
+    CHECK(strstr(text, " SG_ q_actual_0 : 0|16@1- (0.0001,0) [-3.2768|3.2767] \"rad\" Vector__XXX\n") != NULL,
+          "q_actual_0 SG_");
+    CHECK(strstr(text, " SG_ rx : 39|16@0- (0.0001,0) [-3.2768|3.2767] \"rad\" Vector__XXX\n") != NULL, "rx SG_");
+    CHECK(strstr(text, " SG_ alive_counter : 56|4@1+ (1,0) [0|15] \"\" Vector__XXX\n") != NULL, "alive SG_");
+    CHECK(strstr(text, "BO_ 2566848640 status: 4 URRT_GATEWAY\n") != NULL, "extended id flagged");
+    CHECK(strstr(text, "BA_ \"VFrameFormat\" BO_ 2566848640 1;\n") != NULL, "ExtendedCAN");
+    CHECK(strstr(text, "BA_ \"GenMsgCycleTime\" BO_ 385 10;\n") != NULL, "cycle time");
+    CHECK(strstr(text, "BA_ \"GenMsgCycleTime\" BO_ 2566848640 8;\n") != NULL, "every packet at 125 Hz: 8 ms");
+    CHECK(strstr(text, "VAL_ 2566848640 robot_mode -1 \"NO_CONTROLLER\" 0 \"DISCONNECTED\"") != NULL, "robot mode VAL_");
+    CHECK(strstr(text, "VAL_ 1793 state 0 \"STARTING\" 1 \"OK\" 2 \"DATA_STALE\" 3 \"ROBOT_DISCONNECTED\" ;") != NULL,
+          "heartbeat state VAL_");
+    CHECK(strstr(text, "VAL_ 1793 robot_mode -128 \"NOT_AVAILABLE\" -1 \"NO_CONTROLLER\"") != NULL, "hb robot mode");
+    free(text);
+    can_map_free(&map);
+    CHECK_EQ_STR(dbc_number(0.1, num, sizeof num), "0.1");
+    CHECK_EQ_STR(dbc_number(-3276.8, num, sizeof num), "-3276.8");
+    CHECK_EQ_STR(dbc_number(1e-5, num, sizeof num), "1e-05");
+    CHECK_EQ_STR(dbc_number(3.4028234663852886e+38, num, sizeof num), "3.4028234663852886e+38");
+    CHECK(strtod(dbc_number(0.1 + 0.2, num, sizeof num), NULL) == 0.1 + 0.2, "shortest round trip %s", num);
+}
+
+int main(void)
+{
+    test_placement();
+    test_values();
+    test_round_trip();
+    test_layout();
+    test_frame_bits();
+    test_config_good();
+    test_config_rejections();
+    test_config_robots();
+    test_bus_load();
+    test_schedule();
+    test_validity_and_heartbeat();
+    test_heartbeat_rate();
+    test_dbc_text();
+    return check_report();
+}
