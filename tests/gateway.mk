@@ -26,5 +26,11 @@ check-gateway: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim $(GWT)/lcm_sub $(
 	$(PYTHON) tests/gateway/test_gateway.py --build $(BUILD) --result $(BUILD)/results/check-gateway.result \
 	  --port-base 41000
 
+# Every message at every packet (the issue's case), then the focused messages
+# at 50 Hz and no full state: what framing and decoding alone sustain.
 bench-gateway: $(BUILD)/bin/urrt-gateway $(GWT)/bench_gateway
-	$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --port 41500
+	@echo "bench-gateway: all messages at every packet"
+	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --port 41500
+	@echo "bench-gateway: focused messages at 50 Hz, no full state"
+	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --port 41501 --focused-hz 50 --seconds 3 \
+	  | sed 's/^/decimated_/'
