@@ -18,6 +18,15 @@ URRT_FIELDS(URRT_X_GRID_CHECK)
 #undef URRT_X_GRID_CHECK
 URRT_STATIC_ASSERT(grid_is_152_columns,
                    offsetof(urrt_state, unused_53) == URRT_WIRE_COLUMNS * sizeof(double));
+/* The fields only 1.x has follow the grid, back to back, so the 3.x decoder
+ * clears them with one fill. */
+#define URRT_1X_ONLY_DOUBLES 27u
+URRT_STATIC_ASSERT(one_x_only_fields_contiguous,
+                   offsetof(urrt_state, tool_vector) == offsetof(urrt_state, unused_53) + 15 * sizeof(double) &&
+                       offsetof(urrt_state, tcp_speed) == offsetof(urrt_state, tool_vector) + 6 * sizeof(double) &&
+                       offsetof(urrt_state, tcp_speed) + 6 * sizeof(double) ==
+                           offsetof(urrt_state, unused_53) + URRT_1X_ONLY_DOUBLES * sizeof(double) &&
+                       URRT_F_TCP_SPEED == URRT_FIELD_COUNT - 1);
 
 #define URRT_X_COUNT_CHECK(ID, name, count, c1, c3, unit, since, desc) \
     URRT_STATIC_ASSERT(count_##name, (count) <= URRT_FIELD_COUNT_MAX);
@@ -44,10 +53,27 @@ static uint32_t load_be32(const uint8_t *p)
     return ((uint32_t)p[0] << 24) | ((uint32_t)p[1] << 16) | ((uint32_t)p[2] << 8) | (uint32_t)p[3];
 }
 
+#if defined(__GNUC__) && defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__)
+#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define URRT_LOAD_BE64_BUILTIN 1
+#endif
+#endif
+
+#ifdef URRT_LOAD_BE64_BUILTIN
+/* GCC and clang: an unaligned 8-byte load (a fixed-size __builtin_memcpy is
+ * always inlined, never a libc call) and a byte swap the vectoriser knows. */
+static uint64_t load_be64(const uint8_t *p)
+{
+    uint64_t v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return __builtin_bswap64(v);
+}
+#else
 static uint64_t load_be64(const uint8_t *p)
 {
     return ((uint64_t)load_be32(p) << 32) | (uint64_t)load_be32(p + 4);
 }
+#endif
 
 static void store_be64(uint8_t *p, uint64_t v)
 {
@@ -307,30 +333,115 @@ void urrt_state_clear(urrt_state *st)
     st->generation = URRT_GEN_UNKNOWN;
 }
 
+/* Number of grid fields (the rows with a 3.x/5.x column, which come first). */
+static const unsigned grid_fields = 0u
+#define URRT_X_GRID_COUNT(ID, name, count, c1, c3, unit, since, desc) + ((c3) != 0 ? 1u : 0u)
+    URRT_FIELDS(URRT_X_GRID_COUNT)
+#undef URRT_X_GRID_COUNT
+    ;
+
+/*
+ * Vector byte swap for the grid copy, where the compiler offers portable
+ * vector extensions (GCC, clang) and the target has a byte shuffle: x86
+ * SSSE3 (-march=x86-64-v2), AVX2 (-march=x86-64-v3 or native), ARM NEON.
+ * Elsewhere the copy is one 8-byte load and swap per double.
+ */
+#if defined(__GNUC__) && (defined(__SSSE3__) || defined(__ARM_NEON))
+#define URRT_VECTOR 1
+#if defined(__AVX2__)
+#define URRT_VECTOR_BYTES 32
+#else
+#define URRT_VECTOR_BYTES 16
+#endif
+#define URRT_VECTOR_DOUBLES (URRT_VECTOR_BYTES / 8)
+typedef unsigned char urrt_bytes_v __attribute__((vector_size(URRT_VECTOR_BYTES)));
+typedef uint64_t urrt_u64_v __attribute__((vector_size(URRT_VECTOR_BYTES)));
+#if URRT_VECTOR_BYTES == 32
+#define URRT_SWAP_INDEX 7, 6, 5, 4, 3, 2, 1, 0, 15, 14, 13, 12, 11, 10, 9, 8, \
+                        23, 22, 21, 20, 19, 18, 17, 16, 31, 30, 29, 28, 27, 26, 25, 24
+#else
+#define URRT_SWAP_INDEX 7, 6, 5, 4, 3, 2, 1, 0, 15, 14, 13, 12, 11, 10, 9, 8
+#endif
+#if defined(__clang__)
+#define URRT_SWAP64(v) __builtin_shufflevector((v), (v), URRT_SWAP_INDEX)
+#else
+#define URRT_SWAP64(v) __builtin_shuffle((v), (urrt_bytes_v){URRT_SWAP_INDEX})
+#endif
+#endif
+
+/* n big-endian doubles from src into dst. */
+static void load_doubles(double *dst, const uint8_t *src, unsigned n)
+{
+    unsigned i = 0;
+#ifdef URRT_VECTOR
+    for (; i + 2u * URRT_VECTOR_DOUBLES <= n; i += 2u * URRT_VECTOR_DOUBLES) {
+        urrt_bytes_v a, b;
+        __builtin_memcpy(&a, src + 8u * i, sizeof a);
+        __builtin_memcpy(&b, src + 8u * i + URRT_VECTOR_BYTES, sizeof b);
+        a = URRT_SWAP64(a);
+        b = URRT_SWAP64(b);
+        __builtin_memcpy(&dst[i], &a, sizeof a);
+        __builtin_memcpy(&dst[i + URRT_VECTOR_DOUBLES], &b, sizeof b);
+    }
+    if (i + URRT_VECTOR_DOUBLES <= n) {
+        urrt_bytes_v a;
+        __builtin_memcpy(&a, src + 8u * i, sizeof a);
+        a = URRT_SWAP64(a);
+        __builtin_memcpy(&dst[i], &a, sizeof a);
+        i += URRT_VECTOR_DOUBLES;
+    }
+#endif
+    for (; i < n; i++) {
+        dst[i] = double_from_bits(load_be64(src + 8u * i));
+    }
+}
+
+/* fill_nan for the hot path: whole vectors where there are any. */
+static void fill_nan_fast(double *p, unsigned count)
+{
+    unsigned i = 0;
+#ifdef URRT_VECTOR
+    urrt_u64_v nan;
+    for (i = 0; i < URRT_VECTOR_DOUBLES; i++) {
+        nan[i] = URRT_NAN_BITS;
+    }
+    /* Single stores up to a vector boundary: a vector store that straddles
+     * cache lines costs two. */
+    for (i = 0; i < count && ((uintptr_t)(void *)&p[i] & (URRT_VECTOR_BYTES - 1u)) != 0; i++) {
+        p[i] = double_from_bits(URRT_NAN_BITS);
+    }
+    for (; i + URRT_VECTOR_DOUBLES <= count; i += URRT_VECTOR_DOUBLES) {
+        __builtin_memcpy(&p[i], &nan, sizeof nan);
+    }
+#endif
+    fill_nan(p + i, count - i);
+}
+
 /* The hot path (e-series at 500 Hz): one pass over the grid. */
 static void decode_3x(const uint8_t *body, unsigned doubles, urrt_state *st)
 {
     unsigned known = doubles < URRT_WIRE_COLUMNS ? doubles : URRT_WIRE_COLUMNS;
-    unsigned col;
-    unsigned id;
-    uint64_t present = 0;
+    unsigned present_fields = grid_fields;
 
-    for (col = 1; col <= known; col++) {
-        *grid_slot(st, col) = double_from_bits(load_be64(body + 8u * (col - 1u)));
-    }
-    /* Grid fields are in column order, so the present ones are a prefix. */
-    for (id = 0; id < (unsigned)URRT_FIELD_COUNT && field_table[id].col_3x != 0; id++) {
-        const urrt_field_info *f = &field_table[id];
-        if (!field_fits(f, f->col_3x, doubles, URRT_GEN_3X)) {
-            fill_nan(grid_slot(st, f->col_3x), URRT_WIRE_COLUMNS + 1u - f->col_3x);
+    load_doubles(grid_slot(st, 1), body, known);
+    /* Grid fields are in column order and end in ascending columns, so the
+     * whole ones are a prefix: walk back from the last until one fits (no
+     * step at all for 1220 bytes, four for 1116). */
+    while (present_fields > 0) {
+        const urrt_field_info *f = &field_table[present_fields - 1u];
+        if (f->col_3x + f->count - 1u <= known) {
             break;
         }
-        present |= UINT64_C(1) << id;
+        present_fields--;
     }
-    fill_nan(st->unused_53, 15);
-    fill_nan(st->tool_vector, 6);
-    fill_nan(st->tcp_speed, 6);
-    st->present = present;
+    /* Absent grid columns and the 1.x-only fields that follow the grid in
+     * the struct (asserted above) get NaN in one run. */
+    {
+        unsigned first_nan = present_fields < grid_fields ? field_table[present_fields].col_3x
+                                                           : URRT_WIRE_COLUMNS + 1u;
+        fill_nan_fast(grid_slot(st, first_nan), URRT_WIRE_COLUMNS + 1u - first_nan + URRT_1X_ONLY_DOUBLES);
+    }
+    st->present = present_fields >= 64u ? ~UINT64_C(0) : (UINT64_C(1) << present_fields) - 1u;
     st->extra_columns = (uint16_t)(doubles - known);
 }
 
@@ -641,6 +752,9 @@ void urrt_framer_reset(urrt_framer *fr)
 
 static bool header_acceptable(const urrt_framer *fr, uint32_t size)
 {
+    if (size == fr->last_length && size != 0) {
+        return true; /* the usual case: only plausible sizes are remembered */
+    }
     if (!plausible_length(size)) {
         return false;
     }

@@ -38,13 +38,21 @@ $(LIBT)/test_lib: tests/lib/test_lib.c tests/check.h $(LIBURRT) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_TEST_CFLAGS) $(OPT) $< $(LIBURRT) -lm -o $@
 
-# The sanitizer build compiles lib/ itself with the sanitizers too.
+# The sanitizer build compiles lib/ itself with the sanitizers too, for this
+# machine's CPU, so that the vector paths of the decoder (AVX2, NEON) run
+# under the sanitizers while check-lib covers the portable path.
 $(LIBT)/test_lib_san: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(LIB_TEST_CFLAGS) -O1 -g $(SAN_FLAGS) $< $(LIB_SRCS) -lm -o $@
+	$(CC) $(LIB_TEST_CFLAGS) -O1 -g -march=native $(SAN_FLAGS) $< $(LIB_SRCS) -lm -o $@
 
-check-lib: $(LIBT)/test_lib $(LIB_VECTORS)
-	$(call lib_suite,check-lib,$(LIBT)/test_lib $(LIB_VECTORS))
+# On x86-64 also the 16-byte (SSSE3) vector path.
+LIB_TEST_SSSE3 := $(if $(filter x86_64,$(shell uname -m)),$(LIBT)/test_lib_ssse3)
+$(LIBT)/test_lib_ssse3: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LIB_TEST_CFLAGS) $(OPT) -mssse3 $< $(LIB_SRCS) -lm -o $@
+
+check-lib: $(LIBT)/test_lib $(LIB_TEST_SSSE3) $(LIB_VECTORS)
+	$(call lib_suite,check-lib,sh tests/lib/run_all.sh $(LIB_VECTORS) $(LIBT)/test_lib $(LIB_TEST_SSSE3))
 
 check-lib-san: $(LIBT)/test_lib_san $(LIB_VECTORS)
 	$(call lib_suite,check-lib-san,ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $(LIBT)/test_lib_san $(LIB_VECTORS))
@@ -77,7 +85,7 @@ FUZZ_CHECK_SECONDS ?= 15
 
 $(LIBT)/fuzz_lib: tests/lib/fuzz_lib.c $(LIB_SRCS) $(LIB_HDRS)
 	@mkdir -p $(@D)
-	$(FUZZ_CC) -std=c99 -Wall -Wextra -Werror -g -O1 -fsanitize=fuzzer,address,undefined \
+	$(FUZZ_CC) -std=c99 -Wall -Wextra -Werror -g -O1 -march=native -fsanitize=fuzzer,address,undefined \
 	  -fno-sanitize-recover=all $(CPPFLAGS) $< $(LIB_SRCS) -o $@
 
 check-fuzz-lib: $(LIBT)/fuzz_lib $(LIB_VECTORS)
@@ -90,3 +98,13 @@ fuzz-lib: $(LIBT)/fuzz_lib $(LIB_VECTORS)
 	sh tests/lib/fuzz.sh $(LIBT)/fuzz_lib $(LIB_CORPUS) $(LIBT)/fuzz $(FUZZ_SECONDS)
 
 fuzz: fuzz-lib
+
+# ---- benchmark -----------------------------------------------------------------
+
+# Built with $(OPT), the flags README.md recommends for an edge box.
+$(LIBT)/bench_lib: tests/lib/bench_lib.c $(LIBURRT) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LIB_TEST_CFLAGS) $(OPT) -DURRT_BENCH_FLAGS='"$(OPT)"' $< $(LIBURRT) -o $@
+
+bench-lib: $(LIBT)/bench_lib
+	@$(LIBT)/bench_lib

@@ -48,7 +48,22 @@ undefined() {
   ${CROSS}gcc $LDFLAGS "$@" -o "$out/probe-link.elf" 2>&1 |
     sed -n "s/.*undefined reference to \`\([^']*\)'.*/\1/p"
 }
-needed=$( { undefined "$out/startup.o" $objs; undefined "$out/startup.o" $objs $roots; } | sort -u)
+# GCC may also emit calls at -O2 that -Os does not (memset/memcpy for fill
+# and copy loops are its documented freestanding requirement): compile each
+# file at -O2 too and add what those objects leave undefined.
+o2_needed=""
+for src in "$@"; do
+  o2="$out/$(basename "$src" .c).O2.o"
+  if ${CROSS}gcc $(echo "$CFLAGS" | sed 's/-Os/-O2/') -c "$src" -o "$o2"; then
+    o2_needed="$o2_needed $(${CROSS}nm -u "$o2" | awk '{ print $2 }')"
+  else
+    fail "$src does not compile for Cortex-M4 at -O2"
+  fi
+done
+defined=$(${CROSS}nm -g --defined-only $objs | awk 'NF == 3 { print $3 }')
+o2_needed=$(for s in $o2_needed; do echo "$defined" | grep -qx "$s" || echo "$s"; done)
+needed=$( { undefined "$out/startup.o" $objs; undefined "$out/startup.o" $objs $roots;
+            for s in $o2_needed; do echo "$s"; done; } | sort -u)
 listed=$(sed -n '/<!-- cross-symbols:begin/,/<!-- cross-symbols:end/p' "$readme" |
          sed -n 's/^| *`\([A-Za-z_][A-Za-z0-9_]*\)`.*/\1/p' | sort -u)
 echo "cross: symbols lib/ needs from the toolchain: $(echo $needed)"

@@ -1,0 +1,271 @@
+/*
+ * Benchmark of lib/ (make bench): nanoseconds per packet, each beside a
+ * memcpy of the same bytes measured in the same run, and the ratio to it.
+ * Never a test: it prints `name: value` lines and asserts nothing.
+ *
+ * Each figure is the best of several batches (the least disturbed by the
+ * rest of the machine); the subject and its memcpy baseline alternate batch
+ * by batch so that both see the same conditions. Results are kept alive with
+ * a compiler barrier on the output memory and a checksum written to a
+ * volatile, so no work can be optimised away; lib/ is a separate
+ * translation unit in a static library, so its calls cannot be elided
+ * either.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "urrt.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define BATCHES 15
+#define BATCH_NS 10000000.0 /* about 10 ms per batch */
+#define STREAM_PACKETS 59   /* 59 x 1116 bytes: just over 64 KiB */
+
+/* Tells the compiler that memory at p is read: stores to it must happen. */
+#define USE(p) __asm__ volatile("" : : "r"(p) : "memory")
+
+static volatile uint64_t checksum;
+
+static double now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
+}
+
+/* Runs about `iterations` units of work and returns how many it did. */
+typedef size_t (*bench_fn)(void *ctx, size_t iterations);
+
+/* Iterations that take about BATCH_NS. */
+static size_t calibrate(bench_fn fn, void *ctx)
+{
+    size_t n = 16;
+    for (;;) {
+        double t0 = now_ns();
+        size_t done = fn(ctx, n);
+        double dt = (now_ns() - t0) * (double)n / (double)done;
+        if (dt > BATCH_NS / 4 || n > ((size_t)1 << 30)) {
+            return (size_t)((double)n * BATCH_NS / (dt > 1 ? dt : 1)) + 1;
+        }
+        n *= 4;
+    }
+}
+
+/* Best ns per iteration of subject and baseline, batches interleaved. */
+static void measure(bench_fn subject, void *sctx, bench_fn baseline, void *bctx, double *s_ns, double *b_ns)
+{
+    size_t ns = calibrate(subject, sctx), nb = calibrate(baseline, bctx);
+    *s_ns = *b_ns = 1e300;
+    for (int i = 0; i < BATCHES; i++) {
+        double t0 = now_ns();
+        size_t ds = subject(sctx, ns);
+        double t1 = now_ns();
+        size_t db = baseline(bctx, nb);
+        double t2 = now_ns();
+        if ((t1 - t0) / (double)ds < *s_ns) *s_ns = (t1 - t0) / (double)ds;
+        if ((t2 - t1) / (double)db < *b_ns) *b_ns = (t2 - t1) / (double)db;
+    }
+}
+
+/* ---- subjects ------------------------------------------------------------- */
+
+#define VARIANTS 8 /* distinct packets, so that no result is the same twice */
+
+typedef struct packets {
+    uint8_t bytes[VARIANTS][URRT_PACKET_KNOWN_MAX];
+    size_t length;
+} packets;
+
+static uint8_t copy_target[1 << 17];
+
+static size_t bench_memcpy(void *ctx, size_t n)
+{
+    const packets *p = ctx;
+    for (size_t i = 0; i < n; i++) {
+        memcpy(copy_target, p->bytes[i % VARIANTS], p->length);
+        USE(copy_target);
+    }
+    checksum += copy_target[12];
+    return n;
+}
+
+static urrt_state state;
+
+static size_t bench_decode(void *ctx, size_t n)
+{
+    const packets *p = ctx;
+    uint64_t sum = 0;
+    for (size_t i = 0; i < n; i++) {
+        sum += (uint64_t)urrt_decode(p->bytes[i % VARIANTS], p->length, &state);
+        USE(&state);
+        sum += state.present;
+    }
+    checksum += sum;
+    return n;
+}
+
+static const urrt_field_id read_fields[10] = {
+    URRT_F_TIME, URRT_F_Q_ACTUAL, URRT_F_QD_ACTUAL, URRT_F_TOOL_VECTOR_ACTUAL, URRT_F_TCP_FORCE,
+    URRT_F_ROBOT_MODE, URRT_F_SAFETY_MODE, URRT_F_DIGITAL_INPUT_BITS, URRT_F_PROGRAM_STATE, URRT_F_SAFETY_STATUS,
+};
+
+static size_t bench_read10(void *ctx, size_t n)
+{
+    const packets *p = ctx;
+    double values[10];
+    for (size_t i = 0; i < n; i++) {
+        const uint8_t *pkt = p->bytes[i % VARIANTS];
+        for (unsigned f = 0; f < 10; f++) {
+            urrt_read(pkt, p->length, read_fields[f], f % 3, &values[f]);
+        }
+        USE(values);
+    }
+    checksum += (uint64_t)values[0];
+    return n;
+}
+
+typedef struct stream {
+    uint8_t *bytes;
+    size_t length;
+    size_t chunk;
+    size_t packets;
+} stream;
+
+static urrt_framer framer;
+
+/* One iteration = one packet's worth of the stream: the whole stream is fed
+ * in chunks, every packet decoded, and the time divided by its packets. */
+static size_t bench_framer(void *ctx, size_t n)
+{
+    const stream *s = ctx;
+    uint64_t sum = 0;
+    size_t rounds = (n + s->packets - 1) / s->packets;
+    for (size_t r = 0; r < rounds; r++) {
+        urrt_framer_init(&framer);
+        for (size_t at = 0; at < s->length;) {
+            size_t chunk = s->length - at < s->chunk ? s->length - at : s->chunk;
+            const uint8_t *p = s->bytes + at;
+            at += chunk;
+            while (chunk > 0) {
+                size_t used;
+                if (urrt_framer_feed(&framer, p, chunk, &used) > 0) {
+                    size_t len;
+                    const uint8_t *pkt = urrt_framer_packet(&framer, &len);
+                    sum += (uint64_t)urrt_decode(pkt, len, &state);
+                    USE(&state);
+                }
+                p += used;
+                chunk -= used;
+            }
+        }
+    }
+    checksum += sum;
+    return rounds * s->packets;
+}
+
+/* The baseline: the same bytes, memcpy'd a packet at a time. */
+static size_t bench_stream_memcpy(void *ctx, size_t n)
+{
+    const stream *s = ctx;
+    size_t per = s->length / s->packets;
+    size_t rounds = (n + s->packets - 1) / s->packets;
+    for (size_t r = 0; r < rounds; r++) {
+        for (size_t k = 0; k < s->packets; k++) {
+            memcpy(copy_target, s->bytes + k * per, per);
+            USE(copy_target);
+        }
+    }
+    checksum += copy_target[5];
+    return rounds * s->packets;
+}
+
+/* ---- setup ------------------------------------------------------------------ */
+
+static void make_packets(packets *p, uint32_t length)
+{
+    static urrt_state st;
+    uint64_t x = 0x243F6A8885A308D3u;
+    p->length = length;
+    for (int v = 0; v < VARIANTS; v++) {
+        urrt_state_clear(&st);
+        /* Plausible values: every double of the grid set. */
+        for (unsigned c = 0; c < URRT_WIRE_COLUMNS; c++) {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            ((double *)(void *)&st)[c] = (double)(x % 2000000) / 1000.0 - 1000.0;
+        }
+        st.robot_mode[0] = 7;
+        st.safety_mode[0] = 1;
+        if (urrt_encode(&st, length, p->bytes[v], sizeof p->bytes[v]) != (int)length) {
+            fprintf(stderr, "bench: encode failed\n");
+            exit(1);
+        }
+    }
+}
+
+static void report(const char *name, double subject, double baseline)
+{
+    printf("%s_ns: %.1f\n", name, subject);
+    printf("%s_memcpy_ns: %.1f\n", name, baseline);
+    printf("%s_ratio: %.2f\n", name, subject / baseline);
+}
+
+int main(void)
+{
+    static packets p1116, p1220;
+    static stream streams[3];
+    static const size_t chunks[3] = {1, 64, 65536};
+    double s, b;
+
+    make_packets(&p1116, 1116);
+    make_packets(&p1220, 1220);
+    printf("bench: ns per packet, best of %d batches; *_memcpy_ns is memcpy of the same bytes in the same run\n",
+           BATCHES);
+#ifdef URRT_BENCH_FLAGS
+    printf("bench_flags: %s\n", URRT_BENCH_FLAGS);
+#endif
+    {
+        FILE *f = fopen("/proc/cpuinfo", "r");
+        char line[256];
+        while (f != NULL && fgets(line, sizeof line, f) != NULL) {
+            if (strncmp(line, "model name", 10) == 0 && strchr(line, ':') != NULL) {
+                printf("bench_cpu: %s", strchr(line, ':') + 2);
+                break;
+            }
+        }
+        if (f != NULL) {
+            fclose(f);
+        }
+    }
+
+    measure(bench_decode, &p1116, bench_memcpy, &p1116, &s, &b);
+    report("decode_1116", s, b);
+    measure(bench_decode, &p1220, bench_memcpy, &p1220, &s, &b);
+    report("decode_1220", s, b);
+    measure(bench_read10, &p1116, bench_memcpy, &p1116, &s, &b);
+    report("read10_1116", s, b);
+
+    for (int i = 0; i < 3; i++) {
+        stream *st = &streams[i];
+        st->packets = STREAM_PACKETS;
+        st->length = STREAM_PACKETS * p1116.length;
+        st->chunk = chunks[i];
+        st->bytes = malloc(st->length);
+        for (size_t k = 0; k < STREAM_PACKETS; k++) {
+            memcpy(st->bytes + k * p1116.length, p1116.bytes[k % VARIANTS], p1116.length);
+        }
+        measure(bench_framer, st, bench_stream_memcpy, st, &s, &b);
+        {
+            char name[64];
+            snprintf(name, sizeof name, "framer_decode_1116_chunk_%zu", chunks[i]);
+            report(name, s, b);
+        }
+        free(st->bytes);
+    }
+    printf("bench_checksum: %llu\n", (unsigned long long)(checksum & 0xFFFF));
+    return 0;
+}
