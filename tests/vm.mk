@@ -16,7 +16,7 @@ VM_FILES += $(VMT)/can_link_test
 VM_MODULES += sch_plug
 
 CHECKS += check-can-log check-vm
-DEB_DEPS += xz-utils
+DEB_DEPS += qemu-system-x86 busybox-static cpio xz-utils iproute2 can-utils python3-can
 .PHONY: check-vm check-can-log vm-kernel
 
 $(VMT)/can_link_test: tests/vm/can_link_test.c tests/check.h port/port.h $(LIBPORT) $(LIBURRT)

@@ -11,6 +11,7 @@ out=$build/vm/check-vm
 names=''
 for t in $tests; do names="$names $(basename "$t")"; done
 
+rm -rf "$out" "$RESULT"
 start=$(date +%s.%N)
 "$here/run.sh" --out "$out" --script "$here/suite.sh" --timeout 90 \
   --files "$here/counts.sh tests/lib.sh $files $tests" --modules "$modules" \

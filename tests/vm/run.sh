@@ -88,14 +88,14 @@ need tc iproute2
 [ -x /bin/busybox ] || die "/bin/busybox is missing: apt-get install busybox-static"
 ldd /bin/busybox >/dev/null 2>&1 && die "/bin/busybox is not static: apt-get install busybox-static"
 
-kernel=$("$here/fetch-kernel.sh") || die "no kernel (see above)"
-
 if [ -z "$out" ]; then
   out=$(mktemp -d "${TMPDIR:-/tmp}/urrt-vm.XXXXXX")
 else
   rm -rf "$out"; mkdir -p "$out"
 fi
 out=$(cd "$out" && pwd)
+
+kernel=$("$here/fetch-kernel.sh") || die "no kernel (see above)"
 stage=$out/.initramfs
 mkdir -p "$stage"/{bin,sbin,usr/bin,usr/sbin,usr/local/bin,lib/modules,t,proc,sys,dev,tmp,run,out,vmres,etc}
 
