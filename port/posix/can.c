@@ -53,6 +53,7 @@ static const char REASON_IS_DOWN[] = "interface is down";
 static const char REASON_REMOVED[] = "interface removed";
 static const char REASON_MTU[] = "FD frames configured but the MTU is no longer 72";
 static const char REASON_REOPEN[] = "reopen failed";
+static const char REASON_NOT_CAN[] = "the name now belongs to an interface that is not CAN";
 
 typedef struct held_frame {
     urrt_can_frame frame;
@@ -342,10 +343,9 @@ static bool is_down_errno(int err)
     return err == ENETDOWN || err == ENXIO || err == ENODEV || err == ENETUNREACH;
 }
 
-/* The interface facts that decide whether a socket can work. With
- * log_config_errors, a missing or unsuitable interface is an error (at
- * creation); later it is an outage. Returns 1 when usable and up, 0 when
- * usable but down, -1 when unusable. */
+/* The interface facts that decide whether a socket can work. At creation a
+ * missing or unsuitable interface is a configuration error (-1); later it is
+ * part of an outage (0, logged once). Returns 1 when usable and up. */
 static int check_interface(urrt_can *can, int sock, bool at_creation, unsigned *ifindex)
 {
     struct ifreq ifr;
@@ -364,13 +364,21 @@ static int check_interface(urrt_can *can, int sock, bool at_creation, unsigned *
         return at_creation ? -1 : 0;
     }
     if (ioctl(sock, SIOCGIFHWADDR, &ifr) == 0 && ifr.ifr_hwaddr.sa_family != ARPHRD_CAN) {
+        if (!at_creation) {
+            log_down(can, URRT_LOG_ERR, REASON_NOT_CAN, NULL);
+            return 0;
+        }
         urrt_log(URRT_LOG_ERR, "CAN interface %s: not a CAN interface (link type %u)", can->ifname,
                  (unsigned)ifr.ifr_hwaddr.sa_family);
         return -1;
     }
     if (ioctl(sock, SIOCGIFMTU, &ifr) < 0) {
+        if (!at_creation) {
+            log_down(can, URRT_LOG_WARNING, REASON_REOPEN, strerror(errno));
+            return 0;
+        }
         urrt_log(URRT_LOG_ERR, "CAN interface %s: cannot read its MTU: %s", can->ifname, strerror(errno));
-        return at_creation ? -1 : 0;
+        return -1;
     }
     if (can->cfg.fd && ifr.ifr_mtu != (int)CANFD_MTU) {
         if (at_creation) {
@@ -398,10 +406,14 @@ static int open_socket(urrt_can *can, uint64_t now_us, bool at_creation)
     int sock = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
     if (sock < 0) {
         int err = errno;
+        if (!at_creation) {
+            log_down(can, URRT_LOG_WARNING, REASON_REOPEN, strerror(err));
+            return 0;
+        }
         urrt_log(URRT_LOG_ERR, "CAN %s: cannot create a CAN socket: %s%s", can->ifname, strerror(err),
                  err == EAFNOSUPPORT || err == EPROTONOSUPPORT
                      ? " (this kernel has no CAN support: `modprobe can-raw`)" : "");
-        return at_creation ? -1 : 0;
+        return -1;
     }
     unsigned ifindex;
     int usable = check_interface(can, sock, at_creation, &ifindex);
