@@ -46,6 +46,21 @@ static const urrt_field_info field_table[URRT_FIELD_COUNT] = {
 #undef URRT_X_INFO
 };
 
+/* What decoding needs of the table, without the strings: a firmware that
+ * only decodes links 135 bytes of layout instead of the ~3 KiB of names
+ * and descriptions (they come in with urrt_field() and urrt_field_find()). */
+typedef struct field_layout {
+    uint8_t count;
+    uint8_t col_1x;
+    uint8_t col_3x;
+} field_layout;
+
+static const field_layout layout_table[URRT_FIELD_COUNT] = {
+#define URRT_X_LAYOUT(ID, name, count, c1, c3, unit, since, desc) {count, c1, c3},
+    URRT_FIELDS(URRT_X_LAYOUT)
+#undef URRT_X_LAYOUT
+};
+
 /* ---- bytes and bits ---------------------------------------------------- */
 
 static uint32_t load_be32(const uint8_t *p)
@@ -187,10 +202,11 @@ int urrt_field_find(const char *name, size_t name_len)
 
 unsigned urrt_field_column(urrt_field_id id, urrt_generation gen)
 {
-    const urrt_field_info *f = urrt_field(id);
-    if (f == NULL) {
+    const field_layout *f;
+    if ((unsigned)id >= (unsigned)URRT_FIELD_COUNT) {
         return 0;
     }
+    f = &layout_table[id];
     switch (gen) {
     case URRT_GEN_1X: return f->col_1x;
     case URRT_GEN_3X: return f->col_3x;
@@ -269,12 +285,12 @@ int urrt_packet_length(const uint8_t *buf, size_t len)
 
 /* ---- decoding ----------------------------------------------------------- */
 
-static bool field_fits(const urrt_field_info *f, unsigned column, unsigned doubles, urrt_generation gen)
+static bool field_fits(unsigned id, unsigned column, unsigned doubles, urrt_generation gen)
 {
-    if (column == 0 || column + f->count - 1u > doubles) {
+    if (column == 0 || column + layout_table[id].count - 1u > doubles) {
         return false;
     }
-    if (gen == URRT_GEN_1X && f == &field_table[URRT_F_TOOL_ACCELEROMETER]) {
+    if (gen == URRT_GEN_1X && id == (unsigned)URRT_F_TOOL_ACCELEROMETER) {
         return doubles >= URRT_1X_ACCELEROMETER_MIN_DOUBLES;
     }
     return true;
@@ -324,7 +340,7 @@ void urrt_state_clear(urrt_state *st)
         return;
     }
     for (id = 0; id < (unsigned)URRT_FIELD_COUNT; id++) {
-        fill_nan(field_slot(st, id), field_table[id].count);
+        fill_nan(field_slot(st, id), layout_table[id].count);
     }
     st->present = 0;
     st->length = 0;
@@ -428,7 +444,7 @@ static void decode_3x(const uint8_t *body, unsigned doubles, urrt_state *st)
      * whole ones are a prefix: walk back from the last until one fits (no
      * step at all for 1220 bytes, four for 1116). */
     while (present_fields > 0) {
-        const urrt_field_info *f = &field_table[present_fields - 1u];
+        const field_layout *f = &layout_table[present_fields - 1u];
         if (f->col_3x + f->count - 1u <= known) {
             break;
         }
@@ -437,7 +453,7 @@ static void decode_3x(const uint8_t *body, unsigned doubles, urrt_state *st)
     /* Absent grid columns and the 1.x-only fields that follow the grid in
      * the struct (asserted above) get NaN in one run. */
     {
-        unsigned first_nan = present_fields < grid_fields ? field_table[present_fields].col_3x
+        unsigned first_nan = present_fields < grid_fields ? layout_table[present_fields].col_3x
                                                            : URRT_WIRE_COLUMNS + 1u;
         fill_nan_fast(grid_slot(st, first_nan), URRT_WIRE_COLUMNS + 1u - first_nan + URRT_1X_ONLY_DOUBLES);
     }
@@ -451,11 +467,11 @@ static void decode_by_table(const uint8_t *body, unsigned doubles, urrt_generati
     unsigned id;
     urrt_state_clear(st);
     for (id = 0; id < (unsigned)URRT_FIELD_COUNT; id++) {
-        const urrt_field_info *f = &field_table[id];
+        const field_layout *f = &layout_table[id];
         unsigned column = urrt_field_column((urrt_field_id)id, gen);
         double *slot = field_slot(st, id);
         unsigned i;
-        if (!field_fits(f, column, doubles, gen)) {
+        if (!field_fits(id, column, doubles, gen)) {
             continue;
         }
         for (i = 0; i < f->count; i++) {
@@ -524,7 +540,6 @@ int urrt_read_column(const uint8_t *buf, size_t len, unsigned column, double *ou
 
 int urrt_read(const uint8_t *buf, size_t len, urrt_field_id id, unsigned elem, double *out)
 {
-    const urrt_field_info *f = urrt_field(id);
     int size = urrt_packet_length(buf, len);
     unsigned doubles;
     urrt_generation gen;
@@ -533,19 +548,21 @@ int urrt_read(const uint8_t *buf, size_t len, urrt_field_id id, unsigned elem, d
     if (size < 0) {
         return size;
     }
-    if (f == NULL || out == NULL) {
+    if ((unsigned)id >= (unsigned)URRT_FIELD_COUNT || out == NULL) {
         return URRT_E_ARG;
     }
-    if (elem >= f->count) {
+    if (elem >= layout_table[id].count) {
         return URRT_E_RANGE;
     }
     doubles = ((unsigned)size - URRT_HEADER_SIZE) / 8u;
     gen = urrt_generation_of((uint32_t)size);
     column = urrt_field_column(id, gen);
-    if (!field_fits(f, column, doubles, gen)) {
+    if (!field_fits((unsigned)id, column, doubles, gen)) {
         return URRT_E_ABSENT;
     }
-    return urrt_read_column(buf, len, column + elem, out);
+    /* The packet was validated above and the element lies inside it. */
+    *out = double_from_bits(load_be64(buf + URRT_HEADER_SIZE + 8u * (column - 1u + elem)));
+    return URRT_OK;
 }
 
 /* ---- encoding ----------------------------------------------------------- */
@@ -593,7 +610,7 @@ int urrt_encode(const urrt_state *st, uint32_t length, uint8_t *out, size_t out_
         store_be64(out + URRT_HEADER_SIZE + 8u * (col - 1u), 0);
     }
     for (id = 0; id < (unsigned)URRT_FIELD_COUNT; id++) {
-        const urrt_field_info *f = &field_table[id];
+        const field_layout *f = &layout_table[id];
         const double *slot = field_slot_const(st, id);
         unsigned i;
         if (f->col_1x == 0) {
