@@ -366,7 +366,7 @@ def t_restart(args, port):
         restarted = time.time()
         r.sim(port, "--version", "5.10", log="sim2.log")
         time.sleep(2)
-        # A stall: the connection stays open, the data stops.
+        stopping = time.time()
     finally:
         r.stop()
     ch = by_channel(r.messages(), r.prefix)
@@ -378,7 +378,8 @@ def t_restart(args, port):
           "restart: %d GATEWAY reports while down, all saying no data and link not up" % len(down))
     after = [m for m in ch["STATE"] if m["recv_utime"] / 1e6 > restarted]
     check(len(after) > 500, "restart: state flows again after the restart (%d STATE)" % len(after))
-    last = ch["GATEWAY"][-1] if ch["GATEWAY"] else {}
+    before_stop = [m for m in ch["GATEWAY"] if m["utime"] / 1e6 < stopping]
+    last = before_stop[-1] if before_stop else {}
     check(last.get("data_fresh") and last.get("reconnects", 0) >= 1 and last.get("disconnects", 0) >= 1,
           "restart: the last GATEWAY says fresh again, reconnects %s, disconnects %s" %
           (last.get("reconnects"), last.get("disconnects")))
@@ -471,6 +472,29 @@ def t_publish_errors(args, port):
     check(len(seq) > 1000 and seq[-1] - seq[0] + 1 > len(seq) and seq == sorted(seq),
           "publish errors: STATE has a hole where publishing failed and carries on after it")
     check("publishing" in r.log() and "failed" in r.log(), "publish errors: logged")
+
+
+def t_publish_reopen(args, port):
+    """Publishing that keeps failing reopens LCM, and recovers when it works again."""
+    r = Run(args, "reopen")
+    env = {"LD_PRELOAD": args.shim, "ALLOC_SHIM_FAIL_FROM": "1000", "ALLOC_SHIM_FAIL_COUNT": "6000"}
+    try:
+        r.sub(7)
+        r.sim(port, "--version", "5.10")
+        gw = r.gateway(lcm_ini(status_rate="every") + robot_ini(r.prefix, port), env=env)
+        time.sleep(6)
+        alive = gw.poll() is None
+    finally:
+        r.stop()
+    check(alive, "publish reopen: the gateway keeps running through 3 s of failures")
+    check("reopening" in r.log() and "works again" in r.log(), "publish reopen: LCM reopened, recovery logged")
+    ch = by_channel(r.messages(), r.prefix)
+    g = ch["GATEWAY"]
+    check(g and g[-1]["publish_errors"] >= 6000, "publish reopen: %s messages counted lost (>= 6000)" %
+          (g[-1]["publish_errors"] if g else "?"))
+    seq = [m["sequence"] for m in ch["STATE"]]
+    check(len(seq) > 300 and seq[-1] > 2000, "publish reopen: STATE flows after the recovery (last sequence %s)" %
+          (seq[-1] if seq else "-"))
 
 
 def t_jar(args):
@@ -615,6 +639,7 @@ def main():
         ("mismatch", lambda: t_mismatch(args, port + 9)),
         ("alloc", lambda: t_allocations(args, port + 10)),
         ("publish_errors", lambda: t_publish_errors(args, port + 11)),
+        ("publish_reopen", lambda: t_publish_reopen(args, port + 12)),
     ]
     for name, fn in tests:
         if args.only and not re.search(args.only, name):
