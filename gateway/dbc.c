@@ -2,6 +2,7 @@
 #include "dbc.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -33,6 +34,14 @@ const char *dbc_number(double value, char *buf, size_t size)
         snprintf(buf, size, "%.*g", precision, value);
         if (strtod(buf, NULL) == value) {
             break;
+        }
+    }
+    /* Whole digits without an exponent where they fit: "1600", not "1.6e+03". */
+    {
+        double magnitude = fabs(value);
+        int digits = magnitude >= 1 ? (int)floor(log10(magnitude)) + 1 : 0;
+        if (digits > precision && digits <= 17) {
+            snprintf(buf, size, "%.*g", digits, value);
         }
     }
     return buf;

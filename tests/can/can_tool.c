@@ -58,10 +58,8 @@ static int on_key(void *user, const char *section, const char *key, const char *
     if (rc < 0) {
         fprintf(stdout, "%s\n", err);
         ctx->errors++;
-    } else if (rc == 0) {
-        fprintf(stdout, "%s:%d: [%s] is not a CAN section\n", ctx->path, ctx->line, section);
-        ctx->errors++;
     }
+    /* rc == 0: a section of the gateway's own ([gateway], [robot NAME]): skipped. */
     return 1;
 }
 
