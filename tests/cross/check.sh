@@ -13,13 +13,13 @@ out=$1; readme=$2; warn=$3; shift 3
 
 CROSS=arm-none-eabi-
 ARCH="-mcpu=cortex-m4 -mthumb"
-CFLAGS="$ARCH -ffreestanding -Os $warn -ffunction-sections -fdata-sections -Ilib"
+CFLAGS="$ARCH -ffreestanding -Os $warn -ffunction-sections -fdata-sections -fstack-usage -Ilib"
 LDFLAGS="$ARCH -nostdlib -Wl,--gc-sections -T tests/cross/link.ld"
 # Percentage by which a measured text size may differ from README's.
 TOLERANCE=10
 
 mkdir -p "$out"
-rm -f "$out"/*.o "$out"/*.elf
+rm -f "$out"/*.o "$out"/*.elf "$out"/*.su
 
 if ! command -v ${CROSS}gcc >/dev/null; then
   fail "arm-none-eabi-gcc not found: install gcc-arm-none-eabi (make deps)"
@@ -112,6 +112,9 @@ symbol_size() {
 state=$(symbol_size urrt_probe_state)
 framer=$(symbol_size urrt_probe_framer)
 printf '| sizeof(urrt_state) | %s |\n| sizeof(urrt_framer) | %s |\n' "$state" "$framer" >> "$measured"
+rm -f "$out"/*.O2.su
+echo "cross: largest stack frames of lib/ functions (-fstack-usage, bytes; lib/ has no recursion):"
+for obj in $objs; do cat "${obj%.o}.su"; done | sort -t "$(printf '\t')" -k2 -n -r | head -n 5 | sed 's/^/cross:   /'
 echo "cross: footprint (arm-none-eabi-size; bytes):"
 sed 's/^/cross:   /' "$measured"
 

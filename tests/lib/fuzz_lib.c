@@ -46,9 +46,10 @@ static int is_error(int r)
     return r <= URRT_E_ARG && r >= URRT_E_UNKNOWN_FIELD;
 }
 
-/* Invariant 5 and 6: decode of a packet succeeds, presence follows the
- * length, random access agrees with the full decode, the encoder gives the
- * same fields back. */
+/* Invariants 6-8, 10 and 11 of docs/security.md on one packet: decode
+ * succeeds, presence follows the length, random access agrees with the full
+ * decode, names are total, the encoder gives the same fields back.
+ * (Invariant 1, memory safety, is the sanitizers' job throughout.) */
 static void check_packet(const uint8_t *pkt, size_t len)
 {
     static urrt_state st, back;
@@ -107,7 +108,8 @@ typedef struct run {
 
 static urrt_framer framer;
 
-/* Feeds one chunk, checking invariants 2 and 3 on every call. */
+/* Feeds one chunk, checking invariants 2 (progress) and 4 (byte
+ * accounting) on every call. */
 static void feed(const uint8_t *p, size_t n, run *r, size_t *fed)
 {
     do {
@@ -195,7 +197,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (r >= 0) {
             check_packet(stream, (size_t)r);
         } else {
-            REQUIRE(is_error(r) && st.present == 0);
+            REQUIRE(is_error(r) && st.present == 0); /* invariant 9 */
         }
         for (unsigned c = 0; c < 4; c++) {
             double d;
@@ -209,7 +211,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                  memcmp(urrt_field((urrt_field_id)r)->name, stream, n < 40 ? n : 40) == 0));
     }
 
-    /* Framing: once in one call, once in chunks; same packets, same counts. */
+    /* Invariant 5: framing once in one call, once in chunks; same packets,
+     * same counts. */
     frame(stream, n, 0, &whole);
     frame(stream, n, data[0], &chunked);
     REQUIRE(whole.packets == chunked.packets && whole.out_len == chunked.out_len);
