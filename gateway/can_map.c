@@ -329,6 +329,24 @@ bool can_map_enabled(const struct can_map *map)
     return map->configured && map->finished;
 }
 
+void can_map_link_config(const struct can_map *map, urrt_can_config *cfg)
+{
+    cfg->interface = map->interface;
+    cfg->fd = map->fd;
+    cfg->fd_brs = map->fd && map->data_bitrate > map->bitrate;
+}
+
+int can_map_describe(const struct can_map *map, char *buf, size_t size)
+{
+    if (!can_map_enabled(map)) {
+        return snprintf(buf, size, "no CAN output configured");
+    }
+    return snprintf(buf, size, "%zu frame%s + heartbeat 0x%X on %s, worst-case bus load %.1f%% of %u bit/s%s (max %u%%)",
+                    map->frame_count, map->frame_count == 1 ? "" : "s", (unsigned)map->hb_id,
+                    map->interface ? map->interface : "?", map->load * 100.0, (unsigned)map->bitrate,
+                    map->data_bitrate > map->bitrate ? " with an FD data phase" : "", map->max_load_percent);
+}
+
 /* ---- [can] ----------------------------------------------------------------------- */
 
 static int can_key(struct can_map *map, const char *key, const char *value, struct can_map_loc loc, char *err,

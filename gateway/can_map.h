@@ -266,6 +266,18 @@ int can_map_finish(struct can_map *map, const struct can_map_robot *robots, size
 
 bool can_map_enabled(const struct can_map *map);
 
+/* The CAN link's configuration from [can]: interface, fd, and fd_brs (FD
+ * frames switch to data_bitrate when it is above bitrate). cfg must hold
+ * urrt_can_config_defaults() first; the other fields are left alone. The
+ * interface string stays owned by the map. Bit rates are not set on the
+ * interface (ip link does that): the map uses them for the bus load check
+ * and the DBC. */
+void can_map_link_config(const struct can_map *map, urrt_can_config *cfg);
+
+/* One line for the log at start: "4 frames + heartbeat 0x705 on can0,
+ * worst-case bus load 7.6% of 500000 bit/s (max 40%)". Returns snprintf's. */
+int can_map_describe(const struct can_map *map, char *buf, size_t size);
+
 /* ---- run time ------------------------------------------------------------------ */
 
 typedef void (*can_map_emit_fn)(void *ctx, const urrt_can_frame *frame);

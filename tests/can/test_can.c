@@ -582,6 +582,18 @@ static void test_config_good(void)
         return;
     }
     CHECK(can_map_enabled(&map), "enabled");
+    {
+        urrt_can_config cfg;
+        char line[256];
+        memset(&cfg, 0, sizeof cfg);
+        cfg.reopen_interval_ms = 1234;
+        can_map_link_config(&map, &cfg);
+        CHECK(cfg.interface == map.interface && !cfg.fd && !cfg.fd_brs && cfg.reopen_interval_ms == 1234,
+              "link configuration");
+        can_map_describe(&map, line, sizeof line);
+        CHECK_EQ_STR(line, "2 frames + heartbeat 0x701 on vcan0, worst-case bus load 6.0% of 500000 bit/s (max 50%)");
+        /* 2.7 % + 29-bit 4 bytes (54+32+13+21 = 120 bits, 240 us) every 8 ms 3.0 % + 0.27 % */
+    }
     CHECK_EQ_STR(map.interface, "vcan0");
     CHECK_EQ_INT(map.frame_count, 2);
     CHECK_EQ_INT(map.hb_id, 0x701);
