@@ -149,24 +149,6 @@ static uint64_t cpu_ns(pid_t pid)
     return sum;
 }
 
-/* User and system CPU time of pid (all threads) in clock ticks. */
-static void cpu_ticks(pid_t pid, unsigned long long *user, unsigned long long *sys)
-{
-    char path[64], buf[1024];
-    *user = *sys = 0;
-    snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
-    FILE *f = fopen(path, "r");
-    if (f == NULL) return;
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    buf[n] = '\0';
-    char *p = strrchr(buf, ')');
-    if (p != NULL) {
-        /* Fields after the name: state is 3rd; utime 14th, stime 15th. */
-        sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", user, sys);
-    }
-}
-
 static int listen_on(int port)
 {
     int fd = socket(AF_INET, SOCK_STREAM, 0), one = 1;
@@ -306,7 +288,6 @@ int main(int argc, char **argv)
     long index = 1;
     long total = (long)(seconds * 500.0) + 500;
     uint64_t start = mono_ns(), cpu0 = 0, wall0 = 0;
-    unsigned long long user0 = 0, sys0 = 0, user1, sys1;
     long measured_from = 500;
     while (index < total) {
         uint64_t due = start + (uint64_t)index * 2000000u;
@@ -315,7 +296,6 @@ int main(int argc, char **argv)
             if (index == measured_from) {
                 for (int k = 0; k < 4; k++) lat_n[k] = 0;
                 cpu0 = cpu_ns(pid);
-                cpu_ticks(pid, &user0, &sys0);
                 wall0 = now;
             }
             make_packet(pkt, index);
@@ -332,7 +312,6 @@ int main(int argc, char **argv)
         if (ppoll(&p, 1, &ts, NULL) == 1) lcm_handle(lcm);
     }
     uint64_t cpu1 = cpu_ns(pid), wall1 = mono_ns();
-    cpu_ticks(pid, &user1, &sys1);
     /* Collect the last messages. */
     for (uint64_t end = mono_ns() + 200000000u; mono_ns() < end;) {
         struct pollfd p = {.fd = lcm_fd, .events = POLLIN};
@@ -349,11 +328,6 @@ int main(int argc, char **argv)
     printf("packets_at_500hz: %ld\n", packets);
     printf("gateway_cpu_per_packet_us: %.2f\n", (double)(cpu1 - cpu0) / 1000.0 / (double)packets);
     printf("gateway_cpu_percent_of_core_at_500hz: %.3f\n", 100.0 * (double)(cpu1 - cpu0) / (double)(wall1 - wall0));
-    {
-        double tick_us = 1e6 / (double)sysconf(_SC_CLK_TCK);
-        printf("gateway_user_cpu_per_packet_us: %.2f\n", (double)(user1 - user0) * tick_us / (double)packets);
-        printf("gateway_system_cpu_per_packet_us: %.2f\n", (double)(sys1 - sys0) * tick_us / (double)packets);
-    }
 
     /* Phase 2: as fast as the gateway takes them. Stop reading LCM: the
      * kernel drops what this process does not read. */
