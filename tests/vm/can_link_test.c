@@ -164,6 +164,25 @@ static short pump(urrt_can *can, unsigned ms)
     return seen;
 }
 
+/* Pumps until the link is in state (or nothing is held, for want_idle) or
+ * limit_ms pass: waits that depend on the host's speed end as soon as they
+ * can and still have a bound. */
+static short pump_until_state(urrt_can *can, urrt_can_state state, unsigned limit_ms)
+{
+    short seen = 0;
+    for (unsigned waited = 0; urrt_can_get_state(can) != state && waited < limit_ms; waited += 10)
+        seen |= pump(can, 10);
+    return seen;
+}
+
+static short pump_until_idle(urrt_can *can, unsigned limit_ms)
+{
+    short seen = 0;
+    for (unsigned waited = 0; urrt_can_get_stats(can)->pending != 0 && waited < limit_ms; waited += 10)
+        seen |= pump(can, 10);
+    return seen;
+}
+
 /* A receiving socket of our own: the kernel's view of what went out. */
 static int rx_open(const char *ifname)
 {
@@ -651,7 +670,7 @@ static void test_queue_full(void)
     /* The queue drains: the held frames go out, the newest value of each,
      * once. */
     RUN("tc", "qdisc", "change", "dev", "vcan1", "root", "plug", "release_indefinite");
-    pump(can, 30);
+    pump_until_idle(can, 2000);
     CHECK_EQ_INT(st->pending, 0);
     CHECK_EQ_INT(st->sent, 12);
     CHECK(strstr(messages, "takes frames again") != NULL, "recovery logged: %s", messages);
@@ -721,7 +740,7 @@ static void test_socket_buffer_full(void)
 
     uint64_t sent_before = st->sent;
     RUN("tc", "qdisc", "change", "dev", "vcan1", "root", "plug", "release_indefinite");
-    short seen = pump(can, 50);
+    short seen = pump_until_idle(can, 2000);
     CHECK(seen & POLLOUT, "POLLOUT woke the loop");
     CHECK_EQ_INT(st->pending, 0);
     CHECK_EQ_INT(st->sent, sent_before + 4);
@@ -755,7 +774,7 @@ static void test_down_up(void)
     CHECK_EQ_INT(st->pending, 1);
     messages_clear();
     RUN("ip", "link", "set", "vcan0", "down");
-    short seen = pump(can, 50);
+    short seen = pump_until_state(can, URRT_CAN_DOWN, 2000);
     CHECK(seen & (POLLERR | POLLIN), "the down event wakes the loop");
     CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_DOWN);
     CHECK_EQ_INT(st->down_events, 1);
@@ -776,7 +795,7 @@ static void test_down_up(void)
     RUN("tc", "qdisc", "del", "dev", "vcan0", "root");
     RUN("ip", "link", "set", "vcan0", "up");
     rx_collect(rx, got, 64, 50); /* the receiver's own error and the plugged frame */
-    pump(can, 150);
+    pump_until_state(can, URRT_CAN_UP, 2000);
     CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_UP);
     CHECK_EQ_INT(st->opens, 2);
     CHECK(strstr(messages, "up again") != NULL, "recovery logged: %s", messages);
@@ -789,14 +808,14 @@ static void test_down_up(void)
     /* Removed and created again: a new ifindex, found by name. */
     messages_clear();
     RUN("ip", "link", "del", "vcan0");
-    pump(can, 100);
+    pump_until_state(can, URRT_CAN_DOWN, 2000);
     CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_DOWN);
     CHECK_EQ_INT(st->down_events, 2);
     CHECK(strstr(messages, "removed") != NULL, "removal logged: %s", messages);
     RUN("ip", "link", "add", "dev", "vcan0", "type", "vcan");
     RUN("ip", "link", "set", "vcan0", "mtu", "72");
     RUN("ip", "link", "set", "vcan0", "up");
-    pump(can, 150);
+    pump_until_state(can, URRT_CAN_UP, 2000);
     CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_UP);
     CHECK_EQ_INT(st->opens, 3);
     close(rx);
@@ -810,13 +829,15 @@ static void test_down_up(void)
     RUN("ip", "link", "set", "vcan0", "down");
     RUN("ip", "link", "set", "vcan0", "mtu", "16");
     RUN("ip", "link", "set", "vcan0", "up");
-    pump(can, 200);
+    for (int waited = 0; strstr(messages, "mtu 72") == NULL && waited < 2000; waited += 10)
+        pump(can, 10); /* until a reopen attempt has seen the interface up */
+    pump(can, 100);
     CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_DOWN);
     CHECK(strstr(messages, "mtu 72") != NULL, "MTU reason logged: %s", messages);
     RUN("ip", "link", "set", "vcan0", "down");
     RUN("ip", "link", "set", "vcan0", "mtu", "72");
     RUN("ip", "link", "set", "vcan0", "up");
-    pump(can, 150);
+    pump_until_state(can, URRT_CAN_UP, 2000);
     CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_UP);
     close(rx);
     urrt_can_free(can);
@@ -833,7 +854,7 @@ static void test_down_up(void)
     pump(can, 120);
     CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_DOWN);
     RUN("ip", "link", "set", "vcan1", "up");
-    pump(can, 150);
+    pump_until_state(can, URRT_CAN_UP, 2000);
     CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_UP);
     CHECK_EQ_INT(urrt_can_get_stats(can)->opens, 1);
     CHECK_EQ_INT(urrt_can_get_stats(can)->down_events, 0);
