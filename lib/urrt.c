@@ -577,14 +577,14 @@ int urrt_encode(const urrt_state *st, uint32_t length, uint8_t *out, size_t out_
     if (st == NULL || out == NULL) {
         return URRT_E_ARG;
     }
-    if (length < URRT_PACKET_MIN || length > 0x7FFFFFFFu) {
+    if (length < URRT_PACKET_MIN) {
         return URRT_E_SIZE_SMALL;
     }
     if ((length - URRT_HEADER_SIZE) % 8u != 0) {
         return URRT_E_SIZE_ALIGN;
     }
     if (length > URRT_PACKET_MAX) {
-        return URRT_E_SIZE_LARGE;
+        return URRT_E_SIZE_LARGE; /* 0x80000004 and up included: a size, not a sign */
     }
     if (out_size < length) {
         return URRT_E_NO_SPACE;

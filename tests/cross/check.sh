@@ -37,6 +37,13 @@ for src in "$@"; do
     fail "$src does not compile for Cortex-M4 under the library's warnings"
   fi
 done
+# The decoder's NEON path (ARMv7-A with NEON, as on an i.MX or Raspberry Pi
+# class edge box) under the same warnings: compiled only, nothing here runs it.
+for src in "$@"; do
+  check "$src compiles for Cortex-A7 with NEON (vector path)" \
+    ${CROSS}gcc -mcpu=cortex-a7 -mfpu=neon-vfpv4 -mfloat-abi=hard -ffreestanding -O2 $warn -Ilib \
+      -c "$src" -o "$out/$(basename "$src" .c).neon.o"
+done
 check "startup compiles" ${CROSS}gcc $CFLAGS -c tests/cross/startup.c -o "$out/startup.o"
 check "size probe compiles" ${CROSS}gcc $CFLAGS -c tests/cross/probe.c -o "$out/probe.o"
 

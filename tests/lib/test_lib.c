@@ -1101,6 +1101,20 @@ static void test_state_clear_and_encoder(void)
     CHECK(bad == 0, "encoder round trip failed %zu times", bad);
 }
 
+/* ---- regression tests: one per fixed bug ---------------------------------------- */
+
+/* urrt_encode() called a length of 0x80000004 or more "below the minimum"
+ * (URRT_E_SIZE_SMALL): it is past the largest packet. */
+static void regression_encode_huge_length_is_large(void)
+{
+    static uint8_t out[16];
+    urrt_state st;
+    urrt_state_clear(&st);
+    CHECK_EQ_INT(urrt_encode(&st, 0x80000004u, out, sizeof out), URRT_E_SIZE_LARGE);
+    CHECK_EQ_INT(urrt_encode(&st, 0xFFFFFFFCu, out, sizeof out), URRT_E_SIZE_LARGE);
+    CHECK_EQ_INT(urrt_encode(&st, 0xFFFFFFFFu, out, sizeof out), URRT_E_SIZE_ALIGN);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -1122,6 +1136,7 @@ int main(int argc, char **argv)
     test_framer_garbage();
     test_framer_resync_not_fooled();
     test_framer_truncation();
+    regression_encode_huge_length_is_large();
     for (size_t i = 0; i < vector_count; i++) {
         free(vectors[i].packet);
     }
