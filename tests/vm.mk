@@ -12,7 +12,7 @@
 #   check-vm: $(BUILD)/bin/urrt-gateway            (built first)
 VMT := $(BUILD)/tests
 VM_TESTS += tests/vm/can-link.sh
-VM_FILES += $(VMT)/can_link_test
+VM_FILES += $(VMT)/can_link_test $(VMT)/can_link_test_san
 VM_MODULES += sch_plug
 
 CHECKS += check-can-log check-vm
@@ -23,10 +23,15 @@ $(VMT)/can_link_test: tests/vm/can_link_test.c tests/check.h port/port.h $(LIBPO
 	@mkdir -p $(@D)
 	$(CC) $(PROG_WARN) $(OPT) $(CPPFLAGS) $< $(LIBPORT) $(LIBURRT) -o $@
 
-check-vm: $(VMT)/can_link_test
+# The same tests with ASan and UBSan, everything compiled with them.
+$(VMT)/can_link_test_san: tests/vm/can_link_test.c tests/check.h port/port.h $(PORT_SRCS) $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(PROG_WARN) -O1 -g $(SAN_FLAGS) $(CPPFLAGS) $< $(PORT_SRCS) $(LIB_SRCS) -o $@
+
+check-vm: $(VMT)/can_link_test $(VMT)/can_link_test_san
 	@tests/vm/check-vm.sh '$(BUILD)' '$(VM_TESTS)' '$(VM_FILES)' '$(VM_MODULES)'
 
-check-can-log: $(VMT)/can_link_test
+check-can-log: $(VMT)/can_link_test $(VMT)/can_link_test_san
 	@tests/vm/check-can-log.sh '$(BUILD)'
 
 # Downloads the kernel into the cache ahead of time (check-vm does it too).

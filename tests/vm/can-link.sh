@@ -58,4 +58,12 @@ diff want-replay-vcan0.txt got-replay-vcan0.txt; diff want-replay-vcan1.txt got-
 echo "== the socket: refusals, error frames, full queue, down and up"
 counted "can_link_test socket" can_link_test socket
 
+echo "== the socket again, under ASan and UBSan"
+if [ -x /t/can_link_test_san ]; then
+  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+    counted "can_link_test_san socket" can_link_test_san socket
+else
+  fail "can_link_test_san is missing"
+fi
+
 finish

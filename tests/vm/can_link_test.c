@@ -235,20 +235,21 @@ static bool rx_matches(const rx_frame *r, const urrt_can_frame *f, bool brs)
     return memcmp(r->f.data, f->data, f->len) == 0;
 }
 
-static int count_id(const rx_frame *rx, size_t n, uint32_t id)
+/* id as the kernel has it: CAN_EFF_FLAG set for a 29-bit ID. */
+static int count_id(const rx_frame *rx, size_t n, canid_t id)
 {
     int c = 0;
     for (size_t i = 0; i < n; i++)
-        if ((rx[i].f.can_id & CAN_EFF_MASK) == id)
+        if (rx[i].f.can_id == id)
             c++;
     return c;
 }
 
-static const rx_frame *last_of_id(const rx_frame *rx, size_t n, uint32_t id)
+static const rx_frame *last_of_id(const rx_frame *rx, size_t n, canid_t id)
 {
     const rx_frame *last = NULL;
     for (size_t i = 0; i < n; i++)
-        if ((rx[i].f.can_id & CAN_EFF_MASK) == id)
+        if (rx[i].f.can_id == id)
             last = &rx[i];
     return last;
 }
@@ -662,6 +663,17 @@ static void test_queue_full(void)
     CHECK(st->busy >= 1000, "busy %" PRIu64, st->busy);
     CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_UP);
     CHECK_EQ_INT(count_substr(messages, "transmit queue full"), 1);
+    /* 40 more IDs, one the 29-bit twin of 0x20A: each gets a slot of its own
+     * (and the slot table grows past its first allocation). */
+    urrt_can_frame twin = make_frame(0x20A, true, false, 1, 0x99);
+    not_held = timed_send(can, &twin) != 0;
+    for (uint32_t id = 0x210; id < 0x237; id++) {
+        urrt_can_frame f = make_frame(id, false, false, 1, (uint8_t)id);
+        not_held += timed_send(can, &f) != 0;
+    }
+    CHECK_EQ_INT(not_held, 0);
+    CHECK_EQ_INT(st->pending, 42);
+    CHECK_EQ_INT(st->dropped, 998);
     short events;
     urrt_can_poll_fd(can, &events);
     CHECK(!(events & POLLOUT), "no POLLOUT wait on ENOBUFS: the socket would report writable at once");
@@ -672,13 +684,20 @@ static void test_queue_full(void)
     RUN("tc", "qdisc", "change", "dev", "vcan1", "root", "plug", "release_indefinite");
     pump_until_idle(can, 2000);
     CHECK_EQ_INT(st->pending, 0);
-    CHECK_EQ_INT(st->sent, 12);
+    CHECK_EQ_INT(st->sent, 52);
     CHECK(strstr(messages, "takes frames again") != NULL, "recovery logged: %s", messages);
     rx_frame got[64];
     size_t n = rx_collect(rx, got, 64, 200);
-    CHECK_EQ_INT(n, 12);
+    CHECK_EQ_INT(n, 52);
     CHECK_EQ_INT(count_id(got, n, 0x20A), 1);
     CHECK_EQ_INT(count_id(got, n, 0x20B), 1);
+    CHECK_EQ_INT(count_id(got, n, 0x20A | CAN_EFF_FLAG), 1);
+    /* Held frames leave in the order they were first held. */
+    bool order_ok = n == 52 && got[10].f.can_id == 0x20A && got[11].f.can_id == 0x20B &&
+                       got[12].f.can_id == (0x20A | CAN_EFF_FLAG);
+    for (size_t i = 13; order_ok && i < n; i++)
+        order_ok = got[i].f.can_id == 0x210 + (i - 13);
+    CHECK(order_ok, "held frames in the order first held");
     const rx_frame *a = last_of_id(got, n, 0x20A), *b = last_of_id(got, n, 0x20B);
     CHECK(a != NULL && rx_matches(a, &last_a, false), "0x20A carries the newest value");
     CHECK(b != NULL && rx_matches(b, &last_b, false), "0x20B carries the newest value");

@@ -12,4 +12,6 @@ dir=$build/tests/can-log
 rm -rf "$dir"; mkdir -p "$dir"
 counted "can_link_test log" "$build/tests/can_link_test" log "$dir"
 counted "python-can CanutilsLogReader" /usr/bin/python3 tests/vm/check_can_log.py "$dir"
+rm -rf "$dir"; mkdir -p "$dir"
+counted "can_link_test log (ASan+UBSan)" "$build/tests/can_link_test_san" log "$dir"
 finish
