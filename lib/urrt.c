@@ -359,12 +359,16 @@ static const unsigned grid_fields = 0u
 /*
  * Vector byte swap for the grid copy, where the compiler offers portable
  * vector extensions (GCC, clang) and the target has a byte shuffle: x86
- * SSSE3 (-march=x86-64-v2), AVX2 (-march=x86-64-v3 or native), ARM NEON.
- * Elsewhere the copy is one 8-byte load and swap per double.
+ * SSSE3 (-march=x86-64-v2), AVX2 (-march=x86-64-v3), AVX-512BW
+ * (-march=x86-64-v4), ARM NEON; -march=native picks the widest. The decode
+ * is bound by stores, so the widest vector wins. Elsewhere the copy is one
+ * 8-byte load and swap per double.
  */
 #if defined(__GNUC__) && (defined(__SSSE3__) || defined(__ARM_NEON))
 #define URRT_VECTOR 1
-#if defined(__AVX2__)
+#if defined(__AVX512BW__)
+#define URRT_VECTOR_BYTES 64
+#elif defined(__AVX2__)
 #define URRT_VECTOR_BYTES 32
 #else
 #define URRT_VECTOR_BYTES 16
@@ -372,7 +376,12 @@ static const unsigned grid_fields = 0u
 #define URRT_VECTOR_DOUBLES (URRT_VECTOR_BYTES / 8)
 typedef unsigned char urrt_bytes_v __attribute__((vector_size(URRT_VECTOR_BYTES)));
 typedef uint64_t urrt_u64_v __attribute__((vector_size(URRT_VECTOR_BYTES)));
-#if URRT_VECTOR_BYTES == 32
+#if URRT_VECTOR_BYTES == 64
+#define URRT_SWAP_INDEX 7, 6, 5, 4, 3, 2, 1, 0, 15, 14, 13, 12, 11, 10, 9, 8, \
+                        23, 22, 21, 20, 19, 18, 17, 16, 31, 30, 29, 28, 27, 26, 25, 24, \
+                        39, 38, 37, 36, 35, 34, 33, 32, 47, 46, 45, 44, 43, 42, 41, 40, \
+                        55, 54, 53, 52, 51, 50, 49, 48, 63, 62, 61, 60, 59, 58, 57, 56
+#elif URRT_VECTOR_BYTES == 32
 #define URRT_SWAP_INDEX 7, 6, 5, 4, 3, 2, 1, 0, 15, 14, 13, 12, 11, 10, 9, 8, \
                         23, 22, 21, 20, 19, 18, 17, 16, 31, 30, 29, 28, 27, 26, 25, 24
 #else

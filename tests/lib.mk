@@ -45,14 +45,17 @@ $(LIBT)/test_lib_san: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_TEST_CFLAGS) -O1 -g -march=native $(SAN_FLAGS) $< $(LIB_SRCS) -lm -o $@
 
-# On x86-64 also the 16-byte (SSSE3) vector path.
-LIB_TEST_SSSE3 := $(if $(filter x86_64,$(shell uname -m)),$(LIBT)/test_lib_ssse3)
-$(LIBT)/test_lib_ssse3: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+# On x86-64 also each vector width of the decoder's grid copy that this CPU
+# can run: 16 bytes (SSSE3), 32 (AVX2), 64 (AVX-512BW).
+LIB_CPU_FLAGS := $(shell grep -m 1 '^flags' /proc/cpuinfo 2>/dev/null)
+LIB_TEST_ISAS := $(if $(filter x86_64,$(shell uname -m)),$(filter ssse3 avx2 avx512bw,$(LIB_CPU_FLAGS)))
+LIB_TEST_VARIANTS := $(LIB_TEST_ISAS:%=$(LIBT)/test_lib_%)
+$(LIBT)/test_lib_%: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
 	@mkdir -p $(@D)
-	$(CC) $(LIB_TEST_CFLAGS) $(OPT) -mssse3 $< $(LIB_SRCS) -lm -o $@
+	$(CC) $(LIB_TEST_CFLAGS) $(OPT) -m$* $< $(LIB_SRCS) -lm -o $@
 
-check-lib: $(LIBT)/test_lib $(LIB_TEST_SSSE3) $(LIB_VECTORS)
-	$(call lib_suite,check-lib,sh tests/lib/run_all.sh $(LIB_VECTORS) $(LIBT)/test_lib $(LIB_TEST_SSSE3))
+check-lib: $(LIBT)/test_lib $(LIB_TEST_VARIANTS) $(LIB_VECTORS)
+	$(call lib_suite,check-lib,sh tests/lib/run_all.sh $(LIB_VECTORS) $(LIBT)/test_lib $(LIB_TEST_VARIANTS))
 
 check-lib-san: $(LIBT)/test_lib_san $(LIB_VECTORS)
 	$(call lib_suite,check-lib-san,ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $(LIBT)/test_lib_san $(LIB_VECTORS))
