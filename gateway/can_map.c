@@ -93,52 +93,54 @@ static const char *const can_key_names[CAN_MAP_CK_COUNT] = {
     [CAN_MAP_CK_RECEIVER] = "receiver",
 };
 
-/* Appends "FILE:LINE: message" to err, '\n'-separated, as far as it fits. */
-static void add_error(char *err, size_t errlen, struct can_map_loc loc, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
-static void add_error(char *err, size_t errlen, struct can_map_loc loc, const char *fmt, ...)
+/* Reports a problem: to the map's reporter if one is set, and as
+ * "FILE:LINE: reason" into err. add_error appends ('\n'-separated, as far as
+ * it fits); fail replaces and returns -1. */
+static void report(const struct can_map *map, char *err, size_t errlen, bool append, struct can_map_loc loc,
+                   const char *fmt, va_list ap)
 {
-    size_t used;
-    int n;
-    va_list ap;
+    char reason[512];
+    size_t used = 0;
+    vsnprintf(reason, sizeof reason, fmt, ap);
+    if (map != NULL && map->reporter != NULL) {
+        map->reporter(map->reporter_ctx, loc.file, loc.line, reason);
+    }
     if (err == NULL || errlen == 0) {
         return;
     }
-    used = strnlen(err, errlen);
-    if (used + 1 >= errlen) {
-        return;
+    if (append) {
+        used = strnlen(err, errlen);
+        if (used + 1 >= errlen) {
+            return;
+        }
+        if (used > 0) {
+            err[used++] = '\n';
+        }
     }
-    if (used > 0) {
-        err[used++] = '\n';
-        err[used] = '\0';
-    }
-    n = snprintf(err + used, errlen - used, "%s:%d: ", loc.file ? loc.file : "?", loc.line);
-    if (n < 0 || (size_t)n >= errlen - used) {
-        return;
-    }
-    used += (size_t)n;
+    snprintf(err + used, errlen - used, "%s:%d: %s", loc.file ? loc.file : "?", loc.line, reason);
+}
+
+static void add_error(const struct can_map *map, char *err, size_t errlen, struct can_map_loc loc, const char *fmt,
+                      ...) __attribute__((format(printf, 5, 6)));
+
+static void add_error(const struct can_map *map, char *err, size_t errlen, struct can_map_loc loc, const char *fmt,
+                      ...)
+{
+    va_list ap;
     va_start(ap, fmt);
-    vsnprintf(err + used, errlen - used, fmt, ap);
+    report(map, err, errlen, true, loc, fmt, ap);
     va_end(ap);
 }
 
-static int fail(char *err, size_t errlen, struct can_map_loc loc, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
+static int fail(const struct can_map *map, char *err, size_t errlen, struct can_map_loc loc, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
 
-static int fail(char *err, size_t errlen, struct can_map_loc loc, const char *fmt, ...)
+static int fail(const struct can_map *map, char *err, size_t errlen, struct can_map_loc loc, const char *fmt, ...)
 {
     va_list ap;
-    int n;
-    if (err == NULL || errlen == 0) {
-        return -1;
-    }
-    n = snprintf(err, errlen, "%s:%d: ", loc.file ? loc.file : "?", loc.line);
-    if (n >= 0 && (size_t)n < errlen) {
-        va_start(ap, fmt);
-        vsnprintf(err + n, errlen - (size_t)n, fmt, ap);
-        va_end(ap);
-    }
+    va_start(ap, fmt);
+    report(map, err, errlen, false, loc, fmt, ap);
+    va_end(ap);
     return -1;
 }
 
@@ -324,6 +326,12 @@ void can_map_free(struct can_map *map)
     memset(map, 0, sizeof *map);
 }
 
+void can_map_set_reporter(struct can_map *map, can_map_report_fn fn, void *ctx)
+{
+    map->reporter = fn;
+    map->reporter_ctx = ctx;
+}
+
 bool can_map_enabled(const struct can_map *map)
 {
     return map->configured && map->finished;
@@ -360,40 +368,40 @@ static int can_key(struct can_map *map, const char *key, const char *value, stru
         }
     }
     if (k == CAN_MAP_CK_COUNT) {
-        return fail(err, errlen, loc,
+        return fail(map, err, errlen, loc,
                     "unknown key '%s' in [can] (keys: interface, fd, bitrate, data_bitrate, max_bus_load, "
                     "heartbeat_id, heartbeat_extended, heartbeat_period_ms, heartbeat_robot, stale_after_ms, "
                     "robot_generation, node, receiver)",
                     key);
     }
     if (map->key_loc[k].line != 0) {
-        return fail(err, errlen, loc, "[can] %s given twice (first at line %d)", key, map->key_loc[k].line);
+        return fail(map, err, errlen, loc, "[can] %s given twice (first at line %d)", key, map->key_loc[k].line);
     }
     switch ((enum can_map_can_key)k) {
     case CAN_MAP_CK_INTERFACE:
         if (value[0] == '\0' || strlen(value) > 255 || (strncmp(value, "log:", 4) == 0 && value[4] == '\0')) {
-            return fail(err, errlen, loc, "interface = '%s': give a CAN interface (can0) or log:PATH (log:- for stdout)",
+            return fail(map, err, errlen, loc, "interface = '%s': give a CAN interface (can0) or log:PATH (log:- for stdout)",
                         value);
         }
         if (strncmp(value, "log:", 4) != 0 && (strlen(value) >= 16 || strpbrk(value, " /\t") != NULL)) {
-            return fail(err, errlen, loc, "interface = '%s' is not an interface name (at most 15 characters, no '/')",
+            return fail(map, err, errlen, loc, "interface = '%s' is not an interface name (at most 15 characters, no '/')",
                         value);
         }
         free(map->interface);
         map->interface = strdup(value);
         if (map->interface == NULL) {
-            return fail(err, errlen, loc, "out of memory");
+            return fail(map, err, errlen, loc, "out of memory");
         }
         break;
     case CAN_MAP_CK_FD:
         if (!parse_bool(value, &map->fd)) {
-            return fail(err, errlen, loc, "fd = '%s': use yes or no", value);
+            return fail(map, err, errlen, loc, "fd = '%s': use yes or no", value);
         }
         break;
     case CAN_MAP_CK_BITRATE:
     case CAN_MAP_CK_DATA_BITRATE:
         if (!parse_u32(value, 10, &u) || u < 10000 || u > 12000000) {
-            return fail(err, errlen, loc, "%s = '%s': give bits per second between 10000 and 12000000 (500000)", key,
+            return fail(map, err, errlen, loc, "%s = '%s': give bits per second between 10000 and 12000000 (500000)", key,
                         value);
         }
         if (k == CAN_MAP_CK_BITRATE) {
@@ -404,23 +412,23 @@ static int can_key(struct can_map *map, const char *key, const char *value, stru
         break;
     case CAN_MAP_CK_MAX_LOAD:
         if (!parse_u32(value, 10, &u) || u < 1 || u > 100) {
-            return fail(err, errlen, loc, "max_bus_load = '%s': give a percentage 1..100", value);
+            return fail(map, err, errlen, loc, "max_bus_load = '%s': give a percentage 1..100", value);
         }
         map->max_load_percent = u;
         break;
     case CAN_MAP_CK_HB_ID:
         if (!parse_u32(value, 0, &map->hb_id)) {
-            return fail(err, errlen, loc, "heartbeat_id = '%s' is not a number (0x701 or 1793)", value);
+            return fail(map, err, errlen, loc, "heartbeat_id = '%s' is not a number (0x701 or 1793)", value);
         }
         break;
     case CAN_MAP_CK_HB_EXTENDED:
         if (!parse_bool(value, &map->hb_extended)) {
-            return fail(err, errlen, loc, "heartbeat_extended = '%s': use yes or no", value);
+            return fail(map, err, errlen, loc, "heartbeat_extended = '%s': use yes or no", value);
         }
         break;
     case CAN_MAP_CK_HB_PERIOD:
         if (!parse_u32(value, 10, &u) || u < 10 || u > 1000) {
-            return fail(err, errlen, loc,
+            return fail(map, err, errlen, loc,
                         "heartbeat_period_ms = '%s': give 10..1000 (the heartbeat goes at least once a second)",
                         value);
         }
@@ -428,12 +436,12 @@ static int can_key(struct can_map *map, const char *key, const char *value, stru
         break;
     case CAN_MAP_CK_HB_ROBOT:
         if (!copy_text(map->hb_robot, sizeof map->hb_robot, value) || map->hb_robot[0] == '\0') {
-            return fail(err, errlen, loc, "heartbeat_robot = '%s': give a robot name", value);
+            return fail(map, err, errlen, loc, "heartbeat_robot = '%s': give a robot name", value);
         }
         break;
     case CAN_MAP_CK_STALE_AFTER:
         if (!parse_u32(value, 10, &u) || u < 1 || u > 60000) {
-            return fail(err, errlen, loc, "stale_after_ms = '%s': give 1..60000 milliseconds", value);
+            return fail(map, err, errlen, loc, "stale_after_ms = '%s': give 1..60000 milliseconds", value);
         }
         map->stale_after_ms = u;
         break;
@@ -444,7 +452,7 @@ static int can_key(struct can_map *map, const char *key, const char *value, stru
         } else if (strcmp(value, "1") == 0 || strcasecmp(value, "1.x") == 0) {
             map->generation = URRT_GEN_1X;
         } else {
-            return fail(err, errlen, loc,
+            return fail(map, err, errlen, loc,
                         "robot_generation = '%s': use 3 (CB3 and e-series, 3.x/5.x) or 1 (CB1/CB2, 1.x)", value);
         }
         break;
@@ -452,7 +460,7 @@ static int can_key(struct can_map *map, const char *key, const char *value, stru
     case CAN_MAP_CK_RECEIVER: {
         char *dst = k == CAN_MAP_CK_NODE ? map->node : map->receiver;
         if (!is_identifier(value, strlen(value))) {
-            return fail(err, errlen, loc, "%s = '%s': a DBC node name is a C identifier of at most %d characters",
+            return fail(map, err, errlen, loc, "%s = '%s': a DBC node name is a C identifier of at most %d characters",
                         key, value, CAN_MAP_NAME_MAX);
         }
         snprintf(dst, CAN_MAP_NAME_MAX + 1, "%s", value);
@@ -613,7 +621,8 @@ static bool parse_place(const char *word, unsigned *start, unsigned *length)
     "signal = FIELD[ELEM] @START|LENGTH intel|motorola unsigned|signed|float32|float64 " \
     "[factor=F] [offset=O] [min=A] [max=B] [unit=U] [name=N] [invalid=RAW]"
 
-static int frame_signal(struct can_map_frame *f, const char *value, struct can_map_loc loc, char *err, size_t errlen)
+static int frame_signal(const struct can_map *map, struct can_map_frame *f, const char *value, struct can_map_loc loc,
+                        char *err, size_t errlen)
 {
     char line[512];
     char *words[SIGNAL_MAX_WORDS];
@@ -638,15 +647,15 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
     int fid;
 
     if (strlen(value) >= sizeof line) {
-        return fail(err, errlen, loc, "signal line too long");
+        return fail(map, err, errlen, loc, "signal line too long");
     }
     snprintf(line, sizeof line, "%s", value);
     nwords = split_words(line, words);
     if (nwords < 0) {
-        return fail(err, errlen, loc, "signal: unbalanced quotes or more than %d words", SIGNAL_MAX_WORDS);
+        return fail(map, err, errlen, loc, "signal: unbalanced quotes or more than %d words", SIGNAL_MAX_WORDS);
     }
     if (nwords < 4) {
-        return fail(err, errlen, loc, "signal = '%s': expected %s", value, SIGNAL_GRAMMAR);
+        return fail(map, err, errlen, loc, "signal = '%s': expected %s", value, SIGNAL_GRAMMAR);
     }
     memset(&sig, 0, sizeof sig);
     memset(&meta, 0, sizeof meta);
@@ -658,7 +667,7 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
     bracket = strchr(words[0], '[');
     fid = urrt_field_find(words[0], bracket ? (size_t)(bracket - words[0]) : strlen(words[0]));
     if (fid < 0) {
-        return fail(err, errlen, loc, "signal: no field '%.*s' (field names as in docs/protocol.md: q_actual, "
+        return fail(map, err, errlen, loc, "signal: no field '%.*s' (field names as in docs/protocol.md: q_actual, "
                     "tcp_force, robot_mode, ...)",
                     bracket ? (int)(bracket - words[0]) : (int)strlen(words[0]), words[0]);
     }
@@ -669,33 +678,33 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
         char num[16];
         uint32_t e;
         if (blen < 3 || bracket[blen - 1] != ']' || blen - 2 >= sizeof num) {
-            return fail(err, errlen, loc, "signal: '%s': write FIELD[ELEM], e.g. q_actual[0]", words[0]);
+            return fail(map, err, errlen, loc, "signal: '%s': write FIELD[ELEM], e.g. q_actual[0]", words[0]);
         }
         memcpy(num, bracket + 1, blen - 2);
         num[blen - 2] = '\0';
         if (!parse_u32(num, 10, &e)) {
-            return fail(err, errlen, loc, "signal: '%s': the element is a number", words[0]);
+            return fail(map, err, errlen, loc, "signal: '%s': the element is a number", words[0]);
         }
         if (e >= info->count) {
-            return fail(err, errlen, loc, "signal: %s has %u element%s: %s[%u] is out of range (0..%u)", info->name,
+            return fail(map, err, errlen, loc, "signal: %s has %u element%s: %s[%u] is out of range (0..%u)", info->name,
                         (unsigned)info->count, info->count == 1 ? "" : "s", info->name, (unsigned)e,
                         (unsigned)info->count - 1);
         }
         meta.elem = e;
     } else if (info->count > 1) {
-        return fail(err, errlen, loc, "signal: %s has %u elements: write %s[0] .. %s[%u]", info->name,
+        return fail(map, err, errlen, loc, "signal: %s has %u elements: write %s[0] .. %s[%u]", info->name,
                     (unsigned)info->count, info->name, info->name, (unsigned)info->count - 1);
     }
     meta.bitmask = strcmp(info->unit, "bits") == 0;
 
     if (!parse_place(words[1], &start, &length)) {
-        return fail(err, errlen, loc, "signal: '%s': expected @START|LENGTH, e.g. @0|16", words[1]);
+        return fail(map, err, errlen, loc, "signal: '%s': expected @START|LENGTH, e.g. @0|16", words[1]);
     }
     if (length < 1 || length > 64) {
-        return fail(err, errlen, loc, "signal: length %u: give 1..64 bits", length);
+        return fail(map, err, errlen, loc, "signal: length %u: give 1..64 bits", length);
     }
     if (start >= 8 * URRT_CAN_MAX_LEN) {
-        return fail(err, errlen, loc, "signal: start bit %u: give 0..511", start);
+        return fail(map, err, errlen, loc, "signal: start bit %u: give 0..511", start);
     }
     sig.start = (uint16_t)start;
     sig.length = (uint8_t)length;
@@ -719,13 +728,13 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
             } else if (strcmp(w, "float64") == 0) {
                 slot = &type, v = URRT_CAN_FLOAT64;
             } else {
-                return fail(err, errlen, loc,
+                return fail(map, err, errlen, loc,
                             "signal: unknown word '%s': expected intel|motorola, unsigned|signed|float32|float64 "
                             "or factor=, offset=, min=, max=, unit=, name=, invalid=",
                             w);
             }
             if (*slot >= 0) {
-                return fail(err, errlen, loc, "signal: '%s': %s given twice", w,
+                return fail(map, err, errlen, loc, "signal: '%s': %s given twice", w,
                             slot == &order ? "byte order" : "type");
             }
             *slot = v;
@@ -739,11 +748,11 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
             if (strcmp(k, "factor") == 0 || strcmp(k, "offset") == 0 || strcmp(k, "min") == 0 ||
                 strcmp(k, "max") == 0) {
                 if (!parse_double(v, &d)) {
-                    return fail(err, errlen, loc, "signal: %s = '%s' is not a finite number", k, v);
+                    return fail(map, err, errlen, loc, "signal: %s = '%s' is not a finite number", k, v);
                 }
                 if (k[0] == 'f') {
                     if (d == 0.0) {
-                        return fail(err, errlen, loc, "signal: factor must not be 0");
+                        return fail(map, err, errlen, loc, "signal: factor must not be 0");
                     }
                     sig.factor = d;
                 } else if (k[0] == 'o') {
@@ -757,13 +766,13 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
                 }
             } else if (strcmp(k, "unit") == 0) {
                 if (!copy_text(meta.unit, sizeof meta.unit, v)) {
-                    return fail(err, errlen, loc, "signal: unit '%s': at most %d characters, no '\"' or '\\'", v,
+                    return fail(map, err, errlen, loc, "signal: unit '%s': at most %d characters, no '\"' or '\\'", v,
                                 CAN_MAP_UNIT_MAX);
                 }
                 have_unit = true;
             } else if (strcmp(k, "name") == 0) {
                 if (!is_identifier(v, strlen(v))) {
-                    return fail(err, errlen, loc,
+                    return fail(map, err, errlen, loc,
                                 "signal: name '%s': a DBC signal name is a C identifier of at most %d characters", v,
                                 CAN_MAP_NAME_MAX);
                 }
@@ -771,11 +780,11 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
                 have_name = true;
             } else if (strcmp(k, "invalid") == 0) {
                 if (!parse_i64(v, &invalid)) {
-                    return fail(err, errlen, loc, "signal: invalid = '%s' is not an integer raw value", v);
+                    return fail(map, err, errlen, loc, "signal: invalid = '%s' is not an integer raw value", v);
                 }
                 have_invalid = true;
             } else {
-                return fail(err, errlen, loc,
+                return fail(map, err, errlen, loc,
                             "signal: unknown option '%s=': expected factor=, offset=, min=, max=, unit=, name=, "
                             "invalid=",
                             k);
@@ -783,24 +792,24 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
         }
     }
     if (order < 0) {
-        return fail(err, errlen, loc, "signal: byte order missing: add intel (little-endian) or motorola (big-endian)");
+        return fail(map, err, errlen, loc, "signal: byte order missing: add intel (little-endian) or motorola (big-endian)");
     }
     if (type < 0) {
-        return fail(err, errlen, loc, "signal: type missing: add unsigned, signed, float32 or float64");
+        return fail(map, err, errlen, loc, "signal: type missing: add unsigned, signed, float32 or float64");
     }
     sig.byte_order = (uint8_t)order;
     sig.type = (uint8_t)type;
     if (type == URRT_CAN_FLOAT32 && length != 32) {
-        return fail(err, errlen, loc, "signal: float32 needs length 32, not %u", length);
+        return fail(map, err, errlen, loc, "signal: float32 needs length 32, not %u", length);
     }
     if (type == URRT_CAN_FLOAT64 && length != 64) {
-        return fail(err, errlen, loc, "signal: float64 needs length 64, not %u", length);
+        return fail(map, err, errlen, loc, "signal: float64 needs length 64, not %u", length);
     }
     {
         urrt_can_signal bare = sig;
         bare.min = bare.max = 0;
         if (urrt_can_signal_range(&bare, &lo, &hi) < 0) {
-            return fail(err, errlen, loc, "signal: invalid scaling");
+            return fail(map, err, errlen, loc, "signal: invalid scaling");
         }
     }
     {
@@ -811,10 +820,10 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
             slack = 0;
         }
         if (have_min && sig.min < lo - slack) {
-            return fail(err, errlen, loc, "signal: min=%.17g is below what the signal can carry (%.17g)", sig.min, lo);
+            return fail(map, err, errlen, loc, "signal: min=%.17g is below what the signal can carry (%.17g)", sig.min, lo);
         }
         if (have_max && sig.max > hi + slack) {
-            return fail(err, errlen, loc, "signal: max=%.17g is above what the signal can carry (%.17g)", sig.max, hi);
+            return fail(map, err, errlen, loc, "signal: max=%.17g is above what the signal can carry (%.17g)", sig.max, hi);
         }
     }
     if (!have_min) {
@@ -824,17 +833,17 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
         sig.max = hi;
     }
     if (sig.min > sig.max) {
-        return fail(err, errlen, loc, "signal: min=%.17g is above max=%.17g", sig.min, sig.max);
+        return fail(map, err, errlen, loc, "signal: min=%.17g is above max=%.17g", sig.min, sig.max);
     }
     if (have_invalid) {
         uint64_t mask = length >= 64 ? UINT64_MAX : (UINT64_C(1) << length) - 1;
         if (type == URRT_CAN_FLOAT32 || type == URRT_CAN_FLOAT64) {
-            return fail(err, errlen, loc, "signal: invalid= applies to integer signals (float signals send NaN)");
+            return fail(map, err, errlen, loc, "signal: invalid= applies to integer signals (float signals send NaN)");
         }
         if (invalid < 0) {
             int64_t lowest = length >= 64 ? INT64_MIN : -((int64_t)1 << (length - 1));
             if (type != URRT_CAN_SIGNED || invalid < lowest) {
-                return fail(err, errlen, loc, "signal: invalid=%lld does not fit %u %s bits", (long long)invalid,
+                return fail(map, err, errlen, loc, "signal: invalid=%lld does not fit %u %s bits", (long long)invalid,
                             length, type == URRT_CAN_SIGNED ? "signed" : "unsigned");
             }
             sig.invalid_raw = (uint64_t)invalid & mask;
@@ -842,7 +851,7 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
             /* A positive value is the raw bit pattern (0x8000 for a signed
              * 16-bit signal is its most negative value). */
             if (((uint64_t)invalid & ~mask) != 0) {
-                return fail(err, errlen, loc, "signal: invalid=%lld does not fit %u bits", (long long)invalid, length);
+                return fail(map, err, errlen, loc, "signal: invalid=%lld does not fit %u bits", (long long)invalid, length);
             }
             sig.invalid_raw = (uint64_t)invalid;
         }
@@ -860,19 +869,19 @@ static int frame_signal(struct can_map_frame *f, const char *value, struct can_m
     }
     i = signal_named(f, meta.name);
     if (i >= 0) {
-        return fail(err, errlen, loc, "signal name '%s' already used in [frame %s] (line %d): add name=OTHER",
+        return fail(map, err, errlen, loc, "signal name '%s' already used in [frame %s] (line %d): add name=OTHER",
                     meta.name, f->name, f->meta[i].loc.line);
     }
     if (urrt_can_signal_check(&sig, URRT_CAN_MAX_LEN) < 0) {
-        return fail(err, errlen, loc, "signal: does not fit even a 64-byte frame");
+        return fail(map, err, errlen, loc, "signal: does not fit even a 64-byte frame");
     }
     if (add_signal(f, &sig, &meta) < 0) {
-        return fail(err, errlen, loc, "out of memory");
+        return fail(map, err, errlen, loc, "out of memory");
     }
     return 1;
 }
 
-static int frame_marker(struct can_map_frame *f, enum can_map_role role, const char *value, struct can_map_loc loc,
+static int frame_marker(const struct can_map *map, struct can_map_frame *f, enum can_map_role role, const char *value, struct can_map_loc loc,
                         char *err, size_t errlen)
 {
     char buf[64];
@@ -894,7 +903,7 @@ static int frame_marker(struct can_map_frame *f, enum can_map_role role, const c
     sig.byte_order = URRT_CAN_INTEL;
     if (nwords < 1 || nwords > 2 || !parse_u32(words[0], 10, &start) ||
         (nwords == 2 && role == CAN_MAP_ROLE_VALID)) {
-        return fail(err, errlen, loc, role == CAN_MAP_ROLE_ALIVE
+        return fail(map, err, errlen, loc, role == CAN_MAP_ROLE_ALIVE
                                           ? "alive_counter = '%s': give the start bit of the 4-bit counter "
                                             "and optionally its byte order (56, or 59 motorola)"
                                           : "validity_bit = '%s': give the bit number (0..511)",
@@ -904,11 +913,11 @@ static int frame_marker(struct can_map_frame *f, enum can_map_role role, const c
         if (strcmp(words[1], "motorola") == 0) {
             sig.byte_order = URRT_CAN_MOTOROLA;
         } else if (strcmp(words[1], "intel") != 0) {
-            return fail(err, errlen, loc, "alive_counter: byte order '%s': use intel or motorola", words[1]);
+            return fail(map, err, errlen, loc, "alive_counter: byte order '%s': use intel or motorola", words[1]);
         }
     }
     if (start >= 8 * URRT_CAN_MAX_LEN) {
-        return fail(err, errlen, loc, "%s = %u: give a bit number 0..511", key, (unsigned)start);
+        return fail(map, err, errlen, loc, "%s = %u: give a bit number 0..511", key, (unsigned)start);
     }
     sig.start = (uint16_t)start;
     sig.length = role == CAN_MAP_ROLE_ALIVE ? CAN_MAP_ALIVE_BITS : 1;
@@ -919,14 +928,14 @@ static int frame_marker(struct can_map_frame *f, enum can_map_role role, const c
     meta.field = -1;
     snprintf(meta.name, sizeof meta.name, "%s", name);
     if (signal_named(f, name) >= 0) {
-        return fail(err, errlen, loc, "[frame %s] already has a signal named '%s'", f->name, name);
+        return fail(map, err, errlen, loc, "[frame %s] already has a signal named '%s'", f->name, name);
     }
     if (urrt_can_signal_check(&sig, URRT_CAN_MAX_LEN) < 0) {
-        return fail(err, errlen, loc, "%s does not fit even a 64-byte frame", key);
+        return fail(map, err, errlen, loc, "%s does not fit even a 64-byte frame", key);
     }
     index = add_signal(f, &sig, &meta);
     if (index < 0) {
-        return fail(err, errlen, loc, "out of memory");
+        return fail(map, err, errlen, loc, "out of memory");
     }
     if (role == CAN_MAP_ROLE_ALIVE) {
         f->alive_index = index;
@@ -942,7 +951,7 @@ static int frame_key(struct can_map *map, struct can_map_frame *f, const char *k
     int k;
     uint32_t u;
     if (strcmp(key, "signal") == 0) {
-        return frame_signal(f, value, loc, err, errlen);
+        return frame_signal(map, f, value, loc, err, errlen);
     }
     for (k = 0; k < CAN_MAP_FK_COUNT; k++) {
         if (strcmp(key, frame_key_names[k]) == 0) {
@@ -950,34 +959,34 @@ static int frame_key(struct can_map *map, struct can_map_frame *f, const char *k
         }
     }
     if (k == CAN_MAP_FK_COUNT) {
-        return fail(err, errlen, loc,
+        return fail(map, err, errlen, loc,
                     "unknown key '%s' in [frame %s] (keys: id, extended, fd, length, period_ms, robot, signal, "
                     "alive_counter, validity_bit, stale_after_ms, stale_policy, comment)",
                     key, f->name);
     }
     if (f->key_loc[k].line != 0) {
-        return fail(err, errlen, loc, "[frame %s] %s given twice (first at line %d)", f->name, key,
+        return fail(map, err, errlen, loc, "[frame %s] %s given twice (first at line %d)", f->name, key,
                     f->key_loc[k].line);
     }
     switch ((enum can_map_frame_key)k) {
     case CAN_MAP_FK_ID:
         if (!parse_u32(value, 0, &f->id)) {
-            return fail(err, errlen, loc, "id = '%s' is not a number (0x181 or 385)", value);
+            return fail(map, err, errlen, loc, "id = '%s' is not a number (0x181 or 385)", value);
         }
         break;
     case CAN_MAP_FK_EXTENDED:
         if (!parse_bool(value, &f->extended)) {
-            return fail(err, errlen, loc, "extended = '%s': use yes (29-bit id) or no (11-bit id)", value);
+            return fail(map, err, errlen, loc, "extended = '%s': use yes (29-bit id) or no (11-bit id)", value);
         }
         break;
     case CAN_MAP_FK_FD:
         if (!parse_bool(value, &f->fd)) {
-            return fail(err, errlen, loc, "fd = '%s': use yes (CAN FD frame) or no (classic CAN)", value);
+            return fail(map, err, errlen, loc, "fd = '%s': use yes (CAN FD frame) or no (classic CAN)", value);
         }
         break;
     case CAN_MAP_FK_LENGTH:
         if (!parse_u32(value, 10, &u) || u > URRT_CAN_MAX_LEN) {
-            return fail(err, errlen, loc, "length = '%s': give the payload length in bytes, 0..8 (FD: up to 64)",
+            return fail(map, err, errlen, loc, "length = '%s': give the payload length in bytes, 0..8 (FD: up to 64)",
                         value);
         }
         f->len = (uint8_t)u;
@@ -986,7 +995,7 @@ static int frame_key(struct can_map *map, struct can_map_frame *f, const char *k
         if (strcmp(value, "every") == 0) {
             f->every = true;
         } else if (!parse_u32(value, 10, &u) || u < 1 || u > 60000) {
-            return fail(err, errlen, loc, "period_ms = '%s': give 1..60000 milliseconds, or every (each packet)",
+            return fail(map, err, errlen, loc, "period_ms = '%s': give 1..60000 milliseconds, or every (each packet)",
                         value);
         } else {
             f->period_ms = u;
@@ -994,22 +1003,22 @@ static int frame_key(struct can_map *map, struct can_map_frame *f, const char *k
         break;
     case CAN_MAP_FK_ROBOT:
         if (!copy_text(f->robot, sizeof f->robot, value) || f->robot[0] == '\0') {
-            return fail(err, errlen, loc, "robot = '%s': give a robot name", value);
+            return fail(map, err, errlen, loc, "robot = '%s': give a robot name", value);
         }
         break;
     case CAN_MAP_FK_ALIVE:
-        if (frame_marker(f, CAN_MAP_ROLE_ALIVE, value, loc, err, errlen) < 0) {
+        if (frame_marker(map, f, CAN_MAP_ROLE_ALIVE, value, loc, err, errlen) < 0) {
             return -1;
         }
         break;
     case CAN_MAP_FK_VALID:
-        if (frame_marker(f, CAN_MAP_ROLE_VALID, value, loc, err, errlen) < 0) {
+        if (frame_marker(map, f, CAN_MAP_ROLE_VALID, value, loc, err, errlen) < 0) {
             return -1;
         }
         break;
     case CAN_MAP_FK_STALE_AFTER:
         if (!parse_u32(value, 10, &u) || u < 1 || u > 60000) {
-            return fail(err, errlen, loc, "stale_after_ms = '%s': give 1..60000 milliseconds", value);
+            return fail(map, err, errlen, loc, "stale_after_ms = '%s': give 1..60000 milliseconds", value);
         }
         f->stale_after_ms = u;
         break;
@@ -1019,12 +1028,12 @@ static int frame_key(struct can_map *map, struct can_map_frame *f, const char *k
         } else if (strcmp(value, "invalid") == 0) {
             f->stale_policy = CAN_MAP_STALE_INVALID;
         } else {
-            return fail(err, errlen, loc, "stale_policy = '%s': use stop or invalid", value);
+            return fail(map, err, errlen, loc, "stale_policy = '%s': use stop or invalid", value);
         }
         break;
     case CAN_MAP_FK_COMMENT:
         if (!copy_text(f->comment, sizeof f->comment, value)) {
-            return fail(err, errlen, loc, "comment: at most %zu characters, no '\"' or '\\'",
+            return fail(map, err, errlen, loc, "comment: at most %zu characters, no '\"' or '\\'",
                         sizeof f->comment - 1);
         }
         break;
@@ -1054,7 +1063,7 @@ int can_map_ini(struct can_map *map, const char *section, const char *key, const
     loc.file = intern_file(map, file);
     loc.line = line;
     if (map->finished) {
-        return fail(err, errlen, loc, "CAN configuration already finished");
+        return fail(map, err, errlen, loc, "CAN configuration already finished");
     }
     map->configured = true;
     if (strcmp(section, "can") == 0) {
@@ -1075,16 +1084,16 @@ int can_map_ini(struct can_map *map, const char *section, const char *key, const
             len--;
         }
         if (!is_identifier(name, len)) {
-            return fail(err, errlen, loc,
+            return fail(map, err, errlen, loc,
                         "[frame %.*s]: the frame name is its DBC name, a C identifier of at most %d characters",
                         (int)len, name, CAN_MAP_NAME_MAX);
         }
         if (len == strlen(CAN_MAP_HEARTBEAT_NAME) && memcmp(name, CAN_MAP_HEARTBEAT_NAME, len) == 0) {
-            return fail(err, errlen, loc, "[frame %s]: that name is the heartbeat's", CAN_MAP_HEARTBEAT_NAME);
+            return fail(map, err, errlen, loc, "[frame %s]: that name is the heartbeat's", CAN_MAP_HEARTBEAT_NAME);
         }
         f = frame_get(map, name, len, loc);
         if (f == NULL) {
-            return fail(err, errlen, loc, "out of memory");
+            return fail(map, err, errlen, loc, "out of memory");
         }
         return frame_key(map, f, key, value, loc, err, errlen);
     }
@@ -1148,10 +1157,10 @@ static void robot_problem(const struct can_map *map, char *err, size_t errlen, s
     char list[256];
     robot_list(map, list, sizeof list);
     if (name[0] == '\0') {
-        add_error(err, errlen, loc, "%s: the gateway has %zu robots (%s): say which with %s", what,
+        add_error(map, err, errlen, loc, "%s: the gateway has %zu robots (%s): say which with %s", what,
                   map->robot_count, list, strcmp(what, "heartbeat") == 0 ? "heartbeat_robot = NAME" : "robot = NAME");
     } else {
-        add_error(err, errlen, loc, "%s: unknown robot '%s' (robots: %s)", what, name, list);
+        add_error(map, err, errlen, loc, "%s: unknown robot '%s' (robots: %s)", what, name, list);
     }
 }
 
@@ -1173,7 +1182,7 @@ static void check_frame(struct can_map *map, struct can_map_frame *f, char *err,
     struct can_map_loc len_loc = loc_or(f->key_loc[CAN_MAP_FK_LENGTH], f->loc);
 
     snprintf(what, sizeof what, "[frame %s]", f->name);
-#define PROBLEM(loc, ...) (add_error(err, errlen, (loc), __VA_ARGS__), (*errors)++)
+#define PROBLEM(loc, ...) (add_error(map, err, errlen, (loc), __VA_ARGS__), (*errors)++)
     if (f->key_loc[CAN_MAP_FK_ID].line == 0) {
         PROBLEM(f->loc, "%s has no id", what);
     } else if (!urrt_can_id_valid(f->id, f->extended)) {
@@ -1204,7 +1213,7 @@ static void check_frame(struct can_map *map, struct can_map_frame *f, char *err,
         robot_problem(map, err, errlen, loc_or(f->key_loc[CAN_MAP_FK_ROBOT], f->loc), what, f->robot);
         (*errors)++;
         f->robot_index = 0;
-    } else if (!f->every && map->robots[f->robot_index].period_us != 0 &&
+    } else if (!f->every && f->key_loc[CAN_MAP_FK_PERIOD].line != 0 && map->robots[f->robot_index].period_us != 0 &&
                (uint64_t)f->period_ms * 1000u < map->robots[f->robot_index].period_us) {
         uint32_t p = map->robots[f->robot_index].period_us;
         PROBLEM(f->key_loc[CAN_MAP_FK_PERIOD],
@@ -1304,7 +1313,7 @@ int can_map_finish(struct can_map *map, const struct can_map_robot *robots, size
         return 0;
     }
     can_loc = map->can_loc.line ? map->can_loc : (map->frame_count ? map->frames[0].loc : map->can_loc);
-#define PROBLEM(loc, ...) (add_error(err, errlen, (loc), __VA_ARGS__), errors++)
+#define PROBLEM(loc, ...) (add_error(map, err, errlen, (loc), __VA_ARGS__), errors++)
     if (map->can_loc.line == 0) {
         PROBLEM(can_loc, "CAN frames need a [can] section (interface, heartbeat_id, ...)");
     } else {

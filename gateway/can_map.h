@@ -194,7 +194,13 @@ struct can_map_robot_rt {
     urrt_generation generation;
 };
 
+/* Receives each problem can_map_ini and can_map_finish find, as file, line
+ * and reason (without "FILE:LINE: "), for a caller with its own error list. */
+typedef void (*can_map_report_fn)(void *ctx, const char *file, int line, const char *reason);
+
 struct can_map {
+    can_map_report_fn reporter;             /* optional, see can_map_set_reporter */
+    void *reporter_ctx;
     bool configured;                        /* a [can] key or a [frame] section was seen */
     bool finished;
     /* [can] */
@@ -240,6 +246,10 @@ struct can_map {
 
 void can_map_init(struct can_map *map);
 void can_map_free(struct can_map *map);
+
+/* Every problem also goes to fn (NULL: none) as it is found. err buffers
+ * still receive the text. */
+void can_map_set_reporter(struct can_map *map, can_map_report_fn fn, void *ctx);
 
 /*
  * One key of the configuration file, as the INI parser reads it. Handles

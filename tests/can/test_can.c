@@ -749,6 +749,44 @@ static void test_config_rejections(void)
     }
 }
 
+struct reported {
+    int count;
+    char first[512];
+    int first_line;
+};
+
+static void record_problem(void *ctx, const char *file, int line, const char *reason)
+{
+    struct reported *r = ctx;
+    if (r->count++ == 0) {
+        snprintf(r->first, sizeof r->first, "%s|%s", file, reason);
+        r->first_line = line;
+    }
+}
+
+/* A caller with its own error list gets file, line and reason apart. */
+static void test_reporter(void)
+{
+    struct can_map map;
+    struct reported r;
+    char err[256];
+    memset(&r, 0, sizeof r);
+    can_map_init(&map);
+    can_map_set_reporter(&map, record_problem, &r);
+    CHECK_EQ_INT(can_map_ini(&map, "frame a", "id", "zz", "gw.ini", 12, err, sizeof err), -1);
+    CHECK(r.count == 1 && r.first_line == 12, "reported %d at %d", r.count, r.first_line);
+    CHECK_EQ_STR(r.first, "gw.ini|id = 'zz' is not a number (0x181 or 385)");
+    CHECK_EQ_STR(err, "gw.ini:12: id = 'zz' is not a number (0x181 or 385)");
+    CHECK_EQ_INT(can_map_ini(&map, "frame a", "signal", "time @0|8 intel unsigned", "gw.ini", 13, err, sizeof err), 1);
+    CHECK_EQ_INT(can_map_ini(&map, "robot x", "host", "h", "gw.ini", 14, err, sizeof err), 0);
+    memset(&r, 0, sizeof r);
+    CHECK_EQ_INT(can_map_finish(&map, one_robot, 1, err, sizeof err), -1);
+    /* No [can] section, and the frame has neither id nor period: three problems. */
+    CHECK(r.count == 3 && r.first_line == 12, "finish reported %d, first at %d: %s", r.count, r.first_line, r.first);
+    CHECK_EQ_STR(r.first, "gw.ini|CAN frames need a [can] section (interface, heartbeat_id, ...)");
+    can_map_free(&map);
+}
+
 static void test_config_robots(void)
 {
     struct can_map map;
@@ -1266,6 +1304,7 @@ int main(void)
     test_config_good();
     test_config_rejections();
     test_config_robots();
+    test_reporter();
     test_bus_load();
     test_schedule();
     test_validity_and_heartbeat();
