@@ -598,6 +598,38 @@ def t_configs(args):
     check(lines == [3, 4, 5], "config: every error reported, in line order (%s)" % lines)
 
 
+def t_install(args):
+    """make install-gateway puts every file where PREFIX/UNITDIR/SYSCONFDIR say; the unit verifies."""
+    root = tempfile.mkdtemp(prefix="gw-inst-", dir=args.tmp)
+    prefix, unitdir, etc = root + "/usr", root + "/unit", root + "/etc"
+    repo = os.path.join(HERE, "..", "..")
+    p = subprocess.run(["make", "-s", "-C", repo, "BUILD=" + os.path.abspath(args.build), "install-gateway",
+                        "PREFIX=" + prefix, "UNITDIR=" + unitdir, "SYSCONFDIR=" + etc],
+                       capture_output=True, text=True, timeout=300)
+    files = ["usr/bin/urrt-spy", "usr/share/java/urrt_lcmtypes.jar", "usr/share/urrt/urrt-gateway.example.ini",
+             "unit/urrt-gateway.service", "etc/urrt/gateway.ini"]
+    check(p.returncode == 0 and all(os.path.exists(os.path.join(root, f)) for f in files),
+          "install: %s (%s)" % (", ".join(files), p.stderr.strip()[-200:]))
+    unit = open(os.path.join(unitdir, "urrt-gateway.service")).read() if os.path.exists(unitdir) else ""
+    check("ExecStart=%s/bin/urrt-gateway %s/urrt/gateway.ini" % (prefix, etc) in unit and "DynamicUser=yes" in unit
+          and "Restart=on-failure" in unit and "@" not in unit.replace("@system-service", "").replace("@privileged", "")
+          .replace("@resources", ""), "install: the unit names the installed paths, restarts, runs unprivileged")
+    spy = open(os.path.join(prefix, "bin", "urrt-spy")).read() if os.path.exists(prefix) else ""
+    check("URRT_JAR_DEFAULT=%s/share/java/urrt_lcmtypes.jar" % prefix in spy, "install: urrt-spy knows the jar")
+    with open(os.path.join(etc, "urrt", "gateway.ini"), "a") as f:
+        f.write("# edited\n")
+    subprocess.run(["make", "-s", "-C", repo, "BUILD=" + os.path.abspath(args.build), "install-gateway",
+                    "PREFIX=" + prefix, "UNITDIR=" + unitdir, "SYSCONFDIR=" + etc], capture_output=True, timeout=300)
+    check(open(os.path.join(etc, "urrt", "gateway.ini")).read().endswith("# edited\n"),
+          "install: an edited configuration is kept")
+    if subprocess.run(["which", "systemd-analyze"], capture_output=True).returncode == 0:
+        os.makedirs(os.path.join(prefix, "bin"), exist_ok=True)
+        subprocess.run(["cp", args.gateway, os.path.join(prefix, "bin", "urrt-gateway")])
+        v = subprocess.run(["systemd-analyze", "verify", os.path.join(unitdir, "urrt-gateway.service")],
+                           capture_output=True, text=True, timeout=60)
+        check(v.returncode == 0, "install: systemd-analyze verify accepts the unit (%s)" % v.stderr.strip()[:300])
+
+
 def t_cli(args):
     h = subprocess.run([args.gateway, "--help"], capture_output=True, text=True, timeout=10)
     check(h.returncode == 0 and "--check-config" in h.stdout and "[robot NAME]" in h.stdout and
@@ -628,6 +660,7 @@ def main():
     tests = [
         ("cli", lambda: t_cli(args)),
         ("configs", lambda: t_configs(args)),
+        ("install", lambda: t_install(args)),
         ("jar", lambda: t_jar(args)),
         ("values510", lambda: t_values(args, "5.10", port + 1, 1500)),
         ("values310", lambda: t_values(args, "3.10", port + 2, 300)),
