@@ -1,0 +1,48 @@
+/*
+ * cli.h: small helpers the urrt programs share: argument parsing with
+ * useful errors, and the signal handling of a poll loop.
+ *
+ * Parsers return NULL on success or a short English reason ("not a number",
+ * "above 65535") for the caller to put in its message.
+ */
+#ifndef URRT_CLI_H
+#define URRT_CLI_H
+
+#include <signal.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/* Exit codes every program documents in --help. */
+enum {
+    CLI_EXIT_OK = 0,
+    CLI_EXIT_RUNTIME = 1, /* a file, socket or peer failed */
+    CLI_EXIT_USAGE = 2    /* bad command line or configuration */
+};
+
+/*
+ * "HOST", "HOST:PORT", "[V6]", "[V6]:PORT", or a bare IPv6 literal ("::1",
+ * which has more than one colon and so no port). host receives the host
+ * without brackets; *port the port, or default_port when none is given.
+ */
+const char *cli_parse_host_port(const char *arg, uint16_t default_port, char *host, size_t host_size,
+                                uint16_t *port);
+
+/* "host:port", or "[host]:port" when host holds a colon. */
+void cli_format_host_port(const char *host, uint16_t port, char *out, size_t out_size);
+
+/* A whole decimal number (or 0x hex) in [min, max]; no sign, no trailing text. */
+const char *cli_parse_u64(const char *text, uint64_t min, uint64_t max, uint64_t *out);
+const char *cli_parse_u32(const char *text, uint32_t min, uint32_t max, uint32_t *out);
+/* A finite number in [min, max]. */
+const char *cli_parse_double(const char *text, double min, double max, double *out);
+
+/*
+ * SIGINT and SIGTERM clear *running (without SA_RESTART, so that a blocking
+ * poll returns EINTR and the loop looks at the flag); SIGPIPE is ignored, so
+ * that writing to a closed socket or pipe is an EPIPE error and not death.
+ */
+void cli_handle_signals(volatile sig_atomic_t *running);
+/* The signal that cleared the flag, 0 if none. */
+int cli_stop_signal(void);
+
+#endif

@@ -1,0 +1,1104 @@
+/*
+ * urrt-sim: a robot controller's RealTime stream, served here.
+ *
+ * One packet per period on an absolute monotonic schedule, to every
+ * connected client, from a deterministic model of a moving UR5e-like arm
+ * (gateway/sim_model.c) or from a raw capture. Fault modes reproduce what
+ * real links do to the stream. See usage() and docs/tools.md.
+ */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <math.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/prctl.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "port.h"
+#include "sim_model.h"
+#include "urrt.h"
+
+#define PROGRAM "urrt-sim"
+#define DEFAULT_LISTEN "127.0.0.1:30003"
+#define DEFAULT_LENGTH 1116
+#define MAX_CLIENTS_LIMIT 64
+/* A client whose socket stays full this long, or whose queue grows past
+ * this, is too slow: it is dropped so that it cannot stall the others. */
+#define SLOW_CLIENT_NS (2000ull * 1000000ull)
+#define CLIENT_QUEUE_MAX (1u << 20)
+#define CLIENT_SNDBUF (128 * 1024)
+/* Waking up later than this behind the schedule is a stop, not a hiccup:
+ * the overdue packets are skipped rather than sent as a burst. */
+#define CATCH_UP_MAX_NS (100ull * 1000000ull)
+/* Lateness histogram: 10 us buckets up to 20 ms. */
+#define LATE_BUCKET_NS 10000ull
+#define LATE_BUCKETS 2000
+
+static volatile sig_atomic_t running = 1;
+
+/* ---- options ---------------------------------------------------------------- */
+
+typedef struct fault_config {
+    uint64_t close_after;     /* close normally after N packets */
+    uint64_t reset_after;     /* close with RST after N packets */
+    uint64_t truncate_after;  /* N packets, half of the next, then close */
+    uint64_t garbage_every;   /* garbage bytes before packet N+1, 2N+1, ... */
+    uint32_t garbage_bytes;
+    uint32_t tiny_writes;     /* write at most this many bytes at a time, spread over the period */
+    uint64_t coalesce;        /* hold packets and write N at once */
+    uint64_t stall_after;     /* stop sending after N packets ... */
+    uint64_t stall_ms;        /* ... for this long (0: until the client leaves) */
+    uint64_t odd_every;       /* every Nth packet with a length no controller uses */
+    uint32_t odd_length;
+} fault_config;
+
+typedef struct options {
+    char listen_host[256];
+    uint16_t listen_port;
+    uint32_t length;
+    double rate_hz;
+    bool rate_given;
+    uint64_t seed;
+    uint64_t count;
+    const char *record_path;
+    const char *replay_path;
+    bool loop;
+    bool start_on_connect;
+    uint64_t clients_to_serve;
+    uint32_t max_clients;
+    fault_config fault;
+    urrt_log_level log_level;
+} options;
+
+/* ---- the packet source: the model or a capture ------------------------------ */
+
+typedef struct replay {
+    const uint8_t *data;  /* the mapped file */
+    size_t size;
+    size_t count;         /* packets */
+    size_t *end;          /* end offset of packet i: unit i is [end[i-1], end[i]) */
+    uint64_t *due_ns;     /* offset of packet i from the first, by the time column */
+    uint64_t span_ns;     /* one pass, including the pause before the first again */
+} replay;
+
+typedef struct latency_stats {
+    uint64_t samples;
+    uint64_t late;        /* sent one period or more behind its deadline */
+    uint64_t skipped;     /* not sent at all: the schedule was too far behind */
+    uint64_t sum_ns;
+    uint64_t max_ns;
+    uint32_t hist[LATE_BUCKETS + 1];
+} latency_stats;
+
+typedef struct client {
+    int fd;
+    char peer[80];
+    uint64_t id;
+    uint8_t *queue;
+    size_t head, len, cap;   /* queued bytes are queue[head .. head+len) */
+    size_t releasable;       /* bytes at the front that may be written now */
+    uint64_t packets;        /* packets queued for this client */
+    uint64_t bytes_sent;
+    uint64_t next_write_ns;  /* tiny writes: when the next piece may go */
+    uint64_t stall_until_ns; /* UINT64_MAX: stalled for good */
+    bool stalled;
+    uint64_t full_since_ns;
+    bool close_when_drained;
+    bool reset_when_drained;
+    bool recording;
+    uint64_t received;       /* bytes the client sent us (ignored) */
+} client;
+
+typedef struct sim {
+    options opt;
+    int listen_fd;
+    client clients[MAX_CLIENTS_LIMIT];
+    size_t nclients;
+    uint64_t next_client_id;
+    uint64_t clients_done;
+    bool started;
+    uint64_t t0_ns;
+    uint64_t period_ns;       /* model: nominal period */
+    uint64_t next;            /* index of the next packet of the schedule */
+    sim_model model;
+    replay rp;
+    bool replaying;
+    uint8_t packet[URRT_PACKET_MAX];
+    uint8_t odd_packet[URRT_PACKET_MAX];
+    FILE *record;
+    bool record_taken;        /* the first client has been assigned the recording */
+    uint64_t garbage_sent;
+    uint64_t slow_drops;
+    uint64_t packets_out;     /* packets emitted by the schedule */
+    latency_stats lat;
+    bool replay_done;
+} sim;
+
+static uint64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
+}
+
+static void usage(FILE *out)
+{
+    fprintf(out,
+"Usage: " PROGRAM " [options]\n"
+"\n"
+"Serves the Universal Robots RealTime stream (the bytes of TCP port 30003)\n"
+"from a simulated moving arm, or replays a raw capture, to every client that\n"
+"connects. Each client gets the same packets from its connect on.\n"
+"\n"
+"Stream:\n"
+"  -l, --listen HOST:PORT   address to listen on (default " DEFAULT_LISTEN ");\n"
+"                           IPv6 as [::1]:30003\n"
+"      --version V          controller software version whose length to send:\n"
+"                           1.5 1.6 1.7 1.8 3.0 ... 3.15 5.0 ... 5.10 (and later)\n"
+"      --controller V       the same, for scripts (--version alone prints ours)\n"
+"  -L, --length N           packet length in bytes, any 4+8n from 12 to %u,\n"
+"                           lengths no controller uses included (default %u)\n"
+"  -r, --rate HZ            packets per second (default 125; 500 with --version 5.x)\n"
+"  -s, --seed N             motion seed: same seed, same packets (default 1)\n"
+"  -n, --count N            close each client after N packets\n"
+"      --start-on-connect   start the schedule (packet 0) when the first client\n"
+"                           connects, so that runs are byte-identical\n"
+"      --clients N          exit after N clients have come and gone\n"
+"      --max-clients N      refuse clients past N at once (default 16)\n"
+"  -w, --record PATH        write the exact bytes sent to the first client\n"
+"                           (a raw capture for urrt-dump --file and --replay)\n"
+"      --replay PATH        send a raw capture (e.g. `nc robot 30003 > PATH`),\n"
+"                           paced by its time column; bytes between packets\n"
+"                           are sent as they are, a partial packet at the end\n"
+"                           is not\n"
+"      --loop               replay again and again (default: exit at the end)\n"
+"\n"
+"Faults (repeat --fault to combine them; N counts packets per client):\n"
+"  -f, --fault close-after=N          close the connection after N packets\n"
+"      --fault reset-after=N          reset it (RST) after N packets\n"
+"      --fault truncate-after=N       send N packets and half of the next, close\n"
+"      --fault garbage-every=N[,bytes=B]  B bytes of garbage (default 37) before\n"
+"                                     packets N+1, 2N+1, ...\n"
+"      --fault tiny-writes[=B]        write B bytes at a time (default 7), spread\n"
+"                                     over the period\n"
+"      --fault coalesce=N             write N packets at once, every N periods\n"
+"      --fault stall-after=N[,for=MS] stop sending after N packets for MS\n"
+"                                     milliseconds (default: for good) while\n"
+"                                     keeping the connection open\n"
+"      --fault odd-length=N[,length=L]  send every Nth packet with length L\n"
+"                                     (default: the stream's length + 8), a\n"
+"                                     length no controller uses\n"
+"\n"
+"Other:\n"
+"  -v, --verbose            log every client (twice: debug)\n"
+"  -q, --quiet              log errors only\n"
+"  -h, --help               this text\n"
+"  -V, --version            print the version (" URRT_VERSION_STRING ")\n"
+"\n"
+"At exit it logs the schedule's figures: packets, late packets (sent a period\n"
+"or more behind), skipped ones, and the lateness (mean, p99, max).\n"
+"\n"
+"Exit status: 0 done (signal, --clients, end of replay), 1 runtime error\n"
+"(cannot listen, cannot read the capture), 2 usage error.\n"
+"\n"
+"Examples:\n"
+"  " PROGRAM "                                   # CB3 3.10 layout, 125 Hz, 127.0.0.1:30003\n"
+"  " PROGRAM " --version 5.10 -l 0.0.0.0:30003   # e-series 5.10 at 500 Hz, on the LAN\n"
+"  " PROGRAM " --length 1124 --rate 1000         # a length no controller sends\n"
+"  " PROGRAM " -l [::1]:30013 --fault close-after=500 --fault garbage-every=100\n"
+"  " PROGRAM " --start-on-connect -n 1000 -w capture.bin --clients 1\n"
+"  " PROGRAM " --replay capture.bin --loop\n",
+            URRT_PACKET_MAX, DEFAULT_LENGTH);
+}
+
+static void usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
+static void usage_error(const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, PROGRAM ": ");
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\nTry '" PROGRAM " --help'.\n");
+    exit(CLI_EXIT_USAGE);
+}
+
+/* Controller software version -> packet length and default rate. */
+static bool length_of_version(const char *text, uint32_t *length, double *rate)
+{
+    unsigned major, minor;
+    char tail;
+    if (sscanf(text, "%u.%u%c", &major, &minor, &tail) != 2) {
+        return false;
+    }
+    *rate = major >= 5 ? 500.0 : 125.0;
+    if (major == 1) {
+        if (minor == 5) {
+            *length = 756;
+        } else if (minor == 6 || minor == 7) {
+            *length = 764; /* 1.6 is disputed: 756 or 764 */
+        } else if (minor == 8) {
+            *length = 812;
+        } else {
+            return false;
+        }
+        return true;
+    }
+    if (major == 3) {
+        *length = minor <= 1 ? 1044 : minor <= 4 ? 1060 : minor <= 9 ? 1108 : minor <= 13 ? 1116 : minor <= 15 ? 1140 : 0;
+        return *length != 0;
+    }
+    if (major == 5) {
+        *length = minor <= 3 ? 1108 : minor <= 8 ? 1116 : minor == 9 ? 1140 : 1220;
+        return true;
+    }
+    return false;
+}
+
+static void parse_fault(const char *spec, fault_config *f)
+{
+    char buf[128];
+    char *save = NULL;
+    char *tok;
+    char *kind, *value;
+    const char *err;
+
+    if (strlen(spec) >= sizeof buf) {
+        usage_error("fault \"%s\" is too long", spec);
+    }
+    strcpy(buf, spec);
+    kind = strtok_r(buf, ",", &save);
+    if (kind == NULL) {
+        usage_error("empty --fault");
+    }
+    value = strchr(kind, '=');
+    if (value != NULL) {
+        *value++ = '\0';
+    }
+#define NEED_VALUE(field, min, max)                                                              \
+    do {                                                                                         \
+        uint64_t v_;                                                                             \
+        if (value == NULL) {                                                                     \
+            usage_error("fault %s needs a value: %s=N", kind, kind);                             \
+        }                                                                                        \
+        if ((err = cli_parse_u64(value, (min), (max), &v_)) != NULL) {                           \
+            usage_error("fault %s=%s: %s (from %llu to %llu)", kind, value, err,                 \
+                        (unsigned long long)(min), (unsigned long long)(max));                   \
+        }                                                                                        \
+        (field) = v_;                                                                            \
+    } while (0)
+    if (strcmp(kind, "close-after") == 0) {
+        NEED_VALUE(f->close_after, 1, UINT64_MAX);
+    } else if (strcmp(kind, "reset-after") == 0) {
+        NEED_VALUE(f->reset_after, 1, UINT64_MAX);
+    } else if (strcmp(kind, "truncate-after") == 0) {
+        NEED_VALUE(f->truncate_after, 0, UINT64_MAX);
+        f->truncate_after++; /* stored as the packet that is cut */
+    } else if (strcmp(kind, "garbage-every") == 0) {
+        NEED_VALUE(f->garbage_every, 1, UINT64_MAX);
+        f->garbage_bytes = 37;
+    } else if (strcmp(kind, "tiny-writes") == 0) {
+        f->tiny_writes = 7;
+        if (value != NULL) {
+            NEED_VALUE(f->tiny_writes, 1, 4096);
+        }
+    } else if (strcmp(kind, "coalesce") == 0) {
+        NEED_VALUE(f->coalesce, 2, 1000);
+    } else if (strcmp(kind, "stall-after") == 0) {
+        NEED_VALUE(f->stall_after, 1, UINT64_MAX);
+    } else if (strcmp(kind, "odd-length") == 0) {
+        NEED_VALUE(f->odd_every, 1, UINT64_MAX);
+    } else {
+        usage_error("unknown fault \"%s\": use close-after, reset-after, truncate-after, garbage-every, "
+                    "tiny-writes, coalesce, stall-after or odd-length",
+                    kind);
+    }
+    while ((tok = strtok_r(NULL, ",", &save)) != NULL) {
+        char *key = tok;
+        value = strchr(tok, '=');
+        if (value != NULL) {
+            *value++ = '\0';
+        }
+        if (strcmp(kind, "garbage-every") == 0 && strcmp(key, "bytes") == 0) {
+            kind = key;
+            NEED_VALUE(f->garbage_bytes, 1, 65536);
+        } else if (strcmp(kind, "stall-after") == 0 && strcmp(key, "for") == 0) {
+            kind = key;
+            NEED_VALUE(f->stall_ms, 1, 86400000);
+        } else if (strcmp(kind, "odd-length") == 0 && strcmp(key, "length") == 0) {
+            kind = key;
+            NEED_VALUE(f->odd_length, URRT_PACKET_MIN, URRT_PACKET_MAX);
+            if ((f->odd_length - URRT_HEADER_SIZE) % 8 != 0) {
+                usage_error("odd-length length=%s: must be 4 + 8n", value);
+            }
+        } else {
+            usage_error("fault \"%s\": unknown parameter \"%s\"", spec, key);
+        }
+    }
+#undef NEED_VALUE
+}
+
+static void parse_options(int argc, char **argv, options *o)
+{
+    enum { OPT_CONTROLLER = 256, OPT_REPLAY, OPT_LOOP, OPT_START_ON_CONNECT, OPT_CLIENTS, OPT_MAX_CLIENTS };
+    static const struct option longopts[] = {
+        {"listen", required_argument, NULL, 'l'},
+        {"version", optional_argument, NULL, 'V'},
+        {"controller", required_argument, NULL, OPT_CONTROLLER},
+        {"length", required_argument, NULL, 'L'},
+        {"rate", required_argument, NULL, 'r'},
+        {"seed", required_argument, NULL, 's'},
+        {"count", required_argument, NULL, 'n'},
+        {"record", required_argument, NULL, 'w'},
+        {"replay", required_argument, NULL, OPT_REPLAY},
+        {"loop", no_argument, NULL, OPT_LOOP},
+        {"start-on-connect", no_argument, NULL, OPT_START_ON_CONNECT},
+        {"clients", required_argument, NULL, OPT_CLIENTS},
+        {"max-clients", required_argument, NULL, OPT_MAX_CLIENTS},
+        {"fault", required_argument, NULL, 'f'},
+        {"verbose", no_argument, NULL, 'v'},
+        {"quiet", no_argument, NULL, 'q'},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0},
+    };
+    const char *listen_arg = DEFAULT_LISTEN;
+    const char *version_arg = NULL;
+    bool length_given = false;
+    const char *err;
+    int c;
+
+    memset(o, 0, sizeof *o);
+    o->length = DEFAULT_LENGTH;
+    o->rate_hz = 125.0;
+    o->seed = 1;
+    o->max_clients = 16;
+    o->log_level = URRT_LOG_NOTICE;
+    while ((c = getopt_long(argc, argv, "l:L:r:s:n:w:f:vqhV", longopts, NULL)) != -1) {
+        switch (c) {
+        case 'l': listen_arg = optarg; break;
+        case 'V':
+            /* "--version 5.10" names a controller; "--version" alone prints ours. */
+            if (optarg == NULL && optind < argc && argv[optind][0] >= '0' && argv[optind][0] <= '9') {
+                optarg = argv[optind++];
+            }
+            if (optarg == NULL) {
+                printf(PROGRAM " " URRT_VERSION_STRING "\n");
+                exit(CLI_EXIT_OK);
+            }
+            /* fall through */
+        case OPT_CONTROLLER: version_arg = optarg; break;
+        case 'L': {
+            uint32_t v;
+            if ((err = cli_parse_u32(optarg, URRT_PACKET_MIN, URRT_PACKET_MAX, &v)) != NULL) {
+                usage_error("--length %s: %s (from %u to %u)", optarg, err, URRT_PACKET_MIN, URRT_PACKET_MAX);
+            }
+            if ((v - URRT_HEADER_SIZE) % 8 != 0) {
+                usage_error("--length %s: a packet is 4 bytes of size and 8 per double: 4 + 8n (e.g. 1116)", optarg);
+            }
+            o->length = v;
+            length_given = true;
+            break;
+        }
+        case 'r':
+            if ((err = cli_parse_double(optarg, 0.1, 100000.0, &o->rate_hz)) != NULL) {
+                usage_error("--rate %s: %s (from 0.1 to 100000 Hz)", optarg, err);
+            }
+            o->rate_given = true;
+            break;
+        case 's':
+            if ((err = cli_parse_u64(optarg, 0, UINT64_MAX, &o->seed)) != NULL) {
+                usage_error("--seed %s: %s", optarg, err);
+            }
+            break;
+        case 'n':
+            if ((err = cli_parse_u64(optarg, 1, UINT64_MAX, &o->count)) != NULL) {
+                usage_error("--count %s: %s", optarg, err);
+            }
+            break;
+        case 'w': o->record_path = optarg; break;
+        case OPT_REPLAY: o->replay_path = optarg; break;
+        case OPT_LOOP: o->loop = true; break;
+        case OPT_START_ON_CONNECT: o->start_on_connect = true; break;
+        case OPT_CLIENTS:
+            if ((err = cli_parse_u64(optarg, 1, UINT64_MAX, &o->clients_to_serve)) != NULL) {
+                usage_error("--clients %s: %s", optarg, err);
+            }
+            break;
+        case OPT_MAX_CLIENTS:
+            if ((err = cli_parse_u32(optarg, 1, MAX_CLIENTS_LIMIT, &o->max_clients)) != NULL) {
+                usage_error("--max-clients %s: %s (from 1 to %d)", optarg, err, MAX_CLIENTS_LIMIT);
+            }
+            break;
+        case 'f': parse_fault(optarg, &o->fault); break;
+        case 'v': o->log_level = o->log_level == URRT_LOG_NOTICE ? URRT_LOG_INFO : URRT_LOG_DEBUG; break;
+        case 'q': o->log_level = URRT_LOG_ERR; break;
+        case 'h': usage(stdout); exit(CLI_EXIT_OK);
+        default: fprintf(stderr, "Try '" PROGRAM " --help'.\n"); exit(CLI_EXIT_USAGE);
+        }
+    }
+    if (optind < argc) {
+        usage_error("unexpected argument \"%s\" (options only)", argv[optind]);
+    }
+    if (version_arg != NULL) {
+        double rate;
+        if (length_given) {
+            usage_error("give --version or --length, not both");
+        }
+        if (!length_of_version(version_arg, &o->length, &rate)) {
+            usage_error("--version %s: not a RealTime controller version (1.5-1.8, 3.0-3.15, 5.0 and later)",
+                        version_arg);
+        }
+        if (!o->rate_given) {
+            o->rate_hz = rate;
+        }
+    }
+    if (o->replay_path != NULL && (version_arg != NULL || length_given || o->rate_given)) {
+        usage_error("--replay sends the capture's own packets at its own pace: drop --version, --length, --rate");
+    }
+    if (o->loop && o->replay_path == NULL) {
+        usage_error("--loop goes with --replay");
+    }
+    if (o->fault.odd_every != 0 && o->fault.odd_length == 0) {
+        o->fault.odd_length = o->length + 8;
+    }
+    if ((err = cli_parse_host_port(listen_arg, URRT_LINK_PORT_RW, o->listen_host, sizeof o->listen_host,
+                                   &o->listen_port)) != NULL) {
+        usage_error("--listen %s: %s", listen_arg, err);
+    }
+}
+
+/* ---- capture loading ---------------------------------------------------------- */
+
+static bool load_replay(sim *s, const char *path)
+{
+    replay *rp = &s->rp;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    struct stat st;
+    urrt_framer fr;
+    size_t off = 0, cap = 0;
+    double prev_time = NAN;
+    double delta = 0.008;
+    uint64_t due = 0;
+
+    if (fd < 0) {
+        urrt_log(URRT_LOG_ERR, "cannot open capture %s: %s", path, strerror(errno));
+        return false;
+    }
+    if (fstat(fd, &st) != 0 || st.st_size == 0) {
+        urrt_log(URRT_LOG_ERR, "capture %s is empty or unreadable", path);
+        close(fd);
+        return false;
+    }
+    rp->size = (size_t)st.st_size;
+    rp->data = mmap(NULL, rp->size, PROT_READ, MAP_PRIVATE, fd, 0);
+    close(fd);
+    if (rp->data == MAP_FAILED) {
+        urrt_log(URRT_LOG_ERR, "cannot map capture %s: %s", path, strerror(errno));
+        return false;
+    }
+    urrt_framer_init(&fr);
+    while (off < rp->size) {
+        size_t used = 0, len = 0;
+        int got = urrt_framer_feed(&fr, rp->data + off, rp->size - off, &used);
+        off += used;
+        if (got == 1) {
+            const uint8_t *pkt = urrt_framer_packet(&fr, &len);
+            double t = NAN;
+            if (rp->count == cap) {
+                cap = cap ? cap * 2 : 4096;
+                rp->end = realloc(rp->end, cap * sizeof *rp->end);
+                rp->due_ns = realloc(rp->due_ns, cap * sizeof *rp->due_ns);
+                if (rp->end == NULL || rp->due_ns == NULL) {
+                    urrt_log(URRT_LOG_ERR, "capture %s: out of memory", path);
+                    return false;
+                }
+            }
+            (void)urrt_read(pkt, len, URRT_F_TIME, 0, &t);
+            /* A time column that stands still, runs back or jumps (a
+             * reconnect in the capture) keeps the last sensible period. */
+            if (rp->count > 0) {
+                double d = t - prev_time;
+                if (isfinite(d) && d > 0.0 && d < 10.0) {
+                    delta = d;
+                }
+                due += (uint64_t)llround(delta * 1e9);
+            }
+            prev_time = t;
+            rp->end[rp->count] = off;
+            rp->due_ns[rp->count] = due;
+            rp->count++;
+        }
+    }
+    if (rp->count == 0) {
+        urrt_log(URRT_LOG_ERR, "capture %s holds no RealTime packet (is it a raw port-30003 capture?)", path);
+        return false;
+    }
+    rp->span_ns = due + (uint64_t)llround(delta * 1e9);
+    urrt_log(URRT_LOG_INFO, "capture %s: %zu packets over %.3f s; %" PRIu64 " bytes skipped, %zu trailing bytes dropped",
+             path, rp->count, (double)due / 1e9, fr.stats.skipped, rp->size - rp->end[rp->count - 1]);
+    return true;
+}
+
+/* When packet k of the schedule is due, relative to t0. */
+static uint64_t due_offset(const sim *s, uint64_t k)
+{
+    if (s->replaying) {
+        return (k / s->rp.count) * s->rp.span_ns + s->rp.due_ns[k % s->rp.count];
+    }
+    /* k / rate in nanoseconds, exact for any k in 128-bit arithmetic. */
+    return (uint64_t)((unsigned __int128)k * 1000000000000ull / (uint64_t)llround(s->opt.rate_hz * 1000.0));
+}
+
+/* The bytes of packet k of the schedule. */
+static const uint8_t *packet_bytes(sim *s, uint64_t k, size_t *len)
+{
+    if (s->replaying) {
+        size_t i = (size_t)(k % s->rp.count);
+        size_t start = i == 0 ? 0 : s->rp.end[i - 1];
+        *len = s->rp.end[i] - start;
+        return s->rp.data + start;
+    }
+    urrt_state st;
+    sim_model_state(&s->model, k, urrt_generation_of(s->opt.length) == URRT_GEN_1X ? URRT_GEN_1X : URRT_GEN_3X, &st);
+    int n = urrt_encode(&st, s->opt.length, s->packet, sizeof s->packet);
+    *len = n > 0 ? (size_t)n : 0;
+    return s->packet;
+}
+
+/* ---- clients ------------------------------------------------------------------ */
+
+static bool queue_bytes(client *c, const uint8_t *data, size_t len)
+{
+    if (c->head > 0 && c->head + c->len + len > c->cap) {
+        memmove(c->queue, c->queue + c->head, c->len);
+        c->head = 0;
+    }
+    if (c->len + len > c->cap) {
+        size_t cap = c->cap ? c->cap : 16384;
+        uint8_t *q;
+        while (cap < c->len + len) {
+            cap *= 2;
+        }
+        q = realloc(c->queue, cap);
+        if (q == NULL) {
+            return false;
+        }
+        c->queue = q;
+        c->cap = cap;
+    }
+    memcpy(c->queue + c->head + c->len, data, len);
+    c->len += len;
+    return true;
+}
+
+static void drop_client(sim *s, size_t i, urrt_log_level level, const char *why)
+{
+    client *c = &s->clients[i];
+    urrt_log(level, "client %s %s after %" PRIu64 " packets (%" PRIu64 " bytes)", c->peer, why, c->packets,
+             c->bytes_sent);
+    if (c->reset_when_drained) {
+        struct linger lg = {.l_onoff = 1, .l_linger = 0};
+        setsockopt(c->fd, SOL_SOCKET, SO_LINGER, &lg, sizeof lg);
+    }
+    close(c->fd);
+    if (c->recording && s->record != NULL) {
+        fclose(s->record);
+        s->record = NULL;
+    }
+    free(c->queue);
+    s->clients[i] = s->clients[--s->nclients];
+    s->clients_done++;
+}
+
+static void accept_clients(sim *s, uint64_t now)
+{
+    for (;;) {
+        struct sockaddr_storage ss;
+        socklen_t sl = sizeof ss;
+        char host[64], serv[8];
+        int fd = accept4(s->listen_fd, (struct sockaddr *)&ss, &sl, SOCK_NONBLOCK | SOCK_CLOEXEC);
+        client *c;
+        int on = 1, sndbuf = CLIENT_SNDBUF;
+
+        if (fd < 0) {
+            if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR && errno != ECONNABORTED) {
+                urrt_log(URRT_LOG_WARNING, "accept: %s", strerror(errno));
+            }
+            return;
+        }
+        if (getnameinfo((struct sockaddr *)&ss, sl, host, sizeof host, serv, sizeof serv,
+                        NI_NUMERICHOST | NI_NUMERICSERV) != 0) {
+            strcpy(host, "?");
+            strcpy(serv, "?");
+        }
+        if (s->nclients >= s->opt.max_clients) {
+            urrt_log(URRT_LOG_WARNING, "refusing client %s:%s: %zu clients already (--max-clients)", host, serv,
+                     s->nclients);
+            close(fd);
+            continue;
+        }
+        /* A controller sends each packet as it is made, and keeps little
+         * buffered: a reader that falls behind is seen as one. */
+        setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on);
+        setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf);
+        c = &s->clients[s->nclients++];
+        memset(c, 0, sizeof *c);
+        c->fd = fd;
+        c->id = ++s->next_client_id;
+        snprintf(c->peer, sizeof c->peer, strchr(host, ':') ? "[%s]:%s" : "%s:%s", host, serv);
+        if (s->opt.record_path != NULL && !s->record_taken) {
+            s->record_taken = true;
+            c->recording = true;
+        }
+        if (!s->started) {
+            s->started = true;
+            s->t0_ns = now;
+            s->next = 0;
+        }
+        urrt_log(URRT_LOG_INFO, "client %s connected%s", c->peer, c->recording ? " (recorded)" : "");
+    }
+}
+
+/* Packet n (1-based, per client) goes into the client's queue, shaped by
+ * the faults. */
+static void emit_to_client(sim *s, client *c, const uint8_t *pkt, size_t len, uint64_t now)
+{
+    const fault_config *f = &s->opt.fault;
+    uint64_t n;
+    bool ok = true;
+
+    if (c->close_when_drained) {
+        return;
+    }
+    if (c->stalled) {
+        if (now < c->stall_until_ns) {
+            return;
+        }
+        c->stalled = false;
+        urrt_log(URRT_LOG_INFO, "client %s: stall over, sending again", c->peer);
+    }
+    n = ++c->packets;
+    if (f->garbage_every != 0 && n > 1 && (n - 1) % f->garbage_every == 0) {
+        /* Bytes 0x01-0xFF only: no window of them, nor of them and the next
+         * header, reads as a plausible header, so the reader skips exactly
+         * these bytes. */
+        uint8_t junk[256];
+        uint32_t left = f->garbage_bytes;
+        uint64_t h = s->opt.seed ^ (n * 0x9E3779B97F4A7C15ull);
+        while (left > 0 && ok) {
+            uint32_t k = left < sizeof junk ? left : (uint32_t)sizeof junk;
+            for (uint32_t i = 0; i < k; i++) {
+                h = h * 6364136223846793005ull + 1442695040888963407ull;
+                junk[i] = (uint8_t)(1 + (h >> 33) % 255);
+            }
+            ok = queue_bytes(c, junk, k);
+            left -= k;
+        }
+        s->garbage_sent += f->garbage_bytes;
+    }
+    if (f->odd_every != 0 && n % f->odd_every == 0) {
+        /* The same columns at another length: cut, or padded with zeros. */
+        size_t odd = f->odd_length;
+        memset(s->odd_packet, 0, odd);
+        memcpy(s->odd_packet, pkt, len < odd ? len : odd);
+        s->odd_packet[0] = (uint8_t)(odd >> 24);
+        s->odd_packet[1] = (uint8_t)(odd >> 16);
+        s->odd_packet[2] = (uint8_t)(odd >> 8);
+        s->odd_packet[3] = (uint8_t)odd;
+        pkt = s->odd_packet;
+        len = odd;
+    }
+    if (f->truncate_after != 0 && n == f->truncate_after) {
+        len /= 2;
+        c->close_when_drained = true;
+    }
+    ok = ok && queue_bytes(c, pkt, len);
+    if (!ok) {
+        c->close_when_drained = true;
+        c->len = 0;
+        return;
+    }
+    if ((f->close_after != 0 && n == f->close_after) || (s->opt.count != 0 && n == s->opt.count)) {
+        c->close_when_drained = true;
+    }
+    if (f->reset_after != 0 && n == f->reset_after) {
+        c->close_when_drained = true;
+        c->reset_when_drained = true;
+    }
+    if (f->stall_after != 0 && n == f->stall_after) {
+        c->stalled = true;
+        c->stall_until_ns = f->stall_ms ? now + f->stall_ms * 1000000ull : UINT64_MAX;
+        urrt_log(URRT_LOG_INFO, "client %s: stalling after %" PRIu64 " packets", c->peer, n);
+    }
+    if (f->coalesce == 0 || n % f->coalesce == 0 || c->close_when_drained) {
+        c->releasable = c->len;
+    }
+}
+
+/* Writes what may be written now. Returns false when the client is gone. */
+static bool flush_client(sim *s, size_t i, uint64_t now)
+{
+    client *c = &s->clients[i];
+    const uint32_t tiny = s->opt.fault.tiny_writes;
+
+    while (c->releasable > 0) {
+        size_t n = c->releasable;
+        ssize_t w;
+        if (tiny != 0) {
+            if (now < c->next_write_ns) {
+                break;
+            }
+            n = n < tiny ? n : tiny;
+        }
+        w = send(c->fd, c->queue + c->head, n, MSG_DONTWAIT | MSG_NOSIGNAL);
+        if (w < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            if (errno == EAGAIN || errno == EWOULDBLOCK) {
+                if (c->full_since_ns == 0) {
+                    c->full_since_ns = now;
+                }
+                break;
+            }
+            drop_client(s, i, URRT_LOG_INFO, errno == EPIPE || errno == ECONNRESET ? "left" : strerror(errno));
+            return false;
+        }
+        if (c->recording && s->record != NULL && fwrite(c->queue + c->head, 1, (size_t)w, s->record) != (size_t)w) {
+            urrt_log(URRT_LOG_ERR, "cannot write the recording: %s; recording stopped", strerror(errno));
+            fclose(s->record);
+            s->record = NULL;
+        }
+        c->head += (size_t)w;
+        c->len -= (size_t)w;
+        c->releasable -= (size_t)w;
+        c->bytes_sent += (uint64_t)w;
+        c->full_since_ns = 0;
+        if (tiny != 0) {
+            /* Twice as fast as the stream needs, so a backlog drains. */
+            uint64_t per_packet = s->replaying ? 8000000ull : s->period_ns;
+            size_t plen = s->opt.length ? s->opt.length : 1116;
+            c->next_write_ns = now + per_packet * tiny / (2 * plen);
+        }
+    }
+    if (c->len == 0) {
+        c->head = 0;
+    }
+    if (c->close_when_drained && c->releasable == 0) {
+        drop_client(s, i, URRT_LOG_INFO,
+                    c->reset_when_drained ? "reset (fault)"
+                    : s->opt.count != 0 && c->packets == s->opt.count ? "closed (--count reached)"
+                    : "closed");
+        return false;
+    }
+    if ((c->full_since_ns != 0 && now - c->full_since_ns > SLOW_CLIENT_NS) || c->len > CLIENT_QUEUE_MAX) {
+        s->slow_drops++;
+        drop_client(s, i, URRT_LOG_WARNING, "dropped: too slow (its socket stayed full)");
+        return false;
+    }
+    return true;
+}
+
+/* Reads and discards what a client sends: a controller would run it as
+ * URScript, a simulator only says so. Returns false when the client left. */
+static bool read_client(sim *s, size_t i)
+{
+    client *c = &s->clients[i];
+    uint8_t buf[4096];
+    for (;;) {
+        ssize_t n = recv(c->fd, buf, sizeof buf, MSG_DONTWAIT);
+        if (n > 0) {
+            if (c->received == 0) {
+                urrt_log(URRT_LOG_WARNING, "client %s sends data: ignored (a controller on port 30003 would run it as URScript)",
+                         c->peer);
+            }
+            c->received += (uint64_t)n;
+            continue;
+        }
+        if (n < 0 && errno == EINTR) {
+            continue;
+        }
+        if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+            return true;
+        }
+        drop_client(s, i, URRT_LOG_INFO, n == 0 ? "left" : "left (error)");
+        return false;
+    }
+}
+
+/* ---- the schedule ------------------------------------------------------------- */
+
+static void note_lateness(latency_stats *lat, uint64_t late_ns, uint64_t period_ns)
+{
+    size_t b = (size_t)(late_ns / LATE_BUCKET_NS);
+    lat->samples++;
+    lat->sum_ns += late_ns;
+    if (late_ns > lat->max_ns) {
+        lat->max_ns = late_ns;
+    }
+    if (late_ns >= period_ns) {
+        lat->late++;
+    }
+    lat->hist[b < LATE_BUCKETS ? b : LATE_BUCKETS]++;
+}
+
+static uint64_t percentile_ns(const latency_stats *lat, double p)
+{
+    uint64_t want = (uint64_t)ceil(p * (double)lat->samples), seen = 0;
+    for (size_t b = 0; b <= LATE_BUCKETS; b++) {
+        seen += lat->hist[b];
+        if (seen >= want && want > 0) {
+            return (b + 1) * LATE_BUCKET_NS;
+        }
+    }
+    return lat->max_ns;
+}
+
+/* Emits every packet that is due. */
+static void run_schedule(sim *s, uint64_t now)
+{
+    if (!s->started || s->replay_done) {
+        return;
+    }
+    while (s->t0_ns + due_offset(s, s->next) <= now) {
+        uint64_t due = s->t0_ns + due_offset(s, s->next);
+        uint64_t period = s->next > 0 ? due - (s->t0_ns + due_offset(s, s->next - 1)) : s->period_ns;
+        const uint8_t *pkt;
+        size_t len;
+
+        if (!s->replaying || s->opt.loop || s->next < s->rp.count) {
+            if (now - due > CATCH_UP_MAX_NS) {
+                /* Too far behind (stopped, swapped out): skip, do not burst. */
+                s->lat.skipped++;
+                s->next++;
+                continue;
+            }
+            note_lateness(&s->lat, now - due, period ? period : 1);
+            pkt = packet_bytes(s, s->next, &len);
+            for (size_t i = 0; i < s->nclients; i++) {
+                emit_to_client(s, &s->clients[i], pkt, len, now);
+            }
+            s->packets_out++;
+            s->next++;
+        }
+        if (s->replaying && !s->opt.loop && s->next >= s->rp.count) {
+            s->replay_done = true;
+            for (size_t i = 0; i < s->nclients; i++) {
+                s->clients[i].close_when_drained = true;
+                s->clients[i].releasable = s->clients[i].len;
+            }
+            urrt_log(URRT_LOG_INFO, "end of capture");
+            return;
+        }
+    }
+}
+
+static int open_listener(const options *o)
+{
+    struct addrinfo hints, *res = NULL, *ai;
+    char service[8];
+    int fd = -1, rc, on = 1;
+    char where[300];
+
+    cli_format_host_port(o->listen_host, o->listen_port, where, sizeof where);
+    memset(&hints, 0, sizeof hints);
+    hints.ai_family = AF_UNSPEC;
+    hints.ai_socktype = SOCK_STREAM;
+    hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
+    snprintf(service, sizeof service, "%u", (unsigned)o->listen_port);
+    rc = getaddrinfo(o->listen_host, service, &hints, &res);
+    if (rc != 0) {
+        urrt_log(URRT_LOG_ERR, "cannot listen on %s: %s", where, gai_strerror(rc));
+        return -1;
+    }
+    for (ai = res; ai != NULL; ai = ai->ai_next) {
+        fd = socket(ai->ai_family, ai->ai_socktype | SOCK_NONBLOCK | SOCK_CLOEXEC, ai->ai_protocol);
+        if (fd < 0) {
+            continue;
+        }
+        setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+        if (bind(fd, ai->ai_addr, ai->ai_addrlen) == 0 && listen(fd, 16) == 0) {
+            break;
+        }
+        rc = errno;
+        close(fd);
+        fd = -1;
+        errno = rc;
+    }
+    if (fd < 0) {
+        urrt_log(URRT_LOG_ERR, "cannot listen on %s: %s%s", where, strerror(errno),
+                 errno == EADDRINUSE ? " (another simulator or program has the port: pick another with --listen)" : "");
+    }
+    freeaddrinfo(res);
+    return fd;
+}
+
+static void log_summary(const sim *s, uint64_t now)
+{
+    const latency_stats *lat = &s->lat;
+    double secs = s->started ? (double)(now - s->t0_ns) / 1e9 : 0.0;
+    urrt_log(URRT_LOG_NOTICE,
+             "%" PRIu64 " packets in %.3f s; late (a period or more behind) %" PRIu64 ", skipped %" PRIu64
+             "; lateness mean %.1f us, p99 <= %.0f us, max %.1f us; clients %" PRIu64 ", dropped as slow %" PRIu64
+             "; garbage bytes %" PRIu64,
+             s->packets_out, secs, lat->late, lat->skipped,
+             lat->samples ? (double)lat->sum_ns / (double)lat->samples / 1e3 : 0.0,
+             (double)percentile_ns(lat, 0.99) / 1e3, (double)lat->max_ns / 1e3, s->next_client_id, s->slow_drops,
+             s->garbage_sent);
+}
+
+int main(int argc, char **argv)
+{
+    static sim s; /* large (packet buffers, histogram): not on the stack */
+    struct pollfd pfds[MAX_CLIENTS_LIMIT + 1];
+    int status = CLI_EXIT_OK;
+
+    parse_options(argc, argv, &s.opt);
+    urrt_log_init(PROGRAM, s.opt.log_level);
+    cli_handle_signals(&running);
+    /* The default 50 us timer slack would be a quarter of a 500 Hz period. */
+    prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);
+
+    if (s.opt.replay_path != NULL) {
+        if (!load_replay(&s, s.opt.replay_path)) {
+            return CLI_EXIT_RUNTIME;
+        }
+        s.replaying = true;
+        s.opt.length = 0;
+    } else {
+        sim_model_init(&s.model, s.opt.seed, s.opt.rate_hz);
+    }
+    s.period_ns = (uint64_t)llround(1e9 / s.opt.rate_hz);
+    if (s.opt.record_path != NULL) {
+        s.record = fopen(s.opt.record_path, "wb");
+        if (s.record == NULL) {
+            urrt_log(URRT_LOG_ERR, "cannot create the recording %s: %s", s.opt.record_path, strerror(errno));
+            return CLI_EXIT_RUNTIME;
+        }
+    }
+    s.listen_fd = open_listener(&s.opt);
+    if (s.listen_fd < 0) {
+        return CLI_EXIT_RUNTIME;
+    }
+    {
+        char where[300];
+        cli_format_host_port(s.opt.listen_host, s.opt.listen_port, where, sizeof where);
+        if (s.replaying) {
+            urrt_log(URRT_LOG_NOTICE, "replaying %s on %s%s", s.opt.replay_path, where, s.opt.loop ? " in a loop" : "");
+        } else {
+            const char *v = urrt_versions_of(s.opt.length);
+            urrt_log(URRT_LOG_NOTICE, "serving %" PRIu32 "-byte packets (%s) at %g Hz on %s, seed %" PRIu64,
+                     s.opt.length, v ? v : "no controller sends this length", s.opt.rate_hz, where, s.opt.seed);
+        }
+    }
+    if (!s.opt.start_on_connect) {
+        s.started = true;
+        s.t0_ns = now_ns();
+    }
+
+    while (running) {
+        uint64_t now = now_ns();
+        uint64_t wake = UINT64_MAX;
+        size_t nfds = 0;
+        int rc;
+
+        run_schedule(&s, now);
+        for (size_t i = 0; i < s.nclients;) {
+            if (flush_client(&s, i, now)) {
+                i++;
+            }
+        }
+        if ((s.opt.clients_to_serve != 0 && s.clients_done >= s.opt.clients_to_serve && s.nclients == 0) ||
+            (s.replay_done && s.nclients == 0)) {
+            break;
+        }
+
+        if (s.started && !s.replay_done) {
+            wake = s.t0_ns + due_offset(&s, s.next);
+        }
+        pfds[nfds++] = (struct pollfd){.fd = s.listen_fd, .events = POLLIN};
+        for (size_t i = 0; i < s.nclients; i++) {
+            client *c = &s.clients[i];
+            short ev = POLLIN;
+            if (c->releasable > 0) {
+                if (s.opt.fault.tiny_writes != 0 && c->next_write_ns > now) {
+                    wake = c->next_write_ns < wake ? c->next_write_ns : wake;
+                } else {
+                    ev |= POLLOUT;
+                }
+            }
+            if (c->full_since_ns != 0) {
+                uint64_t give_up = c->full_since_ns + SLOW_CLIENT_NS + 1;
+                wake = give_up < wake ? give_up : wake;
+            }
+            pfds[nfds++] = (struct pollfd){.fd = c->fd, .events = ev};
+        }
+        {
+            struct timespec ts, *tsp = NULL;
+            if (wake != UINT64_MAX) {
+                uint64_t d = wake > now ? wake - now : 0;
+                ts.tv_sec = (time_t)(d / 1000000000ull);
+                ts.tv_nsec = (long)(d % 1000000000ull);
+                tsp = &ts;
+            }
+            rc = ppoll(pfds, nfds, tsp, NULL);
+        }
+        if (rc < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            urrt_log(URRT_LOG_ERR, "poll: %s", strerror(errno));
+            status = CLI_EXIT_RUNTIME;
+            break;
+        }
+        now = now_ns();
+        /* Clients by descriptor: dropping one reorders the array. */
+        for (size_t k = nfds; k-- > 1;) {
+            if (pfds[k].revents == 0) {
+                continue;
+            }
+            for (size_t i = 0; i < s.nclients; i++) {
+                if (s.clients[i].fd == pfds[k].fd) {
+                    if (pfds[k].revents & (POLLIN | POLLERR | POLLHUP)) {
+                        if (!read_client(&s, i)) {
+                            break;
+                        }
+                    }
+                    if (pfds[k].revents & POLLOUT) {
+                        (void)flush_client(&s, i, now);
+                    }
+                    break;
+                }
+            }
+        }
+        if (pfds[0].revents & POLLIN) {
+            accept_clients(&s, now);
+        }
+    }
+    if (cli_stop_signal() != 0) {
+        urrt_log(URRT_LOG_INFO, "stopping on %s", strsignal(cli_stop_signal()));
+    }
+    log_summary(&s, now_ns());
+    while (s.nclients > 0) {
+        drop_client(&s, s.nclients - 1, URRT_LOG_DEBUG, "closed at exit");
+    }
+    if (s.record != NULL && fclose(s.record) != 0) {
+        urrt_log(URRT_LOG_ERR, "cannot write the recording %s: %s", s.opt.record_path, strerror(errno));
+        status = CLI_EXIT_RUNTIME;
+    }
+    close(s.listen_fd);
+    return status;
+}
