@@ -1353,8 +1353,9 @@ int can_map_finish(struct can_map *map, const struct can_map_robot *robots, size
     for (i = 0; i <= map->frame_count; i++) {
         uint32_t id_i = i < map->frame_count ? map->frames[i].id : map->hb_id;
         bool ext_i = i < map->frame_count ? map->frames[i].extended : map->hb_extended;
-        if (i == map->frame_count && map->key_loc[CAN_MAP_CK_HB_ID].line == 0) {
-            continue;
+        if (i == map->frame_count ? map->key_loc[CAN_MAP_CK_HB_ID].line == 0
+                                  : map->frames[i].key_loc[CAN_MAP_FK_ID].line == 0) {
+            continue; /* reported as missing */
         }
         for (j = 0; j < i; j++) {
             uint32_t id_j = map->frames[j].id;

@@ -1258,6 +1258,64 @@ static void test_heartbeat_rate(void)
     can_map_free(&map);
 }
 
+/* Mangled configurations: never a crash (the sanitizer build watches), and
+ * either accepted or rejected with "t.ini:LINE: reason". Accepted ones
+ * write a DBC and run a few cycles. */
+static void test_config_mutations(void)
+{
+    static const char alphabet[] = "0123456789@|[]=x \"-.;#_abcfilmnorstuvFX\n";
+    char text[4096];
+    size_t base = strlen(sched_config);
+    int i;
+    int rejected = 0;
+    int accepted = 0;
+    int bad = 0;
+    for (i = 0; i < 3000; i++) {
+        struct can_map map;
+        char err[4096] = "";
+        int k;
+        int edits = 1 + (int)(rnd() % 4);
+        size_t len = base;
+        memcpy(text, sched_config, base + 1);
+        for (k = 0; k < edits; k++) {
+            size_t at = (size_t)(rnd() % len);
+            switch (rnd() % 3) {
+            case 0: text[at] = alphabet[rnd() % (sizeof alphabet - 1)]; break;
+            case 1: memmove(text + at, text + at + 1, len - at); len--; break;
+            default:
+                if (len + 1 < sizeof text) {
+                    memmove(text + at + 1, text + at, len - at + 1);
+                    text[at] = alphabet[rnd() % (sizeof alphabet - 1)];
+                    len++;
+                }
+            }
+        }
+        if (load(&map, text, one_robot, 1, err, sizeof err) == 0) {
+            FILE *devnull = fopen("/dev/null", "w");
+            accepted++;
+            if (devnull != NULL) {
+                bad += dbc_write(devnull, &map, "t.ini") != 0;
+                fclose(devnull);
+            }
+            memset(&cap, 0, sizeof cap);
+            can_map_start(&map, 0);
+            packet(&map, 1000, 1.0, 7, true);
+            can_map_due(&map, 1000, NULL, capture_frame, &cap);
+            can_map_due(&map, 200000, NULL, capture_frame, &cap);
+        } else {
+            rejected++;
+            if (strncmp(err, "t.ini:", 6) != 0 && strstr(err, "not handled") == NULL) {
+                if (bad++ < 3) {
+                    fprintf(stderr, "mutation: error without a location: %s\n", err);
+                }
+            }
+        }
+        can_map_free(&map);
+    }
+    CHECK(bad == 0, "%d mutated configurations misbehaved", bad);
+    CHECK(accepted > 50 && rejected > 1000, "mutations: %d accepted, %d rejected", accepted, rejected);
+}
+
 /* DBC text spot checks (the full comparison is check-can-dbc). */
 static void test_dbc_text(void)
 {
@@ -1309,6 +1367,7 @@ int main(void)
     test_schedule();
     test_validity_and_heartbeat();
     test_heartbeat_rate();
+    test_config_mutations();
     test_dbc_text();
     return check_report();
 }
