@@ -5,6 +5,7 @@
 #                  integer conversion may be undefined), lib/ and gateway/ compiled with them
 #   check-can-dbc  DBCs and payloads against python3-canmatrix and an independent
 #                  Python reference; the example configurations in docs/examples/
+#   bench-can      ns per packet for the CAN mapping beside urrt_decode of the same packet
 
 CANT := $(BUILD)/tests/can
 CAN_TEST_SRCS := gateway/can_map.c gateway/dbc.c
@@ -42,3 +43,14 @@ check-can-san: $(CANT)/test_can_san
 
 check-can-dbc: $(CANT)/can_tool
 	$(call can_suite,check-can-dbc,$(PYTHON) tests/can/test_dbc.py --tool $(CANT)/can_tool --work $(CANT)/work)
+
+# ---- benchmark ---------------------------------------------------------------------
+BENCHES += bench-can
+.PHONY: bench-can
+
+$(CANT)/bench_can: tests/can/bench_can.c $(CAN_GATEWAY_OBJS) $(LIBURRT)
+	@mkdir -p $(@D)
+	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_GATEWAY_OBJS) $(LIBURRT) -linih -lm -o $@
+
+bench-can: $(CANT)/bench_can
+	@$(CANT)/bench_can docs/examples/canopen.ini

@@ -1,0 +1,137 @@
+/*
+ * bench-can (make bench): what the CAN mapping costs per robot packet, beside
+ * what decoding that packet costs in the same run (urrt_decode of a 1220-byte
+ * packet), as ns and as a ratio. Prints `name: value` lines, asserts nothing.
+ *
+ *   can_pack_signal_ns      one 16-bit signal, urrt_can_pack
+ *   can_map_packet_ns       can_map_on_packet + can_map_due for docs/examples/canopen.ini
+ *                           (4 frames, 18 signals), a due frame every packet
+ *   decode_packet_ns        urrt_decode, the baseline
+ *
+ * Each figure is the best of several batches, subject and baseline
+ * alternating, so that both see the same machine.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <ini.h>
+
+#include "can_map.h"
+
+#define BATCHES 9
+#define ITERATIONS 20000
+
+static volatile uint64_t sink;
+
+static double now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
+}
+
+struct loader {
+    struct can_map *map;
+    FILE *file;
+    int line;
+    int errors;
+};
+
+static char *read_line(char *str, int num, void *stream)
+{
+    struct loader *l = stream;
+    char *s = fgets(str, num, l->file);
+    l->line += s != NULL;
+    return s;
+}
+
+static int on_key(void *user, const char *section, const char *key, const char *value)
+{
+    struct loader *l = user;
+    char err[512];
+    if (can_map_ini(l->map, section, key, value, "canopen.ini", l->line, err, sizeof err) < 0) {
+        fprintf(stderr, "%s\n", err);
+        l->errors++;
+    }
+    return 1;
+}
+
+static void count_frame(void *ctx, const urrt_can_frame *f)
+{
+    *(uint64_t *)ctx += 1;
+    sink += f->data[0];
+}
+
+int main(int argc, char **argv)
+{
+    const char *path = argc > 1 ? argv[1] : "docs/examples/canopen.ini";
+    const struct can_map_robot robots[] = {{"arm1", 2000}};
+    struct can_map map;
+    struct loader l = {0};
+    char err[4096];
+    urrt_state st;
+    uint8_t packet[URRT_PACKET_KNOWN_MAX];
+    urrt_can_signal sig = {0.0002, 0, -6.5536, 6.5534, 0, 0, 16, URRT_CAN_INTEL, URRT_CAN_SIGNED, 0};
+    uint8_t data[8] = {0};
+    double best_map = 1e30, best_decode = 1e30, best_pack = 1e30;
+    uint64_t now = 0;
+    uint64_t frames = 0;
+    int b, i;
+
+    can_map_init(&map);
+    l.map = &map;
+    l.file = fopen(path, "r");
+    if (l.file == NULL) {
+        perror(path);
+        return 1;
+    }
+    ini_parse_stream(read_line, &l, on_key, &l);
+    fclose(l.file);
+    if (l.errors || can_map_finish(&map, robots, 1, err, sizeof err) < 0) {
+        fprintf(stderr, "bench-can: %s\n", err);
+        return 1;
+    }
+    urrt_state_clear(&st);
+    for (i = 0; i < 6; i++) {
+        st.q_actual[i] = 0.1 * i;
+    }
+    st.robot_mode[0] = 7;
+    st.safety_mode[0] = 1;
+    if (urrt_encode(&st, 1220, packet, sizeof packet) < 0 || urrt_decode(packet, 1220, &st) < 0) {
+        fprintf(stderr, "bench-can: cannot build a packet\n");
+        return 1;
+    }
+    can_map_start(&map, 0);
+    for (b = 0; b < BATCHES; b++) {
+        double t0 = now_ns();
+        for (i = 0; i < ITERATIONS; i++) {
+            now += 2000; /* 500 Hz */
+            can_map_on_packet(&map, 0, &st, now);
+            can_map_due(&map, now, NULL, count_frame, &frames);
+        }
+        double t1 = now_ns();
+        for (i = 0; i < ITERATIONS; i++) {
+            sink += (uint64_t)urrt_decode(packet, 1220, &st);
+        }
+        double t2 = now_ns();
+        for (i = 0; i < ITERATIONS; i++) {
+            sink += (uint64_t)urrt_can_pack(&sig, (double)i * 1e-4, data, 8) + data[1];
+        }
+        double t3 = now_ns();
+        best_map = (t1 - t0) / ITERATIONS < best_map ? (t1 - t0) / ITERATIONS : best_map;
+        best_decode = (t2 - t1) / ITERATIONS < best_decode ? (t2 - t1) / ITERATIONS : best_decode;
+        best_pack = (t3 - t2) / ITERATIONS < best_pack ? (t3 - t2) / ITERATIONS : best_pack;
+    }
+    sink += frames;
+    printf("can_pack_signal_ns: %.1f\n", best_pack);
+    printf("can_map_packet_ns: %.1f\n", best_map);
+    printf("decode_packet_ns: %.1f\n", best_decode);
+    printf("can_map_packet_vs_decode: %.2f\n", best_map / best_decode);
+    printf("can_frames_per_packet: %.2f\n", (double)frames / (BATCHES * ITERATIONS));
+    can_map_free(&map);
+    return 0;
+}
