@@ -649,7 +649,13 @@ static void begin_section(config_ctx *ctx, const char *raw)
         }
     }
     if (sec == NULL) {
-        config_error(ctx, ctx->line, "unknown section [%s] (sections: [gateway], [lcm], [robot NAME])", raw);
+        char known[256] = "";
+        size_t used = 0;
+        for (index = 0; index < CONFIG_SECTION_COUNT && used < sizeof known; index++) {
+            used += (size_t)snprintf(known + used, sizeof known - used, "%s[%s%s]", index ? ", " : "",
+                                     config_sections[index].kind, config_sections[index].named ? " NAME" : "");
+        }
+        config_error(ctx, ctx->line, "unknown section [%s] (sections: %s)", raw, known);
         return;
     }
     if (sec->named && name_buf[0] == '\0') {
