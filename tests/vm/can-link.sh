@@ -17,10 +17,10 @@ wait_receivers() {
   done
 }
 
-echo "== the candump-log output"
+echo "== the candump-log output (at $(cut -d" " -f1 /proc/uptime) s)"
 counted "can_link_test log" can_link_test log "$OUT"
 
-echo "== frames on the wire, as candump sees them"
+echo "== frames on the wire, as candump sees them (at $(cut -d" " -f1 /proc/uptime) s)"
 # can_link_test frames sends 8 frames on vcan0 and 6 on vcan1.
 candump -L -n 8 -T 5000 vcan0 > candump-vcan0.log & d0=$!
 candump -L -n 6 -T 5000 vcan1 > candump-vcan1.log & d1=$!
@@ -37,7 +37,7 @@ check "vcan1: candump -L lines = log lines (6 classic frames)" \
   sh -c '[ $(wc -l < got-vcan1.txt) = 6 ] && cmp want-vcan1.txt got-vcan1.txt'
 diff want-vcan0.txt got-vcan0.txt; diff want-vcan1.txt got-vcan1.txt
 
-echo "== canplayer replays the log output"
+echo "== canplayer replays the log output (at $(cut -d" " -f1 /proc/uptime) s)"
 n_fd=$(wc -l < log-fd.log); n_cc=$(wc -l < log-classic.log)
 candump -L -n "$n_fd" -T 5000 vcan0 > replay-vcan0.log & d0=$!
 candump -L -n "$n_cc" -T 5000 vcan1 > replay-vcan1.log & d1=$!
@@ -55,10 +55,10 @@ check "the replay on vcan1 equals the file ($n_cc frames, can0 mapped to vcan1)"
   sh -c "[ \$(wc -l < got-replay-vcan1.txt) = $n_cc ] && cmp want-replay-vcan1.txt got-replay-vcan1.txt"
 diff want-replay-vcan0.txt got-replay-vcan0.txt; diff want-replay-vcan1.txt got-replay-vcan1.txt
 
-echo "== the socket: refusals, error frames, full queue, down and up"
+echo "== the socket: refusals, error frames, full queue, down and up (at $(cut -d" " -f1 /proc/uptime) s)"
 counted "can_link_test socket" can_link_test socket
 
-echo "== the socket again, under ASan and UBSan"
+echo "== the socket again, under ASan and UBSan (at $(cut -d" " -f1 /proc/uptime) s)"
 if [ -x /t/can_link_test_san ]; then
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
     counted "can_link_test_san socket" can_link_test_san socket
