@@ -57,7 +57,7 @@ static const char REASON_NOT_CAN[] = "the name now belongs to an interface that 
 
 typedef struct held_frame {
     urrt_can_frame frame;
-    uint64_t since_us;   /* when the value was first held (replacement keeps it fresh) */
+    uint64_t since_us;   /* when this value was handed in: its age decides its expiry */
 } held_frame;
 
 struct urrt_can {
