@@ -200,19 +200,22 @@ int urrt_field_find(const char *name, size_t name_len)
     return URRT_E_UNKNOWN_FIELD;
 }
 
-unsigned urrt_field_column(urrt_field_id id, urrt_generation gen)
+static unsigned layout_column(const field_layout *f, urrt_generation gen)
 {
-    const field_layout *f;
-    if ((unsigned)id >= (unsigned)URRT_FIELD_COUNT) {
-        return 0;
-    }
-    f = &layout_table[id];
     switch (gen) {
     case URRT_GEN_1X: return f->col_1x;
     case URRT_GEN_3X: return f->col_3x;
     case URRT_GEN_UNKNOWN: return f->col_1x == f->col_3x ? f->col_1x : 0u;
     default: return 0;
     }
+}
+
+unsigned urrt_field_column(urrt_field_id id, urrt_generation gen)
+{
+    if ((unsigned)id >= (unsigned)URRT_FIELD_COUNT) {
+        return 0;
+    }
+    return layout_column(&layout_table[id], gen);
 }
 
 /* ---- lengths ------------------------------------------------------------ */
@@ -256,7 +259,8 @@ urrt_generation urrt_generation_of(uint32_t length)
     return URRT_GEN_UNKNOWN;
 }
 
-int urrt_packet_length(const uint8_t *buf, size_t len)
+/* urrt_packet_length(), kept static so that the decoders can inline it. */
+static inline int packet_length(const uint8_t *buf, size_t len)
 {
     int32_t declared;
     uint32_t raw;
@@ -281,6 +285,11 @@ int urrt_packet_length(const uint8_t *buf, size_t len)
         return URRT_E_TRUNCATED;
     }
     return (int)raw;
+}
+
+int urrt_packet_length(const uint8_t *buf, size_t len)
+{
+    return packet_length(buf, len);
 }
 
 /* ---- decoding ----------------------------------------------------------- */
@@ -499,7 +508,7 @@ int urrt_decode(const uint8_t *buf, size_t len, urrt_state *st)
     if (st == NULL) {
         return URRT_E_ARG;
     }
-    size = urrt_packet_length(buf, len);
+    size = packet_length(buf, len);
     if (size < 0) {
         urrt_state_clear(st);
         return size;
@@ -519,7 +528,7 @@ int urrt_decode(const uint8_t *buf, size_t len, urrt_state *st)
 
 int urrt_read_column_bits(const uint8_t *buf, size_t len, unsigned column, uint64_t *out)
 {
-    int size = urrt_packet_length(buf, len);
+    int size = packet_length(buf, len);
     if (size < 0) {
         return size;
     }
@@ -549,7 +558,7 @@ int urrt_read_column(const uint8_t *buf, size_t len, unsigned column, double *ou
 
 int urrt_read(const uint8_t *buf, size_t len, urrt_field_id id, unsigned elem, double *out)
 {
-    int size = urrt_packet_length(buf, len);
+    int size = packet_length(buf, len);
     unsigned doubles;
     urrt_generation gen;
     unsigned column;
@@ -565,7 +574,7 @@ int urrt_read(const uint8_t *buf, size_t len, urrt_field_id id, unsigned elem, d
     }
     doubles = ((unsigned)size - URRT_HEADER_SIZE) / 8u;
     gen = urrt_generation_of((uint32_t)size);
-    column = urrt_field_column(id, gen);
+    column = layout_column(&layout_table[id], gen);
     if (!field_fits((unsigned)id, column, doubles, gen)) {
         return URRT_E_ABSENT;
     }
@@ -776,6 +785,22 @@ void urrt_framer_reset(urrt_framer *fr)
     fr->packet_length = 0;
 }
 
+/* A byte copy without libc: 16-byte blocks where the compiler can inline a
+ * fixed-size copy (GCC, clang: unaligned loads and stores, never a call),
+ * then single bytes. */
+static void copy_bytes(uint8_t *dst, const uint8_t *src, size_t n)
+{
+    size_t i = 0;
+#if defined(__GNUC__)
+    for (; i + 16u <= n; i += 16u) {
+        __builtin_memcpy(dst + i, src + i, 16u);
+    }
+#endif
+    for (; i < n; i++) {
+        dst[i] = src[i];
+    }
+}
+
 static bool header_acceptable(const urrt_framer *fr, uint32_t size)
 {
     if (size == fr->last_length && size != 0) {
@@ -848,13 +873,10 @@ int urrt_framer_feed(urrt_framer *fr, const uint8_t *data, size_t len, size_t *u
         }
         {
             size_t take = fr->need - fr->have;
-            size_t i;
             if (take > len - used) {
                 take = len - used;
             }
-            for (i = 0; i < take; i++) {
-                fr->buf[fr->have + i] = data[used + i];
-            }
+            copy_bytes(fr->buf + fr->have, data + used, take);
             fr->have += (uint32_t)take;
             used += take;
         }
