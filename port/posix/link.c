@@ -61,6 +61,8 @@ struct urrt_link {
     uint64_t conn_packets;    /* on the current connection */
     urrt_framer framer;
     urrt_link_stats stats;
+    urrt_bytes_fn tap;
+    void *tap_ctx;
 };
 
 void urrt_link_config_defaults(urrt_link_config *cfg)
@@ -215,6 +217,14 @@ const urrt_link_stats *urrt_link_get_stats(const urrt_link *link)
 const char *urrt_link_peer(const urrt_link *link)
 {
     return link != NULL ? link->peer : "";
+}
+
+void urrt_link_set_tap(urrt_link *link, urrt_bytes_fn fn, void *ctx)
+{
+    if (link != NULL) {
+        link->tap = fn;
+        link->tap_ctx = ctx;
+    }
 }
 
 /* The wait before the next attempt; doubles up to the cap. */
@@ -413,7 +423,16 @@ static void deliver(urrt_link *link, const uint8_t *data, size_t len, uint64_t n
 {
     while (len > 0) {
         size_t used = 0;
-        if (urrt_framer_feed(&link->framer, data, len, &used) == 1) {
+        int got = urrt_framer_feed(&link->framer, data, len, &used);
+        /* Counters are current at each callback: a program that stops at a
+         * packet reports exactly the stream up to it. */
+        link->stats.bytes = link->framer.stats.bytes;
+        link->stats.resyncs = link->framer.stats.resyncs;
+        link->stats.skipped = link->framer.stats.skipped;
+        if (link->tap != NULL && used > 0) {
+            link->tap(link->tap_ctx, data, used);
+        }
+        if (got == 1) {
             size_t plen = 0;
             const uint8_t *packet = urrt_framer_packet(&link->framer, &plen);
             link->stats.packets++;
@@ -422,7 +441,7 @@ static void deliver(urrt_link *link, const uint8_t *data, size_t len, uint64_t n
             if (link->conn_packets++ == 0) {
                 const char *versions = urrt_versions_of((uint32_t)plen);
                 char after[64] = "";
-                if (link->failed_attempts > 1) {
+                if (link->failed_attempts > 0) {
                     snprintf(after, sizeof after, " after %" PRIu64 " failed attempts", link->failed_attempts);
                 }
                 urrt_log(URRT_LOG_NOTICE, "robot %s: connected to %s%s: %zu-byte packets (%s)", link->name,
@@ -440,9 +459,6 @@ static void deliver(urrt_link *link, const uint8_t *data, size_t len, uint64_t n
         data += used;
         len -= used;
     }
-    link->stats.bytes = link->framer.stats.bytes;
-    link->stats.resyncs = link->framer.stats.resyncs;
-    link->stats.skipped = link->framer.stats.skipped;
 }
 
 static void read_available(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void *ctx)
