@@ -183,7 +183,7 @@ static void usage(FILE *out)
 "      --replay PATH        send a raw capture (e.g. `nc robot 30003 > PATH`),\n"
 "                           paced by its time column; bytes between packets\n"
 "                           are sent as they are, a partial packet at the end\n"
-"                           is not\n"
+"                           is not; it starts when the first client connects\n"
 "      --loop               replay again and again (default: exit at the end)\n"
 "\n"
 "Faults (repeat --fault to combine them; N counts packets per client):\n"
@@ -788,10 +788,14 @@ static bool flush_client(sim *s, size_t i, uint64_t now)
         c->bytes_sent += (uint64_t)w;
         c->full_since_ns = 0;
         if (tiny != 0) {
-            /* Twice as fast as the stream needs, so a backlog drains. */
+            /* Pieces on their own schedule, twice as fast as the stream
+             * needs so that a backlog drains; a pass that wakes late sends
+             * the pieces that are due, each in its own write. */
             uint64_t per_packet = s->replaying ? 8000000ull : s->period_ns;
             size_t plen = s->opt.length ? s->opt.length : 1116;
-            c->next_write_ns = now + per_packet * tiny / (2 * plen);
+            uint64_t interval = per_packet * tiny / (2 * plen);
+            uint64_t from = c->next_write_ns + per_packet > now ? c->next_write_ns : now;
+            c->next_write_ns = from + interval;
         }
     }
     if (c->len == 0) {
@@ -1004,7 +1008,8 @@ int main(int argc, char **argv)
                      s.opt.length, v ? v : "no controller sends this length", s.opt.rate_hz, where, s.opt.seed);
         }
     }
-    if (!s.opt.start_on_connect) {
+    /* A capture starts from its first packet for the first client. */
+    if (!s.opt.start_on_connect && !s.replaying) {
         s.started = true;
         s.t0_ns = now_ns();
     }
