@@ -439,13 +439,22 @@ static void fill_nan_fast(double *p, unsigned count)
     for (i = 0; i < URRT_VECTOR_DOUBLES; i++) {
         nan[i] = URRT_NAN_BITS;
     }
-    /* Single stores up to a vector boundary: a vector store that straddles
-     * cache lines costs two. */
-    for (i = 0; i < count && ((uintptr_t)(void *)&p[i] & (URRT_VECTOR_BYTES - 1u)) != 0; i++) {
-        p[i] = double_from_bits(URRT_NAN_BITS);
-    }
-    for (; i + URRT_VECTOR_DOUBLES <= count; i += URRT_VECTOR_DOUBLES) {
-        __builtin_memcpy(&p[i], &nan, sizeof nan);
+    i = 0;
+    if (count >= URRT_VECTOR_DOUBLES) {
+        /* Whole vectors, aligned: one (unaligned) store covers the head up to
+         * the first boundary and one the tail; they overlap stores in the
+         * middle, which only write NaN where NaN is. A store that straddles
+         * cache lines costs two, a loop of single stores more. */
+        unsigned misaligned = (unsigned)(((uintptr_t)(void *)p & (URRT_VECTOR_BYTES - 1u)) / 8u);
+        __builtin_memcpy(p, &nan, sizeof nan);
+        for (i = misaligned ? URRT_VECTOR_DOUBLES - misaligned : URRT_VECTOR_DOUBLES;
+             i + URRT_VECTOR_DOUBLES <= count; i += URRT_VECTOR_DOUBLES) {
+            __builtin_memcpy(&p[i], &nan, sizeof nan);
+        }
+        if (i < count) {
+            __builtin_memcpy(&p[count - URRT_VECTOR_DOUBLES], &nan, sizeof nan);
+        }
+        return;
     }
 #endif
     fill_nan(p + i, count - i);
