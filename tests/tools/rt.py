@@ -1,0 +1,284 @@
+#!/usr/bin/python3
+"""Independent reference for the tools tests: a RealTime decoder written
+from the wire format alone (big-endian int32 size, then big-endian doubles),
+UR5e kinematics, and the small servers and clients the tests need.
+
+Nothing here imports or calls the C library: it is the second opinion.
+
+  rt.py gnuplot CAPTURE DUMP_OUT [COUNT]  dump's gnuplot lines equal the capture, bit for bit
+  rt.py json CAPTURE DUMP_OUT             dump's JSON lines carry the capture's values
+  rt.py csv CAPTURE DUMP_OUT              dump's CSV rows carry the capture's values
+  rt.py model CAPTURE RATE                the simulated motion is consistent
+  rt.py noread-server PORT CAPTURE OUT    serve CAPTURE twice; fail on any byte received
+  rt.py slow-client PORT SECONDS          connect, never read, hold on
+  rt.py writer-client PORT                connect and send a byte (negative control)
+"""
+import json
+import math
+import select
+import socket
+import struct
+import sys
+import time
+
+
+def packets(path):
+    """Strict framing of a clean capture: every packet is size + doubles."""
+    data = open(path, 'rb').read()
+    out = []
+    off = 0
+    while off + 4 <= len(data):
+        size = struct.unpack_from('>i', data, off)[0]
+        if size < 12 or (size - 4) % 8 or off + size > len(data):
+            break
+        raw = data[off + 4:off + size]
+        out.append((size, raw))
+        off += size
+    return out
+
+
+def doubles(raw):
+    return struct.unpack('>%dd' % (len(raw) // 8), raw)
+
+
+def fail(msg):
+    print('rt.py: FAIL: ' + msg, file=sys.stderr)
+    sys.exit(1)
+
+
+def cmd_gnuplot(capture, dump_out, count=None):
+    pk = packets(capture)
+    lines = [l for l in open(dump_out) if not l.startswith('#')]
+    if count is not None and len(pk) != int(count):
+        fail('capture holds %d packets, expected %s' % (len(pk), count))
+    if len(lines) != len(pk):
+        fail('%d gnuplot lines for %d packets' % (len(lines), len(pk)))
+    for n, ((size, raw), line) in enumerate(zip(pk, lines), 1):
+        cols = line.split()
+        if len(cols) != (size - 4) // 8:
+            fail('packet %d: %d columns, the packet holds %d doubles' % (n, len(cols), (size - 4) // 8))
+        for c, text in enumerate(cols):
+            want = raw[8 * c:8 * c + 8]
+            got = struct.pack('>d', float(text))
+            if got != want:
+                fail('packet %d column %d: printed %s (%s), sent %s' % (n, c + 1, text, got.hex(), want.hex()))
+    print('rt.py: %d packets, %d columns each, bit-exact' % (len(pk), (pk[0][0] - 4) // 8 if pk else 0))
+
+
+# Column (1-based) of a few fields in the 3.x/5.x grid, from UR's table.
+COL3 = {'time': 1, 'q_target': 2, 'qd_target': 8, 'qdd_target': 14, 'i_target': 20, 'm_target': 26,
+        'q_actual': 32, 'qd_actual': 38, 'i_actual': 44, 'tool_vector_actual': 56, 'tcp_speed_actual': 62,
+        'tcp_force': 68, 'tool_vector_target': 74, 'digital_input_bits': 86, 'motor_temperatures': 87,
+        'robot_mode': 95, 'joint_modes': 96, 'safety_mode': 102, 'tool_accelerometer': 109,
+        'speed_scaling': 118, 'digital_outputs': 131, 'program_state': 132, 'elbow_position': 133,
+        'safety_status': 139}
+COL1 = {'time': 1, 'q_target': 2, 'q_actual': 32, 'qd_actual': 38, 'tool_accelerometer': 50,
+        'tool_vector': 74, 'digital_input_bits': 86, 'robot_mode': 95, 'joint_modes': 96}
+COUNTS = {'time': 1, 'digital_input_bits': 1, 'robot_mode': 1, 'safety_mode': 1, 'speed_scaling': 1,
+          'digital_outputs': 1, 'program_state': 1, 'safety_status': 1, 'tool_accelerometer': 3,
+          'elbow_position': 3}
+
+
+def field(vals, name):
+    cols = COL1 if len(vals) <= 101 else COL3
+    c = cols[name] - 1
+    return list(vals[c:c + COUNTS.get(name, 6)])
+
+
+def cmd_json(capture, dump_out):
+    pk = packets(capture)
+    objs = [json.loads(l) for l in open(dump_out)]
+    if len(objs) != len(pk):
+        fail('%d JSON objects for %d packets' % (len(objs), len(pk)))
+    for n, ((size, raw), o) in enumerate(zip(pk, objs), 1):
+        v = doubles(raw)
+        if o['packet'] != n or o['length'] != size:
+            fail('packet %d: packet/length %s/%s' % (n, o['packet'], o['length']))
+        names = COL1 if len(v) <= 101 else COL3
+        for name in names:
+            if name not in o:
+                continue
+            want = field(v, name)
+            got = o[name] if isinstance(o[name], list) else [o[name]]
+            if name in ('digital_input_bits', 'digital_outputs'):
+                want = [int(x) for x in want]
+            if got != want:
+                fail('packet %d %s: %s != %s' % (n, name, got, want))
+        if len(v) > 101:
+            if o.get('robot_mode_name') != 'RUNNING' or o.get('joint_modes_name') != ['RUNNING'] * 6:
+                fail('packet %d: mode names %s %s' % (n, o.get('robot_mode_name'), o.get('joint_modes_name')))
+            if o.get('safety_mode_name') != 'NORMAL' or o.get('program_state_name', 'PLAYING') != 'PLAYING':
+                fail('packet %d: safety/program names' % n)
+    print('rt.py: %d JSON objects match' % len(objs))
+
+
+def cmd_csv(capture, dump_out):
+    pk = packets(capture)
+    rows = [l.rstrip('\n').split(',') for l in open(dump_out)]
+    header, rows = rows[0], rows[1:]
+    if len(rows) != len(pk):
+        fail('%d CSV rows for %d packets' % (len(rows), len(pk)))
+    for n, ((size, raw), row) in enumerate(zip(pk, rows), 1):
+        v = doubles(raw)
+        for h, text in zip(header, row):
+            name, _, idx = h.partition('[')
+            i = int(idx[:-1]) if idx else 0
+            if name not in COL3:
+                continue
+            want = field(v, name)[i]
+            if struct.pack('>d', float(text)) != struct.pack('>d', want):
+                fail('packet %d %s: %s != %r' % (n, h, text, want))
+    print('rt.py: %d CSV rows match (%d columns)' % (len(rows), len(header)))
+
+
+# UR5e standard DH parameters, as Universal Robots publishes them.
+DH_D = [0.1625, 0, 0, 0.1333, 0.0997, 0.0996]
+DH_A = [0, -0.425, -0.3922, 0, 0, 0]
+DH_ALPHA = [math.pi / 2, 0, 0, math.pi / 2, -math.pi / 2, 0]
+
+
+def matmul(a, b):
+    return [[sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
+
+
+def fk(q):
+    t = [[1 if i == j else 0 for j in range(4)] for i in range(4)]
+    for i in range(6):
+        ct, st = math.cos(q[i]), math.sin(q[i])
+        ca, sa = math.cos(DH_ALPHA[i]), math.sin(DH_ALPHA[i])
+        t = matmul(t, [[ct, -st * ca, st * sa, DH_A[i] * ct], [st, ct * ca, -ct * sa, DH_A[i] * st],
+                       [0, sa, ca, DH_D[i]], [0, 0, 0, 1]])
+    return t
+
+
+def rodrigues(rv):
+    th = math.sqrt(sum(x * x for x in rv))
+    if th < 1e-12:
+        return [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+    kx, ky, kz = (x / th for x in rv)
+    c, s, v = math.cos(th), math.sin(th), 1 - math.cos(th)
+    return [[kx * kx * v + c, kx * ky * v - kz * s, kx * kz * v + ky * s],
+            [ky * kx * v + kz * s, ky * ky * v + c, ky * kz * v - kx * s],
+            [kz * kx * v - ky * s, kz * ky * v + kx * s, kz * kz * v + c]]
+
+
+def cmd_model(capture, rate):
+    rate = float(rate)
+    dt = 1.0 / rate
+    pk = [doubles(raw) for _, raw in packets(capture)]
+    if len(pk) < 10:
+        fail('too few packets')
+    lag = int(round(0.004 * rate))
+    worst = {}
+
+    def note(what, err):
+        worst[what] = max(worst.get(what, 0.0), err)
+
+    for k in range(1, len(pk) - 1):
+        p, a, b = pk[k], pk[k - 1], pk[k + 1]
+        note('time step', abs((b[0] - p[0]) - dt))
+        for j in range(6):
+            # Central differences: errors of order dt^2 times the third derivative.
+            note('qd = dq/dt', abs((b[1 + j] - a[1 + j]) / (2 * dt) - p[7 + j]))
+            note('qdd = dqd/dt', abs((b[7 + j] - a[7 + j]) / (2 * dt) - p[13 + j]))
+        if k >= lag:
+            for j in range(6):
+                note('q_actual = q_target a lag earlier', abs(p[31 + j] - pk[k - lag][1 + j]))
+        t = fk(p[31:37])
+        for i in range(3):
+            note('tcp position = fk(q_actual)', abs(t[i][3] - p[55 + i]))
+        r = rodrigues(p[58:61])
+        for i in range(3):
+            for j in range(3):
+                note('tcp rotation = fk(q_actual)', abs(t[i][j] - r[i][j]))
+        # TCP speed against the difference of neighbouring poses.
+        ta, tb = fk(a[31:37]), fk(b[31:37])
+        for i in range(3):
+            note('tcp speed = d(pose)/dt', abs((tb[i][3] - ta[i][3]) / (2 * dt) - p[61 + i]))
+        if p[94] != 7 or any(m != 253 for m in p[95:101]) or p[101] != 1 or p[131] != 2 or p[138] != 1:
+            fail('packet %d: modes %s %s %s %s %s' % (k, p[94], p[95:101], p[101], p[131], p[138]))
+        for j in range(6):
+            # Torque over current: one positive torque constant per joint.
+            if abs(p[43 + j]) > 0.2:
+                note('current follows torque (sign)', 0.0 if (p[43 + j] > 0) == (p[25 + j] > 0) else 1.0)
+        if not 20 < min(p[86:92]) <= max(p[86:92]) < 60:
+            fail('packet %d: temperatures %s' % (k, p[86:92]))
+        acc = math.sqrt(sum(x * x for x in p[108:111]))
+        note('accelerometer ~ g', 0.0 if 7 < acc < 13 else abs(acc - 9.8))
+    limits = {'time step': 1e-9, 'qd = dq/dt': 5e-4, 'qdd = dqd/dt': 5e-3,
+              'q_actual = q_target a lag earlier': 1e-9, 'tcp position = fk(q_actual)': 1e-9,
+              'tcp rotation = fk(q_actual)': 1e-6, 'tcp speed = d(pose)/dt': 5e-4,
+              'current follows torque (sign)': 0.5, 'accelerometer ~ g': 0.5}
+    for what, err in sorted(worst.items()):
+        print('rt.py: model: %-36s worst %.3g (limit %g)' % (what, err, limits[what]))
+        if err > limits[what]:
+            fail('model: %s off by %g' % (what, err))
+    bits = set(p[85] for p in pk)
+    moving = max(abs(pk[-1][31 + j] - pk[0][31 + j]) for j in range(6))
+    print('rt.py: model: %d distinct input masks, joints moved up to %.3f rad' % (len(bits), moving))
+    if moving < 1e-3:
+        fail('model: the joints do not move')
+
+
+def cmd_noread_server(port, capture, out):
+    """Serves the capture in two connections (half, stall until the client
+    gives up, then the rest) and records every byte a client sends."""
+    data = open(capture, 'rb').read()
+    pk = packets(capture)
+    half = sum(size for size, _ in pk[:len(pk) // 2])
+    srv = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    srv.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    srv.bind(('127.0.0.1', int(port)))
+    srv.listen(4)
+    srv.settimeout(10)
+    received = 0
+    result = {'connections': 0, 'received': 0}
+    for part in (data[:half], data[half:]):
+        conn, _ = srv.accept()
+        result['connections'] += 1
+        conn.sendall(part)
+        # Keep the connection open and silent until the client closes it
+        # (the first time: its silence timeout) or 5 s pass; count any byte.
+        end = time.time() + (5 if part is data[:half] else 0.5)
+        while time.time() < end:
+            r, _, _ = select.select([conn], [], [], 0.05)
+            if r:
+                try:
+                    chunk = conn.recv(4096)
+                except ConnectionResetError:
+                    break
+                if not chunk:
+                    break
+                received += len(chunk)
+        conn.close()
+        if received:
+            break
+    result['received'] = received
+    json.dump(result, open(out, 'w'))
+    sys.exit(1 if received else 0)
+
+
+def cmd_slow_client(port, seconds):
+    s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    s.connect(('127.0.0.1', int(port)))
+    time.sleep(float(seconds))
+    s.close()
+
+
+def cmd_writer_client(port):
+    s = socket.create_connection(('127.0.0.1', int(port)), timeout=5)
+    s.recv(100)
+    s.sendall(b'x')
+    time.sleep(0.2)
+    s.close()
+
+
+if __name__ == '__main__':
+    cmds = {'gnuplot': cmd_gnuplot, 'json': cmd_json, 'csv': cmd_csv, 'model': cmd_model,
+            'noread-server': cmd_noread_server, 'slow-client': cmd_slow_client,
+            'writer-client': cmd_writer_client}
+    if len(sys.argv) < 2 or sys.argv[1] not in cmds:
+        print(__doc__, file=sys.stderr)
+        sys.exit(2)
+    cmds[sys.argv[1]](*sys.argv[2:])

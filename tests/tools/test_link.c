@@ -1,0 +1,589 @@
+/*
+ * The POSIX robot link against servers in this process, and the shared
+ * command-line helpers. Real sockets on loopback, real time; every wait is
+ * bounded.
+ */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "cli.h"
+#include "port.h"
+
+static uint16_t port_base = 40500;
+
+/* ---- log capture ---------------------------------------------------------- */
+
+#define MAX_LINES 256
+static char log_lines[MAX_LINES][300];
+static int log_count;
+
+static void sink(void *ctx, urrt_log_level level, const char *message)
+{
+    (void)ctx;
+    if (log_count < MAX_LINES) {
+        snprintf(log_lines[log_count++], sizeof log_lines[0], "%s: %s", urrt_log_level_name(level), message);
+    }
+}
+
+static int lines_with(const char *needle)
+{
+    int n = 0;
+    for (int i = 0; i < log_count; i++) {
+        n += strstr(log_lines[i], needle) != NULL;
+    }
+    return n;
+}
+
+static void dump_log(void)
+{
+    for (int i = 0; i < log_count; i++) {
+        fprintf(stderr, "  log: %s\n", log_lines[i]);
+    }
+}
+
+/* ---- driving a link ----------------------------------------------------------- */
+
+typedef struct rx {
+    uint64_t packets;
+    uint64_t bytes_in_packets;
+    uint64_t tapped;
+    uint8_t first_byte_of_last;
+} rx;
+
+static void on_packet(void *ctx, const uint8_t *pkt, size_t len, uint64_t rx_us)
+{
+    rx *r = ctx;
+    (void)rx_us;
+    r->packets++;
+    r->bytes_in_packets += len;
+    r->first_byte_of_last = pkt[4];
+}
+
+static void on_tap(void *ctx, const uint8_t *data, size_t len)
+{
+    rx *r = ctx;
+    (void)data;
+    r->tapped += len;
+}
+
+typedef bool (*until_fn)(const urrt_link *link, const rx *r);
+
+/* Polls and services the link until done() or ms pass. Returns done(). When
+ * delays is given, each connect failure or loss records the backoff chosen
+ * (deadline - now of that call) in milliseconds. */
+static bool pump(urrt_link *link, rx *r, int ms, until_fn done, uint64_t *delays, int *ndelays, int max_delays)
+{
+    uint64_t end = urrt_port_monotonic_us() + (uint64_t)ms * 1000u;
+    for (;;) {
+        uint64_t now = urrt_port_monotonic_us();
+        short ev = 0;
+        int fd;
+        uint64_t deadline;
+        int timeout;
+        const urrt_link_stats *st = urrt_link_get_stats(link);
+        uint64_t events_before;
+
+        if (done != NULL && done(link, r)) {
+            return true;
+        }
+        if (now >= end) {
+            return done == NULL;
+        }
+        fd = urrt_link_poll_fd(link, &ev);
+        deadline = urrt_link_deadline(link);
+        timeout = deadline <= now ? 0 : (int)((deadline - now + 999) / 1000);
+        if (timeout > (int)((end - now) / 1000) + 1) {
+            timeout = (int)((end - now) / 1000) + 1;
+        }
+        struct pollfd p = {.fd = fd, .events = ev};
+        poll(&p, fd >= 0, timeout);
+        now = urrt_port_monotonic_us();
+        events_before = st->connect_failures + st->disconnects;
+        urrt_link_service(link, now, on_packet, r);
+        if (delays != NULL && st->connect_failures + st->disconnects != events_before && *ndelays < max_delays) {
+            delays[(*ndelays)++] = (urrt_link_deadline(link) - now) / 1000u;
+        }
+    }
+}
+
+static bool is_up(const urrt_link *l, const rx *r)
+{
+    (void)r;
+    return urrt_link_get_state(l) == URRT_LINK_UP;
+}
+
+static bool one_disconnect(const urrt_link *l, const rx *r)
+{
+    (void)r;
+    return urrt_link_get_stats(l)->disconnects >= 1;
+}
+
+static bool two_disconnects(const urrt_link *l, const rx *r)
+{
+    (void)r;
+    return urrt_link_get_stats(l)->disconnects >= 2;
+}
+
+static bool twelve_failures(const urrt_link *l, const rx *r)
+{
+    (void)r;
+    return urrt_link_get_stats(l)->connect_failures >= 12;
+}
+
+static bool one_failure(const urrt_link *l, const rx *r)
+{
+    (void)r;
+    return urrt_link_get_stats(l)->connect_failures >= 1;
+}
+
+static uint64_t want_packets;
+static bool enough_packets(const urrt_link *l, const rx *r)
+{
+    (void)l;
+    return r->packets >= want_packets;
+}
+
+/* ---- a server ------------------------------------------------------------------ */
+
+static int listen_on(int family, uint16_t port, int backlog)
+{
+    int fd = socket(family, SOCK_STREAM | SOCK_CLOEXEC, 0), on = 1;
+    struct sockaddr_storage ss;
+    socklen_t len;
+    memset(&ss, 0, sizeof ss);
+    if (family == AF_INET6) {
+        struct sockaddr_in6 *a = (struct sockaddr_in6 *)&ss;
+        a->sin6_family = AF_INET6;
+        a->sin6_port = htons(port);
+        a->sin6_addr = in6addr_loopback;
+        len = sizeof *a;
+    } else {
+        struct sockaddr_in *a = (struct sockaddr_in *)&ss;
+        a->sin_family = AF_INET;
+        a->sin_port = htons(port);
+        a->sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        len = sizeof *a;
+    }
+    setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+    if (bind(fd, (struct sockaddr *)&ss, len) != 0 || listen(fd, backlog) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+static int accept_within(int lfd, int ms)
+{
+    struct pollfd p = {.fd = lfd, .events = POLLIN};
+    if (poll(&p, 1, ms) != 1) {
+        return -1;
+    }
+    return accept4(lfd, NULL, NULL, SOCK_CLOEXEC);
+}
+
+/* What the link sent: must stay 0. -1 on error. */
+static long bytes_from_client(int fd)
+{
+    uint8_t buf[256];
+    long total = 0;
+    for (;;) {
+        ssize_t n = recv(fd, buf, sizeof buf, MSG_DONTWAIT);
+        if (n > 0) {
+            total += n;
+            continue;
+        }
+        if (n == 0 || errno == EAGAIN || errno == EWOULDBLOCK || errno == ECONNRESET) {
+            return total;
+        }
+        return -1;
+    }
+}
+
+static void make_packet(uint8_t *p, uint32_t len, uint8_t tag)
+{
+    memset(p, 0, len);
+    p[0] = (uint8_t)(len >> 24);
+    p[1] = (uint8_t)(len >> 16);
+    p[2] = (uint8_t)(len >> 8);
+    p[3] = (uint8_t)len;
+    p[4] = tag;
+}
+
+static void send_all(int fd, const uint8_t *p, size_t n)
+{
+    while (n > 0) {
+        ssize_t w = send(fd, p, n, MSG_NOSIGNAL);
+        if (w <= 0) {
+            return;
+        }
+        p += w;
+        n -= (size_t)w;
+    }
+}
+
+static void sleep_ms(int ms)
+{
+    struct timespec ts = {.tv_sec = ms / 1000, .tv_nsec = (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}
+
+/* ---- tests -------------------------------------------------------------------- */
+
+static void test_config(void)
+{
+    urrt_link_config c;
+    urrt_link_config_defaults(&c);
+    CHECK_EQ_INT(c.port, 30003);
+    CHECK_EQ_INT(c.connect_timeout_ms, 2000);
+    CHECK_EQ_INT(c.silence_timeout_ms, 100);
+    CHECK_EQ_INT(c.backoff_initial_ms, 100);
+    CHECK_EQ_INT(c.backoff_max_ms, 5000);
+    log_count = 0;
+    CHECK(urrt_link_new(&c) == NULL, "a link without host");
+    c.host = "127.0.0.1";
+    c.port = 0;
+    CHECK(urrt_link_new(&c) == NULL, "port 0");
+    c.port = 30003;
+    c.backoff_max_ms = 50;
+    CHECK(urrt_link_new(&c) == NULL, "max backoff below initial");
+    CHECK_EQ_INT(lines_with("error: robot"), 3);
+    CHECK(lines_with("port 0") == 1, "the reason is logged");
+    CHECK_EQ_STR(urrt_link_state_name(URRT_LINK_UP), "up");
+}
+
+static void test_refused_backoff(void)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    rx r = {0};
+    uint64_t delays[16];
+    int nd = 0;
+    static const uint64_t want[] = {10, 20, 40, 80, 80, 80, 80, 80, 80, 80, 80};
+    char peer[64];
+
+    urrt_link_config_defaults(&c);
+    c.name = "arm1";
+    c.host = "127.0.0.1";
+    c.port = port_base; /* nothing listens there */
+    c.backoff_initial_ms = 10;
+    c.backoff_max_ms = 80;
+    l = urrt_link_new(&c);
+    CHECK(l != NULL, "link");
+    snprintf(peer, sizeof peer, "127.0.0.1:%u", port_base);
+    CHECK_EQ_STR(urrt_link_peer(l), peer);
+    CHECK_EQ_INT(urrt_link_deadline(l), 0); /* the first attempt is due at once */
+    log_count = 0;
+    CHECK(pump(l, &r, 3000, twelve_failures, delays, &nd, 16), "12 refusals within 3 s");
+    CHECK(nd >= 11, "%d delays", nd);
+    for (int i = 0; i < 11 && i < nd; i++) {
+        /* The recorded delay is the full backoff, give or take the ms rounding. */
+        CHECK(delays[i] == want[i] || delays[i] + 1 == want[i], "backoff %d: %llu ms, want %llu", i,
+              (unsigned long long)delays[i], (unsigned long long)want[i]);
+    }
+    CHECK_EQ_INT(urrt_link_get_stats(l)->connects, 0);
+    CHECK_EQ_INT(lines_with("warning: robot arm1: cannot connect to"), 1);
+    CHECK_EQ_INT(lines_with("still cannot connect"), 1);
+    CHECK_EQ_INT(lines_with("after 10 attempts"), 1);
+    CHECK_EQ_INT(lines_with("connection refused"), 2);
+    CHECK_EQ_INT(lines_with("connecting to"), 1);
+    if (lines_with("cannot connect") != 2) {
+        dump_log();
+    }
+    urrt_link_free(l);
+}
+
+static void test_session(void)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    rx r = {0};
+    uint8_t pkt[1116];
+    uint64_t delays[8];
+    int nd = 0;
+    int lfd = listen_on(AF_INET, (uint16_t)(port_base + 1), 4), s;
+    long sent_by_link = 0;
+
+    CHECK(lfd >= 0, "listen");
+    urrt_link_config_defaults(&c);
+    c.name = "arm1";
+    c.host = "127.0.0.1";
+    c.port = (uint16_t)(port_base + 1);
+    c.backoff_initial_ms = 20;
+    c.backoff_max_ms = 1000;
+    c.silence_timeout_ms = 100;
+    l = urrt_link_new(&c);
+    urrt_link_set_tap(l, on_tap, &r);
+    log_count = 0;
+
+    /* 1: three packets in awkward pieces, half a fourth, then close. */
+    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "connects");
+    s = accept_within(lfd, 2000);
+    CHECK(s >= 0, "accept");
+    for (int i = 0; i < 3; i++) {
+        make_packet(pkt, sizeof pkt, (uint8_t)(i + 1));
+        send_all(s, pkt, 3);
+        pump(l, &r, 10, NULL, NULL, NULL, 0);
+        send_all(s, pkt + 3, 700);
+        pump(l, &r, 10, NULL, NULL, NULL, 0);
+        send_all(s, pkt + 703, sizeof pkt - 703);
+    }
+    make_packet(pkt, sizeof pkt, 4);
+    send_all(s, pkt, 558);
+    want_packets = 3;
+    CHECK(pump(l, &r, 2000, enough_packets, NULL, NULL, 0), "three packets");
+    sent_by_link += bytes_from_client(s);
+    close(s);
+    CHECK(pump(l, &r, 2000, one_disconnect, delays, &nd, 8), "sees the close");
+    CHECK_EQ_INT(r.packets, 3);
+    CHECK_EQ_INT(r.first_byte_of_last, 3);
+    CHECK_EQ_INT(r.tapped, 3 * 1116 + 558);
+    {
+        const urrt_link_stats *st = urrt_link_get_stats(l);
+        CHECK_EQ_INT(st->packets, 3);
+        CHECK_EQ_INT(st->bytes, 3 * 1116 + 558);
+        CHECK_EQ_INT(st->partial_drops, 1);
+        CHECK_EQ_INT(st->partial_bytes, 558);
+        CHECK_EQ_INT(st->connects, 1);
+        CHECK_EQ_INT(st->disconnects, 1);
+        CHECK_EQ_INT(st->last_length, 1116);
+        CHECK(st->last_packet_us != 0, "time of the last packet");
+    }
+    /* It delivered packets: the next attempt waits the initial backoff. */
+    CHECK(nd == 1 && delays[0] >= 19 && delays[0] <= 20, "backoff after a good connection: %llu ms",
+          (unsigned long long)(nd ? delays[0] : 0));
+    CHECK_EQ_INT(urrt_link_get_state(l), URRT_LINK_IDLE);
+    CHECK_EQ_INT(urrt_link_poll_fd(l, NULL), -1);
+    CHECK_EQ_INT(lines_with("connected to 127.0.0.1"), 1);
+    CHECK_EQ_INT(lines_with("lost (closed by peer); reconnecting"), 1);
+
+    /* 2: reconnect; a packet, garbage, a packet, then silence. */
+    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "reconnects");
+    s = accept_within(lfd, 2000);
+    CHECK(s >= 0, "accept again");
+    make_packet(pkt, sizeof pkt, 5);
+    send_all(s, pkt, sizeof pkt);
+    send_all(s, (const uint8_t *)"\x01\x02\x03\x04\x05", 5);
+    make_packet(pkt, sizeof pkt, 6);
+    send_all(s, pkt, sizeof pkt);
+    CHECK(pump(l, &r, 2000, two_disconnects, NULL, NULL, 0), "silence detected");
+    sent_by_link += bytes_from_client(s);
+    close(s);
+    {
+        const urrt_link_stats *st = urrt_link_get_stats(l);
+        CHECK_EQ_INT(st->packets, 5);
+        CHECK_EQ_INT(st->resyncs, 1);
+        CHECK_EQ_INT(st->skipped, 5);
+        CHECK_EQ_INT(st->silences, 1);
+        CHECK_EQ_INT(st->reconnects, 1);
+        CHECK_EQ_INT(st->partial_drops, 1);
+    }
+    CHECK_EQ_INT(lines_with("lost (no data for 100 ms); reconnecting"), 1);
+    CHECK_EQ_INT(lines_with("connected to 127.0.0.1"), 2);
+
+    /* 3: more than one service call's budget arrives at once. */
+    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "third connection");
+    s = accept_within(lfd, 2000);
+    {
+        static uint8_t burst[80 * 1116];
+        uint64_t before = r.packets;
+        for (int i = 0; i < 80; i++) {
+            make_packet(burst + i * 1116, 1116, (uint8_t)i);
+        }
+        send_all(s, burst, sizeof burst);
+        sleep_ms(50);
+        urrt_link_service(l, urrt_port_monotonic_us(), on_packet, &r);
+        CHECK(r.packets - before > 0 && r.packets - before <= 59, "one call read %llu packets (at most 64 KiB)",
+              (unsigned long long)(r.packets - before));
+        CHECK_EQ_INT(urrt_link_deadline(l), 0); /* more to read: service again at once */
+        want_packets = before + 80;
+        CHECK(pump(l, &r, 2000, enough_packets, NULL, NULL, 0), "the rest follows");
+        CHECK_EQ_INT(r.first_byte_of_last, 79);
+    }
+    sent_by_link += bytes_from_client(s);
+    close(s);
+    CHECK_EQ_INT(sent_by_link, 0);
+    urrt_link_free(l);
+    close(lfd);
+}
+
+static void test_connect_timeout(void)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    rx r = {0};
+    uint16_t port = (uint16_t)(port_base + 2);
+    int lfd = listen_on(AF_INET, port, 0);
+    int fillers[4];
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons(port), .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
+    uint64_t t0;
+
+    /* A full accept queue drops further SYNs: a connect that hangs. */
+    for (int i = 0; i < 4; i++) {
+        fillers[i] = socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+        connect(fillers[i], (struct sockaddr *)&a, sizeof a);
+    }
+    sleep_ms(50);
+    urrt_link_config_defaults(&c);
+    c.host = "127.0.0.1";
+    c.port = port;
+    c.connect_timeout_ms = 150;
+    c.backoff_initial_ms = 5000;
+    c.backoff_max_ms = 5000;
+    l = urrt_link_new(&c);
+    log_count = 0;
+    t0 = urrt_port_monotonic_us();
+    CHECK(pump(l, &r, 2000, one_failure, NULL, NULL, 0), "the connect gives up");
+    CHECK(urrt_port_monotonic_us() - t0 >= 150000, "not before the timeout");
+    CHECK(urrt_port_monotonic_us() - t0 < 1000000, "soon after it");
+    CHECK_EQ_INT(urrt_link_get_stats(l)->connects, 0);
+    CHECK_EQ_INT(lines_with("timed out"), 1);
+    if (lines_with("timed out") != 1) {
+        dump_log();
+    }
+    urrt_link_free(l);
+    for (int i = 0; i < 4; i++) {
+        close(fillers[i]);
+    }
+    close(lfd);
+}
+
+static void test_ipv6(void)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    rx r = {0};
+    uint16_t port = (uint16_t)(port_base + 3);
+    int lfd = listen_on(AF_INET6, port, 4), s;
+    uint8_t pkt[1220];
+    char peer[64];
+
+    if (lfd < 0) {
+        printf("skip: no IPv6 loopback\n");
+        return;
+    }
+    urrt_link_config_defaults(&c);
+    c.host = "::1";
+    c.port = port;
+    l = urrt_link_new(&c);
+    snprintf(peer, sizeof peer, "[::1]:%u", port);
+    CHECK_EQ_STR(urrt_link_peer(l), peer);
+    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "connects over IPv6");
+    s = accept_within(lfd, 2000);
+    make_packet(pkt, sizeof pkt, 9);
+    send_all(s, pkt, sizeof pkt);
+    want_packets = 1;
+    CHECK(pump(l, &r, 2000, enough_packets, NULL, NULL, 0), "a packet over IPv6");
+    CHECK_EQ_INT(urrt_link_get_stats(l)->last_length, 1220);
+    CHECK_EQ_INT(bytes_from_client(s), 0);
+    close(s);
+    urrt_link_free(l);
+    close(lfd);
+}
+
+/* A name (from /etc/hosts, no DNS): every address is tried in turn, so a
+ * server on 127.0.0.1 only is found even when ::1 comes first. */
+static void test_name(void)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    rx r = {0};
+    uint16_t port = (uint16_t)(port_base + 4);
+    int lfd = listen_on(AF_INET, port, 4), s;
+    uint8_t pkt[1116];
+
+    urrt_link_config_defaults(&c);
+    c.host = "localhost";
+    c.port = port;
+    l = urrt_link_new(&c);
+    log_count = 0;
+    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "connects to localhost");
+    s = accept_within(lfd, 2000);
+    make_packet(pkt, sizeof pkt, 1);
+    send_all(s, pkt, sizeof pkt);
+    want_packets = 1;
+    CHECK(pump(l, &r, 2000, enough_packets, NULL, NULL, 0), "a packet from localhost");
+    CHECK_EQ_INT(urrt_link_get_stats(l)->connect_failures, 0);
+    CHECK_EQ_INT(lines_with("localhost: connected to localhost"), 1);
+    close(s);
+    urrt_link_free(l);
+    close(lfd);
+}
+
+static void test_cli(void)
+{
+    char host[64];
+    uint16_t port = 0;
+    uint64_t v = 0;
+    uint32_t v32 = 0;
+    double d = 0;
+
+    CHECK(cli_parse_host_port("robot", 30003, host, sizeof host, &port) == NULL, "host");
+    CHECK_EQ_STR(host, "robot");
+    CHECK_EQ_INT(port, 30003);
+    CHECK(cli_parse_host_port("10.0.0.5:30013", 30003, host, sizeof host, &port) == NULL, "host:port");
+    CHECK_EQ_STR(host, "10.0.0.5");
+    CHECK_EQ_INT(port, 30013);
+    CHECK(cli_parse_host_port("[::1]:40001", 30003, host, sizeof host, &port) == NULL, "[v6]:port");
+    CHECK_EQ_STR(host, "::1");
+    CHECK_EQ_INT(port, 40001);
+    CHECK(cli_parse_host_port("[fe80::1%eth0]", 30003, host, sizeof host, &port) == NULL, "[v6]");
+    CHECK_EQ_STR(host, "fe80::1%eth0");
+    CHECK_EQ_INT(port, 30003);
+    CHECK(cli_parse_host_port("::1", 30013, host, sizeof host, &port) == NULL, "bare v6");
+    CHECK_EQ_STR(host, "::1");
+    CHECK_EQ_INT(port, 30013);
+    CHECK(cli_parse_host_port("robot:", 30003, host, sizeof host, &port) != NULL, "no port after colon");
+    CHECK(cli_parse_host_port(":30003", 30003, host, sizeof host, &port) != NULL, "no host");
+    CHECK(cli_parse_host_port("robot:70000", 30003, host, sizeof host, &port) != NULL, "port range");
+    CHECK(cli_parse_host_port("robot:0", 30003, host, sizeof host, &port) != NULL, "port 0");
+    CHECK(cli_parse_host_port("robot:30x", 30003, host, sizeof host, &port) != NULL, "port text");
+    CHECK(cli_parse_host_port("[::1", 30003, host, sizeof host, &port) != NULL, "unclosed bracket");
+    CHECK(cli_parse_host_port("[::1]x", 30003, host, sizeof host, &port) != NULL, "text after bracket");
+    CHECK(cli_parse_host_port("", 30003, host, sizeof host, &port) != NULL, "empty");
+    CHECK(cli_parse_host_port("a-very-long-host-name-that-does-not-fit-into-the-buffer-given-here", 1, host,
+                              sizeof host, &port) != NULL,
+          "too long");
+
+    CHECK(cli_parse_u64("125", 1, 1000, &v) == NULL && v == 125, "u64");
+    CHECK(cli_parse_u64("0x10", 1, 1000, &v) == NULL && v == 16, "hex");
+    CHECK(cli_parse_u64("0", 1, 1000, &v) != NULL, "below min");
+    CHECK(cli_parse_u64("1001", 1, 1000, &v) != NULL, "above max");
+    CHECK(cli_parse_u64("-1", 0, UINT64_MAX, &v) != NULL, "sign");
+    CHECK(cli_parse_u64("12abc", 0, UINT64_MAX, &v) != NULL, "trailing text");
+    CHECK(cli_parse_u64("99999999999999999999999", 0, UINT64_MAX, &v) != NULL, "overflow");
+    CHECK(cli_parse_u32("4294967296", 0, UINT32_MAX, &v32) != NULL, "u32 overflow");
+    CHECK(cli_parse_double("2.5", 0.1, 10, &d) == NULL && d == 2.5, "double");
+    CHECK(cli_parse_double("nan", 0, 10, &d) != NULL, "nan");
+    CHECK(cli_parse_double("1e400", 0, 1e300, &d) != NULL, "overflow");
+    CHECK(cli_parse_double("", 0, 1, &d) != NULL, "empty");
+
+    cli_format_host_port("::1", 30003, host, sizeof host);
+    CHECK_EQ_STR(host, "[::1]:30003");
+    cli_format_host_port("robot", 30013, host, sizeof host);
+    CHECK_EQ_STR(host, "robot:30013");
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1) {
+        port_base = (uint16_t)atoi(argv[1]);
+    }
+    urrt_log_init("test_link", URRT_LOG_DEBUG);
+    urrt_log_set_sink(sink, NULL);
+    test_cli();
+    test_config();
+    test_refused_backoff();
+    test_session();
+    test_connect_timeout();
+    test_ipv6();
+    test_name();
+    return check_report();
+}
