@@ -1,0 +1,265 @@
+#!/bin/sh
+# check-tools: urrt-sim and urrt-dump end to end, against the independent
+# Python reference in tests/tools/rt.py. Every server, client and wait here
+# is bounded by timeout(1) or a counted loop. TCP ports 40200-40299.
+set -u
+BUILD=${BUILD:-build}
+PYTHON=${PYTHON:-/usr/bin/python3}
+SIM=$BUILD/bin/urrt-sim
+DUMP=$BUILD/bin/urrt-dump
+RT="$PYTHON tests/tools/rt.py"
+. tests/lib.sh
+RESULT=$BUILD/results/check-tools.result
+mkdir -p "$BUILD/results"
+T=$(mktemp -d "${TMPDIR:-/tmp}/urrt-tools.XXXXXX")
+PIDS=""
+cleanup() {
+  for p in $PIDS; do kill "$p" 2>/dev/null; done
+  rm -rf "$T"
+}
+trap cleanup EXIT INT TERM
+START=$(date +%s)
+
+# waitport PORT: until something listens there (at most 2 s).
+waitport() {
+  i=0
+  while [ $i -lt 100 ]; do
+    ss -Hltn "sport = :$1" 2>/dev/null | grep -q . && return 0
+    sleep 0.02; i=$((i + 1))
+  done
+  echo "nothing listens on port $1" >&2; return 1
+}
+
+# sim PORT ARGS...: a simulator in the background, stderr to $T/sim.PORT.log.
+sim() {
+  port=$1; shift
+  timeout 30 "$SIM" -l "127.0.0.1:$port" -v "$@" 2> "$T/sim.$port.log" &
+  SIMPID=$!; PIDS="$PIDS $SIMPID"
+  waitport "$port"
+}
+
+# stopsim: end the last simulator and wait for it (it may have ended already).
+stopsim() { kill "$SIMPID" 2>/dev/null; wait "$SIMPID" 2>/dev/null; return 0; }
+
+# has FILE TEXT: FILE holds TEXT (a fixed string).
+has() { grep -qF -- "$2" "$1" || { echo "--- $1 lacks: $2" >&2; sed 's/^/    /' "$1" >&2; return 1; }; }
+
+# ---- command line --------------------------------------------------------------
+"$SIM" --version > "$T/v1"; "$DUMP" --version > "$T/v2"
+check "sim --version" has "$T/v1" "urrt-sim 0.1.0"
+check "dump --version" has "$T/v2" "urrt-dump 0.1.0"
+"$SIM" --help > "$T/h1"; "$DUMP" --help > "$T/h2"
+check "sim --help shows faults and examples" has "$T/h1" "stall-after=N[,for=MS]"
+check "dump --help documents exit codes" has "$T/h2" "Exit status: 0"
+"$DUMP" > /dev/null 2> "$T/e1"; rc=$?
+check "dump without source: usage error 2" [ $rc = 2 ]
+check "dump without source: says what to give" has "$T/e1" "give HOST[:PORT] or --file PATH"
+"$DUMP" --fields time,nosuch --file /dev/null > /dev/null 2> "$T/e2"; rc=$?
+check "unknown field: usage error 2" [ $rc = 2 ]
+check "unknown field: lists the valid names" has "$T/e2" "q_actual"
+check "unknown field: names the wrong one" has "$T/e2" '"nosuch"'
+"$DUMP" -F gnuplot -o time --file /dev/null > /dev/null 2>&1; rc=$?
+check "gnuplot with --fields: usage error" [ $rc = 2 ]
+"$DUMP" --file "$T/nonexistent" > /dev/null 2> "$T/e3"; rc=$?
+check "missing capture: runtime error 1" [ $rc = 1 ]
+check "missing capture: names it" has "$T/e3" "cannot open $T/nonexistent"
+"$SIM" --length 1117 2> "$T/e4"; rc=$?
+check "sim --length 1117: usage error 2" [ $rc = 2 ]
+check "sim --length 1117: says 4 + 8n" has "$T/e4" "4 + 8n"
+"$SIM" --fault explode=3 2> "$T/e5"; rc=$?
+check "unknown fault: usage error, lists faults" sh -c "[ $rc = 2 ] && grep -q garbage-every '$T/e5'"
+"$SIM" --version 4.2 2> /dev/null; rc=$?
+check "unknown controller version: usage error" [ $rc = 2 ]
+"$DUMP" robot:99999 2> "$T/e6"; rc=$?
+check "port out of range: usage error" sh -c "[ $rc = 2 ] && grep -q '1 to 65535' '$T/e6'"
+
+# ---- every length, gnuplot columns bit-exact ----------------------------------------
+# Every length a controller sends, lengths none sends (between the generations,
+# one column past the newest, the largest allowed), each checked column by
+# column against the capture the simulator recorded.
+port=40200
+for len in 540 692 756 764 812 900 1044 1060 1108 1116 1140 1220 1228 2052; do
+  sim $port --length $len --rate 2000 --start-on-connect --count 40 --clients 1 -w "$T/len$len.bin"
+  timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/len$len.txt" 2> "$T/len$len.sum"
+  rc=$?; stopsim
+  check "length $len: dump exits 0" [ $rc = 0 ]
+  check "length $len: 40 packets, bit-exact against the reference" $RT gnuplot "$T/len$len.bin" "$T/len$len.txt" 40
+  check "length $len: summary names the length" has "$T/len$len.sum" "lengths: $len x 40"
+  port=$((port + 1))
+done
+check "1.x length counted as 1.x" has "$T/len812.sum" "generations: 1.x 40, 3.x/5.x 0, unknown 0"
+check "900 bytes: generation unknown" has "$T/len900.sum" "unknown 40"
+check "1220 bytes: 5.10" has "$T/len1220.sum" "1220 x 40 (5.10 or later)"
+check "1228 bytes: no known controller" has "$T/len1228.sum" "1228 x 40 (no known controller)"
+
+# --version picks the length and the rate.
+for pair in 1.5:756:125 1.8:812:125 3.1:1044:125 3.3:1060:125 3.9:1108:125 3.12:1116:125 5.9:1140:500 5.10:1220:500 5.16:1220:500; do
+  v=${pair%%:*}; rest=${pair#*:}; len=${rest%%:*}; rate=${rest#*:}
+  sim $port --version "$v" --start-on-connect --count 3 --clients 1
+  timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > /dev/null 2> "$T/ver.sum"; stopsim
+  check "--version $v: $len bytes at $rate Hz" sh -c "grep -q 'lengths: $len x 3' '$T/ver.sum' && grep -q 'mean rate: $rate.000 Hz by controller' '$T/ver.sum'"
+  port=$((port + 1))
+done
+
+# ---- formats against the reference -----------------------------------------------------
+"$DUMP" --file "$T/len1116.bin" -F json > "$T/j.txt" 2>/dev/null
+check "json: every value and enum name matches" $RT json "$T/len1116.bin" "$T/j.txt"
+"$DUMP" --file "$T/len812.bin" -F json > "$T/j1.txt" 2>/dev/null
+check "json 1.x: values at the 1.x columns" $RT json "$T/len812.bin" "$T/j1.txt"
+"$DUMP" --file "$T/len1220.bin" -F csv > "$T/c.txt" 2>/dev/null
+check "csv: header and every value match" $RT csv "$T/len1220.bin" "$T/c.txt"
+check "csv: multi-element names" has "$T/c.txt" "q_actual[5]"
+"$DUMP" --file "$T/len1116.bin" -F csv -o time,robot_mode,q_actual > "$T/c2.txt" 2>/dev/null
+check "csv --fields: exactly those columns" sh -c "head -n 1 '$T/c2.txt' | grep -qx 'time,q_actual\[0\],q_actual\[1\],q_actual\[2\],q_actual\[3\],q_actual\[4\],q_actual\[5\],robot_mode'"
+check "csv --fields: values too" $RT csv "$T/len1116.bin" "$T/c2.txt"
+"$DUMP" --file "$T/len1116.bin" -n 1 > "$T/t.txt" 2>/dev/null
+check "table: enum names" has "$T/t.txt" "RUNNING(253) RUNNING(253)"
+check "table: robot mode" has "$T/t.txt" "RUNNING(7)"
+check "table: units" has "$T/t.txt" "rad/s^2"
+check "table: bit masks" has "$T/t.txt" "0x00100 [8]"
+check "table: header" has "$T/t.txt" "packet 1: 1116 bytes, 3.x/5.x (3.10-3.13, 5.4-5.8)"
+"$DUMP" --file "$T/len812.bin" -n 1 -o robot_mode,tool_vector > "$T/t1.txt" 2>/dev/null
+check "table 1.x: CB2 robot mode numbering" has "$T/t1.txt" "RUNNING(0)"
+"$DUMP" --file "$T/len756.bin" -n 1 -o robot_mode > "$T/t2.txt" 2>/dev/null
+check "table 1.5: robot mode not in the packet" has "$T/t2.txt" "(not in this packet)"
+"$DUMP" --file "$T/len1116.bin" -e 10 -F gnuplot > "$T/every.txt" 2> "$T/every.sum"
+check "--every 10: 4 of 40 printed, 40 counted" sh -c "[ \$(grep -vc '^#' '$T/every.txt') = 4 ] && grep -q 'packets: 40' '$T/every.sum'"
+"$DUMP" --file - -F gnuplot < "$T/len1116.bin" > "$T/stdin.txt" 2>/dev/null
+check "--file - reads stdin" cmp -s "$T/stdin.txt" "$T/len1116.txt"
+
+# ---- the model ----------------------------------------------------------------------------
+sim $port --version 5.10 --seed 7 --start-on-connect --count 1500 --clients 1 -w "$T/model.bin"
+timeout 15 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > /dev/null 2> "$T/model.sum"; stopsim
+port=$((port + 1))
+check "model: derivatives, lag, kinematics, modes consistent" $RT model "$T/model.bin" 500
+sim $port --version 5.10 --seed 7 --start-on-connect --count 50 --clients 1 -w "$T/seed7.bin"
+timeout 10 "$DUMP" "127.0.0.1:$port" --once -q > /dev/null 2>&1; stopsim; port=$((port + 1))
+sim $port --version 5.10 --seed 8 --start-on-connect --count 50 --clients 1 -w "$T/seed8.bin"
+timeout 10 "$DUMP" "127.0.0.1:$port" --once -q > /dev/null 2>&1; stopsim; port=$((port + 1))
+head -c $((50 * 1220)) "$T/model.bin" > "$T/model50.bin"
+check "same seed, same bytes" cmp -s "$T/seed7.bin" "$T/model50.bin"
+check "another seed, other bytes" sh -c "! cmp -s '$T/seed7.bin' '$T/seed8.bin'"
+
+# ---- faults ---------------------------------------------------------------------------------
+sim $port --rate 1000 --fault close-after=30
+timeout 10 "$DUMP" "127.0.0.1:$port" -n 70 -F gnuplot > "$T/f.txt" 2> "$T/f.sum"; rc=$?; stopsim; port=$((port + 1))
+check "close-after: 70 packets over 3 connections" sh -c "[ $rc = 0 ] && grep -q 'packets: 70' '$T/f.sum'"
+check "close-after: reconnects counted" has "$T/f.sum" "connects 3, reconnects 2, disconnects 2, silences 0"
+check "close-after: logged once per change" sh -c "[ \$(grep -c 'lost (closed by peer); reconnecting' '$T/f.sum') = 2 ] && [ \$(grep -c 'connected to' '$T/f.sum') = 3 ]"
+
+sim $port --rate 1000 --fault reset-after=30
+timeout 10 "$DUMP" "127.0.0.1:$port" -n 40 -F gnuplot > /dev/null 2> "$T/f.sum"; rc=$?; stopsim; port=$((port + 1))
+check "reset-after: seen as a reset, reconnected" sh -c "[ $rc = 0 ] && grep -q 'lost (reset by peer); reconnecting' '$T/f.sum' && grep -q 'reconnects 1,' '$T/f.sum'"
+
+sim $port --rate 1000 --fault truncate-after=20
+timeout 10 "$DUMP" "127.0.0.1:$port" -n 45 -F gnuplot > /dev/null 2> "$T/f.sum"; rc=$?; stopsim; port=$((port + 1))
+check "truncate-after: partial packets reported" has "$T/f.sum" "partial packets dropped: 2 (1116 bytes)"
+check "truncate-after: every whole packet decoded" has "$T/f.sum" "packets: 45"
+
+sim $port --rate 1000 --start-on-connect --count 100 --clients 1 --fault garbage-every=10 -w "$T/garbage.bin"
+timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot -w "$T/garbage-dump.bin" > "$T/g1.txt" 2> "$T/g1.sum"; stopsim; port=$((port + 1))
+check "garbage-every: every resync counted (9 x 37 bytes)" has "$T/g1.sum" "resyncs: 9, skipped bytes: 333"
+check "garbage-every: all 100 packets" has "$T/g1.sum" "packets: 100"
+"$DUMP" --file "$T/garbage.bin" -F gnuplot > "$T/g2.txt" 2> "$T/g2.sum"
+check "garbage-every: the capture decodes the same" cmp -s "$T/g1.txt" "$T/g2.txt"
+check "garbage-every: and resyncs the same" has "$T/g2.sum" "resyncs: 9, skipped bytes: 333"
+check "dump --record holds exactly the bytes the simulator sent" cmp -s "$T/garbage.bin" "$T/garbage-dump.bin"
+
+sim $port --rate 500 --start-on-connect --count 100 --clients 1 --fault tiny-writes=5 -w "$T/tiny.bin"
+timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/t1.txt" 2> "$T/t1.sum"; stopsim; port=$((port + 1))
+check "tiny-writes: bit-exact" $RT gnuplot "$T/tiny.bin" "$T/t1.txt" 100
+check "tiny-writes: no resync" has "$T/t1.sum" "resyncs: 0, skipped bytes: 0"
+check "tiny-writes: keeps the rate" sh -c "grep -q 'Hz by arrival' '$T/t1.sum' && awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 400) }' '$T/t1.sum'"
+
+sim $port --rate 500 --start-on-connect --count 96 --clients 1 --fault coalesce=8 -w "$T/co.bin"
+timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/c1.txt" 2> "$T/c1.sum"; stopsim; port=$((port + 1))
+check "coalesce: bit-exact, all 96" $RT gnuplot "$T/co.bin" "$T/c1.txt" 96
+
+sim $port --rate 1000 --fault stall-after=40
+t0=$(date +%s%N)
+timeout 10 "$DUMP" "127.0.0.1:$port" -n 100 --silence-timeout 200 -F gnuplot > /dev/null 2> "$T/s.sum"; rc=$?; stopsim; port=$((port + 1))
+t1=$(date +%s%N)
+check "stall: detected as silence twice, reconnected" has "$T/s.sum" "connects 3, reconnects 2, disconnects 2, silences 2"
+check "stall: logged" has "$T/s.sum" "lost (no data for 200 ms); reconnecting"
+check "stall: 100 packets within 5 s" sh -c "[ $rc = 0 ] && [ $(( (t1 - t0) / 1000000 )) -lt 5000 ]"
+
+sim $port --rate 1000 --fault stall-after=40,for=300
+timeout 10 "$DUMP" "127.0.0.1:$port" -n 80 --silence-timeout 1000 -F gnuplot > /dev/null 2> "$T/s2.sum"; stopsim; port=$((port + 1))
+check "short stall: no reconnect" has "$T/s2.sum" "connects 1, reconnects 0, disconnects 0, silences 0"
+check "short stall: the gap shows in controller time" sh -c "awk '/largest gap/ { exit !(\$4 >= 0.25 && \$4 < 0.6) }' '$T/s2.sum'"
+
+sim $port --rate 1000 --start-on-connect --count 95 --clients 1 --fault odd-length=10 -w "$T/odd.bin"
+timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/o1.txt" 2> "$T/o1.sum"; stopsim; port=$((port + 1))
+check "odd-length: 9 odd packets skipped (9 x 1124 bytes)" has "$T/o1.sum" "resyncs: 9, skipped bytes: 10116"
+check "odd-length: the 86 others decoded" has "$T/o1.sum" "packets: 86"
+
+# ---- replay ----------------------------------------------------------------------------------
+"$DUMP" --file "$T/garbage.bin" -F json > "$T/r1.txt" 2> "$T/r1.sum"
+sim $port --replay "$T/garbage.bin"
+timeout 10 "$DUMP" "127.0.0.1:$port" --once -F json > "$T/r2.txt" 2> "$T/r2.sum"; stopsim; port=$((port + 1))
+check "replay: same decoded output as --file" cmp -s "$T/r1.txt" "$T/r2.txt"
+check "replay: same resyncs (the bytes between packets are replayed)" has "$T/r2.sum" "resyncs: 9, skipped bytes: 333"
+check "replay: paced by the time column (1000 Hz)" sh -c "awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 900 && r < 1100) }' '$T/r2.sum'"
+sim $port --replay "$T/len1116.bin" --loop
+timeout 10 "$DUMP" "127.0.0.1:$port" -n 100 -F gnuplot > "$T/loop.txt" 2> "$T/loop.sum"; stopsim; port=$((port + 1))
+check "replay --loop: goes round" sh -c "grep -q 'packets: 100' '$T/loop.sum' && grep -q 'time went backwards: 2 times' '$T/loop.sum'"
+check "replay --loop: the same packets each round" sh -c "sed -n '2,41p' '$T/loop.txt' > '$T/loop1' && sed -n '42,81p' '$T/loop.txt' | cmp -s - '$T/loop1'"
+"$SIM" --replay "$T/nonexistent" 2> "$T/e7"; rc=$?
+check "replay of a missing file: runtime error" sh -c "[ $rc = 1 ] && grep -q 'cannot open capture' '$T/e7'"
+
+# ---- several clients, one slow -----------------------------------------------------------------
+sim $port --rate 500
+timeout 10 $PYTHON tests/tools/rt.py slow-client $port 4 &
+SLOW=$!
+timeout 10 "$DUMP" "127.0.0.1:$port" -n 500 -F gnuplot > "$T/m1.txt" 2> "$T/m1.sum" &
+D1=$!
+timeout 10 "$DUMP" "127.0.0.1:$port" -n 500 -F gnuplot > "$T/m2.txt" 2> "$T/m2.sum"
+wait $D1; wait $SLOW
+stopsim; port=$((port + 1))
+check "two clients: 500 packets each" sh -c "grep -q 'packets: 500' '$T/m1.sum' && grep -q 'packets: 500' '$T/m2.sum'"
+check "two clients: the same packets, byte for byte" sh -c "grep -v '^#' '$T/m1.txt' | sort > '$T/m1s'; grep -v '^#' '$T/m2.txt' | sort > '$T/m2s'; [ \$(comm -12 '$T/m1s' '$T/m2s' | wc -l) -ge 400 ]"
+check "two clients: neither stalled by the slow one" sh -c "grep -q 'largest gap: 0.002000' '$T/m1.sum' && grep -q 'largest gap: 0.002000' '$T/m2.sum'"
+check "slow client dropped" has "$T/sim.$((port - 1)).log" "dropped: too slow"
+
+# ---- the link never writes -------------------------------------------------------------------
+timeout 15 $PYTHON tests/tools/rt.py noread-server $port "$T/len1116.bin" "$T/nr.json" &
+NR=$!
+waitport $port
+timeout 10 "$DUMP" "127.0.0.1:$port" -n 40 --silence-timeout 200 -F gnuplot > /dev/null 2> "$T/nr.sum"
+wait $NR; rc=$?; port=$((port + 1))
+check "never writes: the server received nothing over 2 connections" sh -c "[ $rc = 0 ] && grep -q '\"connections\": 2, \"received\": 0' '$T/nr.json'"
+check "never writes: it got all 40 packets" has "$T/nr.sum" "packets: 40"
+timeout 15 $PYTHON tests/tools/rt.py noread-server $port "$T/len1116.bin" "$T/nr2.json" &
+NR=$!
+waitport $port
+timeout 10 $PYTHON tests/tools/rt.py writer-client $port
+wait $NR; rc=$?; port=$((port + 1))
+check "never writes: the server does catch a client that writes" sh -c "[ $rc = 1 ] && grep -q '\"received\": 1' '$T/nr2.json'"
+
+# ---- signals, IPv6, journald ------------------------------------------------------------------
+sim $port --rate 500
+timeout 10 "$DUMP" "127.0.0.1:$port" -F gnuplot -w "$T/sig.bin" > "$T/sig.txt" 2> "$T/sig.sum" &
+D=$!
+sleep 0.5; kill -INT $D; wait $D; rc=$?
+check "dump ends cleanly on SIGINT" sh -c "[ $rc = 0 ] && grep -q 'summary: packets' '$T/sig.sum'"
+check "dump on SIGINT: recording ends on a packet" sh -c "n=\$(grep -vc '^#' '$T/sig.txt'); [ \$n -gt 0 ] && [ \$(stat -c %s '$T/sig.bin') = \$((n * 1116)) ]"
+kill -TERM $SIMPID; wait $SIMPID; rc=$?
+check "sim ends cleanly on SIGTERM, with its figures" sh -c "[ $rc = 0 ] && grep -q 'packets in' '$T/sim.$port.log'"
+port=$((port + 1))
+if "$PYTHON" -c "import socket; s = socket.socket(socket.AF_INET6); s.bind(('::1', 0))" 2>/dev/null; then
+  timeout 10 "$SIM" -l "[::1]:$port" --start-on-connect --count 5 --clients 1 2>/dev/null &
+  PIDS="$PIDS $!"; waitport $port
+  timeout 10 "$DUMP" "[::1]:$port" --once -F gnuplot > /dev/null 2> "$T/v6.sum"
+  check "IPv6 literal with port" sh -c "grep -q 'packets: 5' '$T/v6.sum' && grep -q 'connected to \[::1\]:$port' '$T/v6.sum'"
+else
+  echo "skip: no IPv6 loopback"
+fi
+port=$((port + 1))
+: > "$T/journal.err"
+JOURNAL_STREAM=$(stat -c '%d:%i' "$T/journal.err") "$DUMP" --file "$T/nonexistent" 2> "$T/journal.err"
+check "journald: lines carry the syslog priority" sh -c "grep -q '^<3>cannot open' '$T/journal.err'"
+JOURNAL_STREAM=1:1 "$DUMP" --file "$T/nonexistent" 2> "$T/plain.err"
+check "not the journal: program: level: message" sh -c "grep -q '^urrt-dump: error: cannot open' '$T/plain.err'"
+
+echo "check-tools: $(( $(date +%s) - START )) s"
+finish
