@@ -21,7 +21,7 @@
 #include <string.h>
 #include <time.h>
 
-#define BATCHES 15
+#define BATCHES 21
 #define BATCH_NS 10000000.0 /* about 10 ms per batch */
 #define STREAM_PACKETS 59   /* 59 x 1116 bytes: just over 64 KiB */
 
