@@ -608,10 +608,39 @@ static void robot_finish(config_ctx *ctx, gw_config *cfg)
 /* ---- the section table ---------------------------------------------------------- */
 
 /* One entry per section kind. CAN adds {"can", ...} and {"frame", true, ...}. */
+/* ---- [can] and [frame NAME]: the CAN mapping (can_map.h checks them) ---- */
+
+static void report_can_problem(void *user, const char *file, int line, const char *reason)
+{
+    (void)file; /* always this file: the map is fed one file */
+    config_error(user, line, "%s", reason);
+}
+
+static bool can_section_key(config_ctx *ctx, gw_config *cfg, const char *key, const char *value)
+{
+    char ignored[256]; /* the reporter has it already */
+    return can_map_ini(&cfg->can, ctx->section_raw, key, value, ctx->path, ctx->line, ignored,
+                       sizeof ignored) == 1;
+}
+
+static void can_finish(config_ctx *ctx, gw_config *cfg)
+{
+    struct can_map_robot robots[GW_MAX_ROBOTS];
+    static char ignored[8192];
+    (void)ctx;
+    for (unsigned i = 0; i < cfg->robot_count; i++) {
+        robots[i].name = cfg->robots[i].name;
+        robots[i].period_us = 1000000u / cfg->robots[i].max_rate_hz;
+    }
+    can_map_finish(&cfg->can, robots, cfg->robot_count, ignored, sizeof ignored);
+}
+
 static const config_section config_sections[] = {
     {"gateway", false, false, NULL, gateway_key, NULL},
     {"robot", true, true, robot_begin, robot_key, robot_finish},
     {"lcm", false, false, NULL, lcm_key, lcm_finish},
+    {"can", false, false, NULL, can_section_key, can_finish},
+    {"frame", true, true, NULL, can_section_key, NULL},
 };
 #define CONFIG_SECTION_COUNT (sizeof config_sections / sizeof config_sections[0])
 
@@ -737,7 +766,9 @@ static int on_key(void *user, const char *section, const char *key, const char *
     if (strcmp(section, ctx->section_raw) != 0 || ctx->section == NULL || !ctx->section_ok) {
         return 1; /* the header's error was reported */
     }
-    for (unsigned i = 0; i < ctx->key_count; i++) {
+    /* A frame's "signal" key adds one signal per line. */
+    bool repeatable = strcmp(ctx->section->kind, "frame") == 0 && strcmp(key, "signal") == 0;
+    for (unsigned i = 0; i < ctx->key_count && !repeatable; i++) {
         if (strcmp(ctx->keys[i].name, key) == 0) {
             config_error(ctx, ctx->line, "%s is set again (first at line %d)", key, ctx->keys[i].line);
             return 0;
@@ -769,7 +800,9 @@ int gw_config_load(gw_config *cfg, const char *path, FILE *err)
     cfg->lcm.rate[GW_KIND_STATUS] = (gw_rate){GW_RATE_HZ, 10};
     cfg->lcm.rate[GW_KIND_GATEWAY] = (gw_rate){GW_RATE_HZ, 1};
 
+    can_map_init(&cfg->can);
     memset(&ctx, 0, sizeof ctx);
+    can_map_set_reporter(&cfg->can, report_can_problem, &ctx);
     ctx.path = path;
     ctx.err = err;
     ctx.cfg = cfg;
@@ -799,6 +832,7 @@ int gw_config_load(gw_config *cfg, const char *path, FILE *err)
             config_sections[i].finish(&ctx, cfg);
         }
     }
+    can_map_set_reporter(&cfg->can, NULL, NULL);
     print_errors(&ctx);
     return ctx.errors;
 }
@@ -815,6 +849,7 @@ void gw_config_free(gw_config *cfg)
         free(cfg->robots[i].expected);
     }
     free(cfg->robots);
+    can_map_free(&cfg->can);
     memset(cfg, 0, sizeof *cfg);
 }
 
@@ -845,6 +880,16 @@ void gw_config_usage(FILE *out)
         "  silence_timeout = DURATION   (100 ms)   no packet for this long: reconnect,\n"
         "                                          and no state is published meanwhile\n"
         "  backoff_initial = DURATION   (100 ms)   first wait before reconnecting\n"
-        "  backoff_max = DURATION       (5 s)      doubling up to this\n",
+        "  backoff_max = DURATION       (5 s)      doubling up to this\n"
+        "\n"
+        "  [can]                        CAN output (optional; docs/can.md has every key)\n"
+        "  interface = can0 | log:PATH  SocketCAN interface, or candump log format\n"
+        "  bitrate = 500000             for the bus load check and the DBC\n"
+        "  heartbeat_id = 0x701         gateway state, modes, data age, drops (<= 1 s)\n"
+        "\n"
+        "  [frame NAME]                 one per CAN frame; NAME is its DBC name\n"
+        "  id = 0x181                   (extended = yes for 29-bit)\n"
+        "  period_ms = 10 | every       (fd = yes and length = 64 for CAN FD)\n"
+        "  signal = FIELD[ELEM] ...     one line per signal: see docs/can.md\n",
         out);
 }

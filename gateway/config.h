@@ -15,6 +15,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "can_map.h"
 #include "port.h"
 
 /* The LCM messages, one channel each per robot: "NAME.SUFFIX". */
@@ -75,6 +76,7 @@ typedef struct gw_config {
     gw_lcm_config lcm;
     gw_robot_config *robots;
     unsigned robot_count;
+    struct can_map can;    /* [can] and [frame NAME]; disabled when absent */
 } gw_config;
 
 /* Parse a file. Returns the number of errors (0: *cfg is complete and

@@ -41,7 +41,7 @@ GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o config.o 
                 $(BUILD)/gateway/cli.o $(LCMTYPES_OBJS)
 # Other fragments append their objects (the CAN output, say); read at link time.
 GATEWAY_EXTRA_OBJS ?=
-GATEWAY_HDRS := gateway/config.h gateway/gateway.h gateway/lcm_out.h gateway/cli.h port/port.h $(LIB_HDRS)
+GATEWAY_HDRS := gateway/config.h gateway/gateway.h gateway/lcm_out.h gateway/cli.h gateway/can_map.h gateway/can_out.h gateway/dbc.h port/port.h $(LIB_HDRS)
 GATEWAY_LIBS := -llcm -linih -lm
 
 $(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o config.o lcm_out.o): \

@@ -1,16 +1,20 @@
 /*
  * urrt-gateway: reads the RealTime stream of one or more Universal Robots
- * controllers and publishes it on LCM (see docs/gateway.md).
+ * controllers and publishes it on LCM (docs/gateway.md) and as CAN frames
+ * (docs/can.md).
  */
 #define _GNU_SOURCE
+#include <errno.h>
 #include <getopt.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "can_out.h"
 #include "cli.h"
 #include "config.h"
+#include "dbc.h"
 #include "gateway.h"
 #include "lcm_out.h"
 #include "port.h"
@@ -28,10 +32,14 @@ static void usage(FILE *out)
         "publishes each one's packets on LCM: NAME.STATE (urrt.state_t, every field),\n"
         "NAME.JOINTS, NAME.TOOL, NAME.STATUS, and NAME.GATEWAY (urrt.gateway_t: link\n"
         "state and counters, once per second even while the robot is unreachable).\n"
+        "With a [can] section it also sends the [frame NAME]s of CONFIG on a CAN bus,\n"
+        "with a heartbeat frame, and --print-dbc describes them for the PLC side.\n"
         "Never writes to a robot. Stops on SIGINT or SIGTERM.\n"
         "\n"
         "Options:\n"
         "  -c, --check-config     validate CONFIG, print what would run, exit\n"
+        "  -d, --print-dbc        write the DBC of CONFIG's CAN frames, exit\n"
+        "  -o, --output FILE      with --print-dbc: write to FILE, not stdout\n"
         "  -s, --summary          one line per robot each second on stdout\n"
         "                         (state, data age, reconnects, messages/s per channel)\n"
         "  -u, --lcm-url URL      publish on URL instead of [lcm] url\n"
@@ -58,8 +66,10 @@ static void usage(FILE *out)
         "  urrt-gateway --check-config /etc/urrt/gateway.ini\n"
         "  urrt-gateway --summary /etc/urrt/gateway.ini\n"
         "  urrt-gateway -u 'udpm://239.255.76.67:7667?ttl=1' -l info gateway.ini\n"
+        "  urrt-gateway --print-dbc -o robot.dbc gateway.ini\n"
         "\n"
-        "Exit status: 0 stopped by a signal (or the configuration is valid),\n"
+        "Exit status: 0 stopped by a signal (or the configuration is valid, or the\n"
+        "DBC was written),\n"
         "1 runtime failure, 2 bad command line or configuration.\n",
         out);
 }
@@ -68,6 +78,11 @@ static void print_plan(const gw_config *cfg, const char *url)
 {
     printf("%s: valid\n", cfg->path);
     printf("lcm %s\n", url);
+    if (can_map_enabled(&cfg->can)) {
+        char line[256];
+        can_map_describe(&cfg->can, line, sizeof line);
+        printf("can %s\n", line);
+    }
     for (unsigned i = 0; i < cfg->robot_count; i++) {
         const gw_robot_config *r = &cfg->robots[i];
         char peer[300];
@@ -89,10 +104,36 @@ static void print_plan(const gw_config *cfg, const char *url)
     }
 }
 
+static int write_dbc(const gw_config *cfg, const char *path)
+{
+    FILE *out = stdout;
+    bool ok;
+    if (!can_map_enabled(&cfg->can)) {
+        fprintf(stderr, "urrt-gateway: %s has no [can] section or [frame NAME]: nothing to describe\n", cfg->path);
+        return CLI_EXIT_USAGE;
+    }
+    if (path != NULL && (out = fopen(path, "w")) == NULL) {
+        fprintf(stderr, "urrt-gateway: cannot write %s: %s\n", path, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    ok = dbc_write(out, &cfg->can, cfg->path) == 0;
+    ok = fflush(out) == 0 && ok;
+    if (out != stdout) {
+        ok = fclose(out) == 0 && ok;
+    }
+    if (!ok) {
+        fprintf(stderr, "urrt-gateway: writing the DBC to %s failed: %s\n", path ? path : "stdout", strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    return CLI_EXIT_OK;
+}
+
 int main(int argc, char **argv)
 {
     static const struct option options[] = {
         {"check-config", no_argument, NULL, 'c'},
+        {"print-dbc", no_argument, NULL, 'd'},
+        {"output", required_argument, NULL, 'o'},
         {"summary", no_argument, NULL, 's'},
         {"lcm-url", required_argument, NULL, 'u'},
         {"log-level", required_argument, NULL, 'l'},
@@ -100,7 +141,8 @@ int main(int argc, char **argv)
         {"version", no_argument, NULL, 'V'},
         {NULL, 0, NULL, 0},
     };
-    bool check_only = false, summary = false;
+    bool check_only = false, summary = false, print_dbc = false;
+    const char *output_path = NULL;
     const char *url_override = NULL;
     urrt_log_level level = URRT_LOG_NOTICE;
     bool level_given = false;
@@ -111,9 +153,11 @@ int main(int argc, char **argv)
     int opt;
 
     urrt_log_init(argv[0], URRT_LOG_NOTICE);
-    while ((opt = getopt_long(argc, argv, "csu:l:hV", options, NULL)) != -1) {
+    while ((opt = getopt_long(argc, argv, "cdo:su:l:hV", options, NULL)) != -1) {
         switch (opt) {
         case 'c': check_only = true; break;
+        case 'd': print_dbc = true; break;
+        case 'o': output_path = optarg; break;
         case 's': summary = true; break;
         case 'u': url_override = optarg; break;
         case 'l':
@@ -147,6 +191,16 @@ int main(int argc, char **argv)
         free(cfg.lcm.url);
         cfg.lcm.url = strdup(url_override);
     }
+    if (output_path != NULL && !print_dbc) {
+        fprintf(stderr, "urrt-gateway: --output goes with --print-dbc\nTry 'urrt-gateway --help'.\n");
+        gw_config_free(&cfg);
+        return CLI_EXIT_USAGE;
+    }
+    if (print_dbc) {
+        int rc = write_dbc(&cfg, output_path);
+        gw_config_free(&cfg);
+        return rc;
+    }
     if (check_only) {
         print_plan(&cfg, cfg.lcm.url);
         gw_config_free(&cfg);
@@ -169,6 +223,20 @@ int main(int argc, char **argv)
     }
     output = lcm_out_output(lcm);
     gw_add_output(&gw, &output);
+    if (can_map_enabled(&cfg.can)) {
+        char line[256];
+        can_out *can = can_out_new(&gw, &cfg.can);
+        if (can == NULL) {
+            urrt_log(URRT_LOG_ERR, "the CAN output cannot start (see above); fix [can] in %s", cfg.path);
+            gw_close(&gw);
+            gw_config_free(&cfg);
+            return CLI_EXIT_RUNTIME;
+        }
+        output = can_out_output(can);
+        gw_add_output(&gw, &output);
+        can_map_describe(&cfg.can, line, sizeof line);
+        urrt_log(URRT_LOG_NOTICE, "CAN: %s", line);
+    }
     urrt_log(URRT_LOG_NOTICE, "started: %u robot%s, LCM %s", cfg.robot_count, cfg.robot_count == 1 ? "" : "s",
              cfg.lcm.url);
 

@@ -1,0 +1,164 @@
+/* can_out.c: see can_out.h. */
+#include "can_out.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+struct can_out {
+    gateway *gw;
+    struct can_map *map;
+    urrt_can *link;
+    uint64_t now_us;        /* for emit(): can_map_due passes no time */
+    uint64_t refused;       /* frames the link refused (cannot happen with a checked map) */
+    bool robot_up[GW_MAX_ROBOTS];
+};
+
+static void emit(void *ctx, const urrt_can_frame *frame)
+{
+    can_out *out = ctx;
+    if (urrt_can_send(out->link, frame, out->now_us) < 0) {
+        out->refused++;
+    }
+}
+
+/* Nothing is scheduled while the link is down: frames would only be
+ * dropped, and a heartbeat dropped there would take its "interface was
+ * down" flag with it. The first heartbeat after the outage carries it. */
+static void run_due(can_out *out, uint64_t now_us)
+{
+    if (urrt_can_get_state(out->link) != URRT_CAN_UP) {
+        return;
+    }
+    out->now_us = now_us;
+    can_map_due(out->map, now_us, urrt_can_get_stats(out->link), emit, out);
+}
+
+static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
+{
+    can_out *out = ctx;
+    can_map_on_packet(out->map, robot->index, pkt->state, pkt->rx_us);
+    out->robot_up[robot->index] = true;
+    run_due(out, pkt->rx_us);
+}
+
+static void on_tick(void *ctx, uint64_t now_us)
+{
+    can_out *out = ctx;
+    for (unsigned i = 0; i < out->gw->robot_count; i++) {
+        bool up = urrt_link_get_state(out->gw->robots[i].link) == URRT_LINK_UP;
+        if (up != out->robot_up[i]) {
+            out->robot_up[i] = up;
+            can_map_robot_link(out->map, i, up);
+        }
+    }
+    urrt_can_service(out->link, now_us);
+    run_due(out, now_us);
+}
+
+static unsigned on_poll_fds(void *ctx, struct pollfd *fds, unsigned max)
+{
+    can_out *out = ctx;
+    short events = 0;
+    int fd = urrt_can_poll_fd(out->link, &events);
+    if (fd < 0 || max == 0) {
+        return 0;
+    }
+    fds[0].fd = fd;
+    fds[0].events = events;
+    return 1;
+}
+
+static void on_service(void *ctx, const struct pollfd *fds, unsigned count, uint64_t now_us)
+{
+    can_out *out = ctx;
+    if (count > 0 && fds[0].revents != 0) {
+        urrt_can_service(out->link, now_us);
+    }
+}
+
+static uint64_t on_deadline(void *ctx)
+{
+    can_out *out = ctx;
+    uint64_t map_due = can_map_deadline(out->map);
+    uint64_t link_due = urrt_can_deadline(out->link);
+    return map_due < link_due ? map_due : link_due;
+}
+
+static unsigned on_counters(void *ctx, const gw_robot *robot, gw_counter *counters, unsigned max)
+{
+    can_out *out = ctx;
+    const urrt_can_stats *s = urrt_can_get_stats(out->link);
+    const gw_counter all[] = {
+        {"can_up", urrt_can_get_state(out->link) == URRT_CAN_UP},
+        {"can_sent", s->sent},
+        {"can_dropped", s->dropped},
+        {"can_send_errors", s->send_errors + out->refused},
+        {"can_down_events", s->down_events},
+        {"can_error_frames", s->error_frames},
+        {"can_bus_off", s->bus_off},
+        {"can_restarts", s->restarts},
+        {"can_clamped", out->map->clamped},
+    };
+    unsigned n = 0;
+    (void)robot;
+    for (; n < max && n < sizeof all / sizeof all[0]; n++) {
+        counters[n] = all[n];
+    }
+    return n;
+}
+
+static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *buf, size_t size)
+{
+    can_out *out = ctx;
+    const urrt_can_stats *s = urrt_can_get_stats(out->link);
+    (void)robot;
+    return snprintf(buf, size, " | CAN %s %s, sent %llu, dropped %llu, bus-off %llu",
+                    urrt_can_get_state(out->link) == URRT_CAN_UP ? "up" : "DOWN",
+                    can_map_state_name(can_map_state(out->map, now_us)), (unsigned long long)s->sent,
+                    (unsigned long long)s->dropped, (unsigned long long)s->bus_off);
+}
+
+static void on_close(void *ctx)
+{
+    can_out *out = ctx;
+    urrt_can_free(out->link);
+    free(out);
+}
+
+can_out *can_out_new(gateway *gw, struct can_map *map)
+{
+    urrt_can_config cfg;
+    can_out *out = calloc(1, sizeof *out);
+    if (out == NULL) {
+        urrt_log(URRT_LOG_ERR, "CAN output: out of memory");
+        return NULL;
+    }
+    urrt_can_config_defaults(&cfg);
+    can_map_link_config(map, &cfg);
+    out->link = urrt_can_new(&cfg);
+    if (out->link == NULL) {
+        free(out);
+        return NULL;
+    }
+    out->gw = gw;
+    out->map = map;
+    can_map_start(map, urrt_port_monotonic_us());
+    return out;
+}
+
+gw_output can_out_output(can_out *out)
+{
+    gw_output o = {
+        .name = "can",
+        .ctx = out,
+        .packet = on_packet,
+        .tick = on_tick,
+        .poll_fds = on_poll_fds,
+        .service = on_service,
+        .deadline = on_deadline,
+        .counters = on_counters,
+        .summary = on_summary,
+        .close = on_close,
+    };
+    return o;
+}

@@ -1,0 +1,35 @@
+# Runs inside the VM (tests/vm/run.sh): urrt-sim -> urrt-gateway -> vcan0,
+# recorded by candump. Markers on vcan1 (ID 0x7FF) time the events for
+# e2e-can.post, which decodes the recording through the DBC on the host.
+# candump exits when its interface goes down, so vcan0 is recorded in two
+# logs, before and after the outage.
+. ./lib.sh
+
+mark() { cansend vcan1 "7FF#0$1"; }
+sim() { urrt-sim --listen 127.0.0.1:30003 --version 5.10 --rate 125 --seed "$1" --record "$OUT/sim$1.bin" \
+          >"$OUT/sim$1.log" 2>&1 & }
+
+check "the DBC is written" urrt-gateway --print-dbc -o "$OUT/e2e.dbc" e2e-can.ini
+candump -L vcan1 >"$OUT/marks.log" 2>>"$OUT/candump.err" & marks=$!
+candump -L vcan0 >"$OUT/can-1.log" 2>>"$OUT/candump.err" & dump=$!
+sim 1; sim_pid=$!
+urrt-gateway e2e-can.ini >"$OUT/gateway.log" 2>&1 & gw=$!
+sleep 4
+mark 1; kill "$sim_pid"; wait "$sim_pid"      # the robot goes away
+sleep 2
+mark 2; sim 2; sim_pid=$!                       # and comes back
+sleep 3
+ip link set vcan0 down; mark 3                  # the CAN interface goes down
+sleep 1.5
+ip link set vcan0 up; mark 4                    # and up
+candump -L vcan0 >"$OUT/can-2.log" 2>>"$OUT/candump.err" & dump=$!
+sleep 3
+mark 5
+kill "$gw"; wait "$gw"; gw_rc=$?
+kill "$sim_pid" "$dump" "$marks"; wait "$sim_pid" "$dump" "$marks" 2>/dev/null
+
+check "the gateway stops cleanly on SIGTERM (exit $gw_rc)" [ "$gw_rc" = 0 ]
+check "the gateway reported the interface down" grep -q "vcan0.*down" "$OUT/gateway.log"
+check "the gateway reconnected to the robot" [ "$(grep -c 'connected to 127.0.0.1' "$OUT/gateway.log")" -ge 2 ]
+check "candump recorded before and after the outage" [ -s "$OUT/can-1.log" ] && [ -s "$OUT/can-2.log" ]
+finish
