@@ -13,6 +13,7 @@ check "the DBC is written" urrt-gateway --print-dbc -o "$OUT/e2e.dbc" e2e-can.in
 candump -L vcan1 >"$OUT/marks.log" 2>>"$OUT/candump.err" & marks=$!
 candump -L vcan0 >"$OUT/can-1.log" 2>>"$OUT/candump.err" & dump=$!
 sim 1; sim_pid=$!
+lcm_sub 'udpm://239.255.76.67:7667?ttl=0' 'arm1\.GATEWAY' 30 >"$OUT/lcm.jsonl" 2>"$OUT/lcm_sub.err" & sub=$!
 urrt-gateway e2e-can.ini >"$OUT/gateway.log" 2>&1 & gw=$!
 sleep 4
 mark 1; kill "$sim_pid"; wait "$sim_pid"      # the robot goes away
@@ -24,9 +25,11 @@ sleep 1.5
 ip link set vcan0 up; mark 4                    # and up
 candump -L vcan0 >"$OUT/can-2.log" 2>>"$OUT/candump.err" & dump=$!
 sleep 3
-mark 5
+mark 5; can_error vcan0                         # the controller reports bus-off
+sleep 1.5
+mark 6
 kill "$gw"; wait "$gw"; gw_rc=$?
-kill "$sim_pid" "$dump" "$marks"; wait "$sim_pid" "$dump" "$marks" 2>/dev/null
+kill "$sim_pid" "$dump" "$marks" "$sub"; wait "$sim_pid" "$dump" "$marks" "$sub" 2>/dev/null
 
 check "the gateway stops cleanly on SIGTERM (exit $gw_rc)" [ "$gw_rc" = 0 ]
 check "the gateway reported the interface down" grep -q "vcan0.*down" "$OUT/gateway.log"
