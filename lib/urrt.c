@@ -436,15 +436,14 @@ static void fill_nan_fast(double *p, unsigned count)
     unsigned i = 0;
 #ifdef URRT_VECTOR
     urrt_u64_v nan;
-    for (i = 0; i < URRT_VECTOR_DOUBLES; i++) {
-        nan[i] = URRT_NAN_BITS;
+    unsigned k;
+    for (k = 0; k < URRT_VECTOR_DOUBLES; k++) {
+        nan[k] = URRT_NAN_BITS;
     }
-    i = 0;
     if (count >= URRT_VECTOR_DOUBLES) {
-        /* Whole vectors, aligned: one (unaligned) store covers the head up to
-         * the first boundary and one the tail; they overlap stores in the
-         * middle, which only write NaN where NaN is. A store that straddles
-         * cache lines costs two, a loop of single stores more. */
+        /* Aligned vector stores in the middle (one that straddles cache
+         * lines costs two); the unaligned head and tail get one vector store
+         * each, overlapping the aligned ones: NaN written over NaN. */
         unsigned misaligned = (unsigned)(((uintptr_t)(void *)p & (URRT_VECTOR_BYTES - 1u)) / 8u);
         __builtin_memcpy(p, &nan, sizeof nan);
         for (i = misaligned ? URRT_VECTOR_DOUBLES - misaligned : URRT_VECTOR_DOUBLES;
