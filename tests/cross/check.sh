@@ -13,7 +13,11 @@ out=$1; readme=$2; warn=$3; shift 3
 
 CROSS=arm-none-eabi-
 ARCH="-mcpu=cortex-m4 -mthumb"
+# -nostdinc with only the compiler's own include directory: lib/ may use the
+# headers a freestanding compiler provides (stddef.h, stdint.h, stdbool.h,
+# float.h, limits.h, ...) and no C library header.
 CFLAGS="$ARCH -ffreestanding -Os $warn -ffunction-sections -fdata-sections -fstack-usage -Ilib"
+CFLAGS="$CFLAGS -nostdinc -isystem $(${CROSS}gcc -print-file-name=include)"
 LDFLAGS="$ARCH -nostdlib -Wl,--gc-sections -T tests/cross/link.ld"
 # Percentage by which a measured text size may differ from README's.
 TOLERANCE=10
@@ -31,10 +35,10 @@ objs=""
 for src in "$@"; do
   obj="$out/$(basename "$src" .c).o"
   if ${CROSS}gcc $CFLAGS -c "$src" -o "$obj"; then
-    ok "$src compiles alone for Cortex-M4 (-ffreestanding -Os, strict warnings)"
+    ok "$src compiles alone for Cortex-M4 (-ffreestanding -nostdinc -Os, strict warnings)"
     objs="$objs $obj"
   else
-    fail "$src does not compile for Cortex-M4 under the library's warnings"
+    fail "$src does not compile for Cortex-M4 under the library's warnings, or includes a C library header"
   fi
 done
 # The decoder's NEON path (ARMv7-A with NEON, as on an i.MX or Raspberry Pi
