@@ -629,6 +629,27 @@ static void test_framer_garbage(void)
     }
     check_every_split("garbage between", stream, n, 0);
 
+    /* A length no controller is known to send (a newer one, 1236 bytes):
+     * after garbage the framer finds it again because it equals the last
+     * accepted length. Likewise a 1.8 stream. */
+    {
+        const char *names[2] = {"future_1236", "capture_1_8"};
+        for (int k = 0; k < 2; k++) {
+            const vector *f = find_vector(names[k]);
+            const uint8_t *pk[3] = {f->packet, f->packet, f->packet};
+            size_t ln[3] = {f->length, f->length, f->length};
+            n = concat(stream, 0, f->packet, f->length);
+            n = concat(stream, n, text, sizeof text - 1);
+            n = concat(stream, n, f->packet, f->length);
+            n = concat(stream, n, ff, 3);
+            n = concat(stream, n, f->packet, f->length);
+            run_framer(stream, n, NULL, 0, &rr);
+            expect_packets(names[k], &rr, pk, ln, 3);
+            CHECK(rr.stats.skipped == sizeof text - 1 + 3 && rr.stats.resyncs == 2, "%s: skipped %" PRIu64, names[k],
+                  rr.stats.skipped);
+        }
+    }
+
     /* Inside a packet: the first 500 bytes of one, then whole packets. With
      * no checksum on the wire the cut packet swallows the start of the next
      * (a packet of the declared size is yielded), then the framer must find
