@@ -39,8 +39,9 @@ $(LIBT)/test_lib: tests/lib/test_lib.c tests/check.h $(LIBURRT) $(LIB_HDRS)
 	$(CC) $(LIB_TEST_CFLAGS) $(OPT) $< $(LIBURRT) -lm -o $@
 
 # The sanitizer build compiles lib/ itself with the sanitizers too, for this
-# machine's CPU, so that the vector paths of the decoder (AVX2, NEON) run
-# under the sanitizers while check-lib covers the portable path.
+# machine's CPU, so that the widest vector path of the decoder it has
+# (AVX-512, AVX2, SSSE3 or NEON) runs under the sanitizers; check-lib covers
+# the portable path and the other widths.
 $(LIBT)/test_lib_san: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_TEST_CFLAGS) -O1 -g -march=native $(SAN_FLAGS) $< $(LIB_SRCS) -lm -o $@
@@ -104,7 +105,8 @@ fuzz: fuzz-lib
 
 # ---- benchmark -----------------------------------------------------------------
 
-# Built with $(OPT), the flags README.md recommends for an edge box.
+# Built with $(OPT). README.md quotes it with the flags it recommends for an
+# edge box: make BUILD=build-native OPT="-O2 -g -march=native" bench-lib
 $(LIBT)/bench_lib: tests/lib/bench_lib.c $(LIBURRT) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_TEST_CFLAGS) $(OPT) -DURRT_BENCH_FLAGS='"$(OPT)"' $< $(LIBURRT) -o $@
