@@ -8,6 +8,8 @@
 URRT_STATIC_ASSERT(double_is_ieee754_binary64, sizeof(double) == 8);
 URRT_STATIC_ASSERT(max_doubles_holds_newest_layout, URRT_MAX_DOUBLES >= URRT_WIRE_COLUMNS);
 URRT_STATIC_ASSERT(max_doubles_fits_int, URRT_MAX_DOUBLES <= 0x0FFFFFFF);
+/* urrt_state counts doubles and extra columns in uint16_t. */
+URRT_STATIC_ASSERT(max_doubles_fits_state, URRT_MAX_DOUBLES <= 0xFFFF);
 URRT_STATIC_ASSERT(fields_fit_presence_mask, URRT_FIELD_COUNT <= 64);
 
 /* The decoder fills the 3.x/5.x grid in one pass, so each grid field must

@@ -48,6 +48,20 @@ for src in "$@"; do
     ${CROSS}gcc -mcpu=cortex-a7 -mfpu=neon-vfpv4 -mfloat-abi=hard -ffreestanding -O2 $warn -Ilib \
       -c "$src" -o "$out/$(basename "$src" .c).neon.o"
 done
+# URRT_MAX_DOUBLES is a documented knob: the library must build at the
+# smallest allowed value and a large one, and refuse values its structs cannot
+# count (regression: a value past 65535 used to wrap urrt_state.doubles).
+for max in 152 4096; do
+  check "lib/urrt.c builds with -DURRT_MAX_DOUBLES=$max" \
+    ${CROSS}gcc $CFLAGS -DURRT_MAX_DOUBLES=$max -c lib/urrt.c -o "$out/max$max.o"
+done
+for max in 151 65536; do
+  if ${CROSS}gcc $CFLAGS -DURRT_MAX_DOUBLES=$max -c lib/urrt.c -o "$out/max$max.o" 2>/dev/null; then
+    fail "lib/urrt.c accepts -DURRT_MAX_DOUBLES=$max; it must refuse it at compile time"
+  else
+    ok "lib/urrt.c refuses -DURRT_MAX_DOUBLES=$max at compile time"
+  fi
+done
 check "startup compiles" ${CROSS}gcc $CFLAGS -c tests/cross/startup.c -o "$out/startup.o"
 check "size probe compiles" ${CROSS}gcc $CFLAGS -c tests/cross/probe.c -o "$out/probe.o"
 
