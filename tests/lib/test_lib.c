@@ -126,6 +126,14 @@ static void check_vector(const vector *v, expected_field *e)
     urrt_generation gen = (urrt_generation)v->generation;
     int r;
 
+    if (v->length > URRT_PACKET_MAX) {
+        /* Built with a smaller URRT_MAX_DOUBLES: past it is an error, and the
+         * framer skips such packets. */
+        double d;
+        CHECK_EQ_INT(urrt_decode(v->packet, v->length, &st), URRT_E_SIZE_LARGE);
+        CHECK_EQ_INT(urrt_read(v->packet, v->length, URRT_F_TIME, 0, &d), URRT_E_SIZE_LARGE);
+        return;
+    }
     memset(&st, 0xA5, sizeof st);
     r = urrt_decode(v->packet, v->length, &st);
     CHECK(r == (int)v->length, "%s: decode returned %d", v->name, r);
@@ -516,7 +524,10 @@ static void test_framer_split_equivalence(void)
     static run_result rr;
     const char *pairs[][2] = {
         {"v3_10_1116", "len_1116"}, {"capture_1_8", "capture_1_8_next"}, {"v5_10_1220", "v5_10_1220"},
-        {"future_1236", "future_1236"}, {"early_540", "early_540"},
+        {"early_540", "early_540"},
+#if URRT_MAX_DOUBLES >= 154
+        {"future_1236", "future_1236"},
+#endif
     };
     for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; i++) {
         const vector *a = find_vector(pairs[i][0]), *b = find_vector(pairs[i][1]);
@@ -633,8 +644,8 @@ static void test_framer_garbage(void)
      * after garbage the framer finds it again because it equals the last
      * accepted length. Likewise a 1.8 stream. */
     {
-        const char *names[2] = {"future_1236", "capture_1_8"};
-        for (int k = 0; k < 2; k++) {
+        const char *names[2] = {"capture_1_8", "future_1236"};
+        for (int k = 0; k < (URRT_MAX_DOUBLES >= 154 ? 2 : 1); k++) {
             const vector *f = find_vector(names[k]);
             const uint8_t *pk[3] = {f->packet, f->packet, f->packet};
             size_t ln[3] = {f->length, f->length, f->length};
