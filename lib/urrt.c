@@ -410,6 +410,13 @@ static void load_doubles(double *dst, const uint8_t *src, unsigned n)
 {
     unsigned i = 0;
 #ifdef URRT_VECTOR
+    /* Single doubles up to a vector boundary of dst, so that no vector
+     * store straddles a cache line or, worse, a page: where the caller's
+     * struct crosses a 4 KiB boundary such stores made the decode half again
+     * as slow. */
+    for (; i < n && ((uintptr_t)(void *)&dst[i] & (URRT_VECTOR_BYTES - 1u)) != 0; i++) {
+        dst[i] = double_from_bits(load_be64(src + 8u * i));
+    }
     for (; i + 2u * URRT_VECTOR_DOUBLES <= n; i += 2u * URRT_VECTOR_DOUBLES) {
         urrt_bytes_v a, b;
         __builtin_memcpy(&a, src + 8u * i, sizeof a);
@@ -442,20 +449,12 @@ static void fill_nan_fast(double *p, unsigned count)
     for (k = 0; k < URRT_VECTOR_DOUBLES; k++) {
         nan[k] = URRT_NAN_BITS;
     }
-    if (count >= URRT_VECTOR_DOUBLES) {
-        /* Aligned vector stores in the middle (one that straddles cache
-         * lines costs two); the unaligned head and tail get one vector store
-         * each, overlapping the aligned ones: NaN written over NaN. */
-        unsigned misaligned = (unsigned)(((uintptr_t)(void *)p & (URRT_VECTOR_BYTES - 1u)) / 8u);
-        __builtin_memcpy(p, &nan, sizeof nan);
-        for (i = misaligned ? URRT_VECTOR_DOUBLES - misaligned : URRT_VECTOR_DOUBLES;
-             i + URRT_VECTOR_DOUBLES <= count; i += URRT_VECTOR_DOUBLES) {
-            __builtin_memcpy(&p[i], &nan, sizeof nan);
-        }
-        if (i < count) {
-            __builtin_memcpy(&p[count - URRT_VECTOR_DOUBLES], &nan, sizeof nan);
-        }
-        return;
+    /* Aligned vector stores only, as in load_doubles(). */
+    for (; i < count && ((uintptr_t)(void *)&p[i] & (URRT_VECTOR_BYTES - 1u)) != 0; i++) {
+        p[i] = double_from_bits(URRT_NAN_BITS);
+    }
+    for (; i + URRT_VECTOR_DOUBLES <= count; i += URRT_VECTOR_DOUBLES) {
+        __builtin_memcpy(&p[i], &nan, sizeof nan);
     }
 #endif
     fill_nan(p + i, count - i);
