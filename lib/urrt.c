@@ -818,7 +818,13 @@ static bool header_acceptable(const urrt_framer *fr, uint32_t size)
     if (!plausible_length(size)) {
         return false;
     }
-    return fr->last_length == 0 || size == fr->last_length || urrt_versions_of(size) != NULL;
+    /* An unknown size is trusted only as the very first header of a stream:
+     * found while scanning garbage, it is more likely noise than a newer
+     * controller, and a bogus packet would present noise as values. */
+    if (fr->last_length == 0 && !fr->out_of_sync) {
+        return true;
+    }
+    return urrt_versions_of(size) != NULL;
 }
 
 static void reject_byte(urrt_framer *fr)

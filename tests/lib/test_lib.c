@@ -640,6 +640,24 @@ static void test_framer_garbage(void)
     }
     check_every_split("garbage between", stream, n, 0);
 
+    /* Regression: a fresh framer scanning leading garbage took any plausible
+     * size it met (here 00 00 02 14, 532 bytes) as a packet, so noise came
+     * out as values. Only known lengths lock once it has had to scan. */
+    {
+        const vector *v = find_vector("len_1116");
+        static const uint8_t noise[] = {0xAB, 0x00, 0x00, 0x02, 0x14, 0x99, 0x42};
+        const uint8_t *pk[1] = {v->packet};
+        size_t ln[1] = {v->length};
+        n = concat(stream, 0, noise, sizeof noise);
+        for (size_t pad = sizeof noise; pad < 600; pad++) {
+            stream[n++] = 0x55; /* enough bytes for a 532-byte "packet" */
+        }
+        n = concat(stream, n, v->packet, v->length);
+        run_framer(stream, n, NULL, 0, &rr);
+        expect_packets("regression_fresh_scan_unknown_size", &rr, pk, ln, 1);
+        CHECK(rr.stats.skipped == 600 && rr.stats.resyncs == 1,
+              "regression_fresh_scan_unknown_size: skipped %" PRIu64, rr.stats.skipped);
+    }
     /* A length no controller is known to send (a newer one, 1236 bytes):
      * after garbage the framer finds it again because it equals the last
      * accepted length. Likewise a 1.8 stream. */
