@@ -1,7 +1,8 @@
 #!/bin/sh
 # check-tools: urrt-sim and urrt-dump end to end, against the independent
 # Python reference in tests/tools/rt.py. Every server, client and wait here
-# is bounded by timeout(1) or a counted loop. TCP ports 40200-40299.
+# is bounded by timeout(1) or a counted loop. TCP ports PORT_BASE (default
+# 40200) to PORT_BASE + 99.
 set -u
 BUILD=${BUILD:-build}
 PYTHON=${PYTHON:-/usr/bin/python3}
@@ -20,22 +21,50 @@ cleanup() {
 trap cleanup EXIT INT TERM
 START=$(date +%s)
 
-# waitport PORT: until something listens there (at most 2 s).
+# waitport PORT: until something listens there (at most 10 s).
 waitport() {
   i=0
-  while [ $i -lt 100 ]; do
+  while [ $i -lt 500 ]; do
     ss -Hltn "sport = :$1" 2>/dev/null | grep -q . && return 0
     sleep 0.02; i=$((i + 1))
   done
-  echo "nothing listens on port $1" >&2; return 1
+  echo "nothing listens on port $1" >&2
+  return 1
 }
 
-# sim PORT ARGS...: a simulator in the background, stderr to $T/sim.PORT.log.
+# serverport FILE: the port a Python server wrote to FILE once it listens.
+serverport() {
+  i=0
+  while [ $i -lt 500 ]; do
+    [ -s "$1" ] && { port=$(cat "$1"); return 0; }
+    sleep 0.02; i=$((i + 1))
+  done
+  echo "the test server did not start" >&2; return 1
+}
+
+# sim PORT ARGS...: a simulator in the background, stderr to $T/sim.$port.log,
+# back when it says it listens. Test ports lie in the kernel's ephemeral
+# range, so one may be taken by some connection's local end: then the next
+# port is tried, and $port says which one the simulator got.
 sim() {
   port=$1; shift
-  timeout 30 "$SIM" -l "127.0.0.1:$port" -v "$@" 2> "$T/sim.$port.log" &
-  SIMPID=$!; PIDS="$PIDS $SIMPID"
-  waitport "$port"
+  tries=0
+  while [ $tries -lt 5 ]; do
+    timeout -k 3 30 "$SIM" -l "127.0.0.1:$port" -v "$@" 2> "$T/sim.$port.log" &
+    SIMPID=$!; PIDS="$PIDS $SIMPID"
+    i=0
+    while [ $i -lt 500 ]; do
+      grep -q " on 127.0.0.1:$port" "$T/sim.$port.log" 2>/dev/null && return 0
+      kill -0 $SIMPID 2>/dev/null || break
+      sleep 0.02; i=$((i + 1))
+    done
+    wait $SIMPID 2>/dev/null
+    grep -q "Address already in use" "$T/sim.$port.log" || break
+    port=$((port + 1)); tries=$((tries + 1))
+  done
+  echo "the simulator did not start on port $port:" >&2
+  sed 's/^/    sim: /' "$T/sim.$port.log" >&2
+  return 1
 }
 
 # stopsim: end the last simulator and wait for it (it may have ended already).
@@ -77,10 +106,10 @@ check "port out of range: usage error" sh -c "[ $rc = 2 ] && grep -q '1 to 65535
 # Every length a controller sends, lengths none sends (between the generations,
 # one column past the newest, the largest allowed), each checked column by
 # column against the capture the simulator recorded.
-port=40200
+port=${PORT_BASE:-40200}
 for len in 540 692 756 764 812 900 1044 1060 1108 1116 1140 1220 1228 2052; do
   sim $port --length $len --rate 2000 --start-on-connect --count 40 --clients 1 -w "$T/len$len.bin"
-  timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/len$len.txt" 2> "$T/len$len.sum"
+  timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/len$len.txt" 2> "$T/len$len.sum"
   rc=$?; stopsim
   check "length $len: dump exits 0" [ $rc = 0 ]
   check "length $len: 40 packets, bit-exact against the reference" $RT gnuplot "$T/len$len.bin" "$T/len$len.txt" 40
@@ -96,7 +125,7 @@ check "1228 bytes: no known controller" has "$T/len1228.sum" "1228 x 40 (no know
 for pair in 1.5:756:125 1.8:812:125 3.1:1044:125 3.3:1060:125 3.9:1108:125 3.12:1116:125 5.9:1140:500 5.10:1220:500 5.16:1220:500; do
   v=${pair%%:*}; rest=${pair#*:}; len=${rest%%:*}; rate=${rest#*:}
   sim $port --version "$v" --start-on-connect --count 3 --clients 1
-  timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > /dev/null 2> "$T/ver.sum"; stopsim
+  timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > /dev/null 2> "$T/ver.sum"; stopsim
   check "--version $v: $len bytes at $rate Hz" sh -c "grep -q 'lengths: $len x 3' '$T/ver.sum' && grep -q 'mean rate: $rate.000 Hz by controller' '$T/ver.sum'"
   port=$((port + 1))
 done
@@ -129,35 +158,35 @@ check "--file - reads stdin" cmp -s "$T/stdin.txt" "$T/len1116.txt"
 
 # ---- the model ----------------------------------------------------------------------------
 sim $port --version 5.10 --seed 7 --start-on-connect --count 1500 --clients 1 -w "$T/model.bin"
-timeout 15 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > /dev/null 2> "$T/model.sum"; stopsim
+timeout -k 3 15 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > /dev/null 2> "$T/model.sum"; stopsim
 port=$((port + 1))
 check "model: derivatives, lag, kinematics, modes consistent" $RT model "$T/model.bin" 500
 sim $port --version 5.10 --seed 7 --start-on-connect --count 50 --clients 1 -w "$T/seed7.bin"
-timeout 10 "$DUMP" "127.0.0.1:$port" --once -q > /dev/null 2>&1; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -q > /dev/null 2>&1; stopsim; port=$((port + 1))
 sim $port --version 5.10 --seed 8 --start-on-connect --count 50 --clients 1 -w "$T/seed8.bin"
-timeout 10 "$DUMP" "127.0.0.1:$port" --once -q > /dev/null 2>&1; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -q > /dev/null 2>&1; stopsim; port=$((port + 1))
 head -c $((50 * 1220)) "$T/model.bin" > "$T/model50.bin"
 check "same seed, same bytes" cmp -s "$T/seed7.bin" "$T/model50.bin"
 check "another seed, other bytes" sh -c "! cmp -s '$T/seed7.bin' '$T/seed8.bin'"
 
 # ---- faults ---------------------------------------------------------------------------------
 sim $port --rate 1000 --fault close-after=30
-timeout 10 "$DUMP" "127.0.0.1:$port" -n 70 -F gnuplot > "$T/f.txt" 2> "$T/f.sum"; rc=$?; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 70 -F gnuplot > "$T/f.txt" 2> "$T/f.sum"; rc=$?; stopsim; port=$((port + 1))
 check "close-after: 70 packets over 3 connections" sh -c "[ $rc = 0 ] && grep -q 'packets: 70' '$T/f.sum'"
 check "close-after: reconnects counted" has "$T/f.sum" "connects 3, reconnects 2, disconnects 2, silences 0"
 check "close-after: logged once per change" sh -c "[ \$(grep -c 'lost (closed by peer); reconnecting' '$T/f.sum') = 2 ] && [ \$(grep -c 'connected to' '$T/f.sum') = 3 ]"
 
 sim $port --rate 1000 --fault reset-after=30
-timeout 10 "$DUMP" "127.0.0.1:$port" -n 40 -F gnuplot > /dev/null 2> "$T/f.sum"; rc=$?; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 40 -F gnuplot > /dev/null 2> "$T/f.sum"; rc=$?; stopsim; port=$((port + 1))
 check "reset-after: seen as a reset, reconnected" sh -c "[ $rc = 0 ] && grep -q 'lost (reset by peer); reconnecting' '$T/f.sum' && grep -q 'reconnects 1,' '$T/f.sum'"
 
 sim $port --rate 1000 --fault truncate-after=20
-timeout 10 "$DUMP" "127.0.0.1:$port" -n 45 -F gnuplot > /dev/null 2> "$T/f.sum"; rc=$?; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 45 -F gnuplot > /dev/null 2> "$T/f.sum"; rc=$?; stopsim; port=$((port + 1))
 check "truncate-after: partial packets reported" has "$T/f.sum" "partial packets dropped: 2 (1116 bytes)"
 check "truncate-after: every whole packet decoded" has "$T/f.sum" "packets: 45"
 
 sim $port --rate 1000 --start-on-connect --count 100 --clients 1 --fault garbage-every=10 -w "$T/garbage.bin"
-timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot -w "$T/garbage-dump.bin" > "$T/g1.txt" 2> "$T/g1.sum"; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot -w "$T/garbage-dump.bin" > "$T/g1.txt" 2> "$T/g1.sum"; stopsim; port=$((port + 1))
 check "garbage-every: every resync counted (9 x 37 bytes)" has "$T/g1.sum" "resyncs: 9, skipped bytes: 333"
 check "garbage-every: all 100 packets" has "$T/g1.sum" "packets: 100"
 "$DUMP" --file "$T/garbage.bin" -F gnuplot > "$T/g2.txt" 2> "$T/g2.sum"
@@ -166,42 +195,42 @@ check "garbage-every: and resyncs the same" has "$T/g2.sum" "resyncs: 9, skipped
 check "dump --record holds exactly the bytes the simulator sent" cmp -s "$T/garbage.bin" "$T/garbage-dump.bin"
 
 sim $port --rate 500 --start-on-connect --count 100 --clients 1 --fault tiny-writes=5 -w "$T/tiny.bin"
-timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/t1.txt" 2> "$T/t1.sum"; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/t1.txt" 2> "$T/t1.sum"; stopsim; port=$((port + 1))
 check "tiny-writes: bit-exact" $RT gnuplot "$T/tiny.bin" "$T/t1.txt" 100
 check "tiny-writes: no resync" has "$T/t1.sum" "resyncs: 0, skipped bytes: 0"
 check "tiny-writes: keeps the rate" sh -c "grep -q 'Hz by arrival' '$T/t1.sum' && awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 400) }' '$T/t1.sum'"
 
 sim $port --rate 500 --start-on-connect --count 96 --clients 1 --fault coalesce=8 -w "$T/co.bin"
-timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/c1.txt" 2> "$T/c1.sum"; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/c1.txt" 2> "$T/c1.sum"; stopsim; port=$((port + 1))
 check "coalesce: bit-exact, all 96" $RT gnuplot "$T/co.bin" "$T/c1.txt" 96
 
 sim $port --rate 1000 --fault stall-after=40
 t0=$(date +%s%N)
-timeout 10 "$DUMP" "127.0.0.1:$port" -n 100 --silence-timeout 200 -F gnuplot > /dev/null 2> "$T/s.sum"; rc=$?; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 100 --silence-timeout 200 -F gnuplot > /dev/null 2> "$T/s.sum"; rc=$?; stopsim; port=$((port + 1))
 t1=$(date +%s%N)
 check "stall: detected as silence twice, reconnected" has "$T/s.sum" "connects 3, reconnects 2, disconnects 2, silences 2"
 check "stall: logged" has "$T/s.sum" "lost (no data for 200 ms); reconnecting"
 check "stall: 100 packets within 5 s" sh -c "[ $rc = 0 ] && [ $(( (t1 - t0) / 1000000 )) -lt 5000 ]"
 
 sim $port --rate 1000 --fault stall-after=40,for=300
-timeout 10 "$DUMP" "127.0.0.1:$port" -n 80 --silence-timeout 1000 -F gnuplot > /dev/null 2> "$T/s2.sum"; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 80 --silence-timeout 1000 -F gnuplot > /dev/null 2> "$T/s2.sum"; stopsim; port=$((port + 1))
 check "short stall: no reconnect" has "$T/s2.sum" "connects 1, reconnects 0, disconnects 0, silences 0"
 check "short stall: the gap shows in controller time" sh -c "awk '/largest gap/ { exit !(\$4 >= 0.25 && \$4 < 0.6) }' '$T/s2.sum'"
 
 sim $port --rate 1000 --start-on-connect --count 95 --clients 1 --fault odd-length=10 -w "$T/odd.bin"
-timeout 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/o1.txt" 2> "$T/o1.sum"; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/o1.txt" 2> "$T/o1.sum"; stopsim; port=$((port + 1))
 check "odd-length: 9 odd packets skipped (9 x 1124 bytes)" has "$T/o1.sum" "resyncs: 9, skipped bytes: 10116"
 check "odd-length: the 86 others decoded" has "$T/o1.sum" "packets: 86"
 
 # ---- replay ----------------------------------------------------------------------------------
 "$DUMP" --file "$T/garbage.bin" -F json > "$T/r1.txt" 2> "$T/r1.sum"
 sim $port --replay "$T/garbage.bin"
-timeout 10 "$DUMP" "127.0.0.1:$port" --once -F json > "$T/r2.txt" 2> "$T/r2.sum"; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F json > "$T/r2.txt" 2> "$T/r2.sum"; stopsim; port=$((port + 1))
 check "replay: same decoded output as --file" cmp -s "$T/r1.txt" "$T/r2.txt"
 check "replay: same resyncs (the bytes between packets are replayed)" has "$T/r2.sum" "resyncs: 9, skipped bytes: 333"
 check "replay: paced by the time column (1000 Hz)" sh -c "awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 900 && r < 1100) }' '$T/r2.sum'"
 sim $port --replay "$T/len1116.bin" --loop
-timeout 10 "$DUMP" "127.0.0.1:$port" -n 100 -F gnuplot > "$T/loop.txt" 2> "$T/loop.sum"; stopsim; port=$((port + 1))
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 100 -F gnuplot > "$T/loop.txt" 2> "$T/loop.sum"; stopsim; port=$((port + 1))
 check "replay --loop: goes round" sh -c "grep -q 'packets: 100' '$T/loop.sum' && grep -q 'time went backwards: 2 times' '$T/loop.sum'"
 check "replay --loop: the same packets each round" sh -c "sed -n '2,41p' '$T/loop.txt' > '$T/loop1' && sed -n '42,81p' '$T/loop.txt' | cmp -s - '$T/loop1'"
 "$SIM" --replay "$T/nonexistent" 2> "$T/e7"; rc=$?
@@ -209,11 +238,11 @@ check "replay of a missing file: runtime error" sh -c "[ $rc = 1 ] && grep -q 'c
 
 # ---- several clients, one slow -----------------------------------------------------------------
 sim $port --rate 500
-timeout 10 $PYTHON tests/tools/rt.py slow-client $port 4 &
+timeout -k 3 10 $PYTHON tests/tools/rt.py slow-client $port 4 &
 SLOW=$!
-timeout 10 "$DUMP" "127.0.0.1:$port" -n 500 -F gnuplot > "$T/m1.txt" 2> "$T/m1.sum" &
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 500 -F gnuplot > "$T/m1.txt" 2> "$T/m1.sum" &
 D1=$!
-timeout 10 "$DUMP" "127.0.0.1:$port" -n 500 -F gnuplot > "$T/m2.txt" 2> "$T/m2.sum"
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 500 -F gnuplot > "$T/m2.txt" 2> "$T/m2.sum"
 wait $D1; wait $SLOW
 stopsim; port=$((port + 1))
 check "two clients: 500 packets each" sh -c "grep -q 'packets: 500' '$T/m1.sum' && grep -q 'packets: 500' '$T/m2.sum'"
@@ -222,23 +251,23 @@ check "two clients: neither stalled by the slow one" sh -c "grep -q 'largest gap
 check "slow client dropped" has "$T/sim.$((port - 1)).log" "dropped: too slow"
 
 # ---- the link never writes -------------------------------------------------------------------
-timeout 15 $PYTHON tests/tools/rt.py noread-server $port "$T/len1116.bin" "$T/nr.json" &
+timeout -k 3 15 $PYTHON tests/tools/rt.py noread-server $port "$T/len1116.bin" "$T/nr.json" &
 NR=$!
-waitport $port
-timeout 10 "$DUMP" "127.0.0.1:$port" -n 40 --silence-timeout 200 -F gnuplot > /dev/null 2> "$T/nr.sum"
+serverport "$T/nr.json.port"
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 40 --silence-timeout 200 -F gnuplot > /dev/null 2> "$T/nr.sum"
 wait $NR; rc=$?; port=$((port + 1))
 check "never writes: the server received nothing over 2 connections" sh -c "[ $rc = 0 ] && grep -q '\"connections\": 2, \"received\": 0' '$T/nr.json'"
 check "never writes: it got all 40 packets" has "$T/nr.sum" "packets: 40"
-timeout 15 $PYTHON tests/tools/rt.py noread-server $port "$T/len1116.bin" "$T/nr2.json" &
+timeout -k 3 15 $PYTHON tests/tools/rt.py noread-server $port "$T/len1116.bin" "$T/nr2.json" &
 NR=$!
-waitport $port
-timeout 10 $PYTHON tests/tools/rt.py writer-client $port
+serverport "$T/nr2.json.port"
+timeout -k 3 10 $PYTHON tests/tools/rt.py writer-client $port
 wait $NR; rc=$?; port=$((port + 1))
 check "never writes: the server does catch a client that writes" sh -c "[ $rc = 1 ] && grep -q '\"received\": 1' '$T/nr2.json'"
 
 # ---- signals, IPv6, journald ------------------------------------------------------------------
 sim $port --rate 500
-timeout 10 "$DUMP" "127.0.0.1:$port" -F gnuplot -w "$T/sig.bin" > "$T/sig.txt" 2> "$T/sig.sum" &
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -F gnuplot -w "$T/sig.bin" > "$T/sig.txt" 2> "$T/sig.sum" &
 D=$!
 sleep 0.5; kill -INT $D; wait $D; rc=$?
 check "dump ends cleanly on SIGINT" sh -c "[ $rc = 0 ] && grep -q 'summary: packets' '$T/sig.sum'"
@@ -247,9 +276,9 @@ kill -TERM $SIMPID; wait $SIMPID; rc=$?
 check "sim ends cleanly on SIGTERM, with its figures" sh -c "[ $rc = 0 ] && grep -q 'packets in' '$T/sim.$port.log'"
 port=$((port + 1))
 if "$PYTHON" -c "import socket; s = socket.socket(socket.AF_INET6); s.bind(('::1', 0))" 2>/dev/null; then
-  timeout 10 "$SIM" -l "[::1]:$port" --start-on-connect --count 5 --clients 1 2>/dev/null &
+  timeout -k 3 10 "$SIM" -l "[::1]:$port" --start-on-connect --count 5 --clients 1 2>/dev/null &
   PIDS="$PIDS $!"; waitport $port
-  timeout 10 "$DUMP" "[::1]:$port" --once -F gnuplot > /dev/null 2> "$T/v6.sum"
+  timeout -k 3 10 "$DUMP" "[::1]:$port" --once -F gnuplot > /dev/null 2> "$T/v6.sum"
   check "IPv6 literal with port" sh -c "grep -q 'packets: 5' '$T/v6.sum' && grep -q 'connected to \[::1\]:$port' '$T/v6.sum'"
 else
   echo "skip: no IPv6 loopback"
@@ -261,5 +290,5 @@ check "journald: lines carry the syslog priority" sh -c "grep -q '^<3>cannot ope
 JOURNAL_STREAM=1:1 "$DUMP" --file "$T/nonexistent" 2> "$T/plain.err"
 check "not the journal: program: level: message" sh -c "grep -q '^urrt-dump: error: cannot open' '$T/plain.err'"
 
-echo "check-tools: $(( $(date +%s) - START )) s"
+echo "check-tools: $(( $(date +%s) - START )) s, ports ${PORT_BASE:-40200}-$port"
 finish

@@ -226,10 +226,19 @@ def cmd_noread_server(port, capture, out):
     data = open(capture, 'rb').read()
     pk = packets(capture)
     half = sum(size for size, _ in pk[:len(pk) // 2])
-    srv = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-    srv.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-    srv.bind(('127.0.0.1', int(port)))
+    # Test ports lie in the ephemeral range: one may be some connection's
+    # local end. Try a few, and say in OUT.port which one listens.
+    for p in range(int(port), int(port) + 5):
+        srv = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        srv.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            srv.bind(('127.0.0.1', p))
+            break
+        except OSError:
+            srv.close()
     srv.listen(4)
+    with open(out + '.port', 'w') as f:
+        f.write('%d\n' % p)
     srv.settimeout(10)
     received = 0
     result = {'connections': 0, 'received': 0}

@@ -153,7 +153,7 @@ static bool enough_packets(const urrt_link *l, const rx *r)
 
 /* ---- a server ------------------------------------------------------------------ */
 
-static int listen_on(int family, uint16_t port, int backlog)
+static int listen_once(int family, uint16_t port, int backlog)
 {
     int fd = socket(family, SOCK_STREAM | SOCK_CLOEXEC, 0), on = 1;
     struct sockaddr_storage ss;
@@ -178,6 +178,19 @@ static int listen_on(int family, uint16_t port, int backlog)
         return -1;
     }
     return fd;
+}
+
+/* Test ports lie in the kernel's ephemeral range, so one may be the local
+ * end of some connection: *port moves on by 5 until one is free. */
+static int listen_on(int family, uint16_t *port, int backlog)
+{
+    for (int i = 0; i < 4; i++, *port = (uint16_t)(*port + 5)) {
+        int fd = listen_once(family, *port, backlog);
+        if (fd >= 0 || family == AF_INET6) {
+            return fd;
+        }
+    }
+    return -1;
 }
 
 static int accept_within(int lfd, int ms)
@@ -308,14 +321,15 @@ static void test_session(void)
     uint8_t pkt[1116];
     uint64_t delays[8];
     int nd = 0;
-    int lfd = listen_on(AF_INET, (uint16_t)(port_base + 1), 4), s;
+    uint16_t port = (uint16_t)(port_base + 1);
+    int lfd = listen_on(AF_INET, &port, 4), s;
     long sent_by_link = 0;
 
     CHECK(lfd >= 0, "listen");
     urrt_link_config_defaults(&c);
     c.name = "arm1";
     c.host = "127.0.0.1";
-    c.port = (uint16_t)(port_base + 1);
+    c.port = port;
     c.backoff_initial_ms = 20;
     c.backoff_max_ms = 1000;
     c.silence_timeout_ms = 100;
@@ -420,7 +434,7 @@ static void test_connect_timeout(void)
     urrt_link *l;
     rx r = {0};
     uint16_t port = (uint16_t)(port_base + 2);
-    int lfd = listen_on(AF_INET, port, 0);
+    int lfd = listen_on(AF_INET, &port, 0);
     int fillers[4];
     struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons(port), .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
     uint64_t t0;
@@ -461,7 +475,7 @@ static void test_ipv6(void)
     urrt_link *l;
     rx r = {0};
     uint16_t port = (uint16_t)(port_base + 3);
-    int lfd = listen_on(AF_INET6, port, 4), s;
+    int lfd = listen_on(AF_INET6, &port, 4), s;
     uint8_t pkt[1220];
     char peer[64];
 
@@ -496,7 +510,7 @@ static void test_name(void)
     urrt_link *l;
     rx r = {0};
     uint16_t port = (uint16_t)(port_base + 4);
-    int lfd = listen_on(AF_INET, port, 4), s;
+    int lfd = listen_on(AF_INET, &port, 4), s;
     uint8_t pkt[1116];
 
     urrt_link_config_defaults(&c);
