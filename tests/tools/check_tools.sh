@@ -236,6 +236,29 @@ check "replay --loop: the same packets each round" sh -c "sed -n '2,41p' '$T/loo
 "$SIM" --replay "$T/nonexistent" 2> "$T/e7"; rc=$?
 check "replay of a missing file: runtime error" sh -c "[ $rc = 1 ] && grep -q 'cannot open capture' '$T/e7'"
 
+# ---- the schedule: stopped, it catches up or skips -------------------------------------------
+# A short stop (50 ms) is caught up: every packet still goes out, none is
+# missing in controller time, and the late ones are counted. A long one
+# (400 ms) skips what is more than 100 ms overdue instead of bursting it.
+sim $port --rate 500
+child=$(pgrep -P $SIMPID)
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 600 -F gnuplot > /dev/null 2> "$T/st.sum" &
+D=$!
+sleep 0.4; kill -STOP $child; sleep 0.05; kill -CONT $child
+wait $D; kill -INT $child; wait $SIMPID
+check "short stop: caught up, no packet missing" has "$T/st.sum" "largest gap: 0.002000 s"
+check "short stop: late packets counted, none skipped" sh -c "grep -q 'skipped 0;' '$T/sim.$port.log' && ! grep -q 'late (a period or more behind) 0,' '$T/sim.$port.log'"
+port=$((port + 1))
+sim $port --rate 500
+child=$(pgrep -P $SIMPID)
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 600 -F gnuplot > /dev/null 2> "$T/st2.sum" &
+D=$!
+sleep 0.4; kill -STOP $child; sleep 0.4; kill -CONT $child
+wait $D; kill -INT $child; wait $SIMPID
+check "long stop: the overdue packets skipped, not burst" sh -c "awk '/largest gap/ { exit !(\$4 >= 0.2 && \$4 < 0.6) }' '$T/st2.sum' && ! grep -q 'skipped 0;' '$T/sim.$port.log'"
+check "long stop: no reconnect" has "$T/st2.sum" "connects 1, reconnects 0"
+port=$((port + 1))
+
 # ---- several clients, one slow -----------------------------------------------------------------
 sim $port --rate 500
 timeout -k 3 10 $PYTHON tests/tools/rt.py slow-client $port 4 &
