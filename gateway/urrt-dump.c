@@ -646,8 +646,6 @@ static int run_file(dump *d)
     return status;
 }
 
-static void snapshot_link(void *ctx, const uint8_t *pkt, size_t len, uint64_t rx_us);
-
 typedef struct link_ctx {
     dump *d;
     urrt_link *link;

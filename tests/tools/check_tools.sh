@@ -156,6 +156,11 @@ check "--every 10: 4 of 40 printed, 40 counted" sh -c "[ \$(grep -vc '^#' '$T/ev
 "$DUMP" --file - -F gnuplot < "$T/len1116.bin" > "$T/stdin.txt" 2>/dev/null
 check "--file - reads stdin" cmp -s "$T/stdin.txt" "$T/len1116.txt"
 
+( "$DUMP" --file "$T/len1116.bin" -F gnuplot 2> /dev/null; echo $? > "$T/pipe.rc" ) | head -n 1 > /dev/null
+check "a reader that goes away (| head) is a normal end" sh -c "[ \$(cat '$T/pipe.rc') = 0 ]"
+"$DUMP" --file "$T/len1116.bin" -F gnuplot > /dev/full 2> "$T/full.err"; rc=$?
+check "a full disk is a runtime error" sh -c "[ $rc = 1 ] && grep -q 'cannot write the output' '$T/full.err'"
+
 # ---- the model ----------------------------------------------------------------------------
 sim $port --version 5.10 --seed 7 --start-on-connect --count 1500 --clients 1 -w "$T/model.bin"
 timeout -k 3 15 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > /dev/null 2> "$T/model.sum"; stopsim
