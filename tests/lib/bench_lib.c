@@ -15,6 +15,11 @@
 #define _POSIX_C_SOURCE 200809L
 #include "urrt.h"
 
+/* Names a second build's figures apart ("edge_"), see tests/lib.mk. */
+#ifndef URRT_BENCH_PREFIX
+#define URRT_BENCH_PREFIX ""
+#endif
+
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -223,9 +228,9 @@ static void make_packets(packets *p, uint32_t length)
 
 static void report(const char *name, double subject, double baseline, double ratio)
 {
-    printf("%s_ns: %.1f\n", name, subject);
-    printf("%s_memcpy_ns: %.1f\n", name, baseline);
-    printf("%s_ratio: %.2f\n", name, ratio);
+    printf("%s%s_ns: %.1f\n", URRT_BENCH_PREFIX, name, subject);
+    printf("%s%s_memcpy_ns: %.1f\n", URRT_BENCH_PREFIX, name, baseline);
+    printf("%s%s_ratio: %.2f\n", URRT_BENCH_PREFIX, name, ratio);
 }
 
 int main(void)
