@@ -15,14 +15,27 @@ die() { echo "fetch-kernel: $*" >&2; exit 1; }
 cache=${URRT_VM_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/urrt-vm}
 
 # The metapackage names the current ABI package; apt-cache works offline.
-pkg=${URRT_VM_KERNEL_PKG:-}
-if [ -z "$pkg" ]; then
-  pkg=$(apt-cache depends linux-image-amd64 2>/dev/null |
-        sed -n 's/^ *Depends: \(linux-image-[0-9][^ ]*-amd64\)$/\1/p' | head -n 1)
-  [ -n "$pkg" ] || die "apt-cache does not know linux-image-amd64 (no Debian package lists?): run 'apt-get update'"
-fi
-version=$(apt-cache show --no-all-versions "$pkg" 2>/dev/null | sed -n 's/^Version: //p' | head -n 1)
-[ -n "$version" ] || die "apt-cache has no version of $pkg: run 'apt-get update'"
+# Lists that are missing or older than the mirror (a version it no longer
+# has) are refreshed once, when root, before giving up.
+resolve() {
+  pkg=${URRT_VM_KERNEL_PKG:-}
+  if [ -z "$pkg" ]; then
+    pkg=$(apt-cache depends linux-image-amd64 2>/dev/null |
+          sed -n 's/^ *Depends: \(linux-image-[0-9][^ ]*-amd64\)$/\1/p' | head -n 1)
+  fi
+  version=
+  [ -n "$pkg" ] && version=$(apt-cache show --no-all-versions "$pkg" 2>/dev/null | sed -n 's/^Version: //p' | head -n 1)
+  [ -n "$version" ]
+}
+refreshed=
+refresh() {
+  [ "$(id -u)" = 0 ] && [ -z "$refreshed" ] || return 1
+  refreshed=yes
+  echo "fetch-kernel: refreshing the Debian package lists (apt-get update)" >&2
+  apt-get update -qq >/dev/null 2>&1
+}
+resolve || { refresh && resolve; } ||
+  die "apt-cache does not know linux-image-amd64 or its version (no Debian package lists?): run 'apt-get update'"
 
 dir=$cache/${pkg}_$version
 if [ -f "$dir/.complete" ]; then
@@ -33,11 +46,15 @@ fi
 mkdir -p "$cache" || die "cannot create the cache directory $cache"
 tmp=$(mktemp -d "$cache/.fetch.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
-echo "fetch-kernel: downloading $pkg $version into $cache (once)" >&2
-if ! (cd "$tmp" && apt-get download "$pkg=$version" >"$tmp/apt.log" 2>&1); then
+download() {
+  echo "fetch-kernel: downloading $pkg $version into $cache (once)" >&2
+  (cd "$tmp" && apt-get download "$pkg=$version" >"$tmp/apt.log" 2>&1)
+}
+if ! download && ! { refresh && resolve && download; }; then
   cat "$tmp/apt.log" >&2
   die "could not download $pkg $version (no network or no Debian mirror?); the VM tests need it once, then it is cached in $cache"
 fi
+dir=$cache/${pkg}_$version
 deb=$(ls "$tmp"/*.deb 2>/dev/null | head -n 1)
 [ -n "$deb" ] || die "apt-get download left no .deb in $tmp"
 
