@@ -130,8 +130,9 @@ static void usage(FILE *out)
 "for a robot the link's connects, reconnects and silences.\n"
 "\n"
 "Exit status: 0 done (--count reached, end of file, SIGINT/SIGTERM, end of\n"
-"connection with --once), 1 runtime error (cannot open or write a file, no\n"
-"packet within --timeout, --once without a packet), 2 usage error.\n"
+"connection with --once), 1 runtime error (cannot open or write a file, a\n"
+"file without a packet, no packet within --timeout, --once without a\n"
+"packet), 2 usage error.\n"
 "\n"
 "Examples:\n"
 "  " PROGRAM " 192.168.1.10:30013 -n 1                # one packet, as a table\n"
@@ -643,6 +644,12 @@ static int run_file(dump *d)
     if (fd != STDIN_FILENO) {
         close(fd);
     }
+    if (status == CLI_EXIT_OK && running && d->packets == 0) {
+        urrt_log(URRT_LOG_ERR, "%s holds no RealTime packet (%" PRIu64 " bytes): give a raw capture of port 30003 "
+                 "or 30013 (nc robot 30003 > FILE, urrt-dump -w FILE)",
+                 strcmp(d->opt.file_path, "-") == 0 ? "the input" : d->opt.file_path, fr.stats.bytes);
+        status = CLI_EXIT_RUNTIME;
+    }
     return status;
 }
 
@@ -669,6 +676,7 @@ static int run_link(dump *d)
     link_ctx lc = {.d = d};
     uint64_t last_progress;
     uint64_t seen_packets = 0;
+    uint64_t seen_disconnects = 0;
     int status = CLI_EXIT_OK;
 
     urrt_link_config_defaults(&cfg);
@@ -708,6 +716,13 @@ static int run_link(dump *d)
         ls = urrt_link_get_stats(lc.link);
         if (!d->done) {
             d->lstats = *ls;
+        }
+        if (ls->disconnects != seen_disconnects) {
+            /* Bytes of a packet the connection ended inside: the next
+             * connection starts a new packet, so they never complete one
+             * and stay out of the recording. */
+            seen_disconnects = ls->disconnects;
+            d->pending_len = 0;
         }
         if (ls->packets != seen_packets) {
             seen_packets = ls->packets;

@@ -802,8 +802,8 @@ static bool flush_client(sim *s, size_t i, uint64_t now)
             /* Pieces on their own schedule, twice as fast as the stream
              * needs so that a backlog drains; a pass that wakes late sends
              * the pieces that are due, each in its own write. */
-            uint64_t per_packet = s->replaying ? 8000000ull : s->period_ns;
-            size_t plen = s->opt.length ? s->opt.length : 1116;
+            uint64_t per_packet = s->replaying ? s->rp.span_ns / s->rp.count : s->period_ns;
+            size_t plen = s->replaying ? s->rp.end[s->rp.count - 1] / s->rp.count : s->opt.length;
             uint64_t interval = per_packet * tiny / (2 * plen);
             uint64_t from = c->next_write_ns + per_packet > now ? c->next_write_ns : now;
             c->next_write_ns = from + interval;

@@ -5,7 +5,9 @@
 #   bench-tools       the simulator's schedule at 500 Hz: lateness, late packets
 # TCP ports: check-tools-link 40500-40519, check-tools 40200-40299, and for
 # the sanitized runs 40530-40549 and 40300-40399 (so that -j is safe); bench 40800-40802.
+# The review's regressions in check-tools: 44000-44019 (sanitized: 44100-44119).
 TOOLS_PORT_BASE ?= 40200
+TOOLS_REV_PORT_BASE ?= 44000
 TOOLS_LINK_PORT ?= 40500
 TOOLS_TEST_LINK := $(BUILD)/tests/test_link
 
@@ -21,7 +23,7 @@ check-tools-link: $(TOOLS_TEST_LINK)
 
 check-tools: $(BUILD)/bin/urrt-sim $(BUILD)/bin/urrt-dump
 	@mkdir -p $(BUILD)/results
-	BUILD=$(BUILD) PYTHON=$(PYTHON) PORT_BASE=$(TOOLS_PORT_BASE) timeout -k 5 110 sh tests/tools/check_tools.sh
+	BUILD=$(BUILD) PYTHON=$(PYTHON) PORT_BASE=$(TOOLS_PORT_BASE) REV_PORT_BASE=$(TOOLS_REV_PORT_BASE) timeout -k 5 110 sh tests/tools/check_tools.sh
 
 # The same suites on a sanitized build in its own directory. Leak checking is
 # off: LeakSanitizer needs ptrace, which hangs at exit in some sandboxes.
@@ -33,7 +35,7 @@ check-tools-asan:
 	@rm -rf $(TOOLS_ASAN_BUILD)/results; \
 	  ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  $(MAKE) --no-print-directory -k BUILD=$(TOOLS_ASAN_BUILD) OPT="-O1 -g $(SAN_FLAGS)" \
-	  TOOLS_PORT_BASE=40300 TOOLS_LINK_PORT=40530 check-tools-link check-tools > $(TOOLS_ASAN_BUILD)/check.log 2>&1; rc=$$?; \
+	  TOOLS_PORT_BASE=40300 TOOLS_REV_PORT_BASE=44100 TOOLS_LINK_PORT=40530 check-tools-link check-tools > $(TOOLS_ASAN_BUILD)/check.log 2>&1; rc=$$?; \
 	  grep -v '^ok: ' $(TOOLS_ASAN_BUILD)/check.log | grep -v '^rt.py: ' | tail -n 20; \
 	  sh tests/summary.sh $(TOOLS_ASAN_BUILD)/results check-tools-link check-tools | tail -n 1 > $(BUILD)/results/$@.result; \
 	  cat $(BUILD)/results/$@.result; [ $$rc = 0 ] && grep -q ' 0 failed$$' $(BUILD)/results/$@.result

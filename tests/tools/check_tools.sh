@@ -318,5 +318,35 @@ check "journald: lines carry the syslog priority" sh -c "grep -q '^<3>cannot ope
 JOURNAL_STREAM=1:1 "$DUMP" --file "$T/nonexistent" 2> "$T/plain.err"
 check "not the journal: program: level: message" sh -c "grep -q '^urrt-dump: error: cannot open' '$T/plain.err'"
 
+# ---- regressions from the review (ports REV_PORT_BASE, default 44000, + 0..19) ------------
+last_port=$port
+port=${REV_PORT_BASE:-44000}
+# A connection that ends inside a packet: the recording leaves the partial
+# packet out, so that it replays to what was printed live (it used to glue the
+# partial packet to the next connection's first one).
+sim $port --rate 1000 --fault truncate-after=20
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 45 -F gnuplot -w "$T/tr.bin" > "$T/tr1.txt" 2> "$T/tr1.sum"; stopsim; port=$((port + 1))
+"$DUMP" --file "$T/tr.bin" -F gnuplot > "$T/tr2.txt" 2> "$T/tr2.sum"
+check "record across a truncated connection: replays to the same output" cmp -s "$T/tr1.txt" "$T/tr2.txt"
+check "record across a truncated connection: nothing to resync" has "$T/tr2.sum" "resyncs: 0, skipped bytes: 0"
+check "record across a truncated connection: whole packets only" sh -c "[ \$(stat -c %s '$T/tr.bin') = $((45 * 1116)) ]"
+# A 500 Hz capture replayed in tiny writes keeps its pace (the pieces used to
+# be timed for 125 Hz and 1116 bytes, and the client was dropped as slow).
+sim $port --version 5.10 --start-on-connect --count 300 --clients 1 -w "$T/r500.bin"
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -q --no-summary -F gnuplot > /dev/null 2>&1; stopsim; port=$((port + 1))
+sim $port --replay "$T/r500.bin" --fault tiny-writes=7
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/rt.txt" 2> "$T/rt.sum"; stopsim; port=$((port + 1))
+check "replay in tiny writes: bit-exact, all 300" $RT gnuplot "$T/r500.bin" "$T/rt.txt" 300
+check "replay in tiny writes: keeps 500 Hz" sh -c "awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 450) }' '$T/rt.sum'"
+check "replay in tiny writes: the client is not dropped as slow" sh -c "! grep -q 'too slow' '$T/sim.$((port - 1)).log'"
+# A file without a single packet is an error that says what to check.
+head -c 3000 /dev/urandom | tr '\000' '\001' > "$T/noise.bin"
+"$DUMP" --file "$T/noise.bin" > /dev/null 2> "$T/noise.err"; rc=$?
+check "a file without a packet: runtime error 1" [ $rc = 1 ]
+check "a file without a packet: says what to check" has "$T/noise.err" "holds no RealTime packet"
+"$DUMP" --file - < /dev/null > /dev/null 2> "$T/empty.err"; rc=$?
+check "empty input: runtime error 1" sh -c "[ $rc = 1 ] && grep -q 'holds no RealTime packet' '$T/empty.err'"
+port=$last_port
+
 echo "check-tools: $(( $(date +%s) - START )) s, ports ${PORT_BASE:-40200}-$port"
 finish
