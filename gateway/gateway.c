@@ -4,6 +4,7 @@
 
 #include <errno.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,6 +36,9 @@ int64_t gw_robot_data_age_us(const gw_robot *robot, uint64_t now_us)
 unsigned gw_counters(const gateway *gw, const gw_robot *robot, gw_counter *out, unsigned max)
 {
     unsigned n = 0;
+    if (max > 0) {
+        out[n++] = (gw_counter){"late_packets", robot->late_packets};
+    }
     for (unsigned i = 0; i < gw->output_count && n < max; i++) {
         if (gw->outputs[i].counters != NULL) {
             n += gw->outputs[i].counters(gw->outputs[i].ctx, robot, out + n, max - n);
@@ -62,16 +66,58 @@ static void on_mismatch(gw_robot *robot, size_t length, uint64_t rx_us)
     }
 }
 
+/* Whether a packet was read later than the silence timeout after the
+ * controller sent it: a backlog in the socket, after the gateway was
+ * stopped or starved, holds packets whose data is that old although they
+ * were only just read. The controller's clock against the host's tells:
+ * read time - controller time is smallest for a packet read at once, and
+ * grows by how long a packet waited. The floor may rise by 1% of the time
+ * passed, far more than two clocks drift apart and far less than a
+ * backlog's age. A new connection or a controller clock that went back (a
+ * restart) starts again. */
+static bool packet_late(gw_robot *robot, const urrt_state *st, uint64_t rx_us, bool new_connection)
+{
+    uint64_t timeout_us = (uint64_t)robot->cfg->link.silence_timeout_ms * 1000u;
+    double t = st->time[0];
+    int64_t controller_us, offset, creep;
+
+    if (!urrt_has(st, URRT_F_TIME) || !isfinite(t) || fabs(t) > 9e12 || timeout_us == 0) {
+        return false; /* no clock to judge by */
+    }
+    controller_us = (int64_t)llround(t * 1e6);
+    offset = (int64_t)rx_us - controller_us;
+    if (new_connection || robot->delay_floor_rx_us == 0 || controller_us < robot->last_controller_us) {
+        robot->delay_floor_us = offset;
+        robot->delay_floor_rx_us = rx_us;
+        robot->last_controller_us = controller_us;
+        return false;
+    }
+    robot->last_controller_us = controller_us;
+    creep = (int64_t)((rx_us - robot->delay_floor_rx_us) / 100u);
+    if (creep > 0) {
+        robot->delay_floor_us += creep;
+        robot->delay_floor_rx_us += (uint64_t)creep * 100u;
+    }
+    if (offset <= robot->delay_floor_us) {
+        robot->delay_floor_us = offset;
+        robot->delay_floor_rx_us = rx_us;
+        return false;
+    }
+    return (uint64_t)(offset - robot->delay_floor_us) > timeout_us;
+}
+
 /* The one per-packet path: check, decode once, hand to every output. */
 static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t rx_us)
 {
     gw_robot *robot = ctx;
     gateway *gw = robot->gw;
     gw_packet pkt;
+    uint64_t connects = urrt_link_get_stats(robot->link)->connects;
+    bool new_connection = connects != robot->connects_seen;
     int r;
 
     robot->last_any_rx_us = rx_us;
-    robot->connects_seen = urrt_link_get_stats(robot->link)->connects;
+    robot->connects_seen = connects;
     if (robot->cfg->expected_length != 0 && length != robot->cfg->expected_length) {
         on_mismatch(robot, length, rx_us);
         return;
@@ -88,6 +134,18 @@ static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t r
         snprintf(robot->last_error, sizeof robot->last_error, "decode: %s", urrt_strerror(r));
         return;
     }
+    if (packet_late(robot, &robot->state, rx_us, new_connection)) {
+        robot->late_packets++;
+        if (!robot->late) {
+            urrt_log(URRT_LOG_WARNING, "robot %s: a backlog of packets older than silence_timeout (%u ms) on "
+                     "the controller's clock: not published (late_packets %" PRIu64 "); the gateway was "
+                     "stopped or starved of CPU or network: give it a core, or check the link to the robot",
+                     robot->cfg->name, (unsigned)robot->cfg->link.silence_timeout_ms, robot->late_packets);
+        }
+        robot->late = true;
+        return;
+    }
+    robot->late = false;
     robot->last_rx_us = rx_us;
     robot->sequence++;
     pkt.bytes = bytes;

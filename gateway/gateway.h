@@ -47,6 +47,12 @@ typedef struct gw_robot {
     uint64_t mismatch_logged_us;
     uint64_t mismatches_logged;
     bool mismatch;             /* the last packet had the wrong length */
+    /* Lateness on the controller's clock (gateway.c, packet_late). */
+    int64_t delay_floor_us;    /* smallest read time - controller time lately */
+    uint64_t delay_floor_rx_us; /* when the floor was last moved, 0: not yet on this connection */
+    int64_t last_controller_us;
+    uint64_t late_packets;     /* read later than the silence timeout after the controller sent them */
+    bool late;                 /* the last packet was late */
     char last_error[160];
 } gw_robot;
 

@@ -409,6 +409,35 @@ def t_stall(args, port):
         check(not late, "stall: no stale STATE after the silence (%d)" % len(late))
 
 
+def t_backlog(args, port):
+    """A gateway stopped for a second finds a backlog in its socket: no message
+    may carry data older than the silence timeout on the controller's clock."""
+    r = Run(args, "backlog")
+    try:
+        r.sub(4)
+        r.sim(port, "--version", "5.10")
+        gw = r.gateway(lcm_ini() + robot_ini(r.prefix, port, "silence_timeout = 100 ms"))
+        time.sleep(1)
+        gw.send_signal(signal.SIGSTOP)
+        time.sleep(1)
+        gw.send_signal(signal.SIGCONT)
+        time.sleep(1.5)
+    finally:
+        r.stop()
+    ch = by_channel(r.messages(), r.prefix)
+    # Read time - controller time: smallest for a packet read at once, larger by how long it waited.
+    delay = [m["recv_utime"] / 1e6 - m["time"] for m in ch["STATE"]]
+    if not check(len(delay) > 500, "backlog: STATE before and after the stop (%d)" % len(delay)):
+        return
+    late = [d - min(delay) for d in delay if d - min(delay) > 0.15]
+    check(not late, "backlog: no STATE older than the silence timeout (%d, oldest %.3f s)" %
+          (len(late), max(late) if late else 0))
+    g = ch["GATEWAY"]
+    counted = g[-1]["counters"].get("late_packets", 0) if g else 0
+    check(counted > 0, "backlog: GATEWAY counts the late packets (%d)" % counted)
+    check("backlog of packets older than silence_timeout" in r.log(), "backlog: logged")
+
+
 def t_mismatch(args, port):
     r = Run(args, "mis")
     try:
@@ -670,6 +699,7 @@ def main():
         ("restart", lambda: t_restart(args, port + 7)),
         ("stall", lambda: t_stall(args, port + 8)),
         ("mismatch", lambda: t_mismatch(args, port + 9)),
+        ("backlog", lambda: t_backlog(args, 45001)),
         ("alloc", lambda: t_allocations(args, port + 10)),
         ("publish_errors", lambda: t_publish_errors(args, port + 11)),
         ("publish_reopen", lambda: t_publish_reopen(args, port + 12)),
