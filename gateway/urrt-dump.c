@@ -730,8 +730,9 @@ static int run_link(dump *d)
         }
         if (d->opt.once && !d->done && (ls->disconnects > 0 || (ls->connect_failures > 0 && ls->connects == 0))) {
             if (d->packets == 0) {
-                urrt_log(URRT_LOG_ERR, "%s: no packet before the connection ended",
-                         urrt_link_peer(lc.link));
+                urrt_log(URRT_LOG_ERR, "%s: no RealTime packet (%s, see above); check the address and port, "
+                         "or drop --once to keep trying",
+                         urrt_link_peer(lc.link), ls->connects == 0 ? "no connection" : "the connection ended first");
                 status = CLI_EXIT_RUNTIME;
             }
             break;

@@ -59,6 +59,7 @@ struct urrt_link {
     uint64_t next_report;     /* failure count at which to log again */
     int last_errno;
     uint64_t conn_packets;    /* on the current connection */
+    uint64_t conn_bytes_start; /* stats.bytes when it was established */
     urrt_framer framer;
     urrt_link_stats stats;
     urrt_bytes_fn tap;
@@ -279,6 +280,7 @@ static void became_up(urrt_link *link, uint64_t now_us)
     link->last_rx_us = now_us;
     link->more_to_read = false;
     link->conn_packets = 0;
+    link->conn_bytes_start = link->stats.bytes;
     link->stats.connects++;
     if (link->stats.disconnects > 0) {
         link->stats.reconnects++;
@@ -303,7 +305,20 @@ static void connection_lost(urrt_link *link, uint64_t now_us, const char *reason
     }
     link->more_to_read = false;
     if (link->conn_packets == 0) {
-        attempt_failed(link, now_us, reason);
+        /* Something listens there but sends no RealTime stream: a wrong
+         * port (the dashboard's 29999, the primary 30001), or a peer that
+         * turns clients away. Say so, not just how it ended. */
+        char why[256];
+        uint64_t got = link->stats.bytes - link->conn_bytes_start;
+        if (got > 0) {
+            snprintf(why, sizeof why,
+                     "it accepted and sent %" PRIu64 " bytes but no RealTime packet, then %s: "
+                     "is %u the RealTime port (30003, or 30013)?",
+                     got, reason, (unsigned)link->cfg.port);
+        } else {
+            snprintf(why, sizeof why, "it accepted, then %s before sending anything", reason);
+        }
+        attempt_failed(link, now_us, why);
         return;
     }
     close_socket(link);
@@ -383,9 +398,9 @@ static void start_attempt(urrt_link *link, uint64_t now_us)
         rc = getaddrinfo(link->host, service, &hints, &link->addrs);
     }
     if (rc != 0) {
-        char reason[200];
+        char reason[400];
         link->addrs = NULL;
-        snprintf(reason, sizeof reason, "cannot resolve \"%s\": %s", link->host,
+        snprintf(reason, sizeof reason, "cannot resolve \"%s\": %s; check the name, or give the IP address", link->host,
                  rc == EAI_SYSTEM ? strerror(errno) : gai_strerror(rc));
         attempt_failed(link, now_us, reason);
         return;

@@ -346,6 +346,10 @@ check "a file without a packet: runtime error 1" [ $rc = 1 ]
 check "a file without a packet: says what to check" has "$T/noise.err" "holds no RealTime packet"
 "$DUMP" --file - < /dev/null > /dev/null 2> "$T/empty.err"; rc=$?
 check "empty input: runtime error 1" sh -c "[ $rc = 1 ] && grep -q 'holds no RealTime packet' '$T/empty.err'"
+# --once without a connection says so, and what to try (nothing listens on
+# the last port of the range).
+timeout -k 3 10 "$DUMP" "127.0.0.1:$((${REV_PORT_BASE:-44000} + 19))" --once > /dev/null 2> "$T/once.err"; rc=$?
+check "--once, refused: runtime error 1 that says what to try" sh -c "[ $rc = 1 ] && grep -q 'connection refused' '$T/once.err' && grep -q 'no RealTime packet (no connection, see above); check the address and port, or drop --once' '$T/once.err'"
 port=$last_port
 
 echo "check-tools: $(( $(date +%s) - START )) s, ports ${PORT_BASE:-40200}-$port"

@@ -6,6 +6,7 @@
 #define _GNU_SOURCE
 #include <errno.h>
 #include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,6 +19,7 @@
 #include "port.h"
 
 static uint16_t port_base = 40500;
+static uint16_t rev_port_base = 44020; /* the review's tests */
 
 /* ---- log capture ---------------------------------------------------------- */
 
@@ -531,6 +533,61 @@ static void test_name(void)
     close(lfd);
 }
 
+/* Something listens but sends no RealTime stream (a wrong port): the log
+ * says it connected and what to check, not only how it ended. The socket has
+ * TCP keepalive on, with the short probe times port.h promises. */
+static void test_wrong_port(void)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    rx r = {0};
+    uint16_t port = rev_port_base;
+    int lfd = listen_on(AF_INET, &port, 4), s, fd;
+    int on = 0, idle = 0;
+    socklen_t len = sizeof on;
+    char want[96];
+    static const char banner[] = "Connected: Universal Robots Dashboard Server\n";
+
+    CHECK(lfd >= 0, "listen");
+    urrt_link_config_defaults(&c);
+    c.name = "arm2";
+    c.host = "127.0.0.1";
+    c.port = port;
+    c.silence_timeout_ms = 100;
+    c.backoff_initial_ms = 20;
+    l = urrt_link_new(&c);
+    log_count = 0;
+    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "connects");
+    fd = urrt_link_poll_fd(l, NULL);
+    CHECK(getsockopt(fd, SOL_SOCKET, SO_KEEPALIVE, &on, &len) == 0 && on == 1, "SO_KEEPALIVE on");
+    len = sizeof idle;
+    CHECK(getsockopt(fd, IPPROTO_TCP, TCP_KEEPIDLE, &idle, &len) == 0 && idle == 1, "keepalive after %d s idle", idle);
+    s = accept_within(lfd, 2000);
+    send_all(s, (const uint8_t *)banner, sizeof banner - 1);
+    CHECK(pump(l, &r, 2000, one_failure, NULL, NULL, 0), "no packet: a failed attempt");
+    CHECK_EQ_INT(bytes_from_client(s), 0);
+    close(s);
+    snprintf(want, sizeof want, "sent %zu bytes but no RealTime packet, then no data for 100 ms: is %u the RealTime port",
+             sizeof banner - 1, (unsigned)port);
+    CHECK_EQ_INT(lines_with(want), 1);
+    urrt_link_free(l);
+    /* A peer that accepts and closes at once (a fresh link: only the first
+     * failure is logged). */
+    l = urrt_link_new(&c);
+    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "connects again");
+    s = accept_within(lfd, 2000);
+    CHECK(s >= 0, "second connection");
+    close(s);
+    CHECK(pump(l, &r, 2000, one_failure, NULL, NULL, 0), "the close is a failed attempt");
+    CHECK_EQ_INT(lines_with("it accepted, then closed by peer before sending anything"), 1);
+    CHECK_EQ_INT(r.packets, 0);
+    if (lines_with("RealTime port") != 1 || lines_with("before sending anything") != 1) {
+        dump_log();
+    }
+    urrt_link_free(l);
+    close(lfd);
+}
+
 static void test_cli(void)
 {
     char host[64];
@@ -590,6 +647,9 @@ int main(int argc, char **argv)
     if (argc > 1) {
         port_base = (uint16_t)atoi(argv[1]);
     }
+    if (argc > 2) {
+        rev_port_base = (uint16_t)atoi(argv[2]);
+    }
     urrt_log_init("test_link", URRT_LOG_DEBUG);
     urrt_log_set_sink(sink, NULL);
     test_cli();
@@ -599,5 +659,6 @@ int main(int argc, char **argv)
     test_connect_timeout();
     test_ipv6();
     test_name();
+    test_wrong_port();
     return check_report();
 }
