@@ -936,7 +936,8 @@ static int open_listener(const options *o)
     snprintf(service, sizeof service, "%u", (unsigned)o->listen_port);
     rc = getaddrinfo(o->listen_host, service, &hints, &res);
     if (rc != 0) {
-        urrt_log(URRT_LOG_ERR, "cannot listen on %s: %s", where, gai_strerror(rc));
+        urrt_log(URRT_LOG_ERR, "cannot listen on %s: %s (give an address of this machine, e.g. 127.0.0.1 or 0.0.0.0)",
+                 where, gai_strerror(rc));
         return -1;
     }
     for (ai = res; ai != NULL; ai = ai->ai_next) {
@@ -955,7 +956,11 @@ static int open_listener(const options *o)
     }
     if (fd < 0) {
         urrt_log(URRT_LOG_ERR, "cannot listen on %s: %s%s", where, strerror(errno),
-                 errno == EADDRINUSE ? " (another simulator or program has the port: pick another with --listen)" : "");
+                 errno == EADDRINUSE      ? " (another simulator or program has the port: pick another with --listen)"
+                 : errno == EADDRNOTAVAIL ? " (not an address of this machine: use 127.0.0.1, 0.0.0.0 or one that "
+                                            "`ip addr` lists)"
+                 : errno == EACCES        ? " (ports below 1024 need root: pick another with --listen)"
+                                          : "");
     }
     freeaddrinfo(res);
     return fd;
