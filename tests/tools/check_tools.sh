@@ -350,6 +350,12 @@ check "empty input: runtime error 1" sh -c "[ $rc = 1 ] && grep -q 'holds no Rea
 # the last port of the range).
 timeout -k 3 10 "$DUMP" "127.0.0.1:$((${REV_PORT_BASE:-44000} + 19))" --once > /dev/null 2> "$T/once.err"; rc=$?
 check "--once, refused: runtime error 1 that says what to try" sh -c "[ $rc = 1 ] && grep -q 'connection refused' '$T/once.err' && grep -q 'no RealTime packet (no connection, see above); check the address and port, or drop --once' '$T/once.err'"
+# No drift: the schedule is absolute, so one second of packets at 500 Hz
+# arrives at 500 Hz within 0.5% (a sleep of one period after each send would
+# run about 3% slow here).
+sim $port --rate 500
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 501 -F gnuplot > /dev/null 2> "$T/drift.sum"; stopsim; port=$((port + 1))
+check "500 Hz by arrival within 0.5% over a second" sh -c "awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 497.5 && r < 502.5) }' '$T/drift.sum'"
 # Listening on an address this machine does not have (TEST-NET-1) says what to use.
 timeout -k 3 10 "$SIM" -l "192.0.2.1:$((${REV_PORT_BASE:-44000} + 18))" 2> "$T/listen.err"; rc=$?
 check "sim on a foreign address: runtime error 1 that says what to use" sh -c "[ $rc = 1 ] && grep -q 'not an address of this machine: use 127.0.0.1, 0.0.0.0' '$T/listen.err'"
