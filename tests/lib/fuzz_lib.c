@@ -46,6 +46,53 @@ static int is_error(int r)
     return r <= URRT_E_ARG && r >= URRT_E_UNKNOWN_FIELD;
 }
 
+/* Invariant 11 for one value: the name is the listed entry whose value the
+ * double equals exactly, or UNKNOWN when no entry does (fractions, NaN and
+ * infinities equal none). */
+static void check_enum_name(urrt_enum_kind kind, double value)
+{
+    size_t count = 0;
+    const urrt_enum_entry *e = urrt_enum_entries(kind, &count);
+    const char *name = urrt_enum_name(kind, value);
+    const char *listed = URRT_UNKNOWN_NAME;
+    REQUIRE(name != NULL);
+    for (size_t i = 0; i < count; i++) {
+        if ((double)e[i].value == value) {
+            listed = e[i].name;
+        }
+    }
+    REQUIRE(strcmp(name, listed) == 0);
+}
+
+/* Invariant 11 for a digital I/O value: a mask exactly when the bits are
+ * a raw int64 (sign and exponent clear) or a double holding a non-negative
+ * integer up to 2^53, and then the right mask. */
+static void check_bitmask(double value)
+{
+    uint64_t mask = 0;
+    uint64_t bits = bits_of(value);
+    int r = urrt_bitmask(value, &mask);
+    if (bits >> 52 == 0) {
+        REQUIRE(r == URRT_OK && mask == bits);
+    } else if (value >= 0.0 && value <= 9007199254740992.0 && (double)(uint64_t)value == value) {
+        REQUIRE(r == URRT_OK && mask == (uint64_t)value);
+    } else {
+        REQUIRE(r == URRT_E_NOT_BITMASK);
+    }
+}
+
+/* Invariant 9: a failed decode leaves no field behind. */
+static void check_cleared(const urrt_state *st)
+{
+    REQUIRE(st->present == 0);
+    for (int id = 0; id < URRT_FIELD_COUNT; id++) {
+        const double *v = slot((urrt_state *)st, id);
+        for (unsigned i = 0; i < urrt_field((urrt_field_id)id)->count; i++) {
+            REQUIRE(v[i] != v[i]);
+        }
+    }
+}
+
 /* Invariants 6-8, 10 and 11 of docs/security.md on one packet: decode
  * succeeds, presence follows the length, random access agrees with the full
  * decode, names are total, the encoder gives the same fields back.
@@ -81,13 +128,13 @@ static void check_packet(const uint8_t *pkt, size_t len)
                 REQUIRE(r == URRT_E_ABSENT);
                 REQUIRE(v[i] != v[i]); /* absent fields hold NaN */
             }
-            REQUIRE(urrt_enum_name(urrt_field_enum((urrt_field_id)id, gen), v[i]) != NULL);
+            check_enum_name(urrt_field_enum((urrt_field_id)id, gen), v[i]);
         }
     }
-    {
-        uint64_t mask;
-        int r = urrt_bitmask(st.digital_input_bits[0], &mask);
-        REQUIRE(r == URRT_OK || r == URRT_E_NOT_BITMASK);
+    check_bitmask(st.digital_input_bits[0]);
+    check_bitmask(st.digital_outputs[0]);
+    for (int k = URRT_ENUM_ROBOT_MODE; k <= URRT_ENUM_PROGRAM_STATE; k++) {
+        check_enum_name((urrt_enum_kind)k, st.time[0]);
     }
     REQUIRE(urrt_encode(&st, (uint32_t)len, out, sizeof out) == (int)len);
     REQUIRE(urrt_decode(out, len, &back) == (int)len && back.present == st.present);
@@ -125,6 +172,8 @@ static void feed(const uint8_t *p, size_t n, run *r, size_t *fed)
             const uint8_t *pkt = urrt_framer_packet(&framer, &len);
             REQUIRE(pkt != NULL && len >= URRT_PACKET_MIN && len <= URRT_PACKET_MAX);
             REQUIRE((len - URRT_HEADER_SIZE) % 8 == 0);
+            /* Invariant 6: the size is the packet's own header. */
+            REQUIRE(((uint32_t)pkt[0] << 24 | (uint32_t)pkt[1] << 16 | (uint32_t)pkt[2] << 8 | pkt[3]) == len);
             memcpy(r->out + r->out_len, pkt, len);
             r->out_len += len;
             r->packets++;
@@ -197,7 +246,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (r >= 0) {
             check_packet(stream, (size_t)r);
         } else {
-            REQUIRE(is_error(r) && st.present == 0); /* invariant 9 */
+            REQUIRE(is_error(r)); /* invariant 9 */
+            check_cleared(&st);
         }
         for (unsigned c = 0; c < 4; c++) {
             double d;
