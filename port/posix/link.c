@@ -242,11 +242,11 @@ static void schedule_retry(urrt_link *link, uint64_t now_us)
 static const char *errno_text(int err)
 {
     switch (err) {
-    case ECONNREFUSED: return "connection refused: nothing listens on that port";
-    case ETIMEDOUT: return "timed out";
+    case ECONNREFUSED: return "connection refused: nothing listens on that port; is the controller up, and the port 30003 or 30013?";
+    case ETIMEDOUT: return "timed out: no answer; check the address, the cable and the subnet";
     case ECONNRESET: return "reset by peer";
-    case EHOSTUNREACH: return "host unreachable";
-    case ENETUNREACH: return "network unreachable";
+    case EHOSTUNREACH: return "host unreachable: check the address and the subnet";
+    case ENETUNREACH: return "network unreachable: no route to that address; check it and this machine's network settings";
     default: return strerror(err);
     }
 }

@@ -308,6 +308,7 @@ static void test_refused_backoff(void)
     CHECK_EQ_INT(lines_with("still cannot connect"), 1);
     CHECK_EQ_INT(lines_with("after 10 attempts"), 1);
     CHECK_EQ_INT(lines_with("connection refused"), 2);
+    CHECK_EQ_INT(lines_with("is the controller up, and the port 30003 or 30013?"), 2);
     CHECK_EQ_INT(lines_with("connecting to"), 1);
     if (lines_with("cannot connect") != 2) {
         dump_log();
@@ -461,6 +462,7 @@ static void test_connect_timeout(void)
     CHECK(urrt_port_monotonic_us() - t0 < 1000000, "soon after it");
     CHECK_EQ_INT(urrt_link_get_stats(l)->connects, 0);
     CHECK_EQ_INT(lines_with("timed out"), 1);
+    CHECK_EQ_INT(lines_with("timed out: no answer; check the address"), 1);
     if (lines_with("timed out") != 1) {
         dump_log();
     }
