@@ -71,36 +71,37 @@ static void on_mismatch(gw_robot *robot, size_t length, uint64_t rx_us)
  * stopped or starved, holds packets whose data is that old although they
  * were only just read. The controller's clock against the host's tells:
  * read time - controller time is smallest for a packet read at once, and
- * grows by how long a packet waited. The floor may rise by 1% of the time
- * passed, far more than two clocks drift apart and far less than a
- * backlog's age. A new connection or a controller clock that went back (a
- * restart) starts again. */
+ * larger by how long a packet waited. That floor may rise by a quarter of
+ * the time that passed on both clocks since the previous packet, so that a
+ * controller clock running as slow as 80% of real time (a loaded simulator)
+ * still passes, while a packet read after a stall (little controller time
+ * passed) and the packets read together with it (no host time passed) are
+ * judged by their whole wait. A new connection or a controller clock that
+ * went back (a restart) starts again. */
 static bool packet_late(gw_robot *robot, const urrt_state *st, uint64_t rx_us, bool new_connection)
 {
     uint64_t timeout_us = (uint64_t)robot->cfg->link.silence_timeout_ms * 1000u;
     double t = st->time[0];
-    int64_t controller_us, offset, creep;
+    int64_t controller_us, offset, host_step, controller_step;
 
     if (!urrt_has(st, URRT_F_TIME) || !isfinite(t) || fabs(t) > 9e12 || timeout_us == 0) {
         return false; /* no clock to judge by */
     }
     controller_us = (int64_t)llround(t * 1e6);
     offset = (int64_t)rx_us - controller_us;
-    if (new_connection || robot->delay_floor_rx_us == 0 || controller_us < robot->last_controller_us) {
+    if (new_connection || robot->delay_prev_rx_us == 0 || controller_us < robot->last_controller_us) {
         robot->delay_floor_us = offset;
-        robot->delay_floor_rx_us = rx_us;
+        robot->delay_prev_rx_us = rx_us;
         robot->last_controller_us = controller_us;
         return false;
     }
+    host_step = (int64_t)(rx_us - robot->delay_prev_rx_us);
+    controller_step = controller_us - robot->last_controller_us;
+    robot->delay_floor_us += (host_step < controller_step ? host_step : controller_step) / 4;
+    robot->delay_prev_rx_us = rx_us;
     robot->last_controller_us = controller_us;
-    creep = (int64_t)((rx_us - robot->delay_floor_rx_us) / 100u);
-    if (creep > 0) {
-        robot->delay_floor_us += creep;
-        robot->delay_floor_rx_us += (uint64_t)creep * 100u;
-    }
     if (offset <= robot->delay_floor_us) {
         robot->delay_floor_us = offset;
-        robot->delay_floor_rx_us = rx_us;
         return false;
     }
     return (uint64_t)(offset - robot->delay_floor_us) > timeout_us;

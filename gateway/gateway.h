@@ -49,7 +49,7 @@ typedef struct gw_robot {
     bool mismatch;             /* the last packet had the wrong length */
     /* Lateness on the controller's clock (gateway.c, packet_late). */
     int64_t delay_floor_us;    /* smallest read time - controller time lately */
-    uint64_t delay_floor_rx_us; /* when the floor was last moved, 0: not yet on this connection */
+    uint64_t delay_prev_rx_us; /* read time of the previous packet, 0: none yet on this connection */
     int64_t last_controller_us;
     uint64_t late_packets;     /* read later than the silence timeout after the controller sent them */
     bool late;                 /* the last packet was late */
