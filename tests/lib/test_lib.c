@@ -1043,6 +1043,38 @@ static void test_field_metadata(void)
     CHECK_EQ_STR(URRT_VERSION_STRING, "0.1.0");
 }
 
+/* "since" of every field agrees with the lengths table of protocol-facts.md:
+ * it is the first version of the first documented length whose packets
+ * hold the field (presence itself is checked against the reference). */
+static void test_field_since_follows_lengths(void)
+{
+    static const struct {
+        uint32_t length;
+        const char *first_version;
+    } lengths[] = {
+        {756, "1.5"}, {764, "1.7"}, {812, "1.8"}, {1044, "3.0"}, {1060, "3.2"},
+        {1108, "3.5"}, {1116, "3.10/5.4"}, {1140, "3.14/5.9"}, {1220, "5.10"},
+    };
+    const char *since[URRT_FIELD_COUNT] = {0};
+    static uint8_t pkt[1220];
+    urrt_state st;
+    for (size_t k = 0; k < sizeof lengths / sizeof lengths[0]; k++) {
+        memset(pkt, 0, sizeof pkt);
+        put_be32(pkt, lengths[k].length);
+        CHECK_EQ_INT(urrt_decode(pkt, lengths[k].length, &st), lengths[k].length);
+        for (int id = 0; id < URRT_FIELD_COUNT; id++) {
+            if (since[id] == NULL && urrt_has(&st, id)) {
+                since[id] = lengths[k].first_version;
+            }
+        }
+    }
+    for (int id = 0; id < URRT_FIELD_COUNT; id++) {
+        const urrt_field_info *f = urrt_field((urrt_field_id)id);
+        CHECK(since[id] != NULL && strcmp(f->since, since[id]) == 0, "%s: since \"%s\", the lengths say \"%s\"",
+              f->name, f->since, since[id] ? since[id] : "(never)");
+    }
+}
+
 static void test_bad_arguments(void)
 {
     const vector *p = find_vector("v3_10_1116");
@@ -1174,6 +1206,7 @@ int main(int argc, char **argv)
     load_vectors(argv[1]);
     test_field_metadata();
     test_field_lookup();
+    test_field_since_follows_lengths();
     test_nan_inf_bit_exact();
     test_bitmask();
     test_enums();
