@@ -71,12 +71,12 @@ static void on_mismatch(gw_robot *robot, size_t length, uint64_t rx_us)
  * stopped or starved, holds packets whose data is that old although they
  * were only just read. The controller's clock against the host's tells:
  * read time - controller time is smallest for a packet read at once, and
- * larger by how long a packet waited. That floor may rise by a quarter of
- * the time that passed on both clocks since the previous packet, so that a
- * controller clock running as slow as 80% of real time (a loaded simulator)
- * still passes, while a packet read after a stall (little controller time
- * passed) and the packets read together with it (no host time passed) are
- * judged by their whole wait. A new connection or a controller clock that
+ * larger by how long a packet waited. That floor may rise by the time that
+ * passed since the previous packet on the slower of the two clocks, so that
+ * a controller clock running as slow as half of real time (a loaded
+ * simulator) still passes, while a packet read after a stall (little
+ * controller time passed) and the packets read together with it (no host
+ * time passed) are judged by their whole wait. A new connection or a controller clock that
  * went back (a restart) starts again. */
 static bool packet_late(gw_robot *robot, const urrt_state *st, uint64_t rx_us, bool new_connection)
 {
@@ -97,7 +97,7 @@ static bool packet_late(gw_robot *robot, const urrt_state *st, uint64_t rx_us, b
     }
     host_step = (int64_t)(rx_us - robot->delay_prev_rx_us);
     controller_step = controller_us - robot->last_controller_us;
-    robot->delay_floor_us += (host_step < controller_step ? host_step : controller_step) / 4;
+    robot->delay_floor_us += host_step < controller_step ? host_step : controller_step;
     robot->delay_prev_rx_us = rx_us;
     robot->last_controller_us = controller_us;
     if (offset <= robot->delay_floor_us) {

@@ -98,7 +98,7 @@ static void on_message(const lcm_recv_buf_t *rbuf, const char *channel, void *us
     }
     double t;
     memcpy(&t, &bits, sizeof t);
-    long index = lrint(t * 1000.0);
+    long index = lrint(t * 500.0);
     if (index < 0 || index >= MAX_PACKETS || sent_ns[index] == 0 || lat_n[kind] >= MAX_PACKETS) {
         return;
     }
@@ -178,7 +178,9 @@ static void make_packet(uint8_t *out, long index)
         st.digital_outputs[0] = 3;
         ready = 1;
     }
-    st.time[0] = (double)index / 1000.0;
+    /* A 500 Hz controller's clock: the gateway holds it against its own to
+     * tell a backlog from fresh packets. */
+    st.time[0] = (double)index * 0.002;
     urrt_encode(&st, LENGTH, out, LENGTH);
 }
 
