@@ -643,6 +643,10 @@ def t_install(args):
     check("ExecStart=%s/bin/urrt-gateway %s/urrt/gateway.ini" % (prefix, etc) in unit and "DynamicUser=yes" in unit
           and "Restart=on-failure" in unit and "@" not in unit.replace("@system-service", "").replace("@privileged", "")
           .replace("@resources", ""), "install: the unit names the installed paths, restarts, runs unprivileged")
+    # RestartPreventExitStatus= looks at the main process only: a check that fails in ExecStartPre
+    # would be retried every RestartSec for ever. The gateway checks its configuration itself.
+    check("RestartPreventExitStatus=2" in unit and "ExecStartPre=" not in unit,
+          "install: a bad configuration (exit 2 of the main process) is not restarted in a loop")
     spy = open(os.path.join(prefix, "bin", "urrt-spy")).read() if os.path.exists(prefix) else ""
     check("URRT_JAR_DEFAULT=%s/share/java/urrt_lcmtypes.jar" % prefix in spy, "install: urrt-spy knows the jar")
     with open(os.path.join(etc, "urrt", "gateway.ini"), "a") as f:
