@@ -373,9 +373,11 @@ static const unsigned grid_fields = 0u
  * SSSE3 (-march=x86-64-v2), AVX2 (-march=x86-64-v3), AVX-512BW
  * (-march=x86-64-v4), ARM NEON; -march=native picks the widest. The decode
  * is bound by stores, so the widest vector wins. Elsewhere the copy is one
- * 8-byte load and swap per double.
+ * 8-byte load and swap per double. Little-endian hosts only: on a
+ * big-endian one (armeb, aarch64_be also have NEON) the swap would reverse
+ * bytes that are already in the host's order.
  */
-#if defined(__GNUC__) && (defined(__SSSE3__) || defined(__ARM_NEON))
+#if defined(URRT_LOAD_BE64_BUILTIN) && (defined(__SSSE3__) || defined(__ARM_NEON))
 #define URRT_VECTOR 1
 #if defined(__AVX512BW__)
 #define URRT_VECTOR_BYTES 64

@@ -48,6 +48,23 @@ for src in "$@"; do
     ${CROSS}gcc -mcpu=cortex-a7 -mfpu=neon-vfpv4 -mfloat-abi=hard -ffreestanding -O2 $warn -Ilib \
       -c "$src" -o "$out/$(basename "$src" .c).neon.o"
 done
+# Big-endian NEON (armeb, aarch64_be): the wire's byte order is the host's,
+# so the decoder must not take the byte-swapping vector path there.
+# Regression: it did, and every double of the grid came out byte-reversed.
+# Nothing here runs big-endian code, so the check is on the choice of path.
+be_macros="$out/urrt.be.macros"
+if ${CROSS}gcc -mbig-endian -mcpu=cortex-a7 -mfpu=neon-vfpv4 -mfloat-abi=hard -ffreestanding -O2 $warn -Ilib \
+     -c lib/urrt.c -o "$out/urrt.be.o" &&
+   ${CROSS}gcc -mbig-endian -mcpu=cortex-a7 -mfpu=neon-vfpv4 -mfloat-abi=hard -ffreestanding -O2 -Ilib \
+     -E -dM lib/urrt.c > "$be_macros"; then
+  if grep -q '^#define URRT_VECTOR ' "$be_macros"; then
+    fail "lib/urrt.c byte-swaps doubles with NEON on a big-endian target (regression_big_endian_neon)"
+  else
+    ok "lib/urrt.c compiles for big-endian NEON without the byte-swapping vector path"
+  fi
+else
+  fail "lib/urrt.c does not compile for big-endian Cortex-A7 with NEON"
+fi
 # URRT_MAX_DOUBLES is a documented knob: the library must build at the
 # smallest allowed value and a large one, and refuse values its structs cannot
 # count (regression: a value past 65535 used to wrap urrt_state.doubles).
