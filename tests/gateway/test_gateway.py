@@ -647,6 +647,8 @@ def t_install(args):
     # would be retried every RestartSec for ever. The gateway checks its configuration itself.
     check("RestartPreventExitStatus=2" in unit and "ExecStartPre=" not in unit,
           "install: a bad configuration (exit 2 of the main process) is not restarted in a loop")
+    check("ProtectSystem=strict" in unit and "LogsDirectory=urrt" in unit,
+          "install: the read-only system leaves /var/log/urrt writable for a CAN log")
     spy = open(os.path.join(prefix, "bin", "urrt-spy")).read() if os.path.exists(prefix) else ""
     check("URRT_JAR_DEFAULT=%s/share/java/urrt_lcmtypes.jar" % prefix in spy, "install: urrt-spy knows the jar")
     with open(os.path.join(etc, "urrt", "gateway.ini"), "a") as f:
