@@ -146,7 +146,9 @@ const char *urrt_link_peer(const urrt_link *link);
 /* A tap on the raw stream, for recording it: fn receives every byte read,
  * in order, in pieces that end where a packet ends, each piece before the
  * packet callback for the packet it completes (so a recorder can keep the
- * bytes up to the last complete packet). NULL removes the tap. */
+ * bytes up to the last complete packet). Bytes of a packet that a lost
+ * connection ended inside are never completed: the next connection starts
+ * afresh, and stats.disconnects has gone up. NULL removes the tap. */
 typedef void (*urrt_bytes_fn)(void *ctx, const uint8_t *data, size_t len);
 void urrt_link_set_tap(urrt_link *link, urrt_bytes_fn fn, void *ctx);
 
