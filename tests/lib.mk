@@ -1,5 +1,6 @@
 # tests/lib.mk: proof that lib/ is right and freestanding.
-#   check-lib       black-box tests against the independent Python reference
+#   check-lib       black-box tests against the independent Python reference (every vector
+#                   width, URRT_MAX_DOUBLES=152, and the non-GNU / big-endian code paths)
 #   check-lib-san   the same tests under ASan + UBSan
 #   check-fuzz-lib  the libFuzzer harness, briefly (make fuzz FUZZ_SECONDS=N for longer)
 #   check-cross     every lib/*.c alone for Cortex-M4, linked -nostdlib; footprint vs README
