@@ -187,6 +187,16 @@ int main(int argc, char **argv)
         gw_config_free(&cfg);
         return CLI_EXIT_USAGE;
     }
+    if ((summary || cfg.summary) && !print_dbc && can_map_enabled(&cfg.can) &&
+        strncmp(cfg.can.interface, "log:-", 5) == 0 &&
+        (cfg.can.interface[5] == '\0' || cfg.can.interface[5] == ',')) {
+        /* Summary lines in the CAN log would stop canplayer replaying it. */
+        fprintf(stderr, "%s:%d: interface = %s and the summary both write to stdout: log the frames to a file "
+                "(log:PATH) or turn the summary off\n", cfg.path, cfg.can.key_loc[CAN_MAP_CK_INTERFACE].line,
+                cfg.can.interface);
+        gw_config_free(&cfg);
+        return CLI_EXIT_USAGE;
+    }
     if (url_override != NULL) {
         free(cfg.lcm.url);
         cfg.lcm.url = strdup(url_override);

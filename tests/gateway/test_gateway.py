@@ -625,6 +625,20 @@ def t_configs(args):
     p = subprocess.run([args.gateway, "--check-config", many], capture_output=True, text=True, timeout=10)
     lines = [int(l.split(":")[1]) for l in p.stderr.splitlines() if l.startswith(many + ":")]
     check(lines == [3, 4, 5], "config: every error reported, in line order (%s)" % lines)
+    # A CAN log on stdout next to the summary lines would no longer replay with canplayer.
+    both = os.path.join(d, "both.ini")
+    with open(both, "w") as f:
+        f.write("[gateway]\nsummary = yes\n[robot a]\nhost = h\n[can]\ninterface = log:-\nheartbeat_id = 0x701\n"
+                "[frame f]\nid = 0x181\nperiod_ms = 10\nsignal = q_actual[0] @0|16 intel signed factor=0.001\n")
+    for extra in ([], ["--summary"]):
+        text = open(both).read()
+        with open(both, "w") as f:
+            f.write(text.replace("summary = yes", "summary = no") if extra else text)
+        p = subprocess.run([args.gateway, "--check-config"] + extra + [both], capture_output=True, text=True,
+                           timeout=10)
+        check(p.returncode == 2 and (both + ":6: interface = log:- and the summary both write to stdout") in p.stderr,
+              "config: CAN log on stdout with the summary%s: exit 2 and %s:6 (%r)" %
+              (" (--summary)" if extra else "", os.path.basename(both), p.stderr.strip()[:200]))
 
 
 def t_install(args):
