@@ -1676,9 +1676,15 @@ void can_map_due(struct can_map *map, uint64_t now_us, const urrt_can_stats *sta
         struct can_map_frame *f = &map->frames[i];
         bool fresh = robot_fresh(map, f->robot_index, now_us, f->stale_after_ms);
         if (f->every) {
+            /* Pending since a packet that came while the CAN link was
+             * down: stale by now, it stops with the packets. */
+            if (f->pending && !fresh) {
+                f->pending = false;
+                f->stale_stops++;
+            }
             if (f->pending) {
                 f->pending = false;
-                send_frame(f, fresh && f->outcome == URRT_CAN_PACK_OK, emit, ctx);
+                send_frame(f, f->outcome == URRT_CAN_PACK_OK, emit, ctx);
             }
             continue;
         }

@@ -1096,6 +1096,24 @@ static void test_schedule(void)
               cap.n);
         CHECK_EQ_INT(can_map_deadline(&map), 1010000);
     }
+    /* An every-packet frame left pending while the CAN link was down (the
+     * gateway calls no due() then) must not carry stale data out when the
+     * link comes back: it stops with the packets. */
+    packet(&map, 2000000, 1.234, 7, true);
+    for (t = 2200000; t <= 2300000; t += 100000) {
+        size_t neach = 0;
+        if (t == 2300000) {
+            packet(&map, t, 1.234, 7, true);
+        }
+        cap.n = 0;
+        cap.now = t;
+        can_map_due(&map, t, NULL, capture_frame, &cap);
+        for (i = 0; i < cap.n; i++) {
+            neach += cap.s[i].f.id == 0x381;
+        }
+        CHECK(neach == (t == 2300000 ? 1u : 0u), "every-packet frame at %llu ms, %s data: %zu sent",
+              (unsigned long long)(t / 1000), t == 2300000 ? "fresh" : "200 ms old", neach);
+    }
     can_map_free(&map);
 }
 
