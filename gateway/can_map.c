@@ -23,10 +23,11 @@ const struct can_map_hb_signal can_map_heartbeat_layout[CAN_MAP_HB_COUNT] = {
     [CAN_MAP_HB_ROBOT_MODE] = {"robot_mode", HB_SIG(8, 8, URRT_CAN_SIGNED, -128, 127), "",
                                CAN_MAP_HB_VALUES_ROBOT_MODE,
                                "Robot mode of the heartbeat robot as it sends it (numbering per generation); "
-                               "-128: not available"},
+                               "-128: not available (no data, or older than stale_after_ms)"},
     [CAN_MAP_HB_SAFETY_MODE] = {"safety_mode", HB_SIG(16, 8, URRT_CAN_UNSIGNED, 0, 255), "",
                                 CAN_MAP_HB_VALUES_SAFETY_MODE,
-                                "Safety mode of the heartbeat robot; 0: not available (1.x, or no data)"},
+                                "Safety mode of the heartbeat robot; 0: not available (1.x, no data, or older "
+                                "than stale_after_ms)"},
     [CAN_MAP_HB_GENERATION] = {"generation", HB_SIG(24, 2, URRT_CAN_UNSIGNED, 0, 3), "",
                                CAN_MAP_HB_VALUES_GENERATION,
                                "Controller generation of the heartbeat robot: 0 unknown, 1 CB1/CB2 (1.x), "
@@ -1595,6 +1596,8 @@ static void heartbeat_pack(const struct can_map *map, uint64_t now_us, const urr
 {
     double values[CAN_MAP_HB_COUNT];
     const struct can_map_robot_rt *r = map->robot_count ? &map->robots[map->hb_robot_index] : NULL;
+    /* Modes as old as stale data are not the robot's modes now. */
+    bool current = r != NULL && robot_fresh(map, map->hb_robot_index, now_us, map->stale_after_ms);
     urrt_can_stats zero;
     const urrt_can_stats *seen = &map->hb_seen;
     unsigned k;
@@ -1611,10 +1614,10 @@ static void heartbeat_pack(const struct can_map *map, uint64_t now_us, const urr
 
     values[CAN_MAP_HB_STATE] = can_map_state(map, now_us);
     values[CAN_MAP_HB_ALIVE] = alive;
-    values[CAN_MAP_HB_ROBOT_MODE] = r ? enum_or(r->robot_mode, -127, 127, CAN_MAP_HB_ROBOT_MODE_NA)
-                                      : CAN_MAP_HB_ROBOT_MODE_NA;
-    values[CAN_MAP_HB_SAFETY_MODE] = r ? enum_or(r->safety_mode, 1, 255, CAN_MAP_HB_SAFETY_MODE_NA)
-                                       : CAN_MAP_HB_SAFETY_MODE_NA;
+    values[CAN_MAP_HB_ROBOT_MODE] = current ? enum_or(r->robot_mode, -127, 127, CAN_MAP_HB_ROBOT_MODE_NA)
+                                            : CAN_MAP_HB_ROBOT_MODE_NA;
+    values[CAN_MAP_HB_SAFETY_MODE] = current ? enum_or(r->safety_mode, 1, 255, CAN_MAP_HB_SAFETY_MODE_NA)
+                                             : CAN_MAP_HB_SAFETY_MODE_NA;
     values[CAN_MAP_HB_GENERATION] = r ? (double)r->generation : 0;
     values[CAN_MAP_HB_BUS_OFF] = stats->bus_off != seen->bus_off;
     values[CAN_MAP_HB_CAN_ERRORS] = stats->error_frames != seen->error_frames;

@@ -1044,6 +1044,9 @@ static void test_schedule(void)
             } else {
                 CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_STATE), CAN_MAP_STATE_DATA_STALE);
                 CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_DATA_AGE), 103);
+                /* Modes as old as the data are not current: not available. */
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_ROBOT_MODE), CAN_MAP_HB_ROBOT_MODE_NA);
+                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_SAFETY_MODE), CAN_MAP_HB_SAFETY_MODE_NA);
             }
             CHECK(s->f.len == 8 && !s->f.fd && !s->f.extended, "heartbeat frame shape");
             hb++;
