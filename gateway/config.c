@@ -618,21 +618,19 @@ static void report_can_problem(void *user, const char *file, int line, const cha
 
 static bool can_section_key(config_ctx *ctx, gw_config *cfg, const char *key, const char *value)
 {
-    char ignored[256]; /* the reporter has it already */
-    return can_map_ini(&cfg->can, ctx->section_raw, key, value, ctx->path, ctx->line, ignored,
-                       sizeof ignored) == 1;
+    /* Problems reach config_error() through the reporter: no text buffer. */
+    return can_map_ini(&cfg->can, ctx->section_raw, key, value, ctx->path, ctx->line, NULL, 0) == 1;
 }
 
 static void can_finish(config_ctx *ctx, gw_config *cfg)
 {
     struct can_map_robot robots[GW_MAX_ROBOTS];
-    static char ignored[8192];
     (void)ctx;
     for (unsigned i = 0; i < cfg->robot_count; i++) {
         robots[i].name = cfg->robots[i].name;
         robots[i].period_us = 1000000u / cfg->robots[i].max_rate_hz;
     }
-    can_map_finish(&cfg->can, robots, cfg->robot_count, ignored, sizeof ignored);
+    can_map_finish(&cfg->can, robots, cfg->robot_count, NULL, 0);
 }
 
 static const config_section config_sections[] = {
