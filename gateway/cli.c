@@ -8,8 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *cli_parse_host_port(const char *arg, uint16_t default_port, char *host, size_t host_size,
-                                uint16_t *port)
+static const char *parse_host_port(const char *arg, uint16_t default_port, uint32_t min_port, char *host,
+                                   size_t host_size, uint16_t *port)
 {
     const char *host_start = arg;
     size_t host_len;
@@ -50,13 +50,27 @@ const char *cli_parse_host_port(const char *arg, uint16_t default_port, char *ho
     *port = default_port;
     if (port_text != NULL) {
         uint32_t p;
-        const char *err = cli_parse_u32(port_text, 1, 65535, &p);
+        const char *err = cli_parse_u32(port_text, min_port, 65535, &p);
         if (err != NULL) {
-            return port_text[0] == '\0' ? "no port after ':'" : "port must be a number from 1 to 65535";
+            return port_text[0] == '\0' ? "no port after ':'"
+                   : min_port == 0       ? "port must be a number from 0 to 65535"
+                                         : "port must be a number from 1 to 65535";
         }
         *port = (uint16_t)p;
     }
     return NULL;
+}
+
+const char *cli_parse_host_port(const char *arg, uint16_t default_port, char *host, size_t host_size,
+                                uint16_t *port)
+{
+    return parse_host_port(arg, default_port, 1, host, host_size, port);
+}
+
+const char *cli_parse_listen_address(const char *arg, uint16_t default_port, char *host, size_t host_size,
+                                     uint16_t *port)
+{
+    return parse_host_port(arg, default_port, 0, host, host_size, port);
 }
 
 void cli_format_host_port(const char *host, uint16_t port, char *out, size_t out_size)

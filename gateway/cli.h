@@ -27,6 +27,10 @@ enum {
 const char *cli_parse_host_port(const char *arg, uint16_t default_port, char *host, size_t host_size,
                                 uint16_t *port);
 
+/* The same for an address to listen on: port 0 too (the system picks a free one). */
+const char *cli_parse_listen_address(const char *arg, uint16_t default_port, char *host, size_t host_size,
+                                     uint16_t *port);
+
 /* "host:port", or "[host]:port" when host holds a colon. */
 void cli_format_host_port(const char *host, uint16_t port, char *out, size_t out_size);
 

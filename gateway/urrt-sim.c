@@ -64,11 +64,24 @@ typedef struct fault_config {
     uint64_t stall_ms;        /* ... for this long (0: until the client leaves) */
     uint64_t odd_every;       /* every Nth packet with a length no controller uses */
     uint32_t odd_length;
+    /* Global, for every client: the schedule's packets counted from its start. */
+    uint64_t freeze_after;    /* freeze the whole stream after N packets ... */
+    uint64_t freeze_every;    /* ... or after every N packets ... */
+    uint64_t freeze_ms;       /* ... for this long (0: for good) */
 } fault_config;
+
+/* What the packets' time column counts. */
+typedef enum sim_clock {
+    SIM_CLOCK_START,      /* seconds since the (simulated) controller started */
+    SIM_CLOCK_MONOTONIC,  /* this host's CLOCK_MONOTONIC at the packet's scheduled instant */
+    SIM_CLOCK_REALTIME    /* CLOCK_REALTIME (Unix time) at that instant */
+} sim_clock;
 
 typedef struct options {
     char listen_host[256];
     uint16_t listen_port;
+    const char *port_file;
+    sim_clock clock;
     uint32_t length;
     double rate_hz;
     bool rate_given;
@@ -145,6 +158,9 @@ typedef struct sim {
     uint64_t garbage_sent;
     uint64_t slow_drops;
     uint64_t packets_out;     /* packets emitted by the schedule */
+    uint64_t frozen_until_ns; /* freeze fault: nothing is emitted before this (0: not frozen) */
+    uint64_t freezes;
+    uint64_t frozen_packets;  /* packets of the schedule skipped by freezes */
     latency_stats lat;
     bool replay_done;
 } sim;
@@ -167,7 +183,9 @@ static void usage(FILE *out)
 "\n"
 "Stream:\n"
 "  -l, --listen HOST:PORT   address to listen on (default " DEFAULT_LISTEN ");\n"
-"                           IPv6 as [::1]:30003\n"
+"                           IPv6 as [::1]:30003; port 0: any free port\n"
+"      --port-file FILE     once listening, write the port and a newline to\n"
+"                           FILE (atomically: FILE.tmp, then renamed)\n"
 "      --version V          controller software version whose length to send:\n"
 "                           1.5 1.6 1.7 1.8 3.0 ... 3.15 5.0 ... 5.10 (and later)\n"
 "      --controller V       the same, for scripts (--version alone prints ours)\n"
@@ -175,6 +193,11 @@ static void usage(FILE *out)
 "                           lengths no controller uses included (default %u)\n"
 "  -r, --rate HZ            packets per second (default 125; 500 with --version 5.x)\n"
 "  -s, --seed N             motion seed: same seed, same packets (default 1)\n"
+"      --clock start|monotonic|realtime  what the time column counts: seconds\n"
+"                           since the controller started (1000 s at packet 0;\n"
+"                           default), or this host's CLOCK_MONOTONIC or\n"
+"                           CLOCK_REALTIME at the packet's scheduled instant\n"
+"                           (so that a receiver can tell a packet's age)\n"
 "  -n, --count N            close each client after N packets\n"
 "      --start-on-connect   start the schedule (packet 0) when the first client\n"
 "                           connects, so that runs are byte-identical\n"
@@ -205,6 +228,14 @@ static void usage(FILE *out)
 "      --fault odd-length=N[,length=L]  send every Nth packet with length L\n"
 "                                     (default: the stream's length + 8), a\n"
 "                                     length no controller uses\n"
+"      --fault freeze-after=N[,for=MS] freeze the whole stream once the schedule\n"
+"                                     has produced N packets (counted from its\n"
+"                                     start, for all clients): nothing goes to\n"
+"                                     any client, new ones included, for MS\n"
+"                                     milliseconds (default: for good); then\n"
+"                                     every client gets the stream again, the\n"
+"                                     packets of the frozen period skipped\n"
+"      --fault freeze-every=N,for=MS  the same freeze after every N packets\n"
 "\n"
 "Other:\n"
 "  -v, --verbose            log every client (twice: debug)\n"
@@ -224,6 +255,7 @@ static void usage(FILE *out)
 "  " PROGRAM " --length 1124 --rate 1000         # a length no controller sends\n"
 "  " PROGRAM " -l [::1]:30013 --fault close-after=500 --fault garbage-every=100\n"
 "  " PROGRAM " --start-on-connect -n 1000 -w capture.bin --clients 1\n"
+"  " PROGRAM " -l 127.0.0.1:0 --port-file sim.port --fault freeze-every=2500,for=1500\n"
 "  " PROGRAM " --replay capture.bin --loop\n",
             URRT_PACKET_MAX, DEFAULT_LENGTH);
 }
@@ -325,9 +357,13 @@ static void parse_fault(const char *spec, fault_config *f)
         NEED_VALUE(f->stall_after, 1, UINT64_MAX);
     } else if (strcmp(kind, "odd-length") == 0) {
         NEED_VALUE(f->odd_every, 1, UINT64_MAX);
+    } else if (strcmp(kind, "freeze-after") == 0) {
+        NEED_VALUE(f->freeze_after, 1, UINT64_MAX);
+    } else if (strcmp(kind, "freeze-every") == 0) {
+        NEED_VALUE(f->freeze_every, 1, UINT64_MAX);
     } else {
         usage_error("unknown fault \"%s\": use close-after, reset-after, truncate-after, garbage-every, "
-                    "tiny-writes, coalesce, stall-after or odd-length",
+                    "tiny-writes, coalesce, stall-after, odd-length, freeze-after or freeze-every",
                     kind);
     }
     while ((tok = strtok_r(NULL, ",", &save)) != NULL) {
@@ -342,6 +378,10 @@ static void parse_fault(const char *spec, fault_config *f)
         } else if (strcmp(kind, "stall-after") == 0 && strcmp(key, "for") == 0) {
             kind = key;
             NEED_VALUE(f->stall_ms, 1, 86400000);
+        } else if ((strcmp(kind, "freeze-after") == 0 || strcmp(kind, "freeze-every") == 0) &&
+                   strcmp(key, "for") == 0) {
+            kind = key;
+            NEED_VALUE(f->freeze_ms, 1, 86400000);
         } else if (strcmp(kind, "odd-length") == 0 && strcmp(key, "length") == 0) {
             kind = key;
             NEED_VALUE(f->odd_length, URRT_PACKET_MIN, URRT_PACKET_MAX);
@@ -353,14 +393,22 @@ static void parse_fault(const char *spec, fault_config *f)
         }
     }
 #undef NEED_VALUE
+    if (f->freeze_after != 0 && f->freeze_every != 0) {
+        usage_error("give freeze-after or freeze-every, not both");
+    }
+    if (f->freeze_every != 0 && f->freeze_ms == 0) {
+        usage_error("fault freeze-every needs its length: freeze-every=N,for=MS");
+    }
 }
 
 static void parse_options(int argc, char **argv, options *o)
 {
     enum { OPT_CONTROLLER = 256, OPT_REPLAY, OPT_LOOP, OPT_START_ON_CONNECT, OPT_CLIENTS, OPT_MAX_CLIENTS,
-           OPT_RT_PRIORITY };
+           OPT_RT_PRIORITY, OPT_PORT_FILE, OPT_CLOCK };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, 'l'},
+        {"port-file", required_argument, NULL, OPT_PORT_FILE},
+        {"clock", required_argument, NULL, OPT_CLOCK},
         {"version", optional_argument, NULL, 'V'},
         {"controller", required_argument, NULL, OPT_CONTROLLER},
         {"length", required_argument, NULL, 'L'},
@@ -395,6 +443,18 @@ static void parse_options(int argc, char **argv, options *o)
     while ((c = getopt_long(argc, argv, "l:L:r:s:n:w:f:vqhV", longopts, NULL)) != -1) {
         switch (c) {
         case 'l': listen_arg = optarg; break;
+        case OPT_PORT_FILE: o->port_file = optarg; break;
+        case OPT_CLOCK:
+            if (strcmp(optarg, "start") == 0) {
+                o->clock = SIM_CLOCK_START;
+            } else if (strcmp(optarg, "monotonic") == 0) {
+                o->clock = SIM_CLOCK_MONOTONIC;
+            } else if (strcmp(optarg, "realtime") == 0) {
+                o->clock = SIM_CLOCK_REALTIME;
+            } else {
+                usage_error("--clock %s: use start, monotonic or realtime", optarg);
+            }
+            break;
         case 'V':
             /* "--version 5.10" names a controller; "--version" alone prints ours. */
             if (optarg == NULL && optind < argc && argv[optind][0] >= '0' && argv[optind][0] <= '9') {
@@ -479,13 +539,16 @@ static void parse_options(int argc, char **argv, options *o)
     if (o->replay_path != NULL && (version_arg != NULL || length_given || o->rate_given)) {
         usage_error("--replay sends the capture's own packets at its own pace: drop --version, --length, --rate");
     }
+    if (o->replay_path != NULL && o->clock != SIM_CLOCK_START) {
+        usage_error("--replay sends the capture's own time column: drop --clock");
+    }
     if (o->loop && o->replay_path == NULL) {
         usage_error("--loop goes with --replay");
     }
     if (o->fault.odd_every != 0 && o->fault.odd_length == 0) {
         o->fault.odd_length = o->length + 8;
     }
-    if ((err = cli_parse_host_port(listen_arg, URRT_LINK_PORT_RW, o->listen_host, sizeof o->listen_host,
+    if ((err = cli_parse_listen_address(listen_arg, URRT_LINK_PORT_RW, o->listen_host, sizeof o->listen_host,
                                    &o->listen_port)) != NULL) {
         usage_error("--listen %s: %s", listen_arg, err);
     }
@@ -573,8 +636,33 @@ static uint64_t due_offset(const sim *s, uint64_t k)
     return (uint64_t)((unsigned __int128)k * 1000000000000ull / (uint64_t)llround(s->opt.rate_hz * 1000.0));
 }
 
-/* The bytes of packet k of the schedule. */
-static const uint8_t *packet_bytes(sim *s, uint64_t k, size_t *len)
+/* Nanoseconds to seconds, exact to the double's resolution (a plain
+ * division would round the whole count first). */
+static double ns_to_s(uint64_t ns)
+{
+    return (double)(ns / 1000000000ull) + (double)(ns % 1000000000ull) / 1e9;
+}
+
+/* The time column of a packet due at monotonic instant due (in the past). */
+static double clock_column(const sim *s, uint64_t k, uint64_t due)
+{
+    struct timespec rt;
+    uint64_t mono;
+
+    switch (s->opt.clock) {
+    case SIM_CLOCK_MONOTONIC: return ns_to_s(due);
+    case SIM_CLOCK_REALTIME:
+        /* Unix time at due: now on the realtime clock less how long ago due was. */
+        clock_gettime(CLOCK_REALTIME, &rt);
+        mono = now_ns();
+        return ns_to_s((uint64_t)rt.tv_sec * 1000000000ull + (uint64_t)rt.tv_nsec - (mono > due ? mono - due : 0));
+    case SIM_CLOCK_START: break;
+    }
+    return sim_model_time(&s->model, k);
+}
+
+/* The bytes of packet k of the schedule, due at monotonic instant due. */
+static const uint8_t *packet_bytes(sim *s, uint64_t k, uint64_t due, size_t *len)
 {
     if (s->replaying) {
         size_t i = (size_t)(k % s->rp.count);
@@ -584,6 +672,7 @@ static const uint8_t *packet_bytes(sim *s, uint64_t k, size_t *len)
     }
     urrt_state st;
     sim_model_state(&s->model, k, urrt_generation_of(s->opt.length) == URRT_GEN_1X ? URRT_GEN_1X : URRT_GEN_3X, &st);
+    st.time[0] = clock_column(s, k, due);
     int n = urrt_encode(&st, s->opt.length, s->packet, sizeof s->packet);
     *len = n > 0 ? (size_t)n : 0;
     return s->packet;
@@ -882,6 +971,42 @@ static uint64_t percentile_ns(const latency_stats *lat, double p)
     return lat->max_ns;
 }
 
+/* The freeze fault: whether packet k, due at due, falls in a freeze, which
+ * then swallows it (a controller that stops sending does not buffer). */
+static bool frozen(sim *s, uint64_t due)
+{
+    if (s->frozen_until_ns == 0) {
+        return false;
+    }
+    if (due < s->frozen_until_ns) {
+        s->frozen_packets++;
+        return true;
+    }
+    urrt_log(URRT_LOG_NOTICE, "freeze %" PRIu64 " over: sending to every client again", s->freezes);
+    s->frozen_until_ns = 0;
+    return false;
+}
+
+/* After the packet due at due went out: starts a freeze when one is due. */
+static void maybe_freeze(sim *s, uint64_t due)
+{
+    const fault_config *f = &s->opt.fault;
+    if (!(f->freeze_after != 0 && s->packets_out == f->freeze_after) &&
+        !(f->freeze_every != 0 && s->packets_out % f->freeze_every == 0)) {
+        return;
+    }
+    /* Measured from the last packet sent: the next one goes MS later. */
+    s->frozen_until_ns = f->freeze_ms != 0 ? due + f->freeze_ms * 1000000ull : UINT64_MAX;
+    s->freezes++;
+    if (f->freeze_ms != 0) {
+        urrt_log(URRT_LOG_NOTICE, "freeze %" PRIu64 ": nothing to any client for %" PRIu64 " ms after %" PRIu64
+                 " packets", s->freezes, f->freeze_ms, s->packets_out);
+    } else {
+        urrt_log(URRT_LOG_NOTICE, "freeze %" PRIu64 ": nothing to any client from now on, after %" PRIu64 " packets",
+                 s->freezes, s->packets_out);
+    }
+}
+
 /* Emits every packet that is due. */
 static void run_schedule(sim *s, uint64_t now)
 {
@@ -895,6 +1020,11 @@ static void run_schedule(sim *s, uint64_t now)
         size_t len;
 
         if (!s->replaying || s->opt.loop || s->next < s->rp.count) {
+            /* Frozen first, so that a freeze swallows the same packets however late we are. */
+            if (frozen(s, due)) {
+                s->next++;
+                continue;
+            }
             if (now - due > CATCH_UP_MAX_NS) {
                 /* Too far behind (stopped, swapped out): skip, do not burst. */
                 s->lat.skipped++;
@@ -902,11 +1032,12 @@ static void run_schedule(sim *s, uint64_t now)
                 continue;
             }
             note_lateness(&s->lat, now - due, period ? period : 1);
-            pkt = packet_bytes(s, s->next, &len);
+            pkt = packet_bytes(s, s->next, due, &len);
             for (size_t i = 0; i < s->nclients; i++) {
                 emit_to_client(s, &s->clients[i], pkt, len, now);
             }
             s->packets_out++;
+            maybe_freeze(s, due);
             s->next++;
         }
         if (s->replaying && !s->opt.loop && s->next >= s->rp.count) {
@@ -966,6 +1097,43 @@ static int open_listener(const options *o)
     return fd;
 }
 
+/* The port the listener got (the system picks one for port 0). */
+static uint16_t bound_port(int fd)
+{
+    struct sockaddr_storage ss;
+    socklen_t sl = sizeof ss;
+    if (getsockname(fd, (struct sockaddr *)&ss, &sl) != 0) {
+        return 0;
+    }
+    return ntohs(ss.ss_family == AF_INET6 ? ((struct sockaddr_in6 *)&ss)->sin6_port
+                                          : ((struct sockaddr_in *)&ss)->sin_port);
+}
+
+/* Written to PATH.tmp and renamed, so that a reader sees the whole line or no file. */
+static bool write_port_file(const char *path, uint16_t port)
+{
+    char tmp[4096];
+    FILE *f;
+    bool ok;
+
+    if ((size_t)snprintf(tmp, sizeof tmp, "%s.tmp", path) >= sizeof tmp) {
+        urrt_log(URRT_LOG_ERR, "--port-file %s: name too long", path);
+        return false;
+    }
+    f = fopen(tmp, "w");
+    ok = f != NULL;
+    if (ok) {
+        ok = fprintf(f, "%u\n", (unsigned)port) > 0;
+        ok = fclose(f) == 0 && ok;
+    }
+    ok = ok && rename(tmp, path) == 0;
+    if (!ok) {
+        urrt_log(URRT_LOG_ERR, "cannot write the port file %s: %s", path, strerror(errno));
+        unlink(tmp);
+    }
+    return ok;
+}
+
 static void log_summary(const sim *s, uint64_t now)
 {
     const latency_stats *lat = &s->lat;
@@ -973,11 +1141,11 @@ static void log_summary(const sim *s, uint64_t now)
     urrt_log(URRT_LOG_NOTICE,
              "%" PRIu64 " packets in %.3f s; late (a period or more behind) %" PRIu64 ", skipped %" PRIu64
              "; lateness mean %.1f us, p99 <= %.0f us, max %.1f us; clients %" PRIu64 ", dropped as slow %" PRIu64
-             "; garbage bytes %" PRIu64,
+             "; garbage bytes %" PRIu64 "; freezes %" PRIu64 " (%" PRIu64 " packets not sent)",
              s->packets_out, secs, lat->late, lat->skipped,
              lat->samples ? (double)lat->sum_ns / (double)lat->samples / 1e3 : 0.0,
              (double)percentile_ns(lat, 0.99) / 1e3, (double)lat->max_ns / 1e3, s->next_client_id, s->slow_drops,
-             s->garbage_sent);
+             s->garbage_sent, s->freezes, s->frozen_packets);
 }
 
 int main(int argc, char **argv)
@@ -1020,6 +1188,7 @@ int main(int argc, char **argv)
     if (s.listen_fd < 0) {
         return CLI_EXIT_RUNTIME;
     }
+    s.opt.listen_port = bound_port(s.listen_fd);
     {
         char where[300];
         cli_format_host_port(s.opt.listen_host, s.opt.listen_port, where, sizeof where);
@@ -1030,6 +1199,10 @@ int main(int argc, char **argv)
             urrt_log(URRT_LOG_NOTICE, "serving %" PRIu32 "-byte packets (%s) at %g Hz on %s, seed %" PRIu64,
                      s.opt.length, v ? v : "no controller sends this length", s.opt.rate_hz, where, s.opt.seed);
         }
+    }
+    /* After the log line, so that a reader woken by the file finds it too. */
+    if (s.opt.port_file != NULL && !write_port_file(s.opt.port_file, s.opt.listen_port)) {
+        return CLI_EXIT_RUNTIME;
     }
     /* A capture starts from its first packet for the first client. */
     if (!s.opt.start_on_connect && !s.replaying) {

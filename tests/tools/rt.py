@@ -9,12 +9,22 @@ Nothing here imports or calls the C library: it is the second opinion.
   rt.py json CAPTURE DUMP_OUT             dump's JSON lines carry the capture's values
   rt.py csv CAPTURE DUMP_OUT              dump's CSV rows carry the capture's values
   rt.py model CAPTURE RATE                the simulated motion is consistent
-  rt.py noread-server PORT CAPTURE OUT    serve CAPTURE twice; fail on any byte received
+  rt.py noread-server CAPTURE OUT         serve CAPTURE twice; fail on any byte received;
+                                          the port (from the system) in OUT.port
   rt.py slow-client PORT SECONDS          connect, never read, hold on
   rt.py writer-client PORT                connect and send a byte (negative control)
+  rt.py clock PORT CLOCK RATE COUNT       the time column on the simulator's --clock CLOCK
+  rt.py freeze PORT SIMLOG MS RATE        a freeze (--clock monotonic) seen by a client that
+                                          stays and one that reconnects during it
+  rt.py freeze-every PORT N MS RATE       runs of N packets between freezes of MS
+  rt.py refused-port OUT                  hold a bound port that does not listen; write it to OUT
+
+Clocks: Python's time.monotonic() and time.time() read CLOCK_MONOTONIC and
+CLOCK_REALTIME, the clocks urrt-sim's --clock monotonic and realtime use.
 """
 import json
 import math
+import os
 import select
 import socket
 import struct
@@ -220,25 +230,23 @@ def cmd_model(capture, rate):
         fail('model: the joints do not move')
 
 
-def cmd_noread_server(port, capture, out):
+def write_port(path, port):
+    """As urrt-sim --port-file: the whole line or no file."""
+    with open(path + '.tmp', 'w') as f:
+        f.write('%d\n' % port)
+    os.rename(path + '.tmp', path)
+
+
+def cmd_noread_server(capture, out):
     """Serves the capture in two connections (half, stall until the client
     gives up, then the rest) and records every byte a client sends."""
     data = open(capture, 'rb').read()
     pk = packets(capture)
     half = sum(size for size, _ in pk[:len(pk) // 2])
-    # Test ports lie in the ephemeral range: one may be some connection's
-    # local end. Try a few, and say in OUT.port which one listens.
-    for p in range(int(port), int(port) + 5):
-        srv = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        srv.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            srv.bind(('127.0.0.1', p))
-            break
-        except OSError:
-            srv.close()
+    srv = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    srv.bind(('127.0.0.1', 0))
     srv.listen(4)
-    with open(out + '.port', 'w') as f:
-        f.write('%d\n' % p)
+    write_port(out + '.port', srv.getsockname()[1])
     srv.settimeout(10)
     received = 0
     result = {'connections': 0, 'received': 0}
@@ -283,10 +291,151 @@ def cmd_writer_client(port):
     s.close()
 
 
+class Stream:
+    """One connection to the simulator: (arrival, time column) per packet,
+    and when its first byte came."""
+
+    def __init__(self, port, clock=time.monotonic):
+        self.clock = clock
+        self.sock = socket.create_connection(('127.0.0.1', int(port)), timeout=5)
+        self.connected = clock()
+        self.sock.setblocking(False)
+        self.buf = b''
+        self.first_byte = None
+        self.packets = []
+
+    def read(self):
+        try:
+            data = self.sock.recv(65536)
+        except BlockingIOError:
+            return
+        now = self.clock()
+        if not data:
+            fail('the simulator closed a connection')
+        if self.first_byte is None:
+            self.first_byte = now
+        self.buf += data
+        while len(self.buf) >= 12:
+            size = struct.unpack_from('>i', self.buf)[0]
+            if len(self.buf) < size:
+                break
+            self.packets.append((now, struct.unpack_from('>d', self.buf, 4)[0]))
+            self.buf = self.buf[size:]
+
+
+def serve(streams, until, seconds):
+    """Reads every stream until until() holds; fails after seconds."""
+    end = time.monotonic() + seconds
+    while not until():
+        if time.monotonic() > end:
+            fail('timed out')
+        r, _, _ = select.select([s.sock for s in streams], [], [], 0.01)
+        for s in streams:
+            if s.sock in r:
+                s.read()
+
+
+def gaps(packets, period):
+    """(index after the gap, gap in the time column) where the column jumps."""
+    return [(i, packets[i][1] - packets[i - 1][1]) for i in range(1, len(packets))
+            if packets[i][1] - packets[i - 1][1] > 1.5 * period]
+
+
+def cmd_clock(port, clock, rate, count):
+    period, count = 1.0 / float(rate), int(count)
+    c = Stream(port, time.time if clock == 'realtime' else time.monotonic)
+    serve([c], lambda: len(c.packets) >= count, 10)
+    ages = [arrival - t for arrival, t in c.packets]
+    steps = [b[1] - a[1] for a, b in zip(c.packets, c.packets[1:])]
+    worst_step = max(abs(d - period) for d in steps)
+    print('rt.py: clock %s: time column %.6f, %d packets, age min %.6f s, max %.6f s, step error %.3g s'
+          % (clock, c.packets[0][1], len(ages), min(ages), max(ages), worst_step))
+    # The column is the scheduled instant: a packet cannot arrive before it
+    # (1 us for the double's rounding), and the steps are exact periods to
+    # the microsecond, Unix time (1.8e9 s) included.
+    if worst_step > 1e-6:
+        fail('clock %s: a step of the time column is off the period by %g s' % (clock, worst_step))
+    if clock == 'start':
+        if abs(c.packets[0][1] - (1000.0 + round((c.packets[0][1] - 1000.0) / period) * period)) > 1e-6:
+            fail('clock start: %.9f is not 1000 s + k periods' % c.packets[0][1])
+        return
+    if min(ages) < -1e-6 or max(ages) > 0.5:
+        fail('clock %s: ages from %.6f to %.6f s (0 to 0.5 s expected)' % (clock, min(ages), max(ages)))
+    if clock == 'realtime' and not 1.6e9 < c.packets[0][1] < 4.1e9:
+        fail('clock realtime: %.6f is not Unix time' % c.packets[0][1])
+
+
+def wait_for_line(path, text, streams, seconds):
+    def seen():
+        with open(path) as f:
+            return text in f.read()
+    serve(streams, seen, seconds)
+
+
+def cmd_freeze(port, simlog, ms, rate):
+    """Client a stays connected; client b connects before the freeze and
+    again while it lasts. Times on CLOCK_MONOTONIC, the time column's clock."""
+    freeze, period = float(ms) / 1000.0, 1.0 / float(rate)
+    a, b = Stream(port), Stream(port)
+    serve([a, b], lambda: len(a.packets) >= 10 and len(b.packets) >= 10, 10)
+    wait_for_line(simlog, 'freeze 1: nothing to any client', [a, b], 20)
+    b.sock.close()
+    b2 = Stream(port)
+    wait_for_line(simlog, 'freeze 1 over', [a, b2], 10 + freeze)
+    serve([a, b2], lambda: len(b2.packets) >= 10 and len(a.packets) > 0 and a.packets[-1][1] > b2.packets[9][1], 10)
+    g = gaps(a.packets, period)
+    if len(g) != 1:
+        fail('freeze: %d gaps in the stream of the client that stayed: %s' % (len(g), g))
+    i, gap = g[0]
+    last, first = a.packets[i - 1], a.packets[i]
+    end = last[1] + freeze  # the freeze ends MS after the last packet's instant
+    print('rt.py: freeze: gap %.6f s in the time column, %.6f s by arrival; reconnected %.3f s before its end, '
+          'first byte %.6f s after it' % (gap, first[0] - last[0], end - b2.connected, b2.first_byte - end))
+    if not freeze - 1e-6 <= gap < freeze + period + 1e-6:
+        fail('freeze: the time column jumps %.6f s, not %.3f s (to one period more)' % (gap, freeze))
+    if first[0] < end - 1e-6:
+        fail('freeze: a packet arrived %.6f s before the freeze ended' % (end - first[0]))
+    if b2.connected >= end:
+        fail('freeze: the reconnect came %.3f s after the freeze (the test could not reconnect during it)'
+             % (b2.connected - end))
+    if b2.first_byte < end - 1e-6:
+        fail('freeze: the client that reconnected got a byte %.6f s before the freeze ended' % (end - b2.first_byte))
+    if b2.first_byte > end + 1.0:
+        fail('freeze: the client that reconnected waited %.3f s past the freeze' % (b2.first_byte - end))
+    if b2.packets[0][1] != first[1]:
+        fail('freeze: after it the clients got different packets first (%.6f and %.6f)' % (b2.packets[0][1], first[1]))
+
+
+def cmd_freeze_every(port, n, ms, rate):
+    """Runs of exactly N packets, gaps of MS (to a period) in the time column
+    (--clock start: it counts the frozen packets too)."""
+    n, freeze, period = int(n), float(ms) / 1000.0, 1.0 / float(rate)
+    c = Stream(port)
+    serve([c], lambda: len(gaps(c.packets, period)) >= 4, 10 + 6 * freeze)
+    g = gaps(c.packets, period)
+    runs = [j - i for (i, _), (j, _) in zip(g, g[1:])]
+    print('rt.py: freeze-every: runs %s, gaps %s' % (runs, ['%.6f' % d for _, d in g]))
+    if runs != [n] * len(runs):
+        fail('freeze-every: runs of %s packets, not %d' % (runs, n))
+    for _, d in g:
+        if not freeze - 1e-6 <= d < freeze + period + 1e-6:
+            fail('freeze-every: a gap of %.6f s in the time column, not %.3f s' % (d, freeze))
+
+
+def cmd_refused_port(out):
+    """A port nobody listens on and nobody else can take while this runs:
+    bound (without SO_REUSEADDR) but not listening, so a connect is refused."""
+    s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    s.bind(('127.0.0.1', 0))
+    write_port(out, s.getsockname()[1])
+    time.sleep(60)
+
+
 if __name__ == '__main__':
     cmds = {'gnuplot': cmd_gnuplot, 'json': cmd_json, 'csv': cmd_csv, 'model': cmd_model,
             'noread-server': cmd_noread_server, 'slow-client': cmd_slow_client,
-            'writer-client': cmd_writer_client}
+            'writer-client': cmd_writer_client, 'clock': cmd_clock, 'freeze': cmd_freeze,
+            'freeze-every': cmd_freeze_every, 'refused-port': cmd_refused_port}
     if len(sys.argv) < 2 or sys.argv[1] not in cmds:
         print(__doc__, file=sys.stderr)
         sys.exit(2)

@@ -617,6 +617,11 @@ static void test_cli(void)
     CHECK(cli_parse_host_port(":30003", 30003, host, sizeof host, &port) != NULL, "no host");
     CHECK(cli_parse_host_port("robot:70000", 30003, host, sizeof host, &port) != NULL, "port range");
     CHECK(cli_parse_host_port("robot:0", 30003, host, sizeof host, &port) != NULL, "port 0");
+    CHECK(cli_parse_listen_address("127.0.0.1:0", 30003, host, sizeof host, &port) == NULL, "listen on port 0");
+    CHECK_EQ_INT(port, 0);
+    CHECK(cli_parse_listen_address("[::1]:30013", 30003, host, sizeof host, &port) == NULL, "listen [v6]:port");
+    CHECK_EQ_INT(port, 30013);
+    CHECK(cli_parse_listen_address("robot:65536", 30003, host, sizeof host, &port) != NULL, "listen port range");
     CHECK(cli_parse_host_port("robot:30x", 30003, host, sizeof host, &port) != NULL, "port text");
     CHECK(cli_parse_host_port("[::1", 30003, host, sizeof host, &port) != NULL, "unclosed bracket");
     CHECK(cli_parse_host_port("[::1]x", 30003, host, sizeof host, &port) != NULL, "text after bracket");
