@@ -3,14 +3,8 @@
 #   check-tools       urrt-sim and urrt-dump end to end (shell + Python reference)
 #   check-tools-asan  both again, everything built with ASan and UBSan
 #   bench-tools       the simulator's schedule at 500 Hz: lateness, late packets
-# TCP ports: check-tools-link 40500-40519, check-tools 40200-40299, and for
-# the sanitized runs 40530-40549 and 40300-40399 (so that -j is safe); bench 40800-40802.
-# The review's regressions: check-tools 44000-44019, check-tools-link 44020-44039
-# (sanitized: 44100-44119, 44120-44139).
-TOOLS_PORT_BASE ?= 40200
-TOOLS_REV_PORT_BASE ?= 44000
-TOOLS_REV_LINK_PORT ?= 44020
-TOOLS_LINK_PORT ?= 40500
+# No fixed TCP port: every server takes one from the system, so that runs in
+# two build directories at once (or -j) do not meet.
 TOOLS_TEST_LINK := $(BUILD)/tests/test_link
 
 $(TOOLS_TEST_LINK): tests/tools/test_link.c tests/check.h $(CLI_OBJ) $(LIBPORT) $(LIBURRT)
@@ -20,12 +14,12 @@ $(TOOLS_TEST_LINK): tests/tools/test_link.c tests/check.h $(CLI_OBJ) $(LIBPORT) 
 .PHONY: check-tools-link check-tools check-tools-asan bench-tools
 check-tools-link: $(TOOLS_TEST_LINK)
 	@mkdir -p $(BUILD)/results
-	@rc=0; timeout -k 5 60 $(TOOLS_TEST_LINK) $(TOOLS_LINK_PORT) $(TOOLS_REV_LINK_PORT) > $(BUILD)/results/$@.result || rc=$$?; \
+	@rc=0; timeout -k 5 60 $(TOOLS_TEST_LINK) > $(BUILD)/results/$@.result || rc=$$?; \
 	  cat $(BUILD)/results/$@.result; exit $$rc
 
 check-tools: $(BUILD)/bin/urrt-sim $(BUILD)/bin/urrt-dump
 	@mkdir -p $(BUILD)/results
-	BUILD=$(BUILD) PYTHON=$(PYTHON) PORT_BASE=$(TOOLS_PORT_BASE) REV_PORT_BASE=$(TOOLS_REV_PORT_BASE) timeout -k 5 110 sh tests/tools/check_tools.sh
+	BUILD=$(BUILD) PYTHON=$(PYTHON) timeout -k 5 110 sh tests/tools/check_tools.sh
 
 # The same suites on a sanitized build in its own directory. Leak checking is
 # off: LeakSanitizer needs ptrace, which hangs at exit in some sandboxes.
@@ -37,7 +31,7 @@ check-tools-asan:
 	@rm -rf $(TOOLS_ASAN_BUILD)/results; \
 	  ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  $(MAKE) --no-print-directory -k BUILD=$(TOOLS_ASAN_BUILD) OPT="-O1 -g $(SAN_FLAGS)" \
-	  TOOLS_PORT_BASE=40300 TOOLS_REV_PORT_BASE=44100 TOOLS_REV_LINK_PORT=44120 TOOLS_LINK_PORT=40530 check-tools-link check-tools > $(TOOLS_ASAN_BUILD)/check.log 2>&1; rc=$$?; \
+	  check-tools-link check-tools > $(TOOLS_ASAN_BUILD)/check.log 2>&1; rc=$$?; \
 	  grep -v '^ok: ' $(TOOLS_ASAN_BUILD)/check.log | grep -v '^rt.py: ' | tail -n 20; \
 	  sh tests/summary.sh $(TOOLS_ASAN_BUILD)/results check-tools-link check-tools | tail -n 1 > $(BUILD)/results/$@.result; \
 	  cat $(BUILD)/results/$@.result; [ $$rc = 0 ] && grep -q ' 0 failed$$' $(BUILD)/results/$@.result

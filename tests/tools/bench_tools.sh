@@ -1,7 +1,7 @@
 #!/bin/sh
 # bench-tools: how well urrt-sim keeps its schedule at 500 Hz, alone with
 # one client and with four. Prints "name: value" lines; asserts nothing.
-# TCP ports 40800-40802.
+# The simulator takes its port from the system (--port-file).
 set -u
 BUILD=${BUILD:-build}
 SIM=$BUILD/bin/urrt-sim
@@ -10,21 +10,24 @@ SECONDS_EACH=${BENCH_SECONDS:-5}
 T=$(mktemp -d "${TMPDIR:-/tmp}/urrt-bench.XXXXXX")
 trap 'rm -rf "$T"' EXIT
 
-waitport() {
+# waitfile FILE PID: until FILE is there (at most 10 s, or until PID ends).
+waitfile() {
   i=0
-  while [ $i -lt 100 ]; do
-    ss -Hltn "sport = :$1" 2>/dev/null | grep -q . && return 0
+  while [ $i -lt 500 ] && kill -0 "$2" 2>/dev/null; do
+    [ -s "$1" ] && return 0
     sleep 0.02; i=$((i + 1))
   done
-  return 1
+  [ -s "$1" ]
 }
 
-# run NAME PORT CLIENTS [SIM OPTIONS]
+# run NAME CLIENTS [SIM OPTIONS]
 run() {
-  name=$1; port=$2; clients=$3; shift 3; n=$((SECONDS_EACH * 500))
-  timeout $((SECONDS_EACH + 20)) "$SIM" -l "127.0.0.1:$port" --version 5.10 "$@" 2> "$T/sim.log" &
+  name=$1; clients=$2; shift 2; n=$((SECONDS_EACH * 500))
+  rm -f "$T/port"
+  timeout $((SECONDS_EACH + 20)) "$SIM" -l 127.0.0.1:0 --port-file "$T/port" --version 5.10 "$@" 2> "$T/sim.log" &
   sp=$!
-  waitport "$port"
+  waitfile "$T/port" $sp || { echo "the simulator did not start:" >&2; cat "$T/sim.log" >&2; exit 1; }
+  port=$(cat "$T/port")
   k=0; pids=""
   while [ $k -lt "$clients" ]; do
     timeout $((SECONDS_EACH + 15)) "$DUMP" "127.0.0.1:$port" -n $n -F gnuplot > /dev/null 2> "$T/dump$k.sum" &
@@ -48,8 +51,8 @@ run() {
   eval "mean_$name=$mean"
 }
 
-run 1client 40800 1
-run 4clients 40801 4
+run 1client 1
+run 4clients 4
 # SCHED_FIFO where allowed (root, CAP_SYS_NICE); a warning and normal priority otherwise.
-run 1client_fifo 40802 1 --rt-priority 10
+run 1client_fifo 1 --rt-priority 10
 echo "sim_500hz_lateness_mean_ratio_4clients_vs_1: $(awk "BEGIN { printf \"%.2f\", $mean_4clients / ($mean_1client > 0 ? $mean_1client : 1) }")"

@@ -1,7 +1,8 @@
 /*
  * The POSIX robot link against servers in this process, and the shared
  * command-line helpers. Real sockets on loopback, real time; every wait is
- * bounded.
+ * bounded. Every port comes from the system (bind to port 0), so that two
+ * runs on one machine do not meet.
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -18,8 +19,6 @@
 #include "cli.h"
 #include "port.h"
 
-static uint16_t port_base = 40500;
-static uint16_t rev_port_base = 44020; /* the review's tests */
 
 /* ---- log capture ---------------------------------------------------------- */
 
@@ -155,44 +154,34 @@ static bool enough_packets(const urrt_link *l, const rx *r)
 
 /* ---- a server ------------------------------------------------------------------ */
 
-static int listen_once(int family, uint16_t port, int backlog)
+/* A loopback socket on a port the system picks (*port receives it), listening
+ * with backlog, or only bound when backlog < 0. */
+static int bind_any(int family, uint16_t *port, int backlog)
 {
-    int fd = socket(family, SOCK_STREAM | SOCK_CLOEXEC, 0), on = 1;
+    int fd = socket(family, SOCK_STREAM | SOCK_CLOEXEC, 0);
     struct sockaddr_storage ss;
     socklen_t len;
     memset(&ss, 0, sizeof ss);
     if (family == AF_INET6) {
         struct sockaddr_in6 *a = (struct sockaddr_in6 *)&ss;
         a->sin6_family = AF_INET6;
-        a->sin6_port = htons(port);
         a->sin6_addr = in6addr_loopback;
         len = sizeof *a;
     } else {
         struct sockaddr_in *a = (struct sockaddr_in *)&ss;
         a->sin_family = AF_INET;
-        a->sin_port = htons(port);
         a->sin_addr.s_addr = htonl(INADDR_LOOPBACK);
         len = sizeof *a;
     }
-    setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
-    if (bind(fd, (struct sockaddr *)&ss, len) != 0 || listen(fd, backlog) != 0) {
-        close(fd);
+    if (fd < 0 || bind(fd, (struct sockaddr *)&ss, len) != 0 || (backlog >= 0 && listen(fd, backlog) != 0) ||
+        getsockname(fd, (struct sockaddr *)&ss, &len) != 0) {
+        if (fd >= 0) {
+            close(fd);
+        }
         return -1;
     }
+    *port = ntohs(family == AF_INET6 ? ((struct sockaddr_in6 *)&ss)->sin6_port : ((struct sockaddr_in *)&ss)->sin_port);
     return fd;
-}
-
-/* Test ports lie in the kernel's ephemeral range, so one may be the local
- * end of some connection: *port moves on by 5 until one is free. */
-static int listen_on(int family, uint16_t *port, int backlog)
-{
-    for (int i = 0; i < 4; i++, *port = (uint16_t)(*port + 5)) {
-        int fd = listen_once(family, *port, backlog);
-        if (fd >= 0 || family == AF_INET6) {
-            return fd;
-        }
-    }
-    return -1;
 }
 
 static int accept_within(int lfd, int ms)
@@ -283,16 +272,21 @@ static void test_refused_backoff(void)
     int nd = 0;
     static const uint64_t want[] = {10, 20, 40, 80, 80, 80, 80, 80, 80, 80, 80};
     char peer[64];
+    /* Bound, not listening: a connect is refused, and nobody else can take
+     * the port while we hold it (we set no SO_REUSEADDR). */
+    uint16_t port = 0;
+    int held = bind_any(AF_INET, &port, -1);
 
+    CHECK(held >= 0, "a port that refuses");
     urrt_link_config_defaults(&c);
     c.name = "arm1";
     c.host = "127.0.0.1";
-    c.port = port_base; /* nothing listens there */
+    c.port = port;
     c.backoff_initial_ms = 10;
     c.backoff_max_ms = 80;
     l = urrt_link_new(&c);
     CHECK(l != NULL, "link");
-    snprintf(peer, sizeof peer, "127.0.0.1:%u", port_base);
+    snprintf(peer, sizeof peer, "127.0.0.1:%u", port);
     CHECK_EQ_STR(urrt_link_peer(l), peer);
     CHECK_EQ_INT(urrt_link_deadline(l), 0); /* the first attempt is due at once */
     log_count = 0;
@@ -314,6 +308,7 @@ static void test_refused_backoff(void)
         dump_log();
     }
     urrt_link_free(l);
+    close(held);
 }
 
 static void test_session(void)
@@ -324,8 +319,8 @@ static void test_session(void)
     uint8_t pkt[1116];
     uint64_t delays[8];
     int nd = 0;
-    uint16_t port = (uint16_t)(port_base + 1);
-    int lfd = listen_on(AF_INET, &port, 4), s;
+    uint16_t port = 0;
+    int lfd = bind_any(AF_INET, &port, 4), s;
     long sent_by_link = 0;
 
     CHECK(lfd >= 0, "listen");
@@ -436,8 +431,8 @@ static void test_connect_timeout(void)
     urrt_link_config c;
     urrt_link *l;
     rx r = {0};
-    uint16_t port = (uint16_t)(port_base + 2);
-    int lfd = listen_on(AF_INET, &port, 0);
+    uint16_t port = 0;
+    int lfd = bind_any(AF_INET, &port, 0);
     int fillers[4];
     struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons(port), .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
     uint64_t t0;
@@ -478,8 +473,8 @@ static void test_ipv6(void)
     urrt_link_config c;
     urrt_link *l;
     rx r = {0};
-    uint16_t port = (uint16_t)(port_base + 3);
-    int lfd = listen_on(AF_INET6, &port, 4), s;
+    uint16_t port = 0;
+    int lfd = bind_any(AF_INET6, &port, 4), s;
     uint8_t pkt[1220];
     char peer[64];
 
@@ -513,8 +508,8 @@ static void test_name(void)
     urrt_link_config c;
     urrt_link *l;
     rx r = {0};
-    uint16_t port = (uint16_t)(port_base + 4);
-    int lfd = listen_on(AF_INET, &port, 4), s;
+    uint16_t port = 0;
+    int lfd = bind_any(AF_INET, &port, 4), s;
     uint8_t pkt[1116];
 
     urrt_link_config_defaults(&c);
@@ -543,8 +538,8 @@ static void test_wrong_port(void)
     urrt_link_config c;
     urrt_link *l;
     rx r = {0};
-    uint16_t port = rev_port_base;
-    int lfd = listen_on(AF_INET, &port, 4), s, fd;
+    uint16_t port = 0;
+    int lfd = bind_any(AF_INET, &port, 4), s, fd;
     int on = 0, idle = 0;
     socklen_t len = sizeof on;
     char want[96];
@@ -649,14 +644,8 @@ static void test_cli(void)
     CHECK_EQ_STR(host, "robot:30013");
 }
 
-int main(int argc, char **argv)
+int main(void)
 {
-    if (argc > 1) {
-        port_base = (uint16_t)atoi(argv[1]);
-    }
-    if (argc > 2) {
-        rev_port_base = (uint16_t)atoi(argv[2]);
-    }
     urrt_log_init("test_link", URRT_LOG_DEBUG);
     urrt_log_set_sink(sink, NULL);
     test_cli();
