@@ -298,9 +298,11 @@ typedef void (*can_map_emit_fn)(void *ctx, const urrt_can_frame *frame);
 void can_map_start(struct can_map *map, uint64_t now_us);
 
 /* A decoded packet of robot `robot` (index into the robots given to
- * can_map_finish), received at rx_us: packs every frame of that robot. A
- * packet means the robot's link is up. */
-void can_map_on_packet(struct can_map *map, size_t robot, const urrt_state *st, uint64_t rx_us);
+ * can_map_finish) whose data is no older than now - data_us (its read time,
+ * less any lag the gateway measured: gateway/freshness.h): packs every
+ * frame of that robot. Staleness is judged from data_us. A packet means
+ * the robot's link is up. */
+void can_map_on_packet(struct can_map *map, size_t robot, const urrt_state *st, uint64_t data_us);
 
 /* The robot's link went up or down (down: the heartbeat says disconnected). */
 void can_map_robot_link(struct can_map *map, size_t robot, bool up);

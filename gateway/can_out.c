@@ -36,9 +36,12 @@ static void run_due(can_out *out, uint64_t now_us)
 static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
 {
     can_out *out = ctx;
-    can_map_on_packet(out->map, robot->index, pkt->state, pkt->rx_us);
+    /* The map judges staleness by the data's age, not by the read: a
+     * backlog read just now is as old as its data. Frames are due by the
+     * clock now, just before they are sent. */
+    can_map_on_packet(out->map, robot->index, pkt->state, pkt->data_us);
     out->robot_up[robot->index] = true;
-    run_due(out, pkt->rx_us);
+    run_due(out, urrt_port_monotonic_us());
 }
 
 static void on_tick(void *ctx, uint64_t now_us)

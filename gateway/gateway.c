@@ -12,25 +12,42 @@
 /* A wrong-length stream is logged at once, then at most this often. */
 #define GW_MISMATCH_LOG_US (10u * 1000000u)
 
+static uint64_t bound_us(const gw_robot *robot)
+{
+    return (uint64_t)robot->cfg->link.silence_timeout_ms * 1000u;
+}
+
+bool gw_robot_data_fresh(const gw_robot *robot, uint64_t data_us, uint64_t now_us)
+{
+    return bound_us(robot) == 0 || now_us <= data_us || now_us - data_us <= bound_us(robot);
+}
+
 bool gw_robot_fresh(const gw_robot *robot, uint64_t now_us)
 {
-    uint64_t timeout_us = (uint64_t)robot->cfg->link.silence_timeout_ms * 1000u;
-    if (urrt_link_get_state(robot->link) != URRT_LINK_UP || robot->last_rx_us == 0 || robot->mismatch) {
+    if (urrt_link_get_state(robot->link) != URRT_LINK_UP || robot->last_rx_us == 0 || robot->mismatch ||
+        robot->late) {
         return false;
     }
     /* A connection made after the last packet has sent nothing yet. */
     if (urrt_link_get_stats(robot->link)->connects != robot->connects_seen) {
         return false;
     }
-    return timeout_us == 0 || now_us < robot->last_rx_us + timeout_us;
+    return gw_robot_data_fresh(robot, robot->data_us, now_us);
+}
+
+uint64_t gw_wall_us(uint64_t mono_us)
+{
+    uint64_t mono = urrt_port_monotonic_us();
+    uint64_t wall = urrt_port_realtime_us();
+    return mono >= mono_us ? wall - (mono - mono_us) : wall + (mono_us - mono);
 }
 
 int64_t gw_robot_data_age_us(const gw_robot *robot, uint64_t now_us)
 {
-    if (robot->last_any_rx_us == 0) {
+    if (robot->newest_data_us == 0) {
         return -1;
     }
-    return now_us > robot->last_any_rx_us ? (int64_t)(now_us - robot->last_any_rx_us) : 0;
+    return now_us > robot->newest_data_us ? (int64_t)(now_us - robot->newest_data_us) : 0;
 }
 
 unsigned gw_counters(const gateway *gw, const gw_robot *robot, gw_counter *out, unsigned max)
@@ -66,45 +83,32 @@ static void on_mismatch(gw_robot *robot, size_t length, uint64_t rx_us)
     }
 }
 
-/* Whether a packet was read later than the silence timeout after the
- * controller sent it: a backlog in the socket, after the gateway was
- * stopped or starved, holds packets whose data is that old although they
- * were only just read. The controller's clock against the host's tells:
- * read time - controller time is smallest for a packet read at once, and
- * larger by how long a packet waited. That floor may rise by the time that
- * passed since the previous packet on the slower of the two clocks, so that
- * a controller clock running as slow as half of real time (a loaded
- * simulator) still passes, while a packet read after a stall (little
- * controller time passed) and the packets read together with it (no host
- * time passed) are judged by their whole wait. A new connection or a controller clock that
- * went back (a restart) starts again. */
-static bool packet_late(gw_robot *robot, const urrt_state *st, uint64_t rx_us, bool new_connection)
+/* The lag of a packet's data when read (freshness.h), on both clocks. */
+static uint64_t packet_lag(gw_robot *robot, const urrt_state *st, uint64_t rx_us, bool new_connection)
 {
-    uint64_t timeout_us = (uint64_t)robot->cfg->link.silence_timeout_ms * 1000u;
     double t = st->time[0];
-    int64_t controller_us, offset, host_step, controller_step;
+    bool has_clock = urrt_has(st, URRT_F_TIME) && isfinite(t) && fabs(t) < 9e12;
+    uint64_t lag;
+    if (new_connection) {
+        gw_age_reset(&robot->age);
+    }
+    lag = gw_age_lag_us(&robot->age, rx_us, urrt_link_packet_empty_us(robot->link), has_clock,
+                                 has_clock ? (int64_t)llround(t * 1e6) : 0);
+    return lag < rx_us ? lag : rx_us - 1; /* data_us 0 means "none" */
+}
 
-    if (!urrt_has(st, URRT_F_TIME) || !isfinite(t) || fabs(t) > 9e12 || timeout_us == 0) {
-        return false; /* no clock to judge by */
+static void on_late(gw_robot *robot, uint64_t lag_us)
+{
+    robot->late_packets++;
+    if (!robot->late) {
+        urrt_log(URRT_LOG_WARNING, "robot %s: data %.0f ms old when read, older than silence_timeout (%u ms): "
+                 "not published (late_packets %" PRIu64 "); the gateway was stopped, starved of CPU, slower "
+                 "than the robot, or the link to the robot held data back: give it a core, publish less "
+                 "(rates in [lcm]), or check the network",
+                 robot->cfg->name, (double)lag_us / 1000.0, (unsigned)robot->cfg->link.silence_timeout_ms,
+                 robot->late_packets);
     }
-    controller_us = (int64_t)llround(t * 1e6);
-    offset = (int64_t)rx_us - controller_us;
-    if (new_connection || robot->delay_prev_rx_us == 0 || controller_us < robot->last_controller_us) {
-        robot->delay_floor_us = offset;
-        robot->delay_prev_rx_us = rx_us;
-        robot->last_controller_us = controller_us;
-        return false;
-    }
-    host_step = (int64_t)(rx_us - robot->delay_prev_rx_us);
-    controller_step = controller_us - robot->last_controller_us;
-    robot->delay_floor_us += host_step < controller_step ? host_step : controller_step;
-    robot->delay_prev_rx_us = rx_us;
-    robot->last_controller_us = controller_us;
-    if (offset <= robot->delay_floor_us) {
-        robot->delay_floor_us = offset;
-        return false;
-    }
-    return (uint64_t)(offset - robot->delay_floor_us) > timeout_us;
+    robot->late = true;
 }
 
 /* The one per-packet path: check, decode once, hand to every output. */
@@ -117,9 +121,12 @@ static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t r
     bool new_connection = connects != robot->connects_seen;
     int r;
 
-    robot->last_any_rx_us = rx_us;
+    uint64_t lag;
+
     robot->connects_seen = connects;
     if (robot->cfg->expected_length != 0 && length != robot->cfg->expected_length) {
+        /* Not decoded: the host's clock alone says how old it is. */
+        robot->newest_data_us = urrt_link_packet_empty_us(robot->link);
         on_mismatch(robot, length, rx_us);
         return;
     }
@@ -135,30 +142,26 @@ static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t r
         snprintf(robot->last_error, sizeof robot->last_error, "decode: %s", urrt_strerror(r));
         return;
     }
-    if (packet_late(robot, &robot->state, rx_us, new_connection)) {
-        robot->late_packets++;
-        if (!robot->late) {
-            urrt_log(URRT_LOG_WARNING, "robot %s: a backlog of packets older than silence_timeout (%u ms) on "
-                     "the controller's clock: not published (late_packets %" PRIu64 "); the gateway was "
-                     "stopped or starved of CPU or network: give it a core, or check the link to the robot",
-                     robot->cfg->name, (unsigned)robot->cfg->link.silence_timeout_ms, robot->late_packets);
-        }
-        robot->late = true;
+    lag = packet_lag(robot, &robot->state, rx_us, new_connection);
+    robot->newest_data_us = rx_us - lag;
+    if (!gw_robot_data_fresh(robot, rx_us - lag, rx_us)) {
+        on_late(robot, lag);
         return;
+    }
+    if (robot->late) {
+        urrt_log(URRT_LOG_NOTICE, "robot %s: data fresh again (late_packets %" PRIu64 ")", robot->cfg->name,
+                 robot->late_packets);
     }
     robot->late = false;
     robot->last_rx_us = rx_us;
+    robot->data_us = rx_us - lag;
     robot->sequence++;
     pkt.bytes = bytes;
     pkt.length = length;
     pkt.state = &robot->state;
     pkt.rx_us = rx_us;
-    /* The wall clock of the instant the bytes were read. */
-    {
-        uint64_t mono = urrt_port_monotonic_us();
-        uint64_t wall = urrt_port_realtime_us();
-        pkt.rx_wall_us = wall - (mono > rx_us ? mono - rx_us : 0);
-    }
+    pkt.data_us = robot->data_us;
+    pkt.rx_wall_us = gw_wall_us(rx_us);
     pkt.sequence = robot->sequence;
     for (unsigned i = 0; i < gw->output_count; i++) {
         gw->outputs[i].packet(gw->outputs[i].ctx, robot, &pkt);
@@ -218,10 +221,10 @@ static void print_summary(gateway *gw, uint64_t now_us)
             snprintf(age_text, sizeof age_text, "%.1f s", (double)age / 1e6);
         }
         n = snprintf(line, sizeof line, "%s %s%s age %s reconnects %" PRIu64 " resyncs %" PRIu64
-                     " mismatches %" PRIu64 " |",
+                     " mismatches %" PRIu64 " late %" PRIu64 " |",
                      robot->cfg->name, urrt_link_state_name(urrt_link_get_state(robot->link)),
                      gw_robot_fresh(robot, now_us) ? "" : " (no data)", age_text, ls->reconnects,
-                     ls->resyncs, robot->mismatches);
+                     ls->resyncs, robot->mismatches, robot->late_packets);
         for (unsigned o = 0; o < gw->output_count && n > 0 && (size_t)n < sizeof line; o++) {
             if (gw->outputs[o].summary != NULL) {
                 n += gw->outputs[o].summary(gw->outputs[o].ctx, robot, now_us, line + n, sizeof line - (size_t)n);
@@ -293,6 +296,9 @@ void gw_run(gateway *gw, volatile sig_atomic_t *running)
                 urrt_link_service(robot->link, now, on_packet, robot);
             }
         }
+        /* The outputs judge freshness after the reads: a report must not
+         * say "stale" about an instant before the packets just read. */
+        now = urrt_port_monotonic_us();
         for (unsigned o = 0; o < gw->output_count; o++) {
             const gw_output *out = &gw->outputs[o];
             if (out->service != NULL) {

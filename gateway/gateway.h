@@ -21,6 +21,7 @@
 #include <stdint.h>
 
 #include "config.h"
+#include "freshness.h"
 #include "port.h"
 #include "urrt.h"
 
@@ -42,16 +43,14 @@ typedef struct gw_robot {
     uint64_t mismatches;       /* packets not of the expected length */
     uint64_t decode_errors;
     uint64_t last_rx_us;       /* monotonic time of the last dispatched packet, 0: none */
-    uint64_t last_any_rx_us;   /* of the last packet, dispatched or not */
+    uint64_t data_us;          /* its data is no older than now - data_us (freshness.h) */
+    uint64_t newest_data_us;   /* the same for the last packet read, dispatched or not; 0: none */
     uint64_t connects_seen;    /* link connects when the last packet came */
     uint64_t mismatch_logged_us;
     uint64_t mismatches_logged;
     bool mismatch;             /* the last packet had the wrong length */
-    /* Lateness on the controller's clock (gateway.c, packet_late). */
-    int64_t delay_floor_us;    /* smallest read time - controller time lately */
-    uint64_t delay_prev_rx_us; /* read time of the previous packet, 0: none yet on this connection */
-    int64_t last_controller_us;
-    uint64_t late_packets;     /* read later than the silence timeout after the controller sent them */
+    gw_age age;                /* how old each packet's data is when read */
+    uint64_t late_packets;     /* data older than the silence timeout when read: not dispatched */
     bool late;                 /* the last packet was late */
     char last_error[160];
 } gw_robot;
@@ -62,6 +61,7 @@ typedef struct gw_packet {
     size_t length;
     const urrt_state *state;   /* decoded */
     uint64_t rx_us;            /* monotonic time the bytes were read */
+    uint64_t data_us;          /* the data is no older than now - data_us (<= rx_us) */
     uint64_t rx_wall_us;       /* the same instant on the wall clock (utime) */
     uint64_t sequence;         /* robot->sequence for this packet */
 } gw_packet;
@@ -111,11 +111,19 @@ bool gw_add_output(gateway *gw, const gw_output *output);
 void gw_run(gateway *gw, volatile sig_atomic_t *running);
 void gw_close(gateway *gw);
 
-/* Packets arrive, have the expected length, and the last one is younger
- * than the silence timeout: only then may state be published. */
+/* Packets arrive, have the expected length, the last one was not late, and
+ * its data is no older than the silence timeout: only then may state be
+ * published. */
 bool gw_robot_fresh(const gw_robot *robot, uint64_t now_us);
-/* Microseconds since the last packet was read, -1 before the first. */
+/* Whether a packet's data, no older than now - data_us, is still within the
+ * robot's bound: every output asks just before it sends. */
+bool gw_robot_data_fresh(const gw_robot *robot, uint64_t data_us, uint64_t now_us);
+/* How old the data of the last packet read is at most (microseconds), -1
+ * before the first. */
 int64_t gw_robot_data_age_us(const gw_robot *robot, uint64_t now_us);
+/* The wall-clock time (utime) of a monotonic instant, so that a message
+ * stamped with it and the freshness judged at that instant agree. */
+uint64_t gw_wall_us(uint64_t mono_us);
 /* Every output's counters for a robot. */
 unsigned gw_counters(const gateway *gw, const gw_robot *robot, gw_counter *out, unsigned max);
 

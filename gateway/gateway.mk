@@ -37,14 +37,14 @@ $(LCMTYPES_JAR): $(LCMTYPES)
 	jar cf $@ -C $(BUILD)/lcmjava/classes .
 
 # ---- urrt-gateway ------------------------------------------------------------------
-GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o config.o lcm_out.o) \
+GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_out.o) \
                 $(BUILD)/gateway/cli.o $(LCMTYPES_OBJS)
 # Other fragments append their objects (the CAN output, say); read at link time.
 GATEWAY_EXTRA_OBJS ?=
-GATEWAY_HDRS := gateway/config.h gateway/gateway.h gateway/lcm_out.h gateway/cli.h gateway/can_map.h gateway/can_out.h gateway/dbc.h port/port.h $(LIB_HDRS)
+GATEWAY_HDRS := gateway/config.h gateway/gateway.h gateway/freshness.h gateway/lcm_out.h gateway/cli.h gateway/can_map.h gateway/can_out.h gateway/dbc.h port/port.h $(LIB_HDRS)
 GATEWAY_LIBS := -llcm -linih -lm
 
-$(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o config.o lcm_out.o): \
+$(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_out.o): \
   $(BUILD)/gateway/%.o: gateway/%.c $(GATEWAY_HDRS) $(LCMTYPES_H)
 	@mkdir -p $(@D)
 	$(CC) $(PROG_WARN) $(OPT) $(CPPFLAGS) -Igateway -I$(LCMGEN) -c $< -o $@

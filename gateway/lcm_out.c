@@ -36,6 +36,7 @@ typedef struct lcm_robot {
     int64_t next_due_us[GW_KIND_COUNT]; /* controller time of the next slot */
     int64_t last_time_us;
     uint64_t published[GW_KIND_COUNT];
+    uint64_t stale_dropped;           /* too old by the moment of sending: not published */
     uint64_t errors;
     uint64_t summary_published[GW_KIND_COUNT];
     uint64_t summary_us;
@@ -150,6 +151,19 @@ static void publish(lcm_out *out, gw_robot *robot, gw_kind kind, int length, uin
 }
 
 /* ---- per packet ---------------------------------------------------------------- */
+
+/* A packet's message is sent only if its data is still fresh now, just
+ * before the send: the process may have been stopped or preempted since
+ * the packet was read, or the messages before it may have taken long. */
+static void publish_data(lcm_out *out, gw_robot *robot, gw_kind kind, int length, const gw_packet *pkt)
+{
+    uint64_t now_us = urrt_port_monotonic_us();
+    if (!gw_robot_data_fresh(robot, pkt->data_us, now_us)) {
+        out->robots[robot->index].stale_dropped++;
+        return;
+    }
+    publish(out, robot, kind, length, now_us);
+}
 
 /* Whether this packet takes a slot of kind: every packet, or the first
  * packet at or after each 1/hz step of the controller's clock. A gap or a
@@ -323,16 +337,16 @@ static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
     int64_t t_us = isfinite(t) && fabs(t) < 9e12 ? (int64_t)llround(t * 1e6) : (int64_t)pkt->rx_us;
 
     if (due(&rates[GW_KIND_STATE], lr, GW_KIND_STATE, t_us)) {
-        publish(out, robot, GW_KIND_STATE, encode_state(out, pkt), pkt->rx_us);
+        publish_data(out, robot, GW_KIND_STATE, encode_state(out, pkt), pkt);
     }
     if (due(&rates[GW_KIND_JOINTS], lr, GW_KIND_JOINTS, t_us)) {
-        publish(out, robot, GW_KIND_JOINTS, encode_joints(out, pkt), pkt->rx_us);
+        publish_data(out, robot, GW_KIND_JOINTS, encode_joints(out, pkt), pkt);
     }
     if (due(&rates[GW_KIND_TOOL], lr, GW_KIND_TOOL, t_us)) {
-        publish(out, robot, GW_KIND_TOOL, encode_tool(out, pkt), pkt->rx_us);
+        publish_data(out, robot, GW_KIND_TOOL, encode_tool(out, pkt), pkt);
     }
     if (due(&rates[GW_KIND_STATUS], lr, GW_KIND_STATUS, t_us)) {
-        publish(out, robot, GW_KIND_STATUS, encode_status(out, pkt), pkt->rx_us);
+        publish_data(out, robot, GW_KIND_STATUS, encode_status(out, pkt), pkt);
     }
     lr->last_time_us = t_us;
 }
@@ -352,7 +366,7 @@ static void report(lcm_out *out, gw_robot *robot, uint64_t now_us)
     for (unsigned k = 0; k < GW_KIND_COUNT; k++) {
         published += lr->published[k];
     }
-    msg->utime = (int64_t)urrt_port_realtime_us();
+    msg->utime = (int64_t)gw_wall_us(now_us); /* the instant data_fresh is judged at */
     msg->robot = robot->cfg->name;
     msg->host = robot->cfg->host;
     msg->port = robot->cfg->port;
@@ -438,8 +452,8 @@ static uint64_t on_deadline(void *ctx)
                 d = lr->report_due_us;
             }
             /* The moment the data goes stale is news too. */
-            if (lr->reported_fresh && robot->last_rx_us != 0) {
-                uint64_t stale = robot->last_rx_us + (uint64_t)robot->cfg->link.silence_timeout_ms * 1000u;
+            if (lr->reported_fresh && robot->data_us != 0) {
+                uint64_t stale = robot->data_us + (uint64_t)robot->cfg->link.silence_timeout_ms * 1000u + 1u;
                 if (stale < d) {
                     d = stale;
                 }
@@ -459,6 +473,9 @@ static unsigned on_counters(void *ctx, const gw_robot *robot, gw_counter *counte
         counters[n].value = lr->published[k];
         n++;
     }
+    if (n < max) {
+        counters[n++] = (gw_counter){"lcm.stale_dropped", lr->stale_dropped};
+    }
     return n;
 }
 
@@ -477,7 +494,7 @@ static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *b
         lr->summary_published[k] = lr->published[k];
     }
     if (n < size) {
-        n += (size_t)snprintf(buf + n, size - n, " | lost %" PRIu64 "%s", lr->errors,
+        n += (size_t)snprintf(buf + n, size - n, " | stale %" PRIu64 " lost %" PRIu64 "%s", lr->stale_dropped, lr->errors,
                               out->lcm == NULL ? " (LCM not open)" : "");
     }
     lr->summary_us = now_us;

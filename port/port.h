@@ -117,7 +117,8 @@ typedef struct urrt_link_stats {
 typedef struct urrt_link urrt_link;
 
 /* Called for each complete packet, in order. The bytes are valid during the
- * call only. rx_us is the monotonic time the bytes were read. */
+ * call only. rx_us is the monotonic time the read that completed the packet
+ * returned (taken per read, not per service call). */
 typedef void (*urrt_packet_fn)(void *ctx, const uint8_t *packet, size_t len, uint64_t rx_us);
 
 /* NULL with a logged reason when the configuration is unusable. The first
@@ -140,6 +141,13 @@ void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void
 urrt_link_state urrt_link_get_state(const urrt_link *link);
 const urrt_link_stats *urrt_link_get_stats(const urrt_link *link);
 
+/* During a packet callback: a monotonic time at which the socket's queue
+ * was seen empty before the packet's first byte was read, so every byte of
+ * the packet arrived on this host after it. rx_us minus it bounds how long
+ * the packet waited here (in the socket or half-read), however the process
+ * was delayed: a reader that keeps up sees about one period, one that falls
+ * behind sees its backlog grow. */
+uint64_t urrt_link_packet_empty_us(const urrt_link *link);
 /* "host:port" as log lines name the robot ("[::1]:30003" for IPv6). */
 const char *urrt_link_peer(const urrt_link *link);
 

@@ -5,9 +5,19 @@
 GWT := $(BUILD)/tests/gateway
 GWT_CFLAGS := $(PROG_WARN) $(OPT) $(CPPFLAGS) -I$(LCMGEN)
 
-CHECKS += check-gateway
+CHECKS += check-freshness check-gateway
 BENCHES += bench-gateway
-.PHONY: check-gateway bench-gateway
+.PHONY: check-freshness check-gateway bench-gateway
+
+# The age estimator on a fake clock (gateway/freshness.h).
+$(GWT)/test_freshness: tests/gateway/test_freshness.c tests/check.h gateway/freshness.c gateway/freshness.h
+	@mkdir -p $(@D)
+	$(CC) $(PROG_WARN) $(OPT) -Igateway -Itests $< gateway/freshness.c -o $@
+
+check-freshness: $(GWT)/test_freshness
+	@mkdir -p $(BUILD)/results
+	@$(GWT)/test_freshness > $(BUILD)/results/$@.log 2>&1; rc=$$?; cat $(BUILD)/results/$@.log; \
+	  tail -n 1 $(BUILD)/results/$@.log > $(BUILD)/results/$@.result; exit $$rc
 
 $(GWT)/lcm_sub: tests/gateway/lcm_sub.c $(LCMTYPES_OBJS) $(LCMTYPES_H) $(LIBURRT)
 	@mkdir -p $(@D)
@@ -23,8 +33,7 @@ $(GWT)/bench_gateway: tests/gateway/bench_gateway.c $(LCMTYPES_OBJS) $(LCMTYPES_
 
 check-gateway: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim $(GWT)/lcm_sub $(GWT)/alloc_shim.so $(LCMTYPES_JAR)
 	@mkdir -p $(BUILD)/results
-	$(PYTHON) tests/gateway/test_gateway.py --build $(BUILD) --result $(BUILD)/results/check-gateway.result \
-	  --port-base 41000
+	$(PYTHON) tests/gateway/test_gateway.py --build $(BUILD) --result $(BUILD)/results/check-gateway.result
 
 # Every message at every packet (the issue's case), then the focused messages
 # at 50 Hz and no full state: what framing and decoding alone sustain.

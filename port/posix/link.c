@@ -51,6 +51,12 @@ struct urrt_link {
     struct addrinfo *next_addr;
     uint64_t deadline_us;     /* IDLE: next attempt; CONNECTING: connect timeout */
     uint64_t last_rx_us;      /* UP: last bytes received (or the connect) */
+    /* The socket's queue was seen empty at empty_us (just before the last
+     * read that emptied it, or at the connect): every byte read later
+     * arrived after it. packet_empty_us is empty_us as it was when the first
+     * byte of the packet being collected was read. */
+    uint64_t empty_us;
+    uint64_t packet_empty_us;
     uint64_t backoff_ms;      /* wait before the next attempt after a failure */
     bool more_to_read;        /* the read budget ran out with bytes left */
     bool announced;           /* "connecting" logged */
@@ -278,6 +284,7 @@ static void became_up(urrt_link *link, uint64_t now_us)
     forget_addresses(link);
     link->state = URRT_LINK_UP;
     link->last_rx_us = now_us;
+    link->empty_us = now_us;
     link->more_to_read = false;
     link->conn_packets = 0;
     link->conn_bytes_start = link->stats.bytes;
@@ -438,7 +445,11 @@ static void deliver(urrt_link *link, const uint8_t *data, size_t len, uint64_t n
 {
     while (len > 0) {
         size_t used = 0;
-        int got = urrt_framer_feed(&link->framer, data, len, &used);
+        int got;
+        if (link->framer.have == 0 && link->framer.need == 0) {
+            link->packet_empty_us = link->empty_us; /* the next packet starts in this read */
+        }
+        got = urrt_framer_feed(&link->framer, data, len, &used);
         /* Counters are current at each callback: a program that stops at a
          * packet reports exactly the stream up to it. */
         link->stats.bytes = link->framer.stats.bytes;
@@ -476,35 +487,48 @@ static void deliver(urrt_link *link, const uint8_t *data, size_t len, uint64_t n
     }
 }
 
-static void read_available(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void *ctx)
+/* Each read is stamped with the clock taken just after it returns, so a
+ * packet's rx_us is when its last bytes left the socket, whatever the loop
+ * did since it woke up. A read shorter than asked emptied the queue: the
+ * clock taken just before it is then a time the queue was empty. */
+static void read_available(urrt_link *link, urrt_packet_fn fn, void *ctx)
 {
     uint8_t buf[LINK_READ_CHUNK];
     size_t budget = LINK_READ_BUDGET;
 
     link->more_to_read = false;
     while (link->state == URRT_LINK_UP) {
+        uint64_t before_us = urrt_port_monotonic_us();
         ssize_t n = recv(link->fd, buf, sizeof buf, MSG_DONTWAIT);
+        uint64_t read_us = urrt_port_monotonic_us();
         if (n > 0) {
-            link->last_rx_us = now_us;
-            deliver(link, buf, (size_t)n, now_us, fn, ctx);
+            link->last_rx_us = read_us;
+            deliver(link, buf, (size_t)n, read_us, fn, ctx);
+            if ((size_t)n < sizeof buf) {
+                link->empty_us = before_us;
+                return; /* drained: poll says when there is more */
+            }
             if ((size_t)n >= budget) {
                 link->more_to_read = true;
                 return;
             }
             budget -= (size_t)n;
-            if ((size_t)n < sizeof buf) {
-                return; /* drained, most likely: poll says when there is more */
-            }
         } else if (n == 0) {
-            connection_lost(link, now_us, "closed by peer", false);
+            connection_lost(link, read_us, "closed by peer", false);
         } else if (errno == EINTR) {
             continue;
         } else if (errno == EAGAIN || errno == EWOULDBLOCK) {
+            link->empty_us = before_us;
             return;
         } else {
-            connection_lost(link, now_us, errno_text(errno), false);
+            connection_lost(link, read_us, errno_text(errno), false);
         }
     }
+}
+
+uint64_t urrt_link_packet_empty_us(const urrt_link *link)
+{
+    return link->packet_empty_us;
 }
 
 void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void *ctx)
@@ -527,7 +551,7 @@ void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void
     if (link->state != URRT_LINK_UP) {
         return;
     }
-    read_available(link, now_us, fn, ctx);
+    read_available(link, fn, ctx);
     if (link->state == URRT_LINK_UP && !link->more_to_read && link->cfg.silence_timeout_ms != 0 &&
         now_us > link->last_rx_us && now_us - link->last_rx_us >= (uint64_t)link->cfg.silence_timeout_ms * 1000u) {
         char reason[64];

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * alloc_shim.so: LD_PRELOADed into urrt-gateway by the tests. It counts
  * every heap allocation (malloc, calloc, realloc, posix_memalign,
@@ -9,6 +10,9 @@
  *   ALLOC_SHIM_WINDOW=M        publishes in the window
  *   ALLOC_SHIM_FAIL_FROM=N     make publishes N .. N+COUNT-1 fail (ENOBUFS)
  *   ALLOC_SHIM_FAIL_COUNT=COUNT
+ *   ALLOC_SHIM_DELAY_US=D      every publish on a channel ending in
+ *   ALLOC_SHIM_DELAY_SUFFIX=S  S (default ".STATE") takes D us longer: a
+ *                              gateway slower than its robot
  *
  * When the window closes it writes "publishes M allocs X in_publish Y
  * outside Z" to PATH: the allocations of the whole process over M
@@ -21,6 +25,8 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <time.h>
 
 extern void *__libc_malloc(size_t);
 extern void *__libc_calloc(size_t, size_t);
@@ -54,7 +60,8 @@ int posix_memalign(void **p, size_t a, size_t n)
 typedef struct _lcm_t lcm_t;
 typedef int (*publish_fn)(lcm_t *, const char *, const void *, unsigned int);
 
-static uint64_t publishes, warmup = UINT64_MAX, window, fail_from = UINT64_MAX, fail_count;
+static uint64_t publishes, warmup = UINT64_MAX, window, fail_from = UINT64_MAX, fail_count, delay_us;
+static const char *delay_suffix = ".STATE";
 static uint64_t start_allocs, start_in_publish;
 static const char *report_path;
 static int configured;
@@ -76,10 +83,20 @@ int lcm_publish(lcm_t *lcm, const char *channel, const void *data, unsigned int 
         window = env_u64("ALLOC_SHIM_WINDOW", 0);
         fail_from = env_u64("ALLOC_SHIM_FAIL_FROM", UINT64_MAX);
         fail_count = env_u64("ALLOC_SHIM_FAIL_COUNT", 0);
+        delay_us = env_u64("ALLOC_SHIM_DELAY_US", 0);
+        if (getenv("ALLOC_SHIM_DELAY_SUFFIX") != NULL) {
+            delay_suffix = getenv("ALLOC_SHIM_DELAY_SUFFIX");
+        }
         real = (publish_fn)dlsym(RTLD_NEXT, "lcm_publish");
         configured = 1;
     }
     n = ++publishes;
+    if (delay_us > 0 && strlen(channel) >= strlen(delay_suffix) &&
+        strcmp(channel + strlen(channel) - strlen(delay_suffix), delay_suffix) == 0) {
+        struct timespec d = {(time_t)(delay_us / 1000000u), (long)(delay_us % 1000000u) * 1000};
+        while (nanosleep(&d, &d) != 0) {
+        }
+    }
     if (n == warmup) {
         start_allocs = allocs;
         start_in_publish = allocs_in_publish;

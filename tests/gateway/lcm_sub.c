@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * lcm_sub: a test subscriber built on the generated C types. Every message
  * on the channels matching REGEX is decoded with the type its fingerprint
@@ -8,7 +9,11 @@
  *   lcm_sub --fingerprints      each type's fingerprint, as encoded
  *
  * READY_FILE is created once the subscription is in place. Runs for SECONDS
- * and exits; SIGTERM/SIGINT end it early.
+ * and exits; SIGTERM/SIGINT end it early. Lines are written whole as each
+ * message comes, so that a test can wait for the messages it needs. The
+ * subscription queue holds what a test may receive in a burst: LCM's
+ * default of 30 loses messages after a stopped gateway catches up, and a
+ * test must compare what it received with what the gateway published.
  */
 #define _GNU_SOURCE
 #include <math.h>
@@ -26,6 +31,8 @@
 #include "urrt_state_t.h"
 #include "urrt_status_t.h"
 #include "urrt_tool_t.h"
+
+#define SUB_QUEUE 100000
 
 static volatile sig_atomic_t running = 1;
 static void on_signal(int sig) { (void)sig; running = 0; }
@@ -211,7 +218,8 @@ int main(int argc, char **argv)
     }
     signal(SIGTERM, on_signal);
     signal(SIGINT, on_signal);
-    lcm_subscribe(lcm, argv[2], on_message, NULL);
+    setvbuf(out, NULL, _IOLBF, 1 << 16);
+    lcm_subscription_set_queue_capacity(lcm_subscribe(lcm, argv[2], on_message, NULL), SUB_QUEUE);
     if (argc == 5) {
         FILE *f = fopen(argv[4], "w");
         if (f != NULL) {

@@ -1,0 +1,42 @@
+/* SPDX-License-Identifier: MIT */
+/* freshness.c: see freshness.h. */
+#include "freshness.h"
+
+void gw_age_reset(gw_age *age)
+{
+    age->anchored = false;
+}
+
+/* The floor now: it rises by the allowed drift since it was set. */
+static int64_t floor_at(const gw_age *age, uint64_t rx_us)
+{
+    uint64_t since = rx_us > age->floor_at_us ? rx_us - age->floor_at_us : 0;
+    return age->floor_us + (int64_t)(since / (1000000u / GW_AGE_DRIFT_PPM));
+}
+
+static uint64_t controller_lag(gw_age *age, uint64_t rx_us, int64_t controller_us)
+{
+    int64_t offset = (int64_t)rx_us - controller_us;
+    int64_t floor;
+
+    if (!age->anchored || controller_us < age->last_controller_us) {
+        age->anchored = true;
+        age->floor_us = offset;
+        age->floor_at_us = rx_us;
+    }
+    age->last_controller_us = controller_us;
+    floor = floor_at(age, rx_us);
+    if (offset <= floor) {
+        age->floor_us = offset;
+        age->floor_at_us = rx_us;
+        return 0;
+    }
+    return (uint64_t)(offset - floor);
+}
+
+uint64_t gw_age_lag_us(gw_age *age, uint64_t rx_us, uint64_t empty_us, bool has_clock, int64_t controller_us)
+{
+    uint64_t host = rx_us > empty_us ? rx_us - empty_us : 0;
+    uint64_t controller = has_clock ? controller_lag(age, rx_us, controller_us) : 0;
+    return host > controller ? host : controller;
+}

@@ -1,0 +1,212 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * test_freshness: the age estimator of gateway/freshness.h on a fake clock.
+ * Streams are simulated packet by packet: the controller stamps each packet
+ * with its own clock, the host reads it some time later, and the socket was
+ * last seen empty at a time the simulation knows. Each case asserts the lag
+ * the estimator gives against the true one.
+ */
+#include <stdint.h>
+#include <stdio.h>
+
+#include "check.h"
+#include "freshness.h"
+
+#define MS 1000u
+#define S 1000000u
+#define BOUND (100u * MS)
+
+/* A 500 Hz stream read promptly: sent at k * period (controller clock with
+ * a fixed offset from the host's), read 80 us later, one packet per read. */
+typedef struct stream {
+    gw_age age;
+    uint64_t host0;        /* host time of the controller's zero */
+    double rate;           /* controller seconds per host second */
+    uint64_t period_us;
+    uint64_t k;            /* next packet */
+    uint64_t prev_read_us; /* the previous read emptied the socket just before this */
+} stream;
+
+static void stream_init(stream *s, double rate)
+{
+    gw_age_reset(&s->age);
+    s->host0 = 5000u * S;
+    s->rate = rate;
+    s->period_us = 2 * MS;
+    s->k = 0;
+    s->prev_read_us = s->host0;
+}
+
+/* Host time at which packet k was sent. */
+static uint64_t sent_at(const stream *s, uint64_t k)
+{
+    return s->host0 + k * s->period_us;
+}
+
+/* Packet k read at rx (the socket last empty at empty): its lag. */
+static uint64_t read_packet(stream *s, uint64_t k, uint64_t rx, uint64_t empty)
+{
+    int64_t controller = (int64_t)((double)(k * s->period_us) * s->rate);
+    return gw_age_lag_us(&s->age, rx, empty, true, controller);
+}
+
+/* n packets read promptly; the largest lag seen. */
+static uint64_t run_prompt(stream *s, uint64_t n)
+{
+    uint64_t worst = 0;
+    for (uint64_t i = 0; i < n; i++, s->k++) {
+        uint64_t rx = sent_at(s, s->k) + 80;
+        uint64_t lag = read_packet(s, s->k, rx, s->prev_read_us);
+        s->prev_read_us = rx - 5;
+        if (lag > worst) {
+            worst = lag;
+        }
+    }
+    return worst;
+}
+
+static void prompt_reader(void)
+{
+    stream s;
+    uint64_t worst;
+    stream_init(&s, 1.0);
+    worst = run_prompt(&s, 5000);
+    CHECK(worst <= s.period_us + 100, "a prompt reader: lag within a period (%llu us)", (unsigned long long)worst);
+}
+
+/* The gateway is stopped for a second: the packets sent meanwhile wait in
+ * the socket and are read in a burst after it. */
+static void stopped_gateway(void)
+{
+    stream s;
+    uint64_t stop_k, resume, late = 0, fresh_after = 0;
+    stream_init(&s, 1.0);
+    run_prompt(&s, 1000);
+    stop_k = s.k;
+    resume = sent_at(&s, stop_k) + 1 * S;
+    /* The burst: 500 packets read 10 us apart, in reads of 13 packets. */
+    for (uint64_t i = 0; i < 500; i++) {
+        uint64_t rx = resume + i * 10;
+        uint64_t empty = s.prev_read_us; /* not empty again until the backlog is read */
+        uint64_t lag = read_packet(&s, stop_k + i, rx, empty);
+        uint64_t truth = rx - sent_at(&s, stop_k + i);
+        CHECK(lag + 100 >= truth, "stopped: lag %llu under the truth %llu", (unsigned long long)lag,
+                    (unsigned long long)truth);
+        late += lag > BOUND;
+    }
+    CHECK(late >= 450, "stopped 1 s: the backlog is late (%llu of 500 over the bound)", (unsigned long long)late);
+    s.k = stop_k + 500;
+    s.prev_read_us = resume + 5000;
+    /* Read promptly again. */
+    for (uint64_t i = 0; i < 100; i++, s.k++) {
+        uint64_t rx = sent_at(&s, s.k) + 80;
+        fresh_after += read_packet(&s, s.k, rx, s.prev_read_us) <= BOUND;
+        s.prev_read_us = rx - 5;
+    }
+    CHECK(fresh_after == 100, "after the backlog: fresh again (%llu of 100)", (unsigned long long)fresh_after);
+}
+
+/* A gateway slower than its robot: it reads 400 of every 500 packets' worth
+ * per second, so each packet waits 0.5 ms longer than the one before. The
+ * socket is never empty again once the lag starts. */
+static void slow_gateway(void)
+{
+    stream s;
+    uint64_t first_late = 0, missed = 0, host_missed = 0, start_empty;
+    stream_init(&s, 1.0);
+    run_prompt(&s, 100);
+    start_empty = s.prev_read_us;
+    for (uint64_t i = 0; i < 2000; i++, s.k++) {
+        uint64_t truth = i * 500;
+        uint64_t rx = sent_at(&s, s.k) + 80 + truth;
+        uint64_t lag = read_packet(&s, s.k, rx, start_empty);
+        gw_age no_clock;
+        gw_age_reset(&no_clock);
+        /* The host's bound alone sees it too, whatever the controller's clock says. */
+        host_missed += truth > gw_age_lag_us(&no_clock, rx, start_empty, false, 0);
+        missed += truth > lag + 100;
+        if (first_late == 0 && lag > BOUND) {
+            first_late = truth;
+        }
+    }
+    CHECK(missed == 0, "slowly growing lag: never estimated below the truth (%llu packets)", (unsigned long long)missed);
+    CHECK(host_missed == 0, "slowly growing lag: the host's clock alone bounds it (%llu packets under)",
+          (unsigned long long)host_missed);
+    CHECK(first_late > 0 && first_late <= BOUND + s.period_us,
+          "slowly growing lag: late once the true lag passes the bound (at %llu us)", (unsigned long long)first_late);
+}
+
+/* The same slow lag where the host cannot see it (the controller or the
+ * network holds the packets back; the host reads each at once): the
+ * controller's clock catches it. */
+static void upstream_lag(void)
+{
+    stream s;
+    uint64_t first_late = 0, allowance = 0, start;
+    stream_init(&s, 1.0);
+    run_prompt(&s, 100);
+    start = sent_at(&s, s.k);
+    for (uint64_t i = 0; i < 2000; i++, s.k++) {
+        uint64_t truth = i * 100; /* 5 % of the period more each packet */
+        uint64_t rx = sent_at(&s, s.k) + 80 + truth;
+        uint64_t lag = read_packet(&s, s.k, rx, rx - 50);
+        if (first_late == 0 && lag > BOUND) {
+            first_late = truth;
+            /* The floor may have risen by the drift allowance meanwhile. */
+            allowance = (rx - start) / (1000000u / GW_AGE_DRIFT_PPM);
+        }
+    }
+    CHECK(first_late > BOUND - s.period_us && first_late <= BOUND + allowance + s.period_us,
+          "a lag growing upstream of the host: late once it passes the bound plus the drift allowance "
+          "(%llu us) (at %llu us)", (unsigned long long)allowance, (unsigned long long)first_late);
+}
+
+/* Clocks that differ in rate: a controller 500 ppm slow or fast for an hour
+ * is never taken for a lag. */
+static void clock_drift(void)
+{
+    for (int sign = -1; sign <= 1; sign += 2) {
+        stream s;
+        uint64_t worst;
+        stream_init(&s, 1.0 + sign * 500e-6);
+        worst = run_prompt(&s, 3600u * 500u);
+        CHECK(worst <= s.period_us + 200, "a controller clock %s by 500 ppm for an hour: lag %llu us",
+              sign < 0 ? "slow" : "fast", (unsigned long long)worst);
+    }
+}
+
+/* A controller that restarted: its clock starts again from zero. */
+static void controller_restart(void)
+{
+    stream s;
+    uint64_t lag;
+    stream_init(&s, 1.0);
+    run_prompt(&s, 1000);
+    s.host0 = sent_at(&s, s.k) + 30 * S; /* it comes back 30 s later, from time 0 */
+    s.k = 0;
+    s.prev_read_us = s.host0;
+    lag = run_prompt(&s, 10);
+    CHECK(lag <= s.period_us + 100, "a controller restart (clock back to 0): fresh at once (lag %llu us)",
+          (unsigned long long)lag);
+}
+
+/* No usable controller clock: the host's bound alone. */
+static void no_clock(void)
+{
+    gw_age age;
+    gw_age_reset(&age);
+    CHECK(gw_age_lag_us(&age, 10 * S, 10 * S - 300, false, 0) == 300, "no controller clock: the host's wait");
+    CHECK(gw_age_lag_us(&age, 10 * S, 10 * S + 300, false, 0) == 0, "an empty time after the read: no wait");
+}
+
+int main(void)
+{
+    prompt_reader();
+    stopped_gateway();
+    slow_gateway();
+    upstream_lag();
+    clock_drift();
+    controller_restart();
+    no_clock();
+    return check_report();
+}
