@@ -280,6 +280,18 @@ static bool parse_bool(const char *s, bool *out)
     return false;
 }
 
+/* A byte below ' ' or DEL: it would go raw into the DBC and the log. */
+static bool has_control(const char *s, size_t len)
+{
+    size_t i;
+    for (i = 0; i < len; i++) {
+        if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f) {
+            return true;
+        }
+    }
+    return false;
+}
+
 /* Copies a value, dropping one pair of surrounding double quotes. */
 static bool copy_text(char *dst, size_t size, const char *value)
 {
@@ -288,7 +300,8 @@ static bool copy_text(char *dst, size_t size, const char *value)
         value++;
         len -= 2;
     }
-    if (len >= size || memchr(value, '"', len) != NULL || memchr(value, '\\', len) != NULL) {
+    if (len >= size || memchr(value, '"', len) != NULL || memchr(value, '\\', len) != NULL ||
+        has_control(value, len)) {
         return false;
     }
     memcpy(dst, value, len);
@@ -383,6 +396,9 @@ static int can_key(struct can_map *map, const char *key, const char *value, stru
         if (value[0] == '\0' || strlen(value) > 255 || (strncmp(value, "log:", 4) == 0 && value[4] == '\0')) {
             return fail(map, err, errlen, loc, "interface = '%s': give a CAN interface (can0) or log:PATH (log:- for stdout)",
                         value);
+        }
+        if (has_control(value, strlen(value))) {
+            return fail(map, err, errlen, loc, "interface = '%s': no control characters", value);
         }
         if (strncmp(value, "log:", 4) != 0 && (strlen(value) >= 16 || strpbrk(value, " /\t") != NULL)) {
             return fail(map, err, errlen, loc, "interface = '%s' is not an interface name (at most 15 characters, no '/')",
@@ -767,7 +783,7 @@ static int frame_signal(const struct can_map *map, struct can_map_frame *f, cons
                 }
             } else if (strcmp(k, "unit") == 0) {
                 if (!copy_text(meta.unit, sizeof meta.unit, v)) {
-                    return fail(map, err, errlen, loc, "signal: unit '%s': at most %d characters, no '\"' or '\\'", v,
+                    return fail(map, err, errlen, loc, "signal: unit '%s': at most %d characters, no '\"', '\\' or control characters", v,
                                 CAN_MAP_UNIT_MAX);
                 }
                 have_unit = true;
@@ -1034,7 +1050,7 @@ static int frame_key(struct can_map *map, struct can_map_frame *f, const char *k
         break;
     case CAN_MAP_FK_COMMENT:
         if (!copy_text(f->comment, sizeof f->comment, value)) {
-            return fail(map, err, errlen, loc, "comment: at most %zu characters, no '\"' or '\\'",
+            return fail(map, err, errlen, loc, "comment: at most %zu characters, no '\"', '\\' or control characters",
                         sizeof f->comment - 1);
         }
         break;

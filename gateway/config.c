@@ -82,16 +82,36 @@ static int by_line(const void *a, const void *b)
     return x->line != y->line ? (x->line > y->line) - (x->line < y->line) : x->order - y->order;
 }
 
+/* A message echoes the file's text: control characters (a tab, an escape
+ * sequence, a carriage return that would overwrite the line on a terminal)
+ * are written as \xNN, so each message is one plain line. */
+static void put_message(FILE *out, const char *text)
+{
+    for (; *text != '\0'; text++) {
+        unsigned char c = (unsigned char)*text;
+        if (c < 0x20 || c == 0x7f) {
+            fprintf(out, "\\x%02X", c);
+        } else {
+            fputc(c, out);
+        }
+    }
+    fputc('\n', out);
+}
+
 static void print_errors(config_ctx *ctx)
 {
-    /* File-wide messages (line 0) first, then in line order. */
-    qsort(ctx->messages, (size_t)ctx->errors, sizeof *ctx->messages, by_line);
+    /* File-wide messages (line 0) first, then in line order. No message:
+     * no array, and qsort must not be given NULL. */
+    if (ctx->errors > 0) {
+        qsort(ctx->messages, (size_t)ctx->errors, sizeof *ctx->messages, by_line);
+    }
     for (int i = 0; i < ctx->errors; i++) {
         if (ctx->messages[i].line > 0) {
-            fprintf(ctx->err, "%s:%d: %s\n", ctx->path, ctx->messages[i].line, ctx->messages[i].text);
+            fprintf(ctx->err, "%s:%d: ", ctx->path, ctx->messages[i].line);
         } else {
-            fprintf(ctx->err, "%s: %s\n", ctx->path, ctx->messages[i].text);
+            fprintf(ctx->err, "%s: ", ctx->path);
         }
+        put_message(ctx->err, ctx->messages[i].text);
         free(ctx->messages[i].text);
     }
     free(ctx->messages);
@@ -275,6 +295,13 @@ static bool check_lcm_url(config_ctx *ctx, const char *url)
     static const char *const providers[] = {"udpm", "file", "memq", "tcpq", "mpudpm"};
     const char *sep = strstr(url, "://");
     bool known = false;
+    for (const char *c = url; *c != '\0'; c++) {
+        if ((unsigned char)*c < 0x20 || *c == 0x7f) {
+            /* It is printed at start and by --check-config. */
+            config_error(ctx, ctx->line, "url \"%s\": no control characters", url);
+            return false;
+        }
+    }
     if (sep == NULL) {
         config_error(ctx, ctx->line, "url \"%s\" is not an LCM URL (provider://address?options), e.g. %s",
                      url, GW_DEFAULT_LCM_URL);
@@ -712,18 +739,30 @@ static char *read_line(char *str, int num, void *stream)
 {
     config_ctx *ctx = stream;
     const char *p;
-    size_t n;
+    size_t n = 0;
+    int c = 0;
 
-    if (fgets(str, num, ctx->file) == NULL) {
+    /* Byte by byte, not fgets: after a NUL byte strlen() would miss the
+     * end of a long line, and its rest would count as a line of its own. */
+    while (n + 1 < (size_t)num && c != '\n' && (c = getc(ctx->file)) != EOF) {
+        str[n++] = (char)c;
+    }
+    if (n == 0) {
         return NULL;
     }
+    str[n] = '\0';
     ctx->line++;
-    n = strlen(str);
-    if (n == (size_t)num - 1 && str[n - 1] != '\n' && !feof(ctx->file)) {
-        int c;
-        while ((c = fgetc(ctx->file)) != EOF && c != '\n') {
+    if (n == (size_t)num - 1 && str[n - 1] != '\n' && (c = getc(ctx->file)) != EOF) {
+        while (c != EOF && c != '\n') {
+            c = getc(ctx->file);
         }
         config_error(ctx, ctx->line, "line longer than %d characters", num - 3);
+        str[0] = '\n';
+        str[1] = '\0';
+        return str;
+    }
+    if (memchr(str, '\0', n) != NULL) {
+        config_error(ctx, ctx->line, "a NUL byte: the configuration must be a text file");
         str[0] = '\n';
         str[1] = '\0';
         return str;
@@ -783,12 +822,8 @@ static int on_key(void *user, const char *section, const char *key, const char *
     return ctx->section->key(ctx, ctx->cfg, key, value) ? 1 : 0;
 }
 
-int gw_config_load(gw_config *cfg, const char *path, FILE *err)
+static void config_defaults(gw_config *cfg, const char *path)
 {
-    config_ctx ctx;
-    int seen[CONFIG_SECTION_COUNT] = {0};
-    int r;
-
     memset(cfg, 0, sizeof *cfg);
     cfg->path = path;
     cfg->log_level = URRT_LOG_NOTICE;
@@ -799,26 +834,27 @@ int gw_config_load(gw_config *cfg, const char *path, FILE *err)
     cfg->lcm.rate[GW_KIND_GATEWAY] = (gw_rate){GW_RATE_HZ, 1};
 
     can_map_init(&cfg->can);
+}
+
+static int config_parse(gw_config *cfg, FILE *in, FILE *err)
+{
+    config_ctx ctx;
+    int seen[CONFIG_SECTION_COUNT] = {0};
+    int r;
+
     memset(&ctx, 0, sizeof ctx);
     can_map_set_reporter(&cfg->can, report_can_problem, &ctx);
-    ctx.path = path;
+    ctx.path = cfg->path;
     ctx.err = err;
     ctx.cfg = cfg;
     ctx.seen_line = seen;
-    ctx.file = strcmp(path, "-") == 0 ? stdin : fopen(path, "r");
-    if (ctx.file == NULL) {
-        fprintf(err, "%s: cannot open: %s\n", path, strerror(errno));
-        return 1;
-    }
+    ctx.file = in;
     /* A value is one line; ';' or '#' after a blank starts a comment. */
     ini_allow_multiline = false;
     ini_inline_comment_prefixes = ";#";
     r = ini_parse_stream(read_line, &ctx, on_key, &ctx);
     if (ferror(ctx.file)) {
         config_error(&ctx, 0, "read error: %s", strerror(errno));
-    }
-    if (ctx.file != stdin) {
-        fclose(ctx.file);
     }
     if (r > 0 && ctx.errors == 0) {
         config_error(&ctx, r, "syntax error");
@@ -833,6 +869,30 @@ int gw_config_load(gw_config *cfg, const char *path, FILE *err)
     can_map_set_reporter(&cfg->can, NULL, NULL);
     print_errors(&ctx);
     return ctx.errors;
+}
+
+int gw_config_load(gw_config *cfg, const char *path, FILE *err)
+{
+    FILE *in;
+    int errors;
+
+    config_defaults(cfg, path);
+    in = strcmp(path, "-") == 0 ? stdin : fopen(path, "r");
+    if (in == NULL) {
+        fprintf(err, "%s: cannot open: %s\n", path, strerror(errno));
+        return 1;
+    }
+    errors = config_parse(cfg, in, err);
+    if (in != stdin) {
+        fclose(in);
+    }
+    return errors;
+}
+
+int gw_config_load_stream(gw_config *cfg, FILE *in, const char *path, FILE *err)
+{
+    config_defaults(cfg, path);
+    return config_parse(cfg, in, err);
 }
 
 void gw_config_free(gw_config *cfg)

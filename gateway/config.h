@@ -82,6 +82,9 @@ typedef struct gw_config {
 /* Parse a file. Returns the number of errors (0: *cfg is complete and
  * valid), each written to err as "FILE:LINE: reason". */
 int gw_config_load(gw_config *cfg, const char *path, FILE *err);
+/* The same from an open stream (left open), named path in the messages:
+ * for a configuration that is not a file, and for the fuzz harness. */
+int gw_config_load_stream(gw_config *cfg, FILE *in, const char *path, FILE *err);
 void gw_config_free(gw_config *cfg);
 
 /* Writes the file grammar, for --help. */

@@ -682,6 +682,13 @@ static const struct rejection rejections[] = {
     {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned\nsignal = time @8|8 intel unsigned\n",
      "t.ini:6: signal name 'time' already used in [frame a] (line 5): add name=OTHER"},
     {CAN_HEAD "[frame a]\nalive_counter = 99 big\n", "t.ini:5: alive_counter: byte order 'big'"},
+    /* Control characters would go raw into the DBC and the log (found by
+     * tests/config/fuzz_config.c). */
+    {CAN_HEAD "[frame a]\ncomment = Joint\x01" "positions\n",
+     "t.ini:5: comment: at most 127 characters, no '\"', '\\' or control characters"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned unit=r\x7f" "ad\n",
+     "t.ini:5: signal: unit 'r\x7f" "ad': at most 24 characters, no '\"', '\\' or control characters"},
+    {"[can]\ninterface = log:/tmp/a\x1b[2J\n", "t.ini:2: interface = 'log:/tmp/a\x1b[2J': no control characters"},
     {CAN_HEAD "[frame a]\nvalidity_bit = 600\n", "t.ini:5: validity_bit = 600: give a bit number 0..511"},
     /* Whole-file checks (can_map_finish). */
     {"[frame a]\nid = 1\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
