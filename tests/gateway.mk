@@ -1,7 +1,8 @@
 # tests/gateway.mk: urrt-gateway against urrt-sim, through LCM.
 #   check-gateway   values, decimation, two robots, restart/stall, mismatch,
 #                   zero allocations, publish errors, bad configurations, jar
-#   bench-gateway   latency sim -> subscriber, CPU per packet, highest rate
+#   bench-gateway   latency robot -> subscriber and CPU per packet beside a
+#                   minimal relay (bench_relay.c), 1/10/50 robots, highest rate
 GWT := $(BUILD)/tests/gateway
 GWT_CFLAGS := $(PROG_WARN) $(OPT) $(CPPFLAGS) -I$(LCMGEN)
 
@@ -27,19 +28,28 @@ $(GWT)/alloc_shim.so: tests/gateway/alloc_shim.c
 	@mkdir -p $(@D)
 	$(CC) -std=gnu11 $(OPT) -Wall -Wextra -Werror -fPIC -shared -o $@ $< -ldl
 
-$(GWT)/bench_gateway: tests/gateway/bench_gateway.c $(LCMTYPES_OBJS) $(LCMTYPES_H) $(LIBURRT)
+$(GWT)/bench_gateway: tests/gateway/bench_gateway.c $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(GWT_CFLAGS) -o $@ $< $(LCMTYPES_OBJS) $(LIBURRT) -llcm -lm
+	$(CC) $(GWT_CFLAGS) -o $@ $< $(LIBURRT) -llcm -lm -lpthread
+
+$(GWT)/bench_relay: tests/gateway/bench_relay.c $(LIBURRT)
+	@mkdir -p $(@D)
+	$(CC) $(GWT_CFLAGS) -o $@ $< $(LIBURRT) -llcm
 
 check-gateway: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim $(GWT)/lcm_sub $(GWT)/alloc_shim.so $(LCMTYPES_JAR)
 	@mkdir -p $(BUILD)/results
 	$(PYTHON) tests/gateway/test_gateway.py --build $(BUILD) --result $(BUILD)/results/check-gateway.result
 
-# Every message at every packet (the issue's case), then the focused messages
-# at 50 Hz and no full state: what framing and decoding alone sustain.
-bench-gateway: $(BUILD)/bin/urrt-gateway $(GWT)/bench_gateway
-	@echo "bench-gateway: all messages at every packet"
-	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --port 41500
-	@echo "bench-gateway: focused messages at 50 Hz, no full state"
-	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --port 41501 --focused-hz 50 --seconds 3 \
+# The gateway beside the relay, every message at every packet, then the
+# focused messages at 50 Hz and no state; then one gateway against 1, 10 and
+# 50 robots at 500 Hz each, every message at every packet.
+BENCH_GATEWAY_ROBOTS ?= 1 10 50
+bench-gateway: $(BUILD)/bin/urrt-gateway $(GWT)/bench_gateway $(GWT)/bench_relay
+	@echo "bench-gateway: all messages at every packet, gateway beside relay"
+	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --relay $(GWT)/bench_relay --max-rate
+	@echo "bench-gateway: focused messages at 50 Hz, no state, gateway beside relay"
+	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --relay $(GWT)/bench_relay --focused-hz 50 \
 	  | sed 's/^/decimated_/'
+	@echo "bench-gateway: one gateway, many robots at 500 Hz, every message at every packet"
+	@for n in $(BENCH_GATEWAY_ROBOTS); do \
+	  $(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --robots $$n || exit 1; done

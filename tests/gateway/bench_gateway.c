@@ -1,40 +1,46 @@
+/* SPDX-License-Identifier: MIT */
 /*
- * bench_gateway: urrt-gateway's latency, CPU cost and highest packet rate.
+ * bench_gateway: urrt-gateway's latency and CPU cost beside a minimal relay
+ * (bench_relay.c: the framer and one lcm_publish of the raw bytes per message,
+ * nothing else), its scaling over many robots, and its highest packet rate.
  *
- * This program is the robot and the subscriber at once: it serves 1220-byte
- * packets (encoded with lib's urrt_encode, column 1 carrying the packet's
- * index) to a urrt-gateway it starts, with every message kind enabled at
- * every packet, and subscribes to the gateway's channels.
+ * This program is the robots and the subscriber at once: it serves 1220-byte
+ * packets (lib's urrt_encode, the controller time carrying the packet's index)
+ * at 500 Hz on TCP ports taken from the system, and a thread of its own
+ * subscribes to the subject's channels on an LCM URL (ttl=0) whose UDP port
+ * the system chose. Latency is from the write of a packet to the receipt of
+ * each of its messages; CPU is the subject's (all threads, from
+ * /proc/PID/task/TID/schedstat) per packet read.
  *
- *   1. 500 Hz for SECONDS: latency from the write of a packet to the receipt
- *      of each of its messages (median, p99, max), and the gateway's CPU time
- *      (all its threads, from /proc/PID/task/TID/schedstat) per packet.
- *   2. As fast as the gateway reads: packets per second over the last two
- *      seconds of a three-second blast (TCP back-pressure paces the writes,
- *      so the rate written is the rate the gateway takes).
- *   Baseline, same run: the latency of a bare write-to-read over loopback TCP.
+ *   bench_gateway --gateway PATH --relay PATH [--focused-hz N] [--rounds R]
+ *                 [--seconds S] [--max-rate]
+ *       Relay and gateway in turn, R rounds (3) of S seconds (4) each, one
+ *       robot; prints each subject's figures (median over rounds) and the
+ *       ratios gateway/relay (median of the per-round ratios).
+ *       --focused-hz N: no state message, the focused ones at N Hz (the relay
+ *       sends every 500/N-th packet).
+ *       --max-rate: then the gateway's highest packet rate.
+ *   bench_gateway --gateway PATH --robots N [--seconds S]
+ *       One gateway against N robots, every message at every packet.
  *
  * Prints "name: value" lines; asserts nothing about timings.
- *
- *   bench_gateway --gateway PATH --port PORT [--seconds S] [--focused-hz N]
- *
- * --focused-hz N: no state message, the focused ones decimated to N Hz (the
- * latency phase then sees only the packets that are published).
  */
 #define _GNU_SOURCE
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
+#include <pthread.h>
 #include <signal.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
-#include <math.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -42,9 +48,28 @@
 
 #include "urrt.h"
 
-#define URL "udpm://239.255.76.67:7667?ttl=0"
 #define LENGTH 1220
-#define MAX_PACKETS 200000
+#define HZ 500
+#define WARMUP 250 /* packets per robot not measured */
+#define KINDS 4
+#define MAX_ROBOTS 64
+#define MAX_ROUNDS 9
+
+static const char *kind_names[KINDS] = {"STATE", "JOINTS", "TOOL", "STATUS"};
+
+/* One session: a subject process against n robots. */
+typedef struct {
+    int robots;
+    long per_robot;        /* packets per robot this session, indexes 1..per_robot */
+    bool raw;              /* messages are raw packets (the relay) */
+    char prefix[32];       /* channels are PREFIX_R.KIND */
+    uint64_t *sent_ns;     /* [robot * (per_robot + 1) + index] */
+    double *lat_us[KINDS]; /* measured packets only */
+    size_t lat_n[KINDS];
+    uint64_t received;     /* every message of a known kind, warm-up included */
+    uint64_t late;         /* of an unknown packet or beyond the arrays */
+    volatile int stop;
+} session;
 
 static uint64_t mono_ns(void)
 {
@@ -53,75 +78,87 @@ static uint64_t mono_ns(void)
     return (uint64_t)t.tv_sec * 1000000000u + (uint64_t)t.tv_nsec;
 }
 
-static uint64_t *sent_ns;
-static double *lat_us[4];
-static unsigned lat_n[4];
-static const char *kind_names[4] = {"STATE", "JOINTS", "TOOL", "STATUS"};
-static char prefix[64];
-
-/* The controller time is at offset 8 + 8 after the fingerprint in joints,
- * tool and status (utime first); in state it is the 'time' field further on.
- * Rather than parse, each message's index comes back through the time
- * column, which every kind carries: decode with the generated types' layout
- * is not needed, we look for the double the packet carried. */
-static void on_message(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
-{
-    uint64_t now = mono_ns();
-    const uint8_t *d = rbuf->data;
-    size_t n = rbuf->data_size;
-    int kind = -1;
-    (void)user;
-    for (int k = 0; k < 4; k++) {
-        size_t pl = strlen(prefix);
-        if (strncmp(channel, prefix, pl) == 0 && channel[pl] == '.' && strcmp(channel + pl + 1, kind_names[k]) == 0) {
-            kind = k;
-        }
-    }
-    if (kind < 0) {
-        return;
-    }
-    /* Joints, tool, status: fingerprint(8) utime(8) controller_time(8). */
-    size_t off = 16;
-    if (kind == 0) {
-        /* state: fingerprint, utime, length(4), doubles(2), generation(1),
-         * versions (4-byte length incl. NUL, bytes), present(8), sequence(8), time. */
-        if (n < 23) return;
-        uint32_t slen = (uint32_t)d[23] << 24 | (uint32_t)d[24] << 16 | (uint32_t)d[25] << 8 | d[26];
-        off = 27 + slen + 16;
-    }
-    if (off + 8 > n) {
-        return;
-    }
-    uint64_t bits = 0;
-    for (int i = 0; i < 8; i++) {
-        bits = bits << 8 | d[off + (size_t)i];
-    }
-    double t;
-    memcpy(&t, &bits, sizeof t);
-    long index = lrint(t * 500.0);
-    if (index < 0 || index >= MAX_PACKETS || sent_ns[index] == 0 || lat_n[kind] >= MAX_PACKETS) {
-        return;
-    }
-    lat_us[kind][lat_n[kind]++] = (double)(now - sent_ns[index]) / 1000.0;
-}
-
 static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
     return (x > y) - (x < y);
 }
 
-static void report_latency(const char *name, double *v, unsigned n)
+static double median(double *v, int n)
 {
-    if (n == 0) {
-        printf("%s_messages: 0\n", name);
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
+}
+
+static double be_double(const uint8_t *d)
+{
+    uint64_t bits = 0;
+    double t;
+    for (int i = 0; i < 8; i++) {
+        bits = bits << 8 | d[i];
+    }
+    memcpy(&t, &bits, sizeof t);
+    return t;
+}
+
+/* The controller time of a message: the raw packet's first column, or in the
+ * gateway's types after fingerprint(8) utime(8); in state after the length(4),
+ * doubles(2), generation(1), versions (4-byte length, bytes), present(8) and
+ * sequence(8). */
+static bool message_time(const session *s, int kind, const uint8_t *d, size_t n, double *t)
+{
+    size_t off = s->raw ? 4 : 16;
+    if (!s->raw && kind == 0) {
+        if (n < 27) return false;
+        uint32_t slen = (uint32_t)d[23] << 24 | (uint32_t)d[24] << 16 | (uint32_t)d[25] << 8 | d[26];
+        off = 27 + (size_t)slen + 16;
+    }
+    if (off + 8 > n) return false;
+    *t = be_double(d + off);
+    return true;
+}
+
+static void on_message(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    uint64_t now = mono_ns();
+    session *s = user;
+    size_t pl = strlen(s->prefix);
+    char *end;
+    if (strncmp(channel, s->prefix, pl) != 0 || channel[pl] != '_') return;
+    long r = strtol(channel + pl + 1, &end, 10);
+    if (*end != '.' || r < 0 || r >= s->robots) return;
+    int kind = -1;
+    for (int k = 0; k < KINDS; k++) {
+        if (strcmp(end + 1, kind_names[k]) == 0) kind = k;
+    }
+    double t;
+    if (kind < 0 || !message_time(s, kind, rbuf->data, rbuf->data_size, &t)) return;
+    __atomic_store_n(&s->received, s->received + 1, __ATOMIC_RELAXED);
+    long index = lrint(t * HZ);
+    uint64_t sent = 0;
+    if (index >= 1 && index <= s->per_robot) {
+        sent = __atomic_load_n(&s->sent_ns[(size_t)r * (size_t)(s->per_robot + 1) + (size_t)index], __ATOMIC_ACQUIRE);
+    }
+    if (sent == 0) {
+        s->late++;
         return;
     }
-    qsort(v, n, sizeof *v, cmp_double);
-    printf("%s_latency_median_us: %.1f\n", name, v[n / 2]);
-    printf("%s_latency_p99_us: %.1f\n", name, v[(size_t)(n * 0.99)]);
-    printf("%s_latency_max_us: %.1f\n", name, v[n - 1]);
-    printf("%s_messages: %u\n", name, n);
+    if (index > WARMUP) {
+        s->lat_us[kind][s->lat_n[kind]++] = (double)(now - sent) / 1000.0;
+    }
+}
+
+typedef struct {
+    lcm_t *lcm;
+    session *s;
+} sub_arg;
+
+static void *subscriber(void *arg)
+{
+    sub_arg *a = arg;
+    while (!__atomic_load_n(&a->s->stop, __ATOMIC_ACQUIRE) && lcm_handle_timeout(a->lcm, 20) >= 0) {
+    }
+    return NULL;
 }
 
 /* CPU time of every thread of pid, in ns. */
@@ -149,17 +186,32 @@ static uint64_t cpu_ns(pid_t pid)
     return sum;
 }
 
-static int listen_on(int port)
+static int listen_any(uint16_t *port)
 {
-    int fd = socket(AF_INET, SOCK_STREAM, 0), one = 1;
-    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port),
-                            .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
-    setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-    if (bind(fd, (struct sockaddr *)&a, sizeof a) != 0 || listen(fd, 4) != 0) {
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
+    socklen_t al = sizeof a;
+    if (bind(fd, (struct sockaddr *)&a, sizeof a) != 0 || listen(fd, 4) != 0 ||
+        getsockname(fd, (struct sockaddr *)&a, &al) != 0) {
         perror("bench_gateway: listen");
         exit(1);
     }
+    *port = ntohs(a.sin_port);
     return fd;
+}
+
+/* A UDP port the system is not using now, for the LCM multicast group. */
+static uint16_t free_udp_port(void)
+{
+    int fd = socket(AF_INET, SOCK_DGRAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET};
+    socklen_t al = sizeof a;
+    if (bind(fd, (struct sockaddr *)&a, sizeof a) != 0 || getsockname(fd, (struct sockaddr *)&a, &al) != 0) {
+        perror("bench_gateway: udp port");
+        exit(1);
+    }
+    close(fd);
+    return ntohs(a.sin_port);
 }
 
 static void make_packet(uint8_t *out, long index)
@@ -179,24 +231,19 @@ static void make_packet(uint8_t *out, long index)
         ready = 1;
     }
     /* A 500 Hz controller's clock: the gateway holds it against its own to
-     * tell a backlog from fresh packets. */
-    st.time[0] = (double)index * 0.002;
+     * tell a backlog from fresh packets, and it gives back the index. */
+    st.time[0] = (double)index / HZ;
     urrt_encode(&st, LENGTH, out, LENGTH);
 }
 
-/* Loopback TCP write-to-read with nothing in between: the floor under
- * the gateway's figure. */
+/* Loopback TCP write-to-read with nothing in between. */
 static double baseline_us(void)
 {
-    int sv[2];
     uint8_t buf[LENGTH];
     double v[2000];
-    int lfd = socket(AF_INET, SOCK_STREAM, 0), one = 1;
-    struct sockaddr_in a = {.sin_family = AF_INET, .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
-    socklen_t al = sizeof a;
-    bind(lfd, (struct sockaddr *)&a, sizeof a);
-    listen(lfd, 1);
-    getsockname(lfd, (struct sockaddr *)&a, &al);
+    uint16_t port;
+    int lfd = listen_any(&port), one = 1, sv[2];
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons(port), .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
     sv[0] = socket(AF_INET, SOCK_STREAM, 0);
     connect(sv[0], (struct sockaddr *)&a, sizeof a);
     sv[1] = accept(lfd, NULL, NULL);
@@ -216,135 +263,300 @@ static double baseline_us(void)
     close(sv[0]);
     close(sv[1]);
     close(lfd);
-    qsort(v, 2000, sizeof v[0], cmp_double);
-    return v[1000];
+    return median(v, 2000);
 }
 
-int main(int argc, char **argv)
+/* What a session measured. */
+typedef struct {
+    double cpu_per_packet_us, cpu_percent;
+    double median_us[KINDS], p99_us[KINDS], max_us[KINDS];
+    size_t messages[KINDS];
+    uint64_t expected, received, late;
+    long packets; /* measured, all robots */
+} result;
+
+typedef struct {
+    const char *path;  /* urrt-gateway or bench_relay */
+    bool relay;
+    int robots;
+    double seconds;
+    const char *focused_hz; /* NULL: every message at every packet */
+} subject;
+
+static pid_t start_gateway(const subject *sj, const char *url, const char *prefix, const uint16_t *ports, char *ini)
 {
-    const char *gateway = NULL;
-    int port = 41500;
-    double seconds = 6;
-    const char *focused_hz = NULL; /* NULL: every message at every packet */
-    for (int i = 1; i + 1 < argc; i += 2) {
-        if (strcmp(argv[i], "--gateway") == 0) gateway = argv[i + 1];
-        else if (strcmp(argv[i], "--port") == 0) port = atoi(argv[i + 1]);
-        else if (strcmp(argv[i], "--seconds") == 0) seconds = atof(argv[i + 1]);
-        else if (strcmp(argv[i], "--focused-hz") == 0) focused_hz = argv[i + 1];
-    }
-    if (gateway == NULL) {
-        fprintf(stderr, "usage: bench_gateway --gateway PATH --port PORT [--seconds S] [--focused-hz N]\n");
-        return 2;
-    }
-    signal(SIGPIPE, SIG_IGN);
-    sent_ns = calloc(MAX_PACKETS, sizeof *sent_ns);
-    for (int k = 0; k < 4; k++) lat_us[k] = calloc(MAX_PACKETS, sizeof(double));
-
-    double base = baseline_us();
-
-    snprintf(prefix, sizeof prefix, "bench%d", (int)getpid());
-    char ini[] = "/tmp/bench-gateway-XXXXXX";
     int ifd = mkstemp(ini);
-    if (focused_hz == NULL) {
+    if (sj->focused_hz == NULL) {
         dprintf(ifd, "[lcm]\nurl = %s\nstate_rate = every\njoints_rate = every\ntool_rate = every\n"
-                     "status_rate = every\n", URL);
+                     "status_rate = every\n", url);
     } else {
         dprintf(ifd, "[lcm]\nurl = %s\nstate_rate = off\njoints_rate = %s Hz\ntool_rate = %s Hz\n"
-                     "status_rate = %s Hz\n", URL, focused_hz, focused_hz, focused_hz);
+                     "status_rate = %s Hz\n", url, sj->focused_hz, sj->focused_hz, sj->focused_hz);
     }
-    dprintf(ifd, "gateway_rate = 1 Hz\n[robot %s]\nhost = 127.0.0.1\nport = %d\nsilence_timeout = 2 s\n",
-            prefix, port);
+    dprintf(ifd, "gateway_rate = 1 Hz\n");
+    for (int r = 0; r < sj->robots; r++) {
+        dprintf(ifd, "[robot %s_%d]\nhost = 127.0.0.1\nport = %u\nsilence_timeout = 2 s\n", prefix, r, ports[r]);
+    }
     close(ifd);
-
-    lcm_t *lcm = lcm_create(URL);
-    if (lcm == NULL) {
-        fprintf(stderr, "bench_gateway: cannot open %s\n", URL);
-        return 1;
-    }
-    char regex[96];
-    snprintf(regex, sizeof regex, "%s\\..*", prefix);
-    lcm_subscribe(lcm, regex, on_message, NULL);
-    int lfd = listen_on(port);
-
     pid_t pid = fork();
     if (pid == 0) {
-        execl(gateway, gateway, "--log-level", "warning", ini, (char *)NULL);
+        execl(sj->path, sj->path, "--log-level", "warning", ini, (char *)NULL);
         _exit(127);
     }
-    int cfd = -1;
+    return pid;
+}
+
+static pid_t start_relay(const subject *sj, const char *url, const char *prefix, uint16_t port)
+{
+    char ports[8], every[16], chan[48];
+    snprintf(ports, sizeof ports, "%u", port);
+    snprintf(every, sizeof every, "%d", sj->focused_hz == NULL ? 1 : HZ / atoi(sj->focused_hz));
+    snprintf(chan, sizeof chan, "%s_0", prefix);
+    pid_t pid = fork();
+    if (pid == 0) {
+        if (sj->focused_hz == NULL) {
+            execl(sj->path, sj->path, "127.0.0.1", ports, url, chan, every, "STATE", "JOINTS", "TOOL", "STATUS",
+                  (char *)NULL);
+        } else {
+            execl(sj->path, sj->path, "127.0.0.1", ports, url, chan, every, "JOINTS", "TOOL", "STATUS", (char *)NULL);
+        }
+        _exit(127);
+    }
+    return pid;
+}
+
+static void summarize(session *s, result *res)
+{
+    for (int k = 0; k < KINDS; k++) {
+        size_t n = s->lat_n[k];
+        res->messages[k] = n;
+        if (n == 0) continue;
+        qsort(s->lat_us[k], n, sizeof(double), cmp_double);
+        res->median_us[k] = s->lat_us[k][n / 2];
+        res->p99_us[k] = s->lat_us[k][(size_t)((double)n * 0.99)];
+        res->max_us[k] = s->lat_us[k][n - 1];
+    }
+    res->received = s->received;
+    res->late = s->late;
+}
+
+/* Serve sj->robots robots at 500 Hz for warm-up + seconds; false if the
+ * subject did not connect. */
+static bool run(const subject *sj, result *res)
+{
+    static unsigned serial;
+    session s = {.robots = sj->robots, .raw = sj->relay};
+    uint16_t ports[MAX_ROBOTS];
+    int lfd[MAX_ROBOTS], cfd[MAX_ROBOTS];
+    char url[96], ini[] = "/tmp/bench-gateway-XXXXXX", regex[64];
+    int n = sj->robots;
+
+    memset(res, 0, sizeof *res);
+    s.per_robot = WARMUP + (long)(sj->seconds * HZ);
+    s.sent_ns = calloc((size_t)n * (size_t)(s.per_robot + 1), sizeof *s.sent_ns);
+    for (int k = 0; k < KINDS; k++) s.lat_us[k] = calloc((size_t)n * (size_t)s.per_robot, sizeof(double));
+    snprintf(s.prefix, sizeof s.prefix, "b%d_%u", (int)getpid(), serial++);
+    snprintf(url, sizeof url, "udpm://239.255.76.67:%u?ttl=0", free_udp_port());
+    snprintf(regex, sizeof regex, "%s_.*", s.prefix);
+
+    lcm_t *lcm = lcm_create(url);
+    if (lcm == NULL) {
+        fprintf(stderr, "bench_gateway: cannot open %s\n", url);
+        exit(1);
+    }
+    /* Each packet's messages may all wait while the subscriber is preempted. */
+    lcm_subscription_set_queue_capacity(lcm_subscribe(lcm, regex, on_message, &s), 4 * KINDS * n + 1000);
+    for (int r = 0; r < n; r++) lfd[r] = listen_any(&ports[r]);
+    pid_t pid = sj->relay ? start_relay(sj, url, s.prefix, ports[0]) : start_gateway(sj, url, s.prefix, ports, ini);
+    for (int r = 0; r < n; r++) {
+        struct pollfd pl = {.fd = lfd[r], .events = POLLIN};
+        cfd[r] = poll(&pl, 1, 5000) == 1 ? accept(lfd[r], NULL, NULL) : -1;
+        if (cfd[r] < 0) {
+            fprintf(stderr, "bench_gateway: %s did not connect\n", sj->path);
+            kill(pid, SIGTERM);
+            waitpid(pid, NULL, 0);
+            return false;
+        }
+        int one = 1;
+        setsockopt(cfd[r], IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    }
+    pthread_t th;
+    sub_arg sa = {lcm, &s};
+    pthread_create(&th, NULL, subscriber, &sa);
+
+    uint8_t pkt[LENGTH];
+    uint64_t start = mono_ns(), cpu0 = 0, wall0 = 0;
+    size_t row = (size_t)(s.per_robot + 1);
+    for (long index = 1; index <= s.per_robot; index++) {
+        uint64_t due = start + (uint64_t)index * (1000000000u / HZ);
+        uint64_t now = mono_ns();
+        if (now < due) {
+            struct timespec ts = {.tv_sec = 0, .tv_nsec = (long)(due - now)};
+            nanosleep(&ts, NULL);
+        }
+        if (index == WARMUP + 1) {
+            cpu0 = cpu_ns(pid);
+            wall0 = mono_ns();
+        }
+        make_packet(pkt, index);
+        for (int r = 0; r < n; r++) {
+            __atomic_store_n(&s.sent_ns[(size_t)r * row + (size_t)index], mono_ns(), __ATOMIC_RELEASE);
+            if (write(cfd[r], pkt, LENGTH) != LENGTH) {
+                fprintf(stderr, "bench_gateway: write: %s\n", strerror(errno));
+                exit(1);
+            }
+        }
+    }
+    /* Every message is in once the subject's CPU stops moving and the
+     * subscriber has them all, or after a second at most. */
+    uint64_t cpu1 = cpu_ns(pid), wall1 = mono_ns();
+    res->packets = (long)(s.per_robot - WARMUP) * n;
+    res->expected = sj->focused_hz == NULL ? (uint64_t)s.per_robot * (uint64_t)n * KINDS : 0;
+    for (uint64_t end = mono_ns() + 1000000000u; mono_ns() < end;) {
+        if (res->expected != 0 && __atomic_load_n(&s.received, __ATOMIC_RELAXED) >= res->expected) break;
+        struct timespec ts = {.tv_sec = 0, .tv_nsec = 1000000};
+        nanosleep(&ts, NULL);
+    }
+    kill(pid, SIGTERM);
+    waitpid(pid, NULL, 0);
+    for (int r = 0; r < n; r++) {
+        close(cfd[r]);
+        close(lfd[r]);
+    }
+    __atomic_store_n(&s.stop, 1, __ATOMIC_RELEASE);
+    pthread_join(th, NULL);
+    lcm_destroy(lcm);
+    if (!sj->relay) unlink(ini);
+    res->cpu_per_packet_us = (double)(cpu1 - cpu0) / 1000.0 / (double)res->packets;
+    res->cpu_percent = 100.0 * (double)(cpu1 - cpu0) / (double)(wall1 - wall0);
+    summarize(&s, res);
+    free(s.sent_ns);
+    for (int k = 0; k < KINDS; k++) free(s.lat_us[k]);
+    return true;
+}
+
+static void lower(char *out, const char *in)
+{
+    for (; *in; in++) *out++ = (char)(*in >= 'A' && *in <= 'Z' ? *in - 'A' + 'a' : *in);
+    *out = 0;
+}
+
+static void print_latency(const char *who, const result *res)
+{
+    for (int k = 0; k < KINDS; k++) {
+        char name[16];
+        lower(name, kind_names[k]);
+        if (res->messages[k] == 0) continue;
+        printf("%s%s_latency_median_us: %.1f\n", who, name, res->median_us[k]);
+        printf("%s%s_latency_p99_us: %.1f\n", who, name, res->p99_us[k]);
+        printf("%s%s_latency_max_us: %.1f\n", who, name, res->max_us[k]);
+        printf("%s%s_messages: %zu\n", who, name, res->messages[k]);
+    }
+}
+
+/* Figures across rounds: the median of each. */
+static double med_of(const result *r, int rounds, size_t offset)
+{
+    double v[MAX_ROUNDS];
+    for (int i = 0; i < rounds; i++) v[i] = *(const double *)(const void *)((const char *)&r[i] + offset);
+    return median(v, rounds);
+}
+
+static double med_ratio(const result *g, const result *rl, int rounds, size_t offset)
+{
+    double v[MAX_ROUNDS];
+    for (int i = 0; i < rounds; i++) {
+        v[i] = *(const double *)(const void *)((const char *)&g[i] + offset) /
+               *(const double *)(const void *)((const char *)&rl[i] + offset);
+    }
+    return median(v, rounds);
+}
+
+static void print_subject(const char *who, const result *r, int rounds)
+{
+    result m = r[0];
+    m.cpu_per_packet_us = med_of(r, rounds, offsetof(result, cpu_per_packet_us));
+    m.cpu_percent = med_of(r, rounds, offsetof(result, cpu_percent));
+    for (int k = 0; k < KINDS; k++) {
+        m.median_us[k] = med_of(r, rounds, offsetof(result, median_us) + (size_t)k * sizeof(double));
+        m.p99_us[k] = med_of(r, rounds, offsetof(result, p99_us) + (size_t)k * sizeof(double));
+        m.max_us[k] = med_of(r, rounds, offsetof(result, max_us) + (size_t)k * sizeof(double));
+    }
+    printf("%scpu_per_packet_us: %.2f\n", who, m.cpu_per_packet_us);
+    printf("%scpu_percent_of_core_at_500hz: %.3f\n", who, m.cpu_percent);
+    print_latency(who, &m);
+    uint64_t lost = 0;
+    for (int i = 0; i < rounds; i++) {
+        lost += r[i].expected > r[i].received ? r[i].expected - r[i].received : 0;
+    }
+    if (r[0].expected != 0) printf("%smessages_lost: %llu\n", who, (unsigned long long)lost);
+}
+
+static void compare(subject *gw, subject *relay, int rounds)
+{
+    result g[MAX_ROUNDS], rl[MAX_ROUNDS];
+    for (int i = 0; i < rounds; i++) {
+        if (!run(relay, &rl[i]) || !run(gw, &g[i])) exit(1);
+    }
+    printf("rounds: %d\n", rounds);
+    printf("packets_at_500hz_per_round: %ld\n", g[0].packets);
+    print_subject("relay_", rl, rounds);
+    print_subject("gateway_", g, rounds);
+    printf("gateway_cpu_vs_relay: %.2f\n", med_ratio(g, rl, rounds, offsetof(result, cpu_per_packet_us)));
+    for (int k = 0; k < KINDS; k++) {
+        char name[16];
+        lower(name, kind_names[k]);
+        if (g[0].messages[k] == 0 || rl[0].messages[k] == 0) continue;
+        printf("%s_latency_median_vs_relay: %.2f\n", name,
+               med_ratio(g, rl, rounds, offsetof(result, median_us) + (size_t)k * sizeof(double)));
+        printf("%s_latency_p99_vs_relay: %.2f\n", name,
+               med_ratio(g, rl, rounds, offsetof(result, p99_us) + (size_t)k * sizeof(double)));
+    }
+}
+
+static void scaling(subject *gw)
+{
+    result r;
+    if (!run(gw, &r)) exit(1);
+    char who[32];
+    snprintf(who, sizeof who, "robots_%d_", gw->robots);
+    printf("%spackets: %ld\n", who, r.packets);
+    printf("%scpu_per_packet_us: %.2f\n", who, r.cpu_per_packet_us);
+    printf("%scpu_percent_of_core: %.1f\n", who, r.cpu_percent);
+    print_latency(who, &r);
+    /* All kinds together: the robots' worst message. */
+    double worst = 0;
+    for (int k = 0; k < KINDS; k++) worst = r.p99_us[k] > worst ? r.p99_us[k] : worst;
+    printf("%sworst_kind_latency_p99_us: %.1f\n", who, worst);
+    printf("%smessages_expected: %llu\n", who, (unsigned long long)r.expected);
+    printf("%smessages_received: %llu\n", who, (unsigned long long)r.received);
+    printf("%smessages_lost: %llu\n", who, (unsigned long long)(r.expected > r.received ? r.expected - r.received : 0));
+}
+
+/* As fast as the gateway takes packets: TCP back-pressure paces the writes,
+ * so the rate written is the rate the gateway reads. Nobody subscribes. */
+static void max_rate(const subject *sj)
+{
+    uint16_t port;
+    int lfd = listen_any(&port);
+    char url[96], ini[] = "/tmp/bench-gateway-XXXXXX", prefix[32];
+    snprintf(url, sizeof url, "udpm://239.255.76.67:%u?ttl=0", free_udp_port());
+    snprintf(prefix, sizeof prefix, "b%d_max", (int)getpid());
+    pid_t pid = start_gateway(sj, url, prefix, &port, ini);
     struct pollfd pl = {.fd = lfd, .events = POLLIN};
-    if (poll(&pl, 1, 5000) == 1) cfd = accept(lfd, NULL, NULL);
+    int cfd = poll(&pl, 1, 5000) == 1 ? accept(lfd, NULL, NULL) : -1;
     if (cfd < 0) {
         fprintf(stderr, "bench_gateway: the gateway did not connect\n");
-        kill(pid, SIGTERM);
-        waitpid(pid, NULL, 0);
-        unlink(ini);
-        return 1;
+        exit(1);
     }
-    int one = 1;
-    setsockopt(cfd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    int lcm_fd = lcm_get_fileno(lcm);
-
-    /* Phase 1: 500 Hz. The first second warms up and is not measured. */
-    uint8_t pkt[LENGTH];
-    long index = 1;
-    long total = (long)(seconds * 500.0) + 500;
-    uint64_t start = mono_ns(), cpu0 = 0, wall0 = 0;
-    long measured_from = 500;
-    while (index < total) {
-        uint64_t due = start + (uint64_t)index * 2000000u;
-        uint64_t now = mono_ns();
-        if (now >= due) {
-            if (index == measured_from) {
-                for (int k = 0; k < 4; k++) lat_n[k] = 0;
-                cpu0 = cpu_ns(pid);
-                wall0 = now;
-            }
-            make_packet(pkt, index);
-            sent_ns[index] = mono_ns();
-            if (write(cfd, pkt, LENGTH) != LENGTH) {
-                fprintf(stderr, "bench_gateway: write: %s\n", strerror(errno));
-                break;
-            }
-            index++;
-            continue;
-        }
-        struct pollfd p = {.fd = lcm_fd, .events = POLLIN};
-        struct timespec ts = {.tv_sec = 0, .tv_nsec = (long)(due - now)};
-        if (ppoll(&p, 1, &ts, NULL) == 1) lcm_handle(lcm);
-    }
-    uint64_t cpu1 = cpu_ns(pid), wall1 = mono_ns();
-    /* Collect the last messages. */
-    for (uint64_t end = mono_ns() + 200000000u; mono_ns() < end;) {
-        struct pollfd p = {.fd = lcm_fd, .events = POLLIN};
-        if (poll(&p, 1, 20) == 1) lcm_handle(lcm);
-    }
-    long packets = index - measured_from;
-    printf("baseline_tcp_loopback_median_us: %.1f\n", base);
-    for (int k = 0; k < 4; k++) {
-        char name[32];
-        snprintf(name, sizeof name, "%s", kind_names[k]);
-        for (char *c = name; *c; c++) *c = (char)(*c - 'A' + 'a');
-        report_latency(name, lat_us[k], lat_n[k]);
-    }
-    printf("packets_at_500hz: %ld\n", packets);
-    printf("gateway_cpu_per_packet_us: %.2f\n", (double)(cpu1 - cpu0) / 1000.0 / (double)packets);
-    printf("gateway_cpu_percent_of_core_at_500hz: %.3f\n", 100.0 * (double)(cpu1 - cpu0) / (double)(wall1 - wall0));
-
-    /* Phase 2: as fast as the gateway takes them. Stop reading LCM: the
-     * kernel drops what this process does not read. */
-    lcm_unsubscribe(lcm, NULL);
-    lcm_destroy(lcm);
     fcntl(cfd, F_SETFL, fcntl(cfd, F_GETFL) | O_NONBLOCK);
-    /* 4096 packets whose times keep increasing: refreshed each round, so
-     * that decimation on the controller's clock works as it would live. */
+    /* Packets whose times keep increasing, so that decimation and the age
+     * estimator see a live stream. */
     enum { BURST = 4096 };
     static uint8_t burst[BURST * LENGTH];
-    long next_index = 100000;
+    long next_index = 1;
     for (int i = 0; i < BURST; i++) make_packet(burst + (size_t)i * LENGTH, next_index++);
-    uint64_t t0 = mono_ns(), mark_t = 0;
-    uint64_t written = 0, mark_w = 0;
-    uint64_t cpu_mark = 0;
+    uint64_t t0 = mono_ns(), mark_t = 0, written = 0, mark_w = 0, cpu_mark = 0;
     size_t off = 0;
     while (mono_ns() - t0 < 3000000000u) {
         struct pollfd p = {.fd = cfd, .events = POLLOUT};
@@ -367,14 +579,11 @@ int main(int argc, char **argv)
             cpu_mark = cpu_ns(pid);
         }
     }
-    uint64_t t1 = mono_ns();
-    uint64_t cpu_end = cpu_ns(pid);
+    uint64_t t1 = mono_ns(), cpu_end = cpu_ns(pid);
     double rate = (double)(written - mark_w) / LENGTH / ((double)(t1 - mark_t) / 1e9);
     printf("max_rate_packets_per_s: %.0f\n", rate);
-    printf("gateway_cpu_percent_of_core_at_max_rate: %.1f\n",
-           100.0 * (double)(cpu_end - cpu_mark) / (double)(t1 - mark_t));
-    printf("max_rate_vs_500hz: %.0f\n", rate / 500.0);
-
+    printf("gateway_cpu_percent_of_core_at_max_rate: %.1f\n", 100.0 * (double)(cpu_end - cpu_mark) / (double)(t1 - mark_t));
+    printf("max_rate_vs_500hz: %.0f\n", rate / HZ);
     kill(pid, SIGTERM);
     int status = 0;
     waitpid(pid, &status, 0);
@@ -382,5 +591,40 @@ int main(int argc, char **argv)
     close(cfd);
     close(lfd);
     unlink(ini);
+}
+
+int main(int argc, char **argv)
+{
+    subject gw = {.robots = 0, .seconds = 4}, relay = {.relay = true, .robots = 1};
+    int rounds = 3;
+    bool max = false;
+    for (int i = 1; i < argc; i++) {
+        const char *v = i + 1 < argc ? argv[i + 1] : "";
+        if (strcmp(argv[i], "--gateway") == 0) gw.path = argv[++i];
+        else if (strcmp(argv[i], "--relay") == 0) relay.path = argv[++i];
+        else if (strcmp(argv[i], "--seconds") == 0) gw.seconds = atof(v), i++;
+        else if (strcmp(argv[i], "--focused-hz") == 0) gw.focused_hz = argv[++i];
+        else if (strcmp(argv[i], "--rounds") == 0) rounds = atoi(v), i++;
+        else if (strcmp(argv[i], "--robots") == 0) gw.robots = atoi(v), i++;
+        else if (strcmp(argv[i], "--max-rate") == 0) max = true;
+    }
+    bool scale = gw.robots > 0;
+    if (gw.path == NULL || (!scale && relay.path == NULL) || gw.robots > MAX_ROBOTS || rounds < 1 ||
+        rounds > MAX_ROUNDS || (gw.focused_hz != NULL && (atoi(gw.focused_hz) < 1 || HZ % atoi(gw.focused_hz)))) {
+        fprintf(stderr, "usage: bench_gateway --gateway PATH (--relay PATH [--focused-hz N] [--rounds R] "
+                        "[--max-rate] | --robots N) [--seconds S]\n");
+        return 2;
+    }
+    signal(SIGPIPE, SIG_IGN);
+    relay.seconds = gw.seconds;
+    relay.focused_hz = gw.focused_hz;
+    if (scale) {
+        scaling(&gw);
+        return 0;
+    }
+    gw.robots = 1;
+    printf("baseline_tcp_loopback_median_us: %.1f\n", baseline_us());
+    compare(&gw, &relay, rounds);
+    if (max) max_rate(&gw);
     return 0;
 }
