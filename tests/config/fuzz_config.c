@@ -7,7 +7,8 @@
  *
  *   - a rejected file gets exactly as many messages as errors counted, each
  *     one line "fuzz.ini:LINE: reason" with LINE within the file (or
- *     "fuzz.ini: reason" for a file-wide one), without control characters;
+ *     "fuzz.ini: reason" for a file-wide one, those first), in line order,
+ *     without control characters;
  *   - an accepted file has no message, at least one robot with a host, and
  *     every text the gateway prints from it (the --check-config plan, the CAN
  *     description, the DBC) is free of control characters;
@@ -19,7 +20,9 @@
  *   - loading the same bytes again gives the same messages and the same DBC;
  *   - the scheduler runs on it (packets with ordinary, huge and NaN values, a
  *     stall, the link down): each frame sent is a configured one, with its
- *     id, length and FD flag, or the heartbeat.
+ *     id, length and FD flag, or the heartbeat;
+ *   - the same for the CAN mapping fed key by key, bad keys left out
+ *     (check_can_only), so that many more mappings reach the DBC writer.
  *
  * Any violation aborts with a description, so libFuzzer keeps the input.
  * Replay inputs with: fuzz_config FILE...
@@ -32,6 +35,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <ini.h>
 
 #include "can_map.h"
 #include "config.h"
@@ -157,6 +162,7 @@ static void check_messages(const struct loaded *l, long lines)
     const char *p = l->messages;
     const char *end = l->messages + l->messages_len;
     int count = 0;
+    long previous = 0;
     if (l->messages_len == 0 || end[-1] != '\n') {
         violated("%d errors but the messages are \"%s\" (not whole lines)", l->errors, l->messages);
     }
@@ -175,8 +181,14 @@ static void check_messages(const struct loaded *l, long lines)
             if (*after != ':' || after[1] != ' ' || line < 1 || line > lines) {
                 violated("message %d names line %ld of a %ld-line file: %.*s", count, line, lines, (int)(nl - p), p);
             }
+            if (line < previous) {
+                violated("message %d (line %ld) comes after one of line %ld", count, line, previous);
+            }
+            previous = line;
         } else if (*q != ' ') {
             violated("message %d is neither \"" NAME ":LINE: \" nor \"" NAME ": \": %.*s", count, (int)(nl - p), p);
+        } else if (previous != 0) {
+            violated("message %d is about the whole file but comes after line %ld", count, previous);
         }
         p = nl + 1;
     }
@@ -598,6 +610,54 @@ static void run_schedule(struct can_map *map)
     }
 }
 
+/* ---- the CAN mapping alone -------------------------------------------------------------- */
+
+/* The loader rejects a file for its first mistake, so few mutated files
+ * reach the DBC writer that way. Here every [can] and [frame NAME] key goes
+ * to the map on its own, a bad key is left out, and whatever the map
+ * accepts as a whole is written and run: the DBC writer and the scheduler
+ * see far more mappings (as a tool that generates tables from an INI would
+ * feed them). The robots are those the loader found (one if none). */
+static int can_only_key(void *user, const char *section, const char *key, const char *value)
+{
+    can_map_ini(user, section, key, value, NAME, 1, NULL, 0);
+    return 1;
+}
+
+static void check_can_only(const char *data, size_t size, const gw_config *cfg)
+{
+    struct can_map map;
+    struct can_map_robot robots[GW_MAX_ROBOTS] = {{"arm", 8000}};
+    size_t count = cfg->robot_count ? cfg->robot_count : 1;
+    char *text = strndup(data, size);
+    if (text == NULL) {
+        abort();
+    }
+    for (unsigned i = 0; i < cfg->robot_count; i++) {
+        robots[i].name = cfg->robots[i].name;
+        robots[i].period_us = 1000000u / cfg->robots[i].max_rate_hz;
+    }
+    can_map_init(&map);
+    ini_parse_string(text, can_only_key, &map); /* the loader set libinih's options */
+    if (can_map_finish(&map, robots, count, NULL, 0) == 0 && can_map_enabled(&map)) {
+        size_t len;
+        char *dbc = NULL;
+        FILE *out = open_memstream(&dbc, &len);
+        if (out == NULL) {
+            abort();
+        }
+        if (dbc_write(out, &map, NAME) != 0) {
+            violated("dbc_write failed on a finished map");
+        }
+        fclose(out);
+        dbc_check(dbc, len);
+        free(dbc);
+        run_schedule(&map);
+    }
+    can_map_free(&map);
+    free(text);
+}
+
 /* ---- the entry point ------------------------------------------------------------------ */
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -636,6 +696,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             run_schedule(&a.cfg.can);
         }
     }
+    check_can_only((const char *)data, size, &b.cfg);
     unload(&a);
     unload(&b);
     return 0;
