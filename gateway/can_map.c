@@ -1477,22 +1477,40 @@ static double field_value(const urrt_state *st, const struct can_map_signal *m)
     return v;
 }
 
-/* Packs the field signals of f from st (NULL: every value NaN). */
-static void pack_fields(struct can_map *map, struct can_map_frame *f, const urrt_state *st)
+/* Takes the values of f's field signals from st (NULL: every value NaN).
+ * A packet costs these loads only: the values are packed when the frame
+ * goes out (or before a heartbeat reports clamping), at the frame's rate. */
+static void take_fields(struct can_map_frame *f, const urrt_state *st)
+{
+    size_t i;
+    for (i = 0; i < f->count; i++) {
+        if (f->meta[i].role == CAN_MAP_ROLE_FIELD) {
+            f->meta[i].value = st ? field_value(st, &f->meta[i]) : NAN;
+        }
+    }
+    f->unpacked = true;
+}
+
+/* Packs the values taken last, once. */
+static void pack_fields(struct can_map *map, struct can_map_frame *f)
 {
     size_t i;
     int worst = URRT_CAN_PACK_OK;
+    if (!f->unpacked) {
+        return;
+    }
+    f->unpacked = false;
     memset(f->payload, 0, sizeof f->payload);
     for (i = 0; i < f->count; i++) {
         int outcome;
         if (f->meta[i].role != CAN_MAP_ROLE_FIELD) {
             continue;
         }
-        outcome = urrt_can_pack(&f->sigs[i], st ? field_value(st, &f->meta[i]) : NAN, f->payload, f->len);
+        outcome = urrt_can_pack(&f->sigs[i], f->meta[i].value, f->payload, f->len);
         if (outcome > worst) {
             worst = outcome;
         }
-        if (outcome != URRT_CAN_PACK_OK && st != NULL) {
+        if (outcome != URRT_CAN_PACK_OK) {
             map->clamped++;
         }
     }
@@ -1506,7 +1524,6 @@ void can_map_start(struct can_map *map, uint64_t now_us)
     map->start_us = now_us;
     map->hb_next_us = now_us;
     map->hb_alive = 0;
-    map->clamped = 0;
     map->hb_clamped_seen = 0;
     memset(&map->hb_seen, 0, sizeof map->hb_seen);
     for (i = 0; i < map->robot_count; i++) {
@@ -1519,12 +1536,14 @@ void can_map_start(struct can_map *map, uint64_t now_us)
     }
     for (i = 0; i < map->frame_count; i++) {
         struct can_map_frame *f = &map->frames[i];
-        pack_fields(map, f, NULL);
+        take_fields(f, NULL);
+        pack_fields(map, f);
         f->pending = false;
         f->alive = 0;
         f->stopped = f->stale_policy == CAN_MAP_STALE_STOP;
         f->next_due_us = f->every || f->stopped ? CAN_MAP_NOT_SCHEDULED : now_us;
     }
+    map->clamped = 0; /* the NaNs above are no packet's values */
 }
 
 void can_map_robot_link(struct can_map *map, size_t robot, bool up)
@@ -1556,7 +1575,7 @@ void can_map_on_packet(struct can_map *map, size_t robot, const urrt_state *st, 
         if (f->robot_index != robot) {
             continue;
         }
-        pack_fields(map, f, st);
+        take_fields(f, st);
         if (f->every) {
             f->pending = true;
         } else if (f->stopped) {
@@ -1659,9 +1678,12 @@ void can_map_heartbeat_frame(const struct can_map *map, uint64_t now_us, const u
     heartbeat_pack(map, now_us, stats, map->hb_alive, frame);
 }
 
-static void send_frame(struct can_map_frame *f, bool valid, can_map_emit_fn emit, void *ctx)
+static void send_frame(struct can_map *map, struct can_map_frame *f, bool fresh, can_map_emit_fn emit, void *ctx)
 {
     urrt_can_frame out;
+    bool valid;
+    pack_fields(map, f);
+    valid = fresh && f->outcome == URRT_CAN_PACK_OK;
     memset(&out, 0, sizeof out);
     out.id = f->id;
     out.extended = f->extended;
@@ -1703,7 +1725,7 @@ void can_map_due(struct can_map *map, uint64_t now_us, const urrt_can_stats *sta
             }
             if (f->pending) {
                 f->pending = false;
-                send_frame(f, f->outcome == URRT_CAN_PACK_OK, emit, ctx);
+                send_frame(map, f, true, emit, ctx);
             }
             continue;
         }
@@ -1716,7 +1738,7 @@ void can_map_due(struct can_map *map, uint64_t now_us, const urrt_can_stats *sta
             f->next_due_us = CAN_MAP_NOT_SCHEDULED;
             continue;
         }
-        send_frame(f, fresh && f->outcome == URRT_CAN_PACK_OK, emit, ctx);
+        send_frame(map, f, fresh, emit, ctx);
         /* Keep the cadence; after a stall, skip the missed slots rather
          * than send a burst. */
         f->next_due_us += (uint64_t)f->period_ms * 1000u;
@@ -1726,6 +1748,10 @@ void can_map_due(struct can_map *map, uint64_t now_us, const urrt_can_stats *sta
     }
     if (now_us >= map->hb_next_us) {
         urrt_can_frame hb;
+        /* The clamped flag covers every value taken so far. */
+        for (i = 0; i < map->frame_count; i++) {
+            pack_fields(map, &map->frames[i]);
+        }
         heartbeat_pack(map, now_us, stats, map->hb_alive, &hb);
         map->state = can_map_state(map, now_us);
         map->hb_alive = (uint8_t)((map->hb_alive + 1u) & 0x0Fu);

@@ -67,6 +67,7 @@ struct can_map_signal {
     unsigned elem;
     bool bitmask;            /* field coded as a bit mask (unit "bits"): sent as the integer mask */
     struct can_map_loc loc;
+    double value;            /* run time: the latest packet's value, packed when the frame is sent */
 };
 
 enum can_map_stale_policy {
@@ -107,6 +108,7 @@ struct can_map_frame {
     /* Run time. */
     uint8_t payload[URRT_CAN_MAX_DATA];     /* signals packed from the latest packet */
     int outcome;                            /* worst URRT_CAN_PACK_* of the latest packing */
+    bool unpacked;                          /* values taken since the payload was packed */
     bool pending;                           /* every: a packet arrived since the last send */
     bool stopped;                           /* periodic, stop policy: waiting for fresh data */
     uint64_t next_due_us;                   /* periodic: CAN_MAP_NOT_SCHEDULED while stopped */
