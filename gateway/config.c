@@ -614,7 +614,9 @@ static bool robot_key(config_ctx *ctx, gw_config *cfg, const char *key, const ch
 static void robot_finish(config_ctx *ctx, gw_config *cfg)
 {
     if (cfg->robot_count == 0) {
-        config_error(ctx, 0, "no robot: add a section \"[robot NAME]\" with \"host = ADDRESS\"");
+        /* An unedited install reads a file whose robot is commented out: say which file to edit. */
+        config_error(ctx, 0, "no robot: edit %s and add a section \"[robot NAME]\" with \"host = ADDRESS\" "
+                     "(the installed file has one commented out)", ctx->path);
     }
     for (unsigned i = 0; i < cfg->robot_count; i++) {
         gw_robot_config *robot = &cfg->robots[i];

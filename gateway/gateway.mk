@@ -3,10 +3,6 @@
 
 LCM_JAR ?= /usr/share/java/lcm.jar
 JCHART2D_JAR ?= /usr/share/java/jchart2d.jar
-SYSCONFDIR ?= /etc
-UNITDIR ?= /lib/systemd/system
-DATADIR ?= $(PREFIX)/share
-JAVADIR ?= $(DATADIR)/java
 DEMO_SECONDS ?= 0
 DEMO_PORT ?= 30003
 DEMO_LCM_URL ?= udpm://239.255.76.67:7667?ttl=0
@@ -65,23 +61,7 @@ all: $(LCMTYPES_JAR)
 spy: $(LCMTYPES_JAR)
 	URRT_LCMTYPES_JAR=$(LCMTYPES_JAR) gateway/urrt-spy $(if $(LCM_URL),--lcm-url='$(LCM_URL)')
 
-# ---- install ---------------------------------------------------------------------------
-.PHONY: install-gateway
-install: install-gateway
-install-gateway: $(BUILD)/bin/urrt-gateway $(LCMTYPES_JAR)
-	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(JAVADIR) $(DESTDIR)$(UNITDIR) \
-	  $(DESTDIR)$(DATADIR)/urrt $(DESTDIR)$(SYSCONFDIR)/urrt
-	install -m 0644 $(LCMTYPES_JAR) $(DESTDIR)$(JAVADIR)/urrt_lcmtypes.jar
-	sed -e 's|^URRT_JAR_DEFAULT=.*|URRT_JAR_DEFAULT=$(JAVADIR)/urrt_lcmtypes.jar|' gateway/urrt-spy \
-	  > $(DESTDIR)$(BINDIR)/urrt-spy
-	chmod 0755 $(DESTDIR)$(BINDIR)/urrt-spy
-	sed -e 's|@BINDIR@|$(BINDIR)|g; s|@SYSCONFDIR@|$(SYSCONFDIR)|g' gateway/urrt-gateway.service \
-	  > $(DESTDIR)$(UNITDIR)/urrt-gateway.service
-	chmod 0644 $(DESTDIR)$(UNITDIR)/urrt-gateway.service
-	install -m 0644 gateway/urrt-gateway.example.ini $(DESTDIR)$(DATADIR)/urrt/urrt-gateway.example.ini
-	@# An edited configuration is never overwritten.
-	[ -e $(DESTDIR)$(SYSCONFDIR)/urrt/gateway.ini ] || \
-	  install -m 0644 gateway/urrt-gateway.example.ini $(DESTDIR)$(SYSCONFDIR)/urrt/gateway.ini
+# ---- install: gateway/install.mk ------------------------------------------------------
 
 # ---- make demo ---------------------------------------------------------------------------
 # urrt-sim (e-series 5.10 layout) at 500 Hz on 127.0.0.1:$(DEMO_PORT) and urrt-gateway publishing on

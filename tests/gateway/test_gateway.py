@@ -855,21 +855,39 @@ def t_configs(args):
 
 
 def t_install(args):
-    """make install-gateway puts every file where PREFIX/UNITDIR/SYSCONFDIR say; the unit verifies."""
+    """make install puts every file where PREFIX, DESTDIR and the directory variables say; the unit verifies;
+    make uninstall removes exactly what install put there."""
     root = tempfile.mkdtemp(prefix="gw-inst-", dir=args.tmp)
     prefix, unitdir, etc = root + "/usr", root + "/unit", root + "/etc"
     repo = os.path.join(HERE, "..", "..")
-    p = subprocess.run(["make", "-s", "-C", repo, "BUILD=" + os.path.abspath(args.build), "install-gateway",
-                        "PREFIX=" + prefix, "UNITDIR=" + unitdir, "SYSCONFDIR=" + etc],
-                       capture_output=True, text=True, timeout=300)
-    files = ["usr/bin/urrt-spy", "usr/share/java/urrt_lcmtypes.jar", "usr/share/urrt/urrt-gateway.example.ini",
-             "unit/urrt-gateway.service", "etc/urrt/gateway.ini"]
-    check(p.returncode == 0 and all(os.path.exists(os.path.join(root, f)) for f in files),
-          "install: %s (%s)" % (", ".join(files), p.stderr.strip()[-200:]))
+    where = ["BUILD=" + os.path.abspath(args.build), "PREFIX=" + prefix, "UNITDIR=" + unitdir, "SYSCONFDIR=" + etc]
+
+    def make(target, *settings):
+        return subprocess.run(["make", "-s", "-C", repo, target] + list(settings or where), capture_output=True,
+                              text=True, timeout=300)
+
+    def tree():
+        return sorted(os.path.relpath(os.path.join(d, f), root) for d, _, fs in os.walk(root) for f in fs)
+
+    p = make("install")
+    files = ["usr/bin/urrt-gateway", "usr/bin/urrt-dump", "usr/bin/urrt-sim", "usr/bin/urrt-spy",
+             "usr/share/java/urrt_lcmtypes.jar", "usr/share/urrt/urrt-gateway.example.ini",
+             "unit/urrt-gateway.service", "etc/urrt/gateway.ini",
+             "usr/share/man/man8/urrt-gateway.8", "usr/share/man/man5/urrt-gateway.ini.5",
+             "usr/share/man/man1/urrt-dump.1", "usr/share/man/man1/urrt-sim.1",
+             "usr/share/doc/urrt/README.md", "usr/share/doc/urrt/gateway.md", "usr/share/doc/urrt/can.md",
+             "usr/share/doc/urrt/LICENSE", "usr/share/doc/urrt/examples/canopen.ini",
+             "usr/share/doc/urrt/examples/fd.ini", "usr/share/doc/urrt/examples/j1939.ini",
+             "usr/share/urrt/lcmtypes/state_t.lcm", "usr/share/urrt/lcmtypes/gateway_t.lcm",
+             "usr/include/urrt.h", "usr/include/urrt_can.h", "usr/lib/liburrt.a", "usr/lib/pkgconfig/urrt.pc"]
+    missing = [f for f in files if not os.path.exists(os.path.join(root, f))]
+    check(p.returncode == 0 and not missing, "install: %d files in place (missing: %s; %s)" %
+          (len(files), missing, p.stderr.strip()[-200:]))
+    installed = tree()
     unit = open(os.path.join(unitdir, "urrt-gateway.service")).read() if os.path.exists(unitdir) else ""
     check("ExecStart=%s/bin/urrt-gateway %s/urrt/gateway.ini" % (prefix, etc) in unit and "DynamicUser=yes" in unit
-          and "Restart=on-failure" in unit and "@" not in unit.replace("@system-service", "").replace("@privileged", "")
-          .replace("@resources", ""), "install: the unit names the installed paths, restarts, runs unprivileged")
+          and "Restart=on-failure" in unit and "Documentation=man:urrt-gateway(8)" in unit,
+          "install: the unit names the installed paths and the man page, restarts, runs unprivileged")
     # RestartPreventExitStatus= looks at the main process only: a check that fails in ExecStartPre
     # would be retried every RestartSec for ever. The gateway checks its configuration itself.
     check("RestartPreventExitStatus=2" in unit and "ExecStartPre=" not in unit,
@@ -878,18 +896,51 @@ def t_install(args):
           "install: the read-only system leaves /var/log/urrt writable for a CAN log")
     spy = open(os.path.join(prefix, "bin", "urrt-spy")).read() if os.path.exists(prefix) else ""
     check("URRT_JAR_DEFAULT=%s/share/java/urrt_lcmtypes.jar" % prefix in spy, "install: urrt-spy knows the jar")
-    with open(os.path.join(etc, "urrt", "gateway.ini"), "a") as f:
-        f.write("# edited\n")
-    subprocess.run(["make", "-s", "-C", repo, "BUILD=" + os.path.abspath(args.build), "install-gateway",
-                    "PREFIX=" + prefix, "UNITDIR=" + unitdir, "SYSCONFDIR=" + etc], capture_output=True, timeout=300)
-    check(open(os.path.join(etc, "urrt", "gateway.ini")).read().endswith("# edited\n"),
-          "install: an edited configuration is kept")
+    conf = os.path.join(etc, "urrt", "gateway.ini")
+    c = subprocess.run([args.gateway, "--check-config", conf], capture_output=True, text=True, timeout=10)
+    check(c.returncode == 2 and ("no robot: edit %s" % conf) in c.stderr,
+          "install: the unedited configuration fails its check and names the file to edit (%r)" % c.stderr[:200])
+    ex = subprocess.run([args.gateway, "--check-config", os.path.join(prefix, "share/urrt/urrt-gateway.example.ini")],
+                        capture_output=True, text=True, timeout=10)
+    check(ex.returncode == 0, "install: the installed example is valid")
+    # The C library as a user builds against it, through pkg-config.
+    prog = os.path.join(root, "use.c")
+    with open(prog, "w") as f:
+        f.write('#include <urrt.h>\n#include <urrt_can.h>\n#include <stdio.h>\n'
+                'int main(void) { printf("%d\\n", urrt_field_find("q_actual", 8) == URRT_F_Q_ACTUAL); return 0; }\n')
+    env = dict(os.environ, PKG_CONFIG_PATH=os.path.join(prefix, "lib", "pkgconfig"))
+    pc = subprocess.run(["sh", "-c", "cc -o %s.bin %s $(pkg-config --cflags --libs urrt) && %s.bin" % (prog, prog, prog)],
+                        capture_output=True, text=True, timeout=60, env=env)
+    check(pc.returncode == 0 and pc.stdout == "1\n", "install: urrt.pc, urrt.h and liburrt.a build a program (%s)" %
+          pc.stderr.strip()[:200])
+    os.remove(prog)
+    os.remove(prog + ".bin")
+    # The checked-in unit is the one for PREFIX=/usr, so that it can be copied as it is.
+    usr = make("dist-files", where[0], "PREFIX=/usr")
+    dist_unit = os.path.join(args.build, "dist", "urrt-gateway.service")
+    check(usr.returncode == 0 and open(dist_unit).read() == open(os.path.join(repo, "gateway",
+          "urrt-gateway.service")).read(), "install: for PREFIX=/usr the unit is gateway/urrt-gateway.service as it is")
+    make("dist-files")
     if subprocess.run(["which", "systemd-analyze"], capture_output=True).returncode == 0:
-        os.makedirs(os.path.join(prefix, "bin"), exist_ok=True)
-        subprocess.run(["cp", args.gateway, os.path.join(prefix, "bin", "urrt-gateway")])
         v = subprocess.run(["systemd-analyze", "verify", os.path.join(unitdir, "urrt-gateway.service")],
-                           capture_output=True, text=True, timeout=60)
+                           capture_output=True, text=True, timeout=60,
+                           env=dict(os.environ, MANPATH=os.path.join(prefix, "share", "man")))
         check(v.returncode == 0, "install: systemd-analyze verify accepts the unit (%s)" % v.stderr.strip()[:300])
+    with open(conf, "a") as f:
+        f.write("# edited\n")
+    make("install")
+    check(open(conf).read().endswith("# edited\n"), "install: an edited configuration is kept")
+    check(tree() == installed, "install: a second install adds nothing")
+    u = make("uninstall")
+    left = tree()
+    check(u.returncode == 0 and left == ["etc/urrt/gateway.ini"] and "was edited: kept" in u.stdout,
+          "uninstall: removes every file install put there but the edited configuration (left: %s)" % left[:5])
+    os.remove(conf)
+    make("install")
+    make("uninstall")
+    dirs = sorted(os.path.relpath(d, root) for d, _, _ in os.walk(root) if "urrt" in os.path.relpath(d, root))
+    check(tree() == [] and dirs == [], "uninstall: an unedited configuration and urrt's own directories go too "
+          "(left: %s %s)" % (tree()[:3], dirs[:3]))
 
 
 def t_cli(args):

@@ -1,0 +1,91 @@
+# SPDX-License-Identifier: MIT
+# gateway/install.mk: `make install` and `make uninstall` (PREFIX, DESTDIR and
+# the directory variables below; debian/rules sets them for the package).
+# INSTALL_ITEMS is the one list both rules read: uninstall removes exactly
+# what install put there. Each entry is SOURCE:DIRECTORY:MODE, the file keeping
+# its name; a file that needs another name or rewritten paths is made under
+# $(DIST) first. Other fragments hook their own install-X/uninstall-X rules
+# into install: and uninstall: (gateway/wireshark.mk does).
+SYSCONFDIR ?= /etc
+UNITDIR ?= /lib/systemd/system
+DATADIR ?= $(PREFIX)/share
+JAVADIR ?= $(DATADIR)/java
+DOCDIR ?= $(DATADIR)/doc/urrt
+MANDIR ?= $(DATADIR)/man
+INCLUDEDIR ?= $(PREFIX)/include
+LIBDIR ?= $(PREFIX)/lib
+PKGCONFIGDIR ?= $(LIBDIR)/pkgconfig
+URRT_VERSION := $(shell sed -n 's/^\#define URRT_VERSION_STRING "\(.*\)"/\1/p' lib/urrt.h)
+DIST := $(BUILD)/dist
+
+DOCS := README.md $(sort $(wildcard docs/*.md))
+DOC_IMAGES := $(sort $(wildcard docs/img/*.png))
+EXAMPLES := $(sort $(wildcard docs/examples/*.ini))
+DIST_FILES := $(DIST)/urrt-spy $(DIST)/urrt-gateway.service $(DIST)/urrt.pc $(DIST)/gateway.ini
+
+INSTALL_ITEMS = $(foreach f,$(PROGRAMS) $(DIST)/urrt-spy,$(f):$(BINDIR):0755) \
+  $(LCMTYPES_JAR):$(JAVADIR):0644 \
+  $(DIST)/urrt-gateway.service:$(UNITDIR):0644 \
+  gateway/urrt-gateway.example.ini:$(DATADIR)/urrt:0644 \
+  $(foreach f,$(LCMTYPES),$(f):$(DATADIR)/urrt/lcmtypes:0644) \
+  $(foreach f,$(MAN_PAGES),$(f):$(MANDIR)/man$(subst .,,$(suffix $(f))):0644) \
+  $(foreach f,$(DOCS) LICENSE,$(f):$(DOCDIR):0644) \
+  $(foreach f,$(DOC_IMAGES),$(f):$(DOCDIR)/img:0644) \
+  $(foreach f,$(EXAMPLES),$(f):$(DOCDIR)/examples:0644) \
+  lib/urrt.h:$(INCLUDEDIR):0644 lib/urrt_can.h:$(INCLUDEDIR):0644 \
+  $(LIBURRT):$(LIBDIR):0644 \
+  $(DIST)/urrt.pc:$(PKGCONFIGDIR):0644
+# Directories of our own, removed by uninstall when empty (deepest first).
+INSTALL_OWN_DIRS = $(DATADIR)/urrt/lcmtypes $(DATADIR)/urrt $(DOCDIR)/img $(DOCDIR)/examples $(DOCDIR) \
+  $(SYSCONFDIR)/urrt
+CONFIG_FILE = $(SYSCONFDIR)/urrt/gateway.ini
+
+# The checked-in unit is right for PREFIX=/usr; other prefixes rewrite its paths.
+$(DIST)/urrt-gateway.service: gateway/urrt-gateway.service
+	@mkdir -p $(@D)
+	sed -e 's|/usr/bin/urrt-gateway|$(BINDIR)/urrt-gateway|g; s|/etc/urrt/|$(SYSCONFDIR)/urrt/|g' $< > $@
+
+$(DIST)/urrt-spy: gateway/urrt-spy
+	@mkdir -p $(@D)
+	sed -e 's|^URRT_JAR_DEFAULT=.*|URRT_JAR_DEFAULT=$(JAVADIR)/urrt_lcmtypes.jar|' $< > $@
+
+# The example with its robot commented out: an unedited install refuses to
+# start and says which file to edit.
+$(DIST)/gateway.ini: gateway/urrt-gateway.example.ini
+	@mkdir -p $(@D)
+	awk '/^\[/ { robot = /^\[robot / } \
+	     robot && /^\[robot / { print "# Uncomment this section and set the robot'\''s address, then run"; \
+	       print "#   urrt-gateway --check-config $(CONFIG_FILE)" } \
+	     { print (robot && $$0 != "" && $$0 !~ /^#/ ? "#" : "") $$0 }' $< > $@
+
+$(DIST)/urrt.pc: lib/urrt.h
+	@mkdir -p $(@D)
+	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$(LIBDIR)' 'includedir=$(INCLUDEDIR)' '' 'Name: urrt' \
+	  'Description: Universal Robots RealTime interface decoder and CAN packing (freestanding C99)' \
+	  'Version: $(URRT_VERSION)' 'Libs: -L$${libdir} -lurrt' 'Cflags: -I$${includedir}' > $@
+
+# The paths are baked into the generated files: make them again on every install.
+.PHONY: install-files uninstall-files uninstall dist-files
+dist-files:
+	@rm -f $(DIST_FILES)
+	@$(MAKE) --no-print-directory $(DIST_FILES)
+
+install: install-files
+install-files: all dist-files
+	@set -e; for e in $(INSTALL_ITEMS); do \
+	  src=$${e%%:*}; rest=$${e#*:}; dir=$${rest%:*}; mode=$${rest#*:}; \
+	  install -d $(DESTDIR)$$dir; install -m $$mode $$src $(DESTDIR)$$dir/; \
+	done
+	install -d $(DESTDIR)$(SYSCONFDIR)/urrt
+	@# An existing configuration (edited or not) is never overwritten.
+	[ -e $(DESTDIR)$(CONFIG_FILE) ] || install -m 0644 $(DIST)/gateway.ini $(DESTDIR)$(CONFIG_FILE)
+
+uninstall: uninstall-files
+uninstall-files: dist-files
+	@for e in $(INSTALL_ITEMS); do \
+	  src=$${e%%:*}; rest=$${e#*:}; dir=$${rest%:*}; rm -f $(DESTDIR)$$dir/$${src##*/}; \
+	done
+	@# The configuration goes only as installed; an edited one stays.
+	@if cmp -s $(DIST)/gateway.ini $(DESTDIR)$(CONFIG_FILE); then rm -f $(DESTDIR)$(CONFIG_FILE); \
+	elif [ -e $(DESTDIR)$(CONFIG_FILE) ]; then echo "uninstall: $(DESTDIR)$(CONFIG_FILE) was edited: kept"; fi
+	@for d in $(INSTALL_OWN_DIRS); do [ ! -d $(DESTDIR)$$d ] || rmdir --ignore-fail-on-non-empty $(DESTDIR)$$d; done
