@@ -22,6 +22,8 @@ DEB_DEPS := gcc make python3 gcc-arm-none-eabi binutils-arm-none-eabi clang libc
             liblcm-dev liblcm-bin liblcm-java libjchart2d-java default-jdk-headless \
             libinih-dev pkg-config can-utils python3-can python3-canmatrix \
             qemu-system-x86 busybox-static cpio valgrind iproute2 gnuplot-nox
+# Installed with --no-install-recommends (fragments add theirs with +=).
+DEB_DEPS_NO_RECOMMENDS :=
 
 PROGRAMS :=
 CHECKS :=
@@ -38,17 +40,29 @@ include $(sort $(wildcard tests/*.mk))
 all: $(PROGRAMS)
 
 # Installs what is missing when root; otherwise prints the one command to run.
+# DEB_DEPS_NO_RECOMMENDS (cross toolchains, emulators) are installed without
+# their recommends, which would add hundreds of megabytes (qemu's firmware)
+# the tests do not use. Each package is named once.
+deps_missing = $$(for p in $(1); do \
+    dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; \
+  done)
 deps:
-	@missing=$$(for p in $(DEB_DEPS); do \
-	    dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; \
-	  done); \
-	if [ -n "$$missing" ]; then \
+	@missing=$(call deps_missing,$(sort $(DEB_DEPS))); \
+	missing_nr=$(call deps_missing,$(filter-out $(DEB_DEPS),$(sort $(DEB_DEPS_NO_RECOMMENDS)))); \
+	install=""; \
+	[ -z "$$missing" ] || install="sudo apt-get install -y $$(echo $$missing)"; \
+	[ -z "$$missing_nr" ] || \
+	  install="$${install:+$$install && }sudo apt-get install -y --no-install-recommends $$(echo $$missing_nr)"; \
+	if [ -n "$$install" ]; then \
 	  if [ "$$(id -u)" = 0 ]; then \
-	    echo "deps: installing:" $$missing; \
-	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null || exit 1; \
+	    echo "deps: installing:" $$missing $$missing_nr; \
+	    apt-get update -qq || exit 1; \
+	    [ -z "$$missing" ] || DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null || exit 1; \
+	    [ -z "$$missing_nr" ] || DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+	      $$missing_nr >/dev/null || exit 1; \
 	  else \
 	    echo "deps: missing Debian packages. Run, then make again:"; \
-	    echo "  sudo apt-get install -y" $$missing; exit 1; \
+	    echo "  $$install"; exit 1; \
 	  fi; \
 	fi
 

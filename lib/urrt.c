@@ -70,15 +70,35 @@ static uint32_t load_be32(const uint8_t *p)
     return ((uint32_t)p[0] << 24) | ((uint32_t)p[1] << 16) | ((uint32_t)p[2] << 8) | (uint32_t)p[3];
 }
 
+/*
+ * How a big-endian double is loaded, chosen by what the compiler and the
+ * target guarantee (one place, so that a runtime choice can be added here):
+ *
+ * URRT_LOAD_UNALIGNED: GCC or clang on a little-endian target whose every
+ *   load may be unaligned (x86, AArch64, ARM with __ARM_FEATURE_UNALIGNED:
+ *   ARMv7-M/A without -mno-unaligned-access). A fixed-size __builtin_memcpy
+ *   is then one load, never a call, and the byte swap is one instruction.
+ * URRT_LOAD_WORDS: GCC or clang on little-endian ARM without unaligned
+ *   access but with REV (ARMv6-M such as Cortex-M0/M0+, or ARMv7-M built
+ *   with -mno-unaligned-access): word loads where the source is 4-byte
+ *   aligned (packets in the framer's buffer are), bytes where it is not.
+ * Otherwise (RISC-V, whose misaligned loads may trap or be emulated, any
+ *   big-endian target, compilers without GNU extensions): byte loads,
+ *   which GCC merges into wider loads where that is allowed. A
+ *   __builtin_memcpy of unaligned bytes is a call to the C library's memcpy
+ *   on those targets, which lib/ must not need.
+ */
 #if defined(__GNUC__) && defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__)
 #if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-#define URRT_LOAD_BE64_BUILTIN 1
+#if defined(__x86_64__) || defined(__i386__) || defined(__aarch64__) || defined(__ARM_FEATURE_UNALIGNED)
+#define URRT_LOAD_UNALIGNED 1
+#elif defined(__arm__) && defined(__ARM_ARCH) && __ARM_ARCH >= 6
+#define URRT_LOAD_WORDS 1
+#endif
 #endif
 #endif
 
-#ifdef URRT_LOAD_BE64_BUILTIN
-/* GCC and clang: an unaligned 8-byte load (a fixed-size __builtin_memcpy is
- * always inlined, never a libc call) and a byte swap the vectoriser knows. */
+#ifdef URRT_LOAD_UNALIGNED
 static uint64_t load_be64(const uint8_t *p)
 {
     uint64_t v;
@@ -89,6 +109,18 @@ static uint64_t load_be64(const uint8_t *p)
 static uint64_t load_be64(const uint8_t *p)
 {
     return ((uint64_t)load_be32(p) << 32) | (uint64_t)load_be32(p + 4);
+}
+#endif
+
+#ifdef URRT_LOAD_WORDS
+/* p must be 4-byte aligned: two word loads and two REV. */
+static uint64_t load_be64_aligned4(const uint8_t *p)
+{
+    const uint8_t *a = (const uint8_t *)__builtin_assume_aligned(p, 4);
+    uint32_t hi, lo;
+    __builtin_memcpy(&hi, a, 4);
+    __builtin_memcpy(&lo, a + 4, 4);
+    return ((uint64_t)__builtin_bswap32(hi) << 32) | __builtin_bswap32(lo);
 }
 #endif
 
@@ -377,7 +409,7 @@ static const unsigned grid_fields = 0u
  * big-endian one (armeb, aarch64_be also have NEON) the swap would reverse
  * bytes that are already in the host's order.
  */
-#if defined(URRT_LOAD_BE64_BUILTIN) && (defined(__SSSE3__) || defined(__ARM_NEON))
+#if defined(URRT_LOAD_UNALIGNED) && (defined(__SSSE3__) || defined(__ARM_NEON))
 #define URRT_VECTOR 1
 #if defined(__AVX512BW__)
 #define URRT_VECTOR_BYTES 64
@@ -434,6 +466,13 @@ static void load_doubles(double *dst, const uint8_t *src, unsigned n)
         a = URRT_SWAP64(a);
         __builtin_memcpy(&dst[i], &a, sizeof a);
         i += URRT_VECTOR_DOUBLES;
+    }
+#endif
+#ifdef URRT_LOAD_WORDS
+    if (((uintptr_t)(const void *)src & 3u) == 0) {
+        for (; i < n; i++) {
+            dst[i] = double_from_bits(load_be64_aligned4(src + 8u * i));
+        }
     }
 #endif
     for (; i < n; i++) {
@@ -796,13 +835,13 @@ void urrt_framer_reset(urrt_framer *fr)
     fr->packet_length = 0;
 }
 
-/* A byte copy without libc: 16-byte blocks where the compiler can inline a
- * fixed-size copy (GCC, clang: unaligned loads and stores, never a call),
- * then single bytes. */
+/* A byte copy without libc: 16-byte blocks where unaligned loads and stores
+ * make a fixed-size copy a few instructions (see URRT_LOAD_UNALIGNED; on
+ * other targets the same builtin is a call to memcpy), then single bytes. */
 static void copy_bytes(uint8_t *dst, const uint8_t *src, size_t n)
 {
     size_t i = 0;
-#if defined(__GNUC__)
+#ifdef URRT_LOAD_UNALIGNED
     for (; i + 16u <= n; i += 16u) {
         __builtin_memcpy(dst + i, src + i, 16u);
     }

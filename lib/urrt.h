@@ -327,6 +327,23 @@ typedef struct urrt_framer {
 /* Sizes for static allocation: a framer needs about URRT_PACKET_MAX bytes. */
 #define URRT_FRAMER_RAM (sizeof(urrt_framer))
 
+/*
+ * The framer's size follows URRT_MAX_DOUBLES, so every file must see the same
+ * value: its functions' link names carry it (urrt_framer_feed is the symbol
+ * urrt_framer_feed_URRT_MAX_DOUBLES_256 by default). A file built with
+ * another value than lib/urrt.c then fails to link with "undefined reference
+ * to urrt_framer_feed_URRT_MAX_DOUBLES_152" instead of running with a framer
+ * of the wrong size. URRT_MAX_DOUBLES must therefore be a plain decimal
+ * number.
+ */
+#define URRT_MAX_DOUBLES_NAME_(name, max) name##_URRT_MAX_DOUBLES_##max
+#define URRT_MAX_DOUBLES_NAME(name, max) URRT_MAX_DOUBLES_NAME_(name, max)
+#define urrt_framer_init URRT_MAX_DOUBLES_NAME(urrt_framer_init, URRT_MAX_DOUBLES)
+#define urrt_framer_reset URRT_MAX_DOUBLES_NAME(urrt_framer_reset, URRT_MAX_DOUBLES)
+#define urrt_framer_feed URRT_MAX_DOUBLES_NAME(urrt_framer_feed, URRT_MAX_DOUBLES)
+#define urrt_framer_packet URRT_MAX_DOUBLES_NAME(urrt_framer_packet, URRT_MAX_DOUBLES)
+#define urrt_framer_finish URRT_MAX_DOUBLES_NAME(urrt_framer_finish, URRT_MAX_DOUBLES)
+
 void urrt_framer_init(urrt_framer *fr);
 
 /* Forget any partial packet and the last length: call on a new connection.

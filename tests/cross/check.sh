@@ -82,47 +82,91 @@ done
 check "startup compiles" ${CROSS}gcc $CFLAGS -c tests/cross/startup.c -o "$out/startup.o"
 check "size probe compiles" ${CROSS}gcc $CFLAGS -c tests/cross/probe.c -o "$out/probe.o"
 
-# Undefined references of a -nostdlib link without libgcc: what lib/ needs
-# from outside, (a) for framer + decode + random access, (b) with every
-# global function of lib/ kept as a root.
-roots=$(${CROSS}nm -g --defined-only $objs | awk 'NF == 3 && $2 ~ /[TDRB]/ { printf " -Wl,-u,%s", $3 }')
-undefined() {
-  ${CROSS}gcc $LDFLAGS "$@" -o "$out/probe-link.elf" 2>&1 |
-    sed -n "s/.*undefined reference to \`\([^']*\)'.*/\1/p"
-}
-# GCC may also emit calls at -O2 that -Os does not (memset/memcpy for fill
-# and copy loops are its documented freestanding requirement): compile each
-# file at -O2 too and add what those objects leave undefined.
-o2_needed=""
-for src in "$@"; do
-  o2="$out/$(basename "$src" .c).O2.o"
-  if ${CROSS}gcc $(echo "$CFLAGS" | sed 's/-Os/-O2/') -c "$src" -o "$o2"; then
-    o2_needed="$o2_needed $(${CROSS}nm -u "$o2" | awk '{ print $2 }')"
-  else
-    fail "$src does not compile for Cortex-M4 at -O2"
+# What lib/ needs from outside, on every core a firmware may build it for, at
+# -Os and -O2 (GCC may emit memcpy/memset calls for loops at -O2, or call
+# memcpy for a __builtin_memcpy it cannot inline): every symbol an object
+# leaves undefined that no lib/ object defines. Each must come from that
+# core's libgcc (checked against libgcc.a itself) and README.md's table must
+# list exactly these symbols and cores.
+#   name|compiler|flags
+CORES="m0+|arm-none-eabi-gcc|-mcpu=cortex-m0plus -mthumb
+m4|arm-none-eabi-gcc|-mcpu=cortex-m4 -mthumb
+m4-na|arm-none-eabi-gcc|-mcpu=cortex-m4 -mthumb -mno-unaligned-access
+m7-hf|arm-none-eabi-gcc|-mcpu=cortex-m7 -mthumb -mfpu=fpv5-d16 -mfloat-abi=hard
+rv32|riscv64-unknown-elf-gcc|-march=rv32imac -mabi=ilp32"
+pairs="$out/needed-pairs"
+: > "$pairs"
+core_ok=yes
+while IFS='|' read -r core cc flags; do
+  if ! command -v "$cc" >/dev/null; then
+    fail "$cc not found: make deps installs it"; core_ok=no; continue
   fi
-done
-defined=$(${CROSS}nm -g --defined-only $objs | awk 'NF == 3 { print $3 }')
-o2_needed=$(for s in $o2_needed; do echo "$defined" | grep -qx "$s" || echo "$s"; done)
-needed=$( { undefined "$out/startup.o" $objs; undefined "$out/startup.o" $objs $roots;
-            for s in $o2_needed; do echo "$s"; done; } | sort -u)
+  dir="$out/core-$core"
+  mkdir -p "$dir"
+  cflags="$flags -ffreestanding $warn -ffunction-sections -fdata-sections -Ilib -nostdinc -isystem $($cc $flags -print-file-name=include)"
+  libgcc=$($cc $flags -print-libgcc-file-name)
+  for opt in -Os -O2; do
+    cobjs=""
+    for src in "$@"; do
+      o="$dir/$(basename "$src" .c)$opt.o"
+      if $cc $cflags $opt -c "$src" -o "$o"; then cobjs="$cobjs $o"; else
+        fail "$src does not compile for $core at $opt"; core_ok=no; fi
+    done
+    [ -n "$cobjs" ] || continue
+    nm=${cc%gcc}nm
+    defined=$($nm -g --defined-only $cobjs | awk 'NF == 3 { print $3 }')
+    from_libgcc=$($nm -g --defined-only "$libgcc" 2>/dev/null | awk 'NF == 3 { print $3 }')
+    for sym in $($nm -u $cobjs | awk '{ print $2 }' | sort -u); do
+      echo "$defined" | grep -qx "$sym" && continue
+      echo "$sym $core" >> "$pairs"
+      echo "$from_libgcc" | grep -qx "$sym" ||
+        fail "lib/ needs $sym on $core at $opt, which $libgcc does not define (a C library symbol?)"
+    done
+    # A real image: libgcc gives what is needed, nothing else links in.
+    check "$core $opt: every lib/ function links with -nostdlib -lgcc" sh -c "
+      $cc $cflags -Os -c tests/cross/startup.c -o $dir/startup.o &&
+      $cc $flags -nostdlib -Wl,--gc-sections -T tests/cross/link.ld $dir/startup.o $cobjs \
+        $($nm -g --defined-only $cobjs | awk 'NF == 3 && $2 ~ /[TDRB]/ { printf " -Wl,-u,%s", $3 }') -lgcc \
+        -o $dir/image$opt.elf"
+  done
+done <<EOF_CORES
+$CORES
+EOF_CORES
+needed=$(sort -u "$pairs" | awk '{ c[$1] = c[$1] ? c[$1] " " $2 : $2 } END { for (s in c) print s ": " c[s] }' | sort)
 listed=$(sed -n '/<!-- cross-symbols:begin/,/<!-- cross-symbols:end/p' "$readme" |
-         sed -n 's/^| *`\([A-Za-z_][A-Za-z0-9_]*\)`.*/\1/p' | sort -u)
-echo "cross: symbols lib/ needs from the toolchain: $(echo $needed)"
-for sym in $needed; do
-  if echo "$listed" | grep -qx "$sym"; then
-    ok "needed symbol $sym is listed in README.md"
+         sed -n 's/^| *`\([A-Za-z_][A-Za-z0-9_]*\)` *| *[^|]*| *\([^|]*[^ |]\) *|.*/\1: \2/p' | sort)
+echo "cross: symbols lib/ needs from the toolchain, and on which cores:"
+echo "$needed" | sed 's/^/cross:   /'
+if [ "$core_ok" = yes ]; then
+  if [ "$needed" = "$listed" ]; then
+    ok "README.md's cross-symbols table lists exactly these symbols and cores"
   else
-    fail "lib/ needs $sym, which README.md's cross-symbols table does not list and justify"
+    fail "README.md's cross-symbols table differs from what lib/ needs (symbol: cores, measured above): update it"
+    echo "$listed" > "$out/listed-pairs"
+    echo "$needed" > "$out/needed-sorted"
+    diff "$out/listed-pairs" "$out/needed-sorted" | sed 's/^/cross:   README vs measured: /'
   fi
-done
-for sym in $listed; do
-  echo "$needed" | grep -qx "$sym" || fail "README.md lists $sym, which lib/ no longer needs: remove it"
-done
+fi
 
-# The real images: libgcc supplies what the table lists, nothing else links in.
+# URRT_MAX_DOUBLES changes the framer's size, so urrt.h puts it into the
+# framer's link names: a file built with another value than lib/urrt.c must
+# fail to link, naming the macro (regression: it linked and corrupted memory).
+printf '#include "urrt.h"\nint mix_feed(urrt_framer *f, const uint8_t *p, size_t n, size_t *u)\n{ return urrt_framer_feed(f, p, n, u); }\n' > "$out/mix.c"
+mixed="$out/mix-link.txt"
+if ${CROSS}gcc $CFLAGS -DURRT_MAX_DOUBLES=152 -c "$out/mix.c" -o "$out/mix152.o" &&
+   ! ${CROSS}gcc $LDFLAGS "$out/startup.o" "$out/mix152.o" $objs -Wl,-u,mix_feed -o "$out/mix.elf" > "$mixed" 2>&1 &&
+   grep -q "undefined reference to .urrt_framer_feed_URRT_MAX_DOUBLES_152" "$mixed"; then
+  ok "two files with different URRT_MAX_DOUBLES fail to link: $(grep -o 'undefined reference to .urrt_framer_feed[^ ]*' "$mixed" | head -n 1)"
+else
+  fail "a file built with -DURRT_MAX_DOUBLES=152 linked against lib/ built with 256 (or failed for another reason): $(cat "$mixed")"
+fi
+check "a file with lib/'s URRT_MAX_DOUBLES links" sh -c "${CROSS}gcc $CFLAGS -c $out/mix.c -o $out/mix256.o &&
+  ${CROSS}gcc $LDFLAGS $out/startup.o $out/mix256.o $objs -Wl,-u,mix_feed -o $out/mix.elf"
+
+# The M4 images the footprint table measures.
 check "image (framer + decode + random access) links with -nostdlib" \
   ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs -o "$out/image-min.elf"
+roots=$(${CROSS}nm -g --defined-only $objs | awk 'NF == 3 && $2 ~ /[TDRB]/ { printf " -Wl,-u,%s", $3 }')
 check "image (every lib/ function) links with -nostdlib -lgcc" \
   ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $roots -lgcc -o "$out/image-all.elf"
 
@@ -138,6 +182,19 @@ for obj in $objs; do
   [ "$2" = 0 ] && [ "$3" = 0 ] && ok "$(basename "$obj" .o).c has no globals (data and bss are 0)" ||
     fail "$(basename "$obj" .o).c has data $2 / bss $3: lib/ must keep no state of its own"
 done
+# Every core: each file's text at -Os (a core without unaligned access or
+# with Thumb-1 only needs more instructions per double; RV32 has no 64-bit
+# registers).
+while IFS='|' read -r core cc flags; do
+  [ "$core" = m4 ] && continue # the rows above
+  for o in "$out/core-$core"/*-Os.o; do
+    [ -f "$o" ] || continue
+    set -- $(${cc%gcc}size "$o" | awk 'NR == 2 { print $1, $2, $3 }')
+    row "lib/$(basename "$o" -Os.o).c on $core (-Os)" "$1" "$2" "$3" >> "$measured"
+  done
+done <<EOF_CORES
+$CORES
+EOF_CORES
 for img in min all; do
   [ -f "$out/image-$img.elf" ] || continue
   set -- $(${CROSS}size "$out/image-$img.elf" | awk 'NR == 2 { print $1, $2, $3 }')

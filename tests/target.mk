@@ -1,0 +1,154 @@
+# SPDX-License-Identifier: MIT
+# tests/target.mk: lib/ executed where firmware runs (tests/target/).
+#   check-lib-m4   the reference vectors (decode and random access from every misalignment,
+#                  encoder round trip), the framer on streams of every length with garbage in
+#                  every chunk size 1..1460, on qemu's Cortex-M boards: mps2-an386 (Cortex-M4
+#                  soft-float -Os as check-cross builds lib/, and hard-float -O2), netduinoplus2
+#                  (STM32F405) and microbit (Cortex-M0, -Os and -O2); no C library in the
+#                  images, results through semihosting and qemu's exit status; and the painted
+#                  stack of every public lib/ function against -fstack-usage and README.md
+#   check-lib-be   tests/lib/test_lib.c and the lib/urrt_can tests of tests/can/test_can.c on
+#                  big-endian s390x, powerpc and mips and on little-endian NEON (aarch64,
+#                  armhf) under qemu-user; on big-endian NEON (aarch64_be, armeb; freestanding)
+#                  lib/ passes and lib/ with the old vector condition (commit d7588d7) fails
+#   bench-lib-m4   instructions per operation on the emulated Cortex-M4 (qemu -icount),
+#                  a cycle estimate at 168 MHz, checked against README.md
+
+TGT := $(BUILD)/tests/target
+TGT_QEMU_M := qemu-system-arm -nographic -monitor none -serial none -semihosting-config enable=on,target=native
+TGT_CM := arm-none-eabi-gcc
+# lib/ as check-cross compiles it; the drivers as tests, freestanding.
+TGT_LIB_FLAGS := $(LIB_WARN) -ffreestanding -ffunction-sections -fdata-sections -fstack-usage -fcallgraph-info=su
+TGT_FLAGS := $(PROG_WARN) -ffreestanding -fno-tree-loop-distribute-patterns -ffunction-sections -fdata-sections \
+             -Ilib -Itests/target
+TGT_LINK := -nostdlib -Ltests/target -Wl,--gc-sections -lgcc
+TGT_M4 := -mcpu=cortex-m4 -mthumb
+TGT_M4F := -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
+TGT_M0 := -mcpu=cortex-m0 -mthumb
+
+DEB_DEPS_NO_RECOMMENDS += qemu-system-arm qemu-user gcc-s390x-linux-gnu gcc-powerpc-linux-gnu \
+                          gcc-mips-linux-gnu gcc-aarch64-linux-gnu gcc-arm-linux-gnueabihf \
+                          libc6-dev-s390x-cross libc6-dev-powerpc-cross libc6-dev-mips-cross \
+                          libc6-dev-arm64-cross libc6-dev-armhf-cross gcc-riscv64-unknown-elf
+
+CHECKS += check-lib-m4 check-lib-be bench-lib-m4
+BENCHES += bench-lib-m4
+.PHONY: check-lib-m4 check-lib-be bench-lib-m4
+
+# The reference's vectors as C arrays: all of them, or fewer for small flash.
+$(TGT)/vectors_%.c: $(LIB_VECTORS) tests/target/vectors_c.py
+	@mkdir -p $(@D)
+	$(PYTHON) tests/target/vectors_c.py $(LIB_VECTORS) $@ $*
+
+TGT_DRIVER := tests/target/test_target.c tests/target/stack_target.h tests/target/target.h \
+              tests/target/test_vectors.h tests/target/cm.c tests/target/sections.ld
+
+# $(call tgt_image,NAME,CPU FLAGS,OPT,LINKER SCRIPT,VECTORS): lib/ objects and a test image.
+define tgt_image
+$(TGT)/$(1)/lib/%.o: lib/%.c $(LIB_HDRS)
+	@mkdir -p $$(@D)
+	$(TGT_CM) $(2) $(3) $(TGT_LIB_FLAGS) -c $$< -o $$@
+$(TGT)/$(1)/test.elf: $(TGT_DRIVER) tests/target/$(4) $(TGT)/vectors_$(5).c $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
+	$(TGT_CM) $(2) $(3) $(TGT_FLAGS) -DURRT_TARGET_CORTEX_M tests/target/cm.c tests/target/test_target.c \
+	  $(TGT)/vectors_$(5).c $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -T tests/target/$(4) $(TGT_LINK) -o $$@
+endef
+$(eval $(call tgt_image,m4-os,$(TGT_M4),-Os,an386.ld,all))
+$(eval $(call tgt_image,m4f-o2,$(TGT_M4F),-O2,an386.ld,all))
+$(eval $(call tgt_image,f405-os,$(TGT_M4F),-Os,f405.ld,named+2))
+$(eval $(call tgt_image,m0-os,$(TGT_M0),-Os,microbit.ld,named))
+$(eval $(call tgt_image,m0-o2,$(TGT_M0),-O2,microbit.ld,named+32))
+TGT_BOARDS := m4-os:mps2-an386 m4f-o2:mps2-an386 f405-os:netduinoplus2 m0-os:microbit m0-o2:microbit
+
+check-lib-m4: $(foreach b,$(TGT_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/test.elf) tests/target/stack.py
+	$(call lib_suite,check-lib-m4,sh tests/target/run.sh $(TGT)/logs \
+	  $(foreach b,$(TGT_BOARDS),$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M) -M $(lastword $(subst :, ,$(b))) \
+	    -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/test.elf") \
+	  stack-m4-os="$(PYTHON) tests/target/stack.py $(TGT)/logs/m4-os.log README.md $(TGT)/m4-os/lib/*.ci")
+
+# ---- big-endian and NEON under qemu-user ---------------------------------------------
+
+# $(call tgt_linux,NAME,CC AND FLAGS,QEMU): test_lib and the urrt_can tests, static.
+TGT_CAN_LIB := $(TGT)/can_lib_tests.c
+$(TGT_CAN_LIB): tests/can/test_can.c tests/target/can_lib_tests.sh
+	@mkdir -p $(@D)
+	sh tests/target/can_lib_tests.sh $< $@
+
+define tgt_linux
+$(TGT)/$(1)/test_lib: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $$(@D)
+	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS) -lm -o $$@
+$(TGT)/$(1)/test_can: $(TGT_CAN_LIB) tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $$(@D)
+	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS) -lm -o $$@
+TGT_BE_BINS += $(TGT)/$(1)/test_lib $(TGT)/$(1)/test_can
+TGT_BE_RUNS += $(1)="$(3) $(TGT)/$(1)/test_lib $(LIB_VECTORS)" $(1)-can="$(3) $(TGT)/$(1)/test_can"
+endef
+TGT_NEON := -mfpu=neon-vfpv4
+$(eval $(call tgt_linux,s390x,s390x-linux-gnu-gcc,qemu-s390x))
+$(eval $(call tgt_linux,powerpc,powerpc-linux-gnu-gcc,qemu-ppc))
+$(eval $(call tgt_linux,mips,mips-linux-gnu-gcc,qemu-mips))
+$(eval $(call tgt_linux,aarch64,aarch64-linux-gnu-gcc,qemu-aarch64))
+$(eval $(call tgt_linux,armhf,arm-linux-gnueabihf-gcc $(TGT_NEON),qemu-arm))
+
+# Which grid copy each build takes: the byte-swapping vector path on little-endian
+# NEON, never on big-endian NEON (where the wire's order is the host's).
+TGT_ARMEB := arm-none-eabi-gcc -mbig-endian -mcpu=cortex-a7 $(TGT_NEON) -mfloat-abi=hard -Wl,--be8
+TGT_A64BE := aarch64-linux-gnu-gcc -mbig-endian
+tgt_vector = $(1) -ffreestanding -O2 -Ilib -E -dM lib/urrt.c | grep -q '^\#define URRT_VECTOR ' && echo '1 passed, 0 failed'
+tgt_no_vector = ! $(1) -ffreestanding -O2 -Ilib -E -dM lib/urrt.c | grep -q '^\#define URRT_VECTOR ' && echo '1 passed, 0 failed'
+
+# Big-endian NEON has no C library in Debian: freestanding images of
+# test_target.c with tests/target/linux_start.c. The regression build is
+# lib/urrt.c with the vector condition as it was before commit d7588d7
+# (any GNU compiler, not little-endian only), generated here; it must fail.
+TGT_OLD_NEON := $(TGT)/old_neon/urrt.c
+$(TGT_OLD_NEON): lib/urrt.c
+	@mkdir -p $(@D)
+	sed 's/^#if defined(URRT_LOAD_UNALIGNED) && (defined(__SSSE3__) || defined(__ARM_NEON))$$/#if defined(__GNUC__) \&\& (defined(__SSSE3__) || defined(__ARM_NEON))/' $< > $@.tmp
+	@grep -q '^#if defined(__GNUC__) && (defined(__SSSE3__) || defined(__ARM_NEON))$$' $@.tmp || \
+	  { echo "$@: lib/urrt.c's vector condition changed: update the regression's sed"; exit 1; }
+	mv $@.tmp $@
+
+TGT_BE_FREE := $(TGT_FLAGS) -O2 -nostdlib -static tests/target/linux_start.c tests/target/test_target.c \
+               $(TGT)/vectors_named.c
+$(TGT)/%/neon_be: $(TGT_DRIVER) tests/target/linux_start.c $(TGT)/vectors_named.c lib/urrt.c $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(if $(filter armeb,$*),$(TGT_ARMEB),$(TGT_A64BE)) $(TGT_BE_FREE) lib/urrt.c -o $@
+$(TGT)/%/neon_be_old: $(TGT_DRIVER) tests/target/linux_start.c $(TGT)/vectors_named.c $(TGT_OLD_NEON) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(if $(filter armeb,$*),$(TGT_ARMEB),$(TGT_A64BE)) $(TGT_BE_FREE) -Ilib $(TGT_OLD_NEON) -o $@
+TGT_BE_BINS += $(foreach a,armeb aarch64_be,$(TGT)/$(a)/neon_be $(TGT)/$(a)/neon_be_old)
+
+check-lib-be: $(TGT_BE_BINS) $(LIB_VECTORS) $(TGT_OLD_NEON)
+	$(call lib_suite,check-lib-be,sh tests/target/run.sh $(TGT)/logs-be $(TGT_BE_RUNS) \
+	  aarch64-vector-path="$(call tgt_vector,aarch64-linux-gnu-gcc)" \
+	  armhf-vector-path="$(call tgt_vector,arm-linux-gnueabihf-gcc $(TGT_NEON))" \
+	  armeb-no-vector-path="$(call tgt_no_vector,$(TGT_ARMEB))" \
+	  aarch64_be-no-vector-path="$(call tgt_no_vector,$(TGT_A64BE))" \
+	  armeb-neon="qemu-armeb $(TGT)/armeb/neon_be" aarch64_be-neon="qemu-aarch64_be $(TGT)/aarch64_be/neon_be" \
+	  !armeb-neon-before-d7588d7="qemu-armeb $(TGT)/armeb/neon_be_old" \
+	  !aarch64_be-neon-before-d7588d7="qemu-aarch64_be $(TGT)/aarch64_be/neon_be_old")
+
+# ---- instructions per operation -------------------------------------------------------
+
+# $(call tgt_bench,NAME,CPU FLAGS,OPT,LINKER SCRIPT,EXTRA FLAGS FOR lib/)
+define tgt_bench
+$(TGT)/bench-$(1).elf: tests/target/bench_target.c tests/target/target.h tests/target/cm.c tests/target/$(4) \
+  $(TGT)/vectors_named.c $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $$(@D)
+	$(TGT_CM) $(2) $(3) $(TGT_FLAGS) -DURRT_TARGET_CORTEX_M -c $(TGT)/vectors_named.c -o $$@.vectors.o
+	$(TGT_CM) $(2) $(3) $(TGT_FLAGS) -DURRT_TARGET_CORTEX_M tests/target/cm.c tests/target/bench_target.c \
+	  $$@.vectors.o $(5) $(LIB_SRCS) -T tests/target/$(4) $(TGT_LINK) -o $$@
+endef
+$(eval $(call tgt_bench,m4-os,$(TGT_M4),-Os,an386.ld,))
+$(eval $(call tgt_bench,m4-o2,$(TGT_M4),-O2,an386.ld,))
+# Cortex-M0: lib/'s word path against its portable byte path (no __BYTE_ORDER__).
+$(eval $(call tgt_bench,m0-os,$(TGT_M0),-Os,microbit.ld,))
+$(eval $(call tgt_bench,m0-os-portable,$(TGT_M0),-Os,microbit.ld,-U__BYTE_ORDER__))
+
+bench-lib-m4: $(foreach b,m4-os m4-o2 m0-os m0-os-portable,$(TGT)/bench-$(b).elf) tests/target/bench.py
+	$(call lib_suite,bench-lib-m4,sh tests/target/run.sh $(TGT)/logs-bench \
+	  m4="$(PYTHON) tests/target/bench.py README.md '$(TGT_QEMU_M) -M mps2-an386' \
+	    -Os=$(TGT)/bench-m4-os.elf -O2=$(TGT)/bench-m4-o2.elf" \
+	  m0="$(PYTHON) tests/target/bench.py --not-slower '$(TGT_QEMU_M) -M microbit' \
+	    words=$(TGT)/bench-m0-os.elf portable=$(TGT)/bench-m0-os-portable.elf")

@@ -1,0 +1,208 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Instructions per operation on an emulated Cortex-M4 (mps2-an386), read
+ * from SysTick under qemu -icount: with shift=6 every instruction advances
+ * virtual time by 64 ns, which SysTick counts at the 25 MHz core clock. The
+ * ratio is calibrated on a loop of known length, and the cost of reading
+ * SysTick is measured and taken off. Prints "bench: NAME INSTRUCTIONS";
+ * bench_begin()/bench_end() delimit each operation for the cycle estimate
+ * (tests/target/bench.py, from a single-step trace of the same image).
+ */
+#include "target.h"
+#include "test_vectors.h"
+#include "urrt.h"
+#include "urrt_can.h"
+
+static void put_uint(uint64_t v)
+{
+    char text[24];
+    int i = 23;
+    text[i] = '\0';
+    do {
+        text[--i] = (char)('0' + v % 10u);
+        v /= 10u;
+    } while (v != 0);
+    target_puts(text + i);
+}
+
+/* Marks for the trace: the operation runs between their calls. */
+__attribute__((noinline)) void bench_begin(void)
+{
+    __asm__ volatile("" ::: "memory");
+}
+__attribute__((noinline)) void bench_end(void)
+{
+    __asm__ volatile("" ::: "memory");
+}
+
+/* Each operation is timed from one SysTick read to the next. */
+#define TIMED(ticks, ...)                 \
+    do {                                  \
+        uint32_t t0_, t1_;                \
+        bench_begin();                    \
+        t0_ = target_systick();           \
+        __VA_ARGS__;                      \
+        t1_ = target_systick();           \
+        bench_end();                      \
+        (ticks) = (t0_ - t1_) & 0xFFFFFFu; \
+    } while (0)
+
+static uint32_t overhead_ticks;
+/* SysTick ticks per 1000 instructions, calibrated. */
+static uint32_t ticks_per_kinsn;
+
+static void report(const char *name, uint32_t ticks)
+{
+    uint32_t net = ticks > overhead_ticks ? ticks - overhead_ticks : 0;
+    target_puts("bench: ");
+    target_puts(name);
+    target_puts(" ");
+    put_uint(((uint64_t)net * 1000u + ticks_per_kinsn / 2u) / ticks_per_kinsn);
+    target_puts("\n");
+}
+
+/* 2 instructions per iteration (subs, bne). */
+static __attribute__((noinline)) void known_loop(uint32_t n)
+{
+    __asm__ volatile(".syntax unified\n1:\tsubs %0, %0, #1\n\tbne 1b" : "+l"(n) : : "cc");
+}
+
+static const tv_vector *vector(uint32_t length)
+{
+    unsigned i;
+    for (i = 0; i < tv_vector_count; i++) {
+        if (tv_vectors[i].length == length && tv_vectors[i].generation == URRT_GEN_3X) {
+            return &tv_vectors[i];
+        }
+    }
+    target_puts("bench: no reference vector of that length\n");
+    target_exit(2);
+}
+
+/* The floor: a byte-swapping copy of the same bytes (word loads, REV,
+ * stores); src is 4-byte aligned, as a packet body in a word-aligned buffer. */
+static __attribute__((noinline)) void swap_copy(uint64_t *dst, const uint8_t *src, unsigned n)
+{
+    const uint8_t *a = __builtin_assume_aligned(src, 4);
+    unsigned i;
+    for (i = 0; i < n; i++) {
+        uint32_t hi, lo;
+        __builtin_memcpy(&hi, a + 8u * i, 4);
+        __builtin_memcpy(&lo, a + 8u * i + 4, 4);
+        dst[i] = (uint64_t)__builtin_bswap32(hi) << 32 | __builtin_bswap32(lo);
+    }
+}
+
+static urrt_state st;
+static urrt_framer framer;
+static uint64_t packet_words[1224 / 8 + 1];
+static uint64_t copy_words[1220 / 8];
+#define STREAM_PACKETS 4 /* 3 whole segments; small enough for 16 KiB of RAM */
+static uint8_t stream[STREAM_PACKETS * 1116];
+
+static const urrt_field_id read_fields[10] = {
+    URRT_F_TIME, URRT_F_Q_ACTUAL, URRT_F_QD_ACTUAL, URRT_F_TOOL_VECTOR_ACTUAL, URRT_F_TCP_FORCE,
+    URRT_F_ROBOT_MODE, URRT_F_SAFETY_MODE, URRT_F_DIGITAL_INPUT_BITS, URRT_F_PROGRAM_STATE, URRT_F_SAFETY_STATUS,
+};
+
+/* docs/examples/canopen.ini's TPDO1 (0x185) as urrt_can signals: q_actual[0..2]
+ * as 16-bit Intel signed at factor 0.0002, the alive counter in byte 7's low
+ * bits (56|4, unsigned) and the validity bit 63. */
+static urrt_can_signal tpdo1[5];
+static void tpdo1_signal(unsigned i, unsigned start, unsigned length, unsigned type, double factor)
+{
+    urrt_can_signal *s = &tpdo1[i];
+    s->factor = factor;
+    s->offset = 0;
+    s->invalid_raw = 0;
+    s->start = (uint16_t)start;
+    s->length = (uint8_t)length;
+    s->byte_order = URRT_CAN_INTEL;
+    s->type = (uint8_t)type;
+    s->flags = 0;
+    urrt_can_signal_range(s, &s->min, &s->max);
+}
+
+int main(void)
+{
+    uint32_t ticks, i;
+    int sink = 0;
+    uint8_t *pkt = (uint8_t *)packet_words;
+    const tv_vector *v1116 = vector(1116), *v1220 = vector(1220);
+
+    target_systick_start();
+    TIMED(overhead_ticks, (void)0);
+    TIMED(ticks, known_loop(10000));
+    /* known_loop: 20000 in the loop, plus the call and return (mov, bl, bx). */
+    ticks_per_kinsn = (uint32_t)(((uint64_t)(ticks - overhead_ticks) * 1000u + 10001u) / 20003u);
+    target_puts("bench: systick_ticks_per_1000_instructions ");
+    put_uint(ticks_per_kinsn);
+    target_puts("\n");
+
+    for (i = 0; i < v1116->length; i++) {
+        pkt[i] = v1116->packet[i];
+    }
+    TIMED(ticks, sink += urrt_decode(pkt, v1116->length, &st));
+    report("decode_1116", ticks);
+    TIMED(ticks, swap_copy(copy_words, pkt + 4, (v1116->length - 4u) / 8u));
+    report("swap_copy_1116", ticks);
+    {
+        double values[10];
+        TIMED(ticks, for (i = 0; i < 10; i++) sink += urrt_read(pkt, v1116->length, read_fields[i], i % 3u,
+                                                               &values[i]));
+        report("read10_1116", ticks);
+    }
+    for (i = 0; i < v1220->length; i++) {
+        pkt[i] = v1220->packet[i];
+    }
+    TIMED(ticks, sink += urrt_decode(pkt, v1220->length, &st));
+    report("decode_1220", ticks);
+    TIMED(ticks, swap_copy(copy_words, pkt + 4, (v1220->length - 4u) / 8u));
+    report("swap_copy_1220", ticks);
+
+    /* The framer in steady state: a stream of 1116-byte packets arriving as
+     * 1460-byte TCP segments; the figure is the mean over the whole segments. */
+    for (i = 0; i < sizeof stream; i++) {
+        stream[i] = v1116->packet[i % 1116u];
+    }
+    urrt_framer_init(&framer);
+    {
+        uint32_t total = 0, segments = 0, pos;
+        for (pos = 0; pos + 1460u <= sizeof stream; pos += 1460u) {
+            TIMED(ticks, {
+                const uint8_t *p = stream + pos;
+                size_t n = 1460, used;
+                while (n > 0) {
+                    sink += urrt_framer_feed(&framer, p, n, &used);
+                    p += used;
+                    n -= used;
+                }
+            });
+            total += ticks - overhead_ticks;
+            segments++;
+        }
+        report("framer_feed_1460", total / segments + overhead_ticks);
+    }
+
+    tpdo1_signal(0, 0, 16, URRT_CAN_SIGNED, 0.0002);
+    tpdo1_signal(1, 16, 16, URRT_CAN_SIGNED, 0.0002);
+    tpdo1_signal(2, 32, 16, URRT_CAN_SIGNED, 0.0002);
+    tpdo1_signal(3, 56, 4, URRT_CAN_UNSIGNED, 1.0);
+    tpdo1_signal(4, 63, 1, URRT_CAN_UNSIGNED, 1.0);
+    {
+        uint8_t frame[8] = {0};
+        double values[5];
+        urrt_decode(v1116->packet, v1116->length, &st);
+        values[0] = st.q_actual[0];
+        values[1] = st.q_actual[1];
+        values[2] = st.q_actual[2];
+        values[3] = 5;
+        values[4] = 1;
+        TIMED(ticks, sink += urrt_can_pack_frame(tpdo1, values, 5, frame, 8, NULL));
+        report("can_pack_tpdo1", ticks);
+    }
+    target_puts("bench: sink ");
+    put_uint((uint32_t)sink);
+    target_puts("\n");
+    return 0;
+}

@@ -1,0 +1,95 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""Worst stack of every public lib/ function: the high-water marks a target
+run painted (its "stack: NAME BYTES" lines) beside the worst path of
+-fstack-usage frames through gcc's call graph (-fcallgraph-info=su .ci files
+of the same build), and README.md's table between <!-- stack:begin --> and
+<!-- stack:end -->, which must be these rows.
+
+Agreement: for a function whose calls all stay in lib/, painted and static
+must be equal (within TOLERANCE bytes: the frame of a path the run did not
+take, or words a frame reserves but never writes); for one that calls
+libgcc's soft-float routines, whose frames -fstack-usage cannot see, the
+painted mark must cover the static lib/ part, and the difference is libgcc's.
+
+Usage: stack.py RUN_LOG README CI_FILE... (prints the table, then
+"N passed, N failed")"""
+import re
+import sys
+
+TOLERANCE = 8
+
+
+def call_graph(paths):
+    frames, edges = {}, {}
+    for path in paths:
+        for line in open(path):
+            m = re.match(r'node: \{ title: "([^"]+)" label: "[^"]*\\n(\d+) bytes', line)
+            if m:
+                frames[m.group(1)] = int(m.group(2))
+            m = re.match(r'edge: \{ sourcename: "([^"]+)" targetname: "([^"]+)"', line)
+            if m:
+                edges.setdefault(m.group(1), set()).add(m.group(2))
+    return frames, edges
+
+
+def worst(name, frames, edges, seen=()):
+    """(bytes, calls outside lib/) of the deepest path from name."""
+    if name not in frames:
+        return 0, {name}
+    if name in seen:
+        sys.exit("stack.py: recursion through %s" % name)
+    deepest, outside = 0, set()
+    for callee in edges.get(name, ()):
+        b, o = worst(callee, frames, edges, seen + (name,))
+        deepest = max(deepest, b)
+        outside |= o
+    return frames[name] + deepest, outside
+
+
+def main():
+    log, readme, cis = sys.argv[1], sys.argv[2], sys.argv[3:]
+    frames, edges = call_graph(cis)
+    painted = [(m.group(1), int(m.group(2)))
+               for m in re.finditer(r"^stack: (\w+) (\d+)$", open(log).read(), re.M)]
+    passed = failed = 0
+
+    def result(ok, text):
+        nonlocal passed, failed
+        if ok:
+            passed += 1
+        else:
+            failed += 1
+            print("FAIL: " + text)
+
+    result(len(painted) > 0, "%s holds no stack lines" % log)
+    rows = ["| function | painted (bytes) | -fstack-usage call graph (bytes) |",
+            "|---|---:|---:|"]
+    for name, measured in painted:
+        # urrt.h gives the framer's functions link names carrying URRT_MAX_DOUBLES.
+        key = next((k for k in frames if re.sub(r"_URRT_MAX_DOUBLES_\d+$", "", k) == name), None)
+        if key is None:
+            result(False, "%s: not in the call graph" % name)
+            continue
+        static, outside = worst(key, frames, edges)
+        if outside:
+            note = "%d + libgcc" % static
+            ok = measured >= static
+            why = "painted %d below the static lib/ part %d" % (measured, static)
+        else:
+            note = "%d" % static
+            ok = static - TOLERANCE <= measured <= static
+            why = "painted %d, -fstack-usage %d" % (measured, static)
+        result(ok, "%s: %s" % (name, why))
+        rows.append("| `%s` | %d | %s |" % (name, measured, note))
+    print("\n".join(rows))
+    text = open(readme).read()
+    m = re.search(r"<!-- stack:begin[^\n]*-->\n(.*?)<!-- stack:end -->", text, re.S)
+    stated = [l for l in (m.group(1).splitlines() if m else []) if l.startswith("|")]
+    result(stated == rows, "README.md's stack table differs from the measured one above: replace it")
+    print("%d passed, %d failed" % (passed, failed))
+    return 0 if failed == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
