@@ -28,8 +28,15 @@ trap cleanup EXIT INT TERM
 
 # Only the dissector under test: not one installed in Wireshark's global or
 # personal plugin folders (two would clash), and no settings of this user.
+# Wireshark ignores WIRESHARK_PLUGIN_DIR when run by root, so root's tshark
+# reads the capture as nobody.
 export WIRESHARK_PLUGIN_DIR="$T/plugins" HOME="$T/home"
 mkdir -p "$WIRESHARK_PLUGIN_DIR" "$HOME"
+chmod 755 "$T"
+cp "$LUA" "$T/urrt.lua" && LUA=$T/urrt.lua
+reader() {
+  if [ "$(id -u)" = 0 ]; then setpriv --reuid=nobody --regid=nogroup --clear-groups "$@"; else "$@"; fi
+}
 
 if ! command -v tshark > /dev/null; then
   fail "tshark is not installed (make deps installs it)"; finish; exit 1
@@ -110,6 +117,7 @@ all_fins() {
 }
 check "tshark wrote every stream to its end" waitfor "every simulator's FIN in the capture" $TSHARK all_fins
 kill "$TSHARK" 2>/dev/null; wait "$TSHARK" 2>/dev/null
+chmod 644 "$T/cap.pcapng"
 
 # ---- dissect and compare --------------------------------------------------------
 specs=""; heur_specs=""
@@ -125,7 +133,7 @@ done < "$T/cases"
 # compare LABEL SPECS TSHARK_OPTIONS...: dissect, compare, count compare.py's lines.
 compare() {
   label=$1; cases=$2; shift 2
-  if ! timeout -k 3 120 tshark -r "$T/cap.pcapng" -X lua_script:"$LUA" "$@" -Y urrt -T pdml \
+  if ! reader timeout -k 3 120 tshark -r "$T/cap.pcapng" -X lua_script:"$LUA" "$@" -Y urrt -T pdml \
       > "$T/$label.pdml" 2> "$T/$label.err"; then
     cat "$T/$label.err" >&2; fail "$label: tshark failed"; return
   fi
