@@ -187,11 +187,13 @@ check "garbage-every: the capture decodes the same" cmp -s "$T/g1.txt" "$T/g2.tx
 check "garbage-every: and resyncs the same" has "$T/g2.sum" "resyncs: 9, skipped bytes: 333"
 check "dump --record holds exactly the bytes the simulator sent" cmp -s "$T/garbage.bin" "$T/garbage-dump.bin"
 
-sim --rate 500 --start-on-connect --count 100 --clients 1 --fault tiny-writes=5 -w "$T/tiny.bin"
+# 125 Hz: 5-byte pieces at 500 Hz are 110,000 writes a second, a core's
+# worth here, and a busy machine would decide whether the rate holds.
+sim --rate 125 --start-on-connect --count 100 --clients 1 --fault tiny-writes=5 -w "$T/tiny.bin"
 timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/t1.txt" 2> "$T/t1.sum"; stopsim
 check "tiny-writes: bit-exact" $RT gnuplot "$T/tiny.bin" "$T/t1.txt" 100
 check "tiny-writes: no resync" has "$T/t1.sum" "resyncs: 0, skipped bytes: 0"
-check "tiny-writes: keeps the rate" sh -c "grep -q 'Hz by arrival' '$T/t1.sum' && awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 400) }' '$T/t1.sum'"
+check "tiny-writes: keeps the rate" sh -c "grep -q 'Hz by arrival' '$T/t1.sum' && awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 100) }' '$T/t1.sum'"
 
 sim --rate 500 --start-on-connect --count 96 --clients 1 --fault coalesce=8 -w "$T/co.bin"
 timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/c1.txt" 2> "$T/c1.sum"; stopsim
@@ -219,7 +221,9 @@ check "odd-length: the 86 others decoded" has "$T/o1.sum" "packets: 86"
 # A client that stays and one that reconnects during a 1 s freeze: nothing
 # arrives before it ends (by the time column, which --clock monotonic makes
 # the host's clock), then both get the same next packet at once.
-sim --rate 500 --clock monotonic --fault freeze-after=300,for=1000
+# --start-on-connect: the count starts with the first client, not with the
+# simulator (a slow start of the helper put both clients in the freeze).
+sim --rate 500 --clock monotonic --start-on-connect --fault freeze-after=300,for=1000
 check "freeze: nobody gets a byte during it, a reconnect included" timeout -k 3 25 $RT freeze $port "$SIMLOG" 1000 500
 stopsim
 check "freeze: logged, and the packets it swallowed counted (1 s at 500 Hz less one)" sh -c "grep -q 'freeze 1: nothing to any client for 1000 ms after 300 packets' '$SIMLOG' && grep -q 'freeze 1 over' '$SIMLOG' && grep -q 'freezes 1 (499 packets not sent)' '$SIMLOG'"
@@ -265,7 +269,11 @@ sim --replay "$T/garbage.bin"
 timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F json > "$T/r2.txt" 2> "$T/r2.sum"; stopsim
 check "replay: same decoded output as --file" cmp -s "$T/r1.txt" "$T/r2.txt"
 check "replay: same resyncs (the bytes between packets are replayed)" has "$T/r2.sum" "resyncs: 9, skipped bytes: 333"
-check "replay: paced by the time column (1000 Hz)" sh -c "awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 900 && r < 1100) }' '$T/r2.sum'"
+# Pace by the time column, judged by medians (rt.py pace): the arrival rate
+# of 100 packets (0.1 s) moved 10% with one 10 ms preemption.
+sim --replay "$T/model.bin"
+check "replay: paced by the time column (500 Hz), no drift" timeout -k 3 15 $RT pace $port 500 500
+stopsim
 sim --replay "$T/len1116.bin" --loop
 timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 100 -F gnuplot > "$T/loop.txt" 2> "$T/loop.sum"; stopsim
 check "replay --loop: goes round" sh -c "grep -q 'packets: 100' '$T/loop.sum' && grep -q 'time went backwards: 2 times' '$T/loop.sum'"
@@ -359,10 +367,12 @@ check "record across a truncated connection: replays to the same output" cmp -s 
 check "record across a truncated connection: nothing to resync" has "$T/tr2.sum" "resyncs: 0, skipped bytes: 0"
 check "record across a truncated connection: whole packets only" sh -c "[ \$(stat -c %s '$T/tr.bin') = $((45 * 1116)) ]"
 # A 500 Hz capture replayed in tiny writes keeps its pace (the pieces used to
-# be timed for 125 Hz and 1116 bytes, and the client was dropped as slow).
+# be timed for 125 Hz and 1116 bytes: 229 Hz, and the client was dropped as
+# slow). 61-byte pieces: 20 per packet, 10,000 writes a second (7-byte ones
+# need most of a core, and fell to 370 Hz on a loaded machine).
 sim --version 5.10 --start-on-connect --count 300 --clients 1 -w "$T/r500.bin"
 timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -q --no-summary -F gnuplot > /dev/null 2>&1; stopsim
-sim --replay "$T/r500.bin" --fault tiny-writes=7
+sim --replay "$T/r500.bin" --fault tiny-writes=61
 timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/rt.txt" 2> "$T/rt.sum"; stopsim
 check "replay in tiny writes: bit-exact, all 300" $RT gnuplot "$T/r500.bin" "$T/rt.txt" 300
 check "replay in tiny writes: keeps 500 Hz" sh -c "awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 450) }' '$T/rt.sum'"
@@ -384,10 +394,12 @@ kill $R 2>/dev/null; wait $R 2>/dev/null
 check "--once, refused: runtime error 1 that says what to try" sh -c "[ $rc = 1 ] && grep -q 'connection refused' '$T/once.err' && grep -q 'no RealTime packet (no connection, see above); check the address and port, or drop --once' '$T/once.err'"
 # No drift: the schedule is absolute, so one second of packets at 500 Hz
 # arrives at 500 Hz within 0.5% (a sleep of one period after each send would
-# run about 3% slow here).
+# run about 3% slow here). By medians of arrival less time column (rt.py
+# pace): the first and last packets' arrival alone moved the rate 0.5% with
+# one 5 ms preemption.
 sim --rate 500
-timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 501 -F gnuplot > /dev/null 2> "$T/drift.sum"; stopsim
-check "500 Hz by arrival within 0.5% over a second" sh -c "awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 497.5 && r < 502.5) }' '$T/drift.sum'"
+check "500 Hz by arrival within 0.5% over a second" timeout -k 3 15 $RT pace $port 500 501
+stopsim
 # Listening on an address this machine does not have (TEST-NET-1) says what to use.
 timeout -k 3 10 "$SIM" -l "192.0.2.1:0" 2> "$T/listen.err"; rc=$?
 check "sim on a foreign address: runtime error 1 that says what to use" sh -c "[ $rc = 1 ] && grep -q 'not an address of this machine: use 127.0.0.1, 0.0.0.0' '$T/listen.err'"

@@ -17,6 +17,8 @@ Nothing here imports or calls the C library: it is the second opinion.
   rt.py freeze PORT SIMLOG MS RATE        a freeze (--clock monotonic) seen by a client that
                                           stays and one that reconnects during it
   rt.py freeze-every PORT N MS RATE       runs of N packets between freezes of MS
+  rt.py pace PORT RATE COUNT              packets at RATE by the time column keep that pace
+                                          by arrival (no drift), to 0.5%
   rt.py refused-port OUT                  hold a bound port that does not listen; write it to OUT
 
 Clocks: Python's time.monotonic() and time.time() read CLOCK_MONOTONIC and
@@ -27,6 +29,7 @@ import math
 import os
 import select
 import socket
+import statistics
 import struct
 import sys
 import time
@@ -385,7 +388,8 @@ def cmd_freeze(port, simlog, ms, rate):
     serve([a, b2], lambda: len(b2.packets) >= 10 and len(a.packets) > 0 and a.packets[-1][1] > b2.packets[9][1], 10)
     g = gaps(a.packets, period)
     if len(g) != 1:
-        fail('freeze: %d gaps in the stream of the client that stayed: %s' % (len(g), g))
+        fail('freeze: %d gaps in the stream of the client that stayed: %s (none: it connected during the freeze)'
+             % (len(g), g))
     i, gap = g[0]
     last, first = a.packets[i - 1], a.packets[i]
     end = last[1] + freeze  # the freeze ends MS after the last packet's instant
@@ -422,6 +426,27 @@ def cmd_freeze_every(port, n, ms, rate):
             fail('freeze-every: a gap of %.6f s in the time column, not %.3f s' % (d, freeze))
 
 
+def cmd_pace(port, rate, count):
+    """Arrival less time column, compared between the first and the last
+    fifth of the packets by their medians: a sender that drifts (sleeps a
+    period after each send) grows it by 3% of the span, while one late
+    packet, or a catch-up burst after a preemption, moves no median."""
+    period, count = 1.0 / float(rate), int(count)
+    c = Stream(port)
+    serve([c], lambda: len(c.packets) >= count, 10 + count * period)
+    steps = [b[1] - a[1] for a, b in zip(c.packets, c.packets[1:])]
+    if max(abs(d - period) for d in steps) > 1e-6:
+        fail('pace: the time column does not step by %g s' % period)
+    k = count // 5
+    lag = [arrival - t for arrival, t in c.packets]
+    drift = statistics.median(lag[-k:]) - statistics.median(lag[:k])
+    span = c.packets[-1][1] - c.packets[0][1]
+    print('rt.py: pace: %d packets over %.3f s by the time column; arrival drifted %.6f s (%.3f%%)'
+          % (len(c.packets), span, drift, 100 * drift / span))
+    if abs(drift) > 0.005 * span:
+        fail('pace: arrival drifted %.6f s over %.3f s' % (drift, span))
+
+
 def cmd_refused_port(out):
     """A port nobody listens on and nobody else can take while this runs:
     bound (without SO_REUSEADDR) but not listening, so a connect is refused."""
@@ -435,7 +460,7 @@ if __name__ == '__main__':
     cmds = {'gnuplot': cmd_gnuplot, 'json': cmd_json, 'csv': cmd_csv, 'model': cmd_model,
             'noread-server': cmd_noread_server, 'slow-client': cmd_slow_client,
             'writer-client': cmd_writer_client, 'clock': cmd_clock, 'freeze': cmd_freeze,
-            'freeze-every': cmd_freeze_every, 'refused-port': cmd_refused_port}
+            'freeze-every': cmd_freeze_every, 'pace': cmd_pace, 'refused-port': cmd_refused_port}
     if len(sys.argv) < 2 or sys.argv[1] not in cmds:
         print(__doc__, file=sys.stderr)
         sys.exit(2)
