@@ -43,8 +43,6 @@
 #include "dbc.h"
 
 #define NAME "fuzz.ini"
-#define DBC_MAX_FRAMES 4096
-#define DBC_MAX_SIGNALS 1024
 
 static const char *current_input;
 static size_t current_size;
@@ -235,19 +233,26 @@ static void check_accepted(const gw_config *cfg)
 
 /* ---- the DBC, read back --------------------------------------------------------------- */
 
+struct dbc_signal {
+    char name[CAN_MAP_NAME_MAX + 1];
+    unsigned len;
+};
+
 struct dbc_frame {
     unsigned long id;
     char name[CAN_MAP_NAME_MAX + 1];
     unsigned len;
+    struct dbc_signal *sig; /* nsig of dbc_read.sigs */
     unsigned nsig;
-    char (*sig)[CAN_MAP_NAME_MAX + 1];
-    unsigned *sig_len;
     uint8_t used[URRT_CAN_MAX_LEN];
 };
 
+/* Sized by counting the BO_ and SG_ lines first. */
 struct dbc_read {
     struct dbc_frame *frames;
     unsigned count;
+    struct dbc_signal *sigs;
+    unsigned nsigs;
 };
 
 static const struct dbc_frame *dbc_find(const struct dbc_read *d, unsigned long id)
@@ -263,7 +268,7 @@ static const struct dbc_frame *dbc_find(const struct dbc_read *d, unsigned long 
 static int dbc_signal(const struct dbc_frame *f, const char *name)
 {
     for (unsigned i = 0; i < f->nsig; i++) {
-        if (strcmp(f->sig[i], name) == 0) {
+        if (strcmp(f->sig[i].name, name) == 0) {
             return (int)i;
         }
     }
@@ -307,9 +312,6 @@ static void dbc_bo(struct dbc_read *d, const char *line)
         line[used] != '\0') {
         violated("DBC: malformed frame line: %s", line);
     }
-    if (d->count == DBC_MAX_FRAMES) {
-        violated("DBC: more than %d frames", DBC_MAX_FRAMES);
-    }
     if (!c_identifier(line + name_at, (size_t)(name_end - name_at)) || !c_identifier(node, strlen(node))) {
         violated("DBC: frame or node name is not a C identifier of at most %d characters: %s", CAN_MAP_NAME_MAX, line);
     }
@@ -333,11 +335,7 @@ static void dbc_bo(struct dbc_read *d, const char *line)
     f->id = id;
     memcpy(f->name, line + name_at, (size_t)(name_end - name_at));
     f->len = len;
-    f->sig = calloc(DBC_MAX_SIGNALS, sizeof *f->sig);
-    f->sig_len = calloc(DBC_MAX_SIGNALS, sizeof *f->sig_len);
-    if (f->sig == NULL || f->sig_len == NULL) {
-        abort();
-    }
+    f->sig = d->sigs + d->nsigs;
 }
 
 static void dbc_sg(struct dbc_read *d, const char *line)
@@ -375,12 +373,10 @@ static void dbc_sg(struct dbc_read *d, const char *line)
     if (dbc_signal(f, name) >= 0) {
         violated("DBC: signal %s appears twice in %s", name, f->name);
     }
-    if (f->nsig == DBC_MAX_SIGNALS) {
-        violated("DBC: more than %d signals in %s", DBC_MAX_SIGNALS, f->name);
-    }
     dbc_place(f, name, start, length, order);
-    snprintf(f->sig[f->nsig], sizeof f->sig[0], "%s", name);
-    f->sig_len[f->nsig++] = length;
+    snprintf(f->sig[f->nsig].name, sizeof f->sig[0].name, "%s", name);
+    f->sig[f->nsig++].len = length;
+    d->nsigs++;
 }
 
 /* A quoted string from *p (at the opening quote): backslash escapes only
@@ -420,7 +416,7 @@ static const char *dbc_ref(const struct dbc_read *d, const char *p, const char *
         violated("DBC: reference to a frame or signal that does not exist: %s", line);
     }
     if (sig_len != NULL) {
-        *sig_len = f->sig_len[s];
+        *sig_len = f->sig[s].len;
     }
     return p + used;
 }
@@ -487,9 +483,19 @@ static void dbc_check(const char *text, size_t len)
     }
     no_control("the DBC", text, len, true);
     memset(&d, 0, sizeof d);
-    d.frames = calloc(DBC_MAX_FRAMES, sizeof *d.frames);
-    if (d.frames == NULL) {
-        abort();
+    {
+        unsigned frames = 0, signals = 0;
+        for (const char *p = text; p != NULL && p < text + len;) {
+            frames += strncmp(p, "BO_ ", 4) == 0;
+            signals += strncmp(p, " SG_ ", 5) == 0;
+            p = memchr(p, '\n', (size_t)(text + len - p));
+            p = p != NULL ? p + 1 : NULL;
+        }
+        d.frames = calloc(frames + 1, sizeof *d.frames);
+        d.sigs = calloc(signals + 1, sizeof *d.sigs);
+        if (d.frames == NULL || d.sigs == NULL) {
+            abort();
+        }
     }
     for (char *line = strtok_r(copy, "\n", &save); line != NULL; line = strtok_r(NULL, "\n", &save)) {
         if (strchr(line, '\t') != NULL && line[0] != '\t') {
@@ -510,10 +516,9 @@ static void dbc_check(const char *text, size_t len)
         if (d.frames[i].nsig == 0) {
             violated("DBC: frame %s has no signal", d.frames[i].name);
         }
-        free(d.frames[i].sig);
-        free(d.frames[i].sig_len);
     }
     free(d.frames);
+    free(d.sigs);
     free(copy);
 }
 
