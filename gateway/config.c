@@ -802,7 +802,9 @@ static int on_key(void *user, const char *section, const char *key, const char *
         config_error(ctx, ctx->line, "\"%s\" is outside of any section: put it under [gateway], [lcm] or [robot NAME]", key);
         return 0;
     }
-    if (strcmp(section, ctx->section_raw) != 0 || ctx->section == NULL || !ctx->section_ok) {
+    /* libinih keeps the first 49 characters of a section header only
+     * ("[robot NAME]" takes up to 70): its name is a prefix of ours. */
+    if (strncmp(section, ctx->section_raw, strlen(section)) != 0 || ctx->section == NULL || !ctx->section_ok) {
         return 1; /* the header's error was reported */
     }
     /* A frame's "signal" key adds one signal per line. */

@@ -144,6 +144,30 @@ static void test_control_characters_refused(void)
     free(messages);
 }
 
+/* Finding 5 (found reading the loader while writing the harness, not by
+ * the fuzzer): libinih truncates section names to 49 characters, the
+ * loader compared its name with the whole header and, on a mismatch,
+ * skipped the section's keys silently: a robot named with 44 to 64
+ * characters (valid names) was rejected as having no host. */
+static void test_long_robot_name(void)
+{
+    static const char name[] = "a123456789012345678901234567890123456789012345678901234567890123";
+    char text[256];
+    char *messages = NULL;
+    gw_config cfg;
+    snprintf(text, sizeof text, "[robot %s]\nhost = h\nport = 30013\n", name);
+    CHECK_EQ_INT(strlen(name), 64);
+    CHECK_EQ_INT(load(text, strlen(text), &messages, &cfg), 0);
+    CHECK_EQ_STR(messages, "");
+    if (cfg.robot_count == 1) {
+        CHECK_EQ_STR(cfg.robots[0].name, name);
+        CHECK_EQ_STR(cfg.robots[0].host, "h");
+        CHECK_EQ_INT(cfg.robots[0].port, 30013);
+    }
+    gw_config_free(&cfg);
+    free(messages);
+}
+
 int main(void)
 {
     test_stream_and_file();
@@ -151,5 +175,6 @@ int main(void)
     test_control_characters_escaped();
     test_nul_byte();
     test_control_characters_refused();
+    test_long_robot_name();
     return check_report();
 }
