@@ -22,7 +22,7 @@ T=$(mktemp -d "${TMPDIR:-/tmp}/urrt-wireshark.XXXXXX")
 PIDS=""
 cleanup() {
   for p in $PIDS; do kill "$p" 2>/dev/null; done
-  [ -n "${KEEP:-}" ] || rm -rf "$T"
+  [ -n "${KEEP:-}" ] || rm -rf "$T"   # KEEP=1: keep the capture and outputs
 }
 trap cleanup EXIT INT TERM
 
@@ -101,7 +101,11 @@ timeout -k 3 120 tshark -i lo -f "${filter# or }" -w "$T/cap.pcapng" -P -l \
 TSHARK=$!; PIDS="$PIDS $TSHARK"
 # Its "Capturing on" line comes before dumpcap has even started; "Capture
 # started" once dumpcap has opened the interface and the file.
-check "tshark captures on lo" waitfor "tshark's 'Capture started'" $TSHARK grep -q 'Capture started' "$T/tshark.err"
+if ! waitfor "tshark's 'Capture started'" $TSHARK grep -q 'Capture started' "$T/tshark.err"; then
+  sed 's/^/    tshark: /' "$T/tshark.err" >&2
+  fail "tshark captures on lo (capturing needs root or the wireshark group)"; finish; exit 1
+fi
+ok "tshark captures on lo"
 
 DUMPS=""
 while read -r name skips heur opts; do
@@ -137,8 +141,8 @@ compare() {
       > "$T/$label.pdml" 2> "$T/$label.err"; then
     cat "$T/$label.err" >&2; fail "$label: tshark failed"; return
   fi
-  if grep -q 'Lua Error' "$T/$label.pdml" "$T/$label.err"; then
-    grep -m 3 'Lua Error' "$T/$label.pdml" "$T/$label.err" >&2; fail "$label: Lua errors"
+  if grep -q 'Lua Error\|Lua: Error' "$T/$label.pdml" "$T/$label.err"; then
+    grep -m 3 'Lua Error\|Lua: Error' "$T/$label.pdml" "$T/$label.err" >&2; fail "$label: Lua errors"
   fi
   # shellcheck disable=SC2086 # cases is a word list
   $PYTHON tests/wireshark/compare.py docs/protocol.md "$T/$label.pdml" "$label" $cases > "$T/$label.out"
