@@ -83,7 +83,7 @@ static int lua_size_rule(long size)
 
 static void print_size_rules(void)
 {
-    static uint8_t buf[URRT_PACKET_MAX + 64];
+    uint8_t buf[URRT_PACKET_MAX + 64] = {0};
     for (long size = -64; size <= URRT_PACKET_MAX + 64; size++) {
         uint32_t u = (uint32_t)size;
         int lib;
@@ -218,7 +218,7 @@ typedef struct row {
  */
 static bool probe_field(unsigned id, urrt_generation gen, row *r)
 {
-    static uint8_t pkt[URRT_PACKET_MAX];
+    uint8_t pkt[URRT_PACKET_MAX];
     const urrt_field_info *f = urrt_field((urrt_field_id)id);
     unsigned first_doubles = 0;
     bool found = false;
