@@ -773,7 +773,9 @@ static char *read_line(char *str, int num, void *stream)
     if (ctx->line == 1 && (unsigned char)p[0] == 0xEF && (unsigned char)p[1] == 0xBB && (unsigned char)p[2] == 0xBF) {
         p += 3;
     }
-    while (*p == ' ' || *p == '\t') {
+    /* Blanks as libinih skips them (isspace: a form feed too), so that a
+     * line is a header for both or for neither. */
+    while (isspace((unsigned char)*p)) {
         p++;
     }
     if (*p == '[') {

@@ -11,7 +11,8 @@
  *     without control characters;
  *   - an accepted file has no message, at least one robot with a host, and
  *     every text the gateway prints from it (the --check-config plan, the CAN
- *     description, the DBC) is free of control characters;
+ *     description, the DBC) is free of control characters; every key libinih
+ *     reads in it belongs to a section the loader took (none ignored);
  *   - its DBC is written and reads back (dbc_check below): every BO_ has a
  *     valid and unique id, a C identifier as name and a CAN length, every
  *     signal is a unique C identifier that fits its frame without overlap,
@@ -229,6 +230,74 @@ static void check_accepted(const gw_config *cfg)
     if (can_map_enabled(&cfg->can)) {
         no_control_str("the CAN interface", cfg->can.interface);
     }
+}
+
+/* ---- an accepted file: no key ignored -------------------------------------------------- */
+
+/* The loader sees each line before libinih does and dispatches keys by
+ * its own view of the section; libinih hands the keys over with its view.
+ * Where the two disagree a key can be dropped without a word. So: every
+ * key libinih finds in an accepted file sits in a section the loader took,
+ * [gateway], [lcm], [can], or a [robot NAME] or [frame NAME] it has
+ * (libinih keeps 49 characters of a header: then a prefix matches). */
+#define INIH_SECTION_MAX 49
+
+static bool section_is(const char *inih, const char *kind, const char *name)
+{
+    char want[128];
+    char got[128];
+    size_t n = 0;
+    const char *p = inih;
+    while (isspace((unsigned char)*p)) {
+        p++;
+    }
+    /* KIND NAME with the blanks between them and around taken out. */
+    while (*p != '\0' && n + 2 < sizeof got) {
+        if (isspace((unsigned char)*p)) {
+            while (isspace((unsigned char)*p)) {
+                p++;
+            }
+            if (*p != '\0') {
+                got[n++] = ' ';
+            }
+            continue;
+        }
+        got[n++] = *p++;
+    }
+    got[n] = '\0';
+    snprintf(want, sizeof want, "%s%s%s", kind, name ? " " : "", name ? name : "");
+    if (strlen(inih) >= INIH_SECTION_MAX) {
+        return strncmp(want, got, n) == 0;
+    }
+    return strcmp(want, got) == 0;
+}
+
+static int accepted_key(void *user, const char *section, const char *key, const char *value)
+{
+    const gw_config *cfg = user;
+    bool known = section_is(section, "gateway", NULL) || section_is(section, "lcm", NULL) ||
+                 section_is(section, "can", NULL);
+    (void)value;
+    for (unsigned i = 0; !known && i < cfg->robot_count; i++) {
+        known = section_is(section, "robot", cfg->robots[i].name);
+    }
+    for (size_t i = 0; !known && i < cfg->can.frame_count; i++) {
+        known = section_is(section, "frame", cfg->can.frames[i].name);
+    }
+    if (!known) {
+        violated("accepted, but libinih reads key \"%s\" in a section the loader does not have: [%s]", key, section);
+    }
+    return 1;
+}
+
+static void check_no_key_ignored(const char *data, size_t size, const gw_config *cfg)
+{
+    char *text = strndup(data, size);
+    if (text == NULL) {
+        abort();
+    }
+    ini_parse_string(text, accepted_key, (void *)cfg); /* the loader set libinih's options */
+    free(text);
 }
 
 /* ---- the DBC, read back --------------------------------------------------------------- */
@@ -688,6 +757,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             violated("accepted, but with messages: %s", a.messages);
         }
         check_accepted(&a.cfg);
+        check_no_key_ignored((const char *)data, size, &a.cfg);
         if (can_map_enabled(&a.cfg.can)) {
             size_t len_a, len_b;
             char *dbc_a = write_dbc(&a.cfg, &len_a);
