@@ -782,6 +782,15 @@ static char *read_line(char *str, int num, void *stream)
         const char *end = strchr(p, ']');
         if (end != NULL) {
             char raw[256];
+            const char *rest = end + 1;
+            while (isspace((unsigned char)*rest)) {
+                rest++;
+            }
+            if (*rest != '\0' && *rest != ';' && *rest != '#') {
+                /* libinih ignores it: "[lcm] url = ..." would be lost. */
+                config_error(ctx, ctx->line, "text after the section header: \"%.*s\" (keys go on lines of their own)",
+                             (int)strcspn(rest, "\r\n"), rest);
+            }
             snprintf(raw, sizeof raw, "%.*s", (int)(end - p - 1), p + 1);
             begin_section(ctx, raw);
         } else {

@@ -193,6 +193,21 @@ static void test_header_after_form_feed(void)
     free(messages);
 }
 
+/* Finding 7 (review while writing the harness): text after a section
+ * header was ignored by libinih and by the loader alike, so
+ * "[lcm] url = ...?ttl=1" left the default URL in place without a word. */
+static void test_text_after_header(void)
+{
+    char *messages = NULL;
+    CHECK_ERRORS(load_str("[lcm] url = udpm://239.255.76.67:7667?ttl=1\n[robot a]\nhost = h\n", &messages), 1);
+    CHECK_EQ_STR(messages, "t.ini:1: text after the section header: \"url = udpm://239.255.76.67:7667?ttl=1\" (keys go "
+                           "on lines of their own)\n");
+    free(messages);
+    CHECK_ERRORS(load_str("[lcm] ; the bus\n[robot a] # first\t\nhost = h\n", &messages), 0);
+    CHECK_EQ_STR(messages, "");
+    free(messages);
+}
+
 int main(void)
 {
     test_stream_and_file();
@@ -202,5 +217,6 @@ int main(void)
     test_control_characters_refused();
     test_long_robot_name();
     test_header_after_form_feed();
+    test_text_after_header();
     return check_report();
 }
