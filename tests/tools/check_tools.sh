@@ -272,7 +272,7 @@ check "replay: same resyncs (the bytes between packets are replayed)" has "$T/r2
 # Pace by the time column, judged by medians (rt.py pace): the arrival rate
 # of 100 packets (0.1 s) moved 10% with one 10 ms preemption.
 sim --replay "$T/model.bin"
-check "replay: paced by the time column (500 Hz), no drift" timeout -k 3 15 $RT pace $port 500 500
+check "replay: paced by the time column (500 Hz), no drift" timeout -k 3 15 $RT pace $port 500 500 0.01
 stopsim
 sim --replay "$T/len1116.bin" --loop
 timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 100 -F gnuplot > "$T/loop.txt" 2> "$T/loop.sum"; stopsim
@@ -282,26 +282,37 @@ check "replay --loop: the same packets each round" sh -c "sed -n '2,41p' '$T/loo
 check "replay of a missing file: runtime error" sh -c "[ $rc = 1 ] && grep -q 'cannot open capture' '$T/e7'"
 
 # ---- the schedule: stopped, it catches up or skips -------------------------------------------
-# A short stop (50 ms) is caught up: every packet still goes out, none is
+# A short stop (20 ms) is caught up: every packet still goes out, none is
 # missing in controller time, and the late ones are counted. A long one
 # (400 ms) skips what is more than 100 ms overdue instead of bursting it.
-sim --rate 500
-child=$(pgrep -P $SIMPID)
-timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 600 -F gnuplot > /dev/null 2> "$T/st.sum" &
-D=$!
-waitfor "the client" $D grep -q "client .* connected" "$SIMLOG"
-kill -STOP $child; sleep 0.05; kill -CONT $child
-wait $D; kill -INT $child; wait $SIMPID
-check "short stop: caught up, no packet missing" has "$T/st.sum" "largest gap: 0.002000 s"
+# How long the simulator was really held is its largest lateness (stop plus
+# the wait for a core after SIGCONT): on a loaded machine a "short" stop can
+# pass 100 ms, which is then not a short stop; that is tried again (3 times).
+tries=0
+while :; do
+  sim --rate 500
+  child=$(pgrep -P $SIMPID)
+  timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 600 -F gnuplot > /dev/null 2> "$T/st.sum" &
+  D=$!
+  waitfor "the client" $D grep -q "client .* connected" "$SIMLOG"
+  kill -STOP $child; sleep 0.02; kill -CONT $child
+  wait $D; kill -INT $child; wait $SIMPID
+  held=$(sed -n 's/.*, max \([0-9]*\)\.[0-9] us;.*/\1/p' "$SIMLOG")
+  tries=$((tries + 1))
+  [ "${held:-0}" -lt 95000 ] || [ $tries = 3 ] && break
+  echo "note: the 20 ms stop held the simulator $held us (a loaded machine): again"
+done
+check "short stop: caught up, no packet missing (held ${held:-?} us)" has "$T/st.sum" "largest gap: 0.002000 s"
 check "short stop: late packets counted, none skipped" sh -c "grep -q 'skipped 0;' '$SIMLOG' && ! grep -q 'late (a period or more behind) 0,' '$SIMLOG'"
 sim --rate 500
 child=$(pgrep -P $SIMPID)
 timeout -k 3 10 "$DUMP" "127.0.0.1:$port" -n 600 -F gnuplot > /dev/null 2> "$T/st2.sum" &
 D=$!
 waitfor "the client" $D grep -q "client .* connected" "$SIMLOG"
-kill -STOP $child; sleep 0.4; kill -CONT $child
+t0=$(date +%s%N); kill -STOP $child; sleep 0.4; kill -CONT $child; t1=$(date +%s%N)
 wait $D; kill -INT $child; wait $SIMPID
-check "long stop: the overdue packets skipped, not burst" sh -c "awk '/largest gap/ { exit !(\$4 >= 0.2 && \$4 < 0.6) }' '$T/st2.sum' && ! grep -q 'skipped 0;' '$SIMLOG'"
+# The gap: the stop less the 100 ms caught up, so at most the stop as measured here.
+check "long stop: the overdue packets skipped, not burst" sh -c "awk '/largest gap/ { exit !(\$4 >= 0.2 && \$4 <= $(( (t1 - t0) / 1000 )) / 1e6) }' '$T/st2.sum' && ! grep -q 'skipped 0;' '$SIMLOG'"
 check "long stop: no reconnect" has "$T/st2.sum" "connects 1, reconnects 0"
 
 # ---- several clients, one slow -----------------------------------------------------------------
@@ -375,8 +386,12 @@ timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -q --no-summary -F gnuplot > /d
 sim --replay "$T/r500.bin" --fault tiny-writes=61
 timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -F gnuplot > "$T/rt.txt" 2> "$T/rt.sum"; stopsim
 check "replay in tiny writes: bit-exact, all 300" $RT gnuplot "$T/r500.bin" "$T/rt.txt" 300
-check "replay in tiny writes: keeps 500 Hz" sh -c "awk '/by arrival/ { for (i = 1; i < NF; i++) if (\$(i+1) == \"Hz\" && \$(i+3) == \"arrival\") r = \$i; exit !(r > 450) }' '$T/rt.sum'"
 check "replay in tiny writes: the client is not dropped as slow" sh -c "! grep -q 'too slow' '$SIMLOG'"
+# The pace by medians (the arrival rate of these 0.6 s fell below 450 Hz
+# with load on both cores); the old timing drifted by 100%.
+sim --replay "$T/r500.bin" --fault tiny-writes=61
+check "replay in tiny writes: keeps 500 Hz (within 5%)" timeout -k 3 15 $RT pace $port 500 300 0.05
+stopsim
 # A file without a single packet is an error that says what to check.
 head -c 3000 /dev/urandom | tr '\000' '\001' > "$T/noise.bin"
 "$DUMP" --file "$T/noise.bin" > /dev/null 2> "$T/noise.err"; rc=$?
@@ -393,12 +408,12 @@ timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once > /dev/null 2> "$T/once.err"; r
 kill $R 2>/dev/null; wait $R 2>/dev/null
 check "--once, refused: runtime error 1 that says what to try" sh -c "[ $rc = 1 ] && grep -q 'connection refused' '$T/once.err' && grep -q 'no RealTime packet (no connection, see above); check the address and port, or drop --once' '$T/once.err'"
 # No drift: the schedule is absolute, so one second of packets at 500 Hz
-# arrives at 500 Hz within 0.5% (a sleep of one period after each send would
+# arrives at 500 Hz within 1% (a sleep of one period after each send would
 # run about 3% slow here). By medians of arrival less time column (rt.py
 # pace): the first and last packets' arrival alone moved the rate 0.5% with
 # one 5 ms preemption.
 sim --rate 500
-check "500 Hz by arrival within 0.5% over a second" timeout -k 3 15 $RT pace $port 500 501
+check "500 Hz by arrival within 1% over a second" timeout -k 3 15 $RT pace $port 500 501 0.01
 stopsim
 # Listening on an address this machine does not have (TEST-NET-1) says what to use.
 timeout -k 3 10 "$SIM" -l "192.0.2.1:0" 2> "$T/listen.err"; rc=$?

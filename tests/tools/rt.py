@@ -17,8 +17,8 @@ Nothing here imports or calls the C library: it is the second opinion.
   rt.py freeze PORT SIMLOG MS RATE        a freeze (--clock monotonic) seen by a client that
                                           stays and one that reconnects during it
   rt.py freeze-every PORT N MS RATE       runs of N packets between freezes of MS
-  rt.py pace PORT RATE COUNT              packets at RATE by the time column keep that pace
-                                          by arrival (no drift), to 0.5%
+  rt.py pace PORT RATE COUNT LIMIT        packets at RATE by the time column keep that pace
+                                          by arrival (no drift), to LIMIT (a fraction)
   rt.py refused-port OUT                  hold a bound port that does not listen; write it to OUT
 
 Clocks: Python's time.monotonic() and time.time() read CLOCK_MONOTONIC and
@@ -426,7 +426,7 @@ def cmd_freeze_every(port, n, ms, rate):
             fail('freeze-every: a gap of %.6f s in the time column, not %.3f s' % (d, freeze))
 
 
-def cmd_pace(port, rate, count):
+def cmd_pace(port, rate, count, limit):
     """Arrival less time column, compared between the first and the last
     fifth of the packets by their medians: a sender that drifts (sleeps a
     period after each send) grows it by 3% of the span, while one late
@@ -443,8 +443,8 @@ def cmd_pace(port, rate, count):
     span = c.packets[-1][1] - c.packets[0][1]
     print('rt.py: pace: %d packets over %.3f s by the time column; arrival drifted %.6f s (%.3f%%)'
           % (len(c.packets), span, drift, 100 * drift / span))
-    if abs(drift) > 0.005 * span:
-        fail('pace: arrival drifted %.6f s over %.3f s' % (drift, span))
+    if abs(drift) > float(limit) * span:
+        fail('pace: arrival drifted %.6f s over %.3f s (%g allowed)' % (drift, span, float(limit) * span))
 
 
 def cmd_refused_port(out):
