@@ -3,7 +3,11 @@
 #                   width, URRT_MAX_DOUBLES=152, and the non-GNU / big-endian code paths)
 #   check-lib-san   the same tests under ASan + UBSan
 #   check-fuzz-lib  the libFuzzer harness, briefly (make fuzz FUZZ_SECONDS=N for longer)
-#   check-cross     every lib/*.c alone for Cortex-M4, linked -nostdlib; footprint vs README
+#   check-cross     every lib/*.c alone for Cortex-M0+, M4 (with and without unaligned access),
+#                   M7 hard-float and RV32IMAC at -Os and -O2, linked -nostdlib -lgcc: what it
+#                   needs is libgcc's and README's symbol table; footprint vs README; mixing
+#                   URRT_MAX_DOUBLES values fails to link
+# Executed on emulated Cortex-M and big-endian CPUs: tests/target.mk.
 #   check-docs      docs/protocol.md's generated tables are current (make docs rewrites them)
 #   bench-lib       ns/packet beside memcpy of the same bytes
 # Every lib-level rule takes lib/*.c by wildcard (LIB_SRCS), so new modules are covered.
@@ -55,6 +59,19 @@ LIB_TEST_VARIANTS := $(LIB_TEST_ISAS:%=$(LIBT)/test_lib_%)
 $(LIBT)/test_lib_%: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_TEST_CFLAGS) $(OPT) -m$* $< $(LIB_SRCS) -lm -o $@
+
+# And the widths a baseline build (no -m flags: SSSE3 off) chooses at run
+# time, each forced by capping the choice (URRT_X86_MAX_VECTOR_BYTES), the
+# test asserting the width that ran; 0 is the scalar fallback.
+LIB_ISA_BYTES_ssse3 := 16
+LIB_ISA_BYTES_avx2 := 32
+LIB_ISA_BYTES_avx512bw := 64
+LIB_DISPATCH_WIDTHS := $(if $(filter x86_64,$(shell uname -m)),0 $(foreach i,$(LIB_TEST_ISAS),$(LIB_ISA_BYTES_$(i))))
+LIB_TEST_VARIANTS += $(LIB_DISPATCH_WIDTHS:%=$(LIBT)/test_lib_dispatch%)
+$(LIBT)/test_lib_dispatch%: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LIB_TEST_CFLAGS) $(OPT) -mno-ssse3 -DURRT_X86_MAX_VECTOR_BYTES=$* -DURRT_TEST_VECTOR_BYTES=$* \
+	  $< $(LIB_SRCS) -lm -o $@
 
 # And the smallest packet bound a firmware may choose (URRT_MAX_DOUBLES=152):
 # longer reference packets must then be refused, not misread.

@@ -2,10 +2,11 @@
 # Proof that lib/ is freestanding: every lib/*.c compiled alone for a
 # Cortex-M4 under the library's strict warnings, linked with -nostdlib into a
 # small image (tests/cross/startup.c), and the footprint compared with the
-# figures README.md states.
+# figures README.md states; then for every core of README's symbol table at
+# -Os and -O2, what lib/ needs from outside (libgcc only).
 #
 # usage: check.sh OUTDIR README "LIB_WARN flags" lib/a.c lib/b.c ...
-# Needs arm-none-eabi-gcc, -nm and -size. RESULT (if set) receives the
+# Needs arm-none-eabi-gcc, -nm and -size, and riscv64-unknown-elf-gcc. RESULT (if set) receives the
 # closing "N passed, N failed" line.
 set -u
 out=$1; readme=$2; warn=$3; shift 3
@@ -105,6 +106,9 @@ while IFS='|' read -r core cc flags; do
   mkdir -p "$dir"
   cflags="$flags -ffreestanding $warn -ffunction-sections -fdata-sections -Ilib -nostdinc -isystem $($cc $flags -print-file-name=include)"
   libgcc=$($cc $flags -print-libgcc-file-name)
+  nm=${cc%gcc}nm
+  $nm -g --defined-only "$libgcc" 2>/dev/null | awk 'NF == 3 { print $3 }' | sort -u > "$dir/libgcc.syms"
+  $cc $cflags -Os -c tests/cross/startup.c -o "$dir/startup.o" || fail "startup.c does not compile for $core"
   for opt in -Os -O2; do
     cobjs=""
     for src in "$@"; do
@@ -113,21 +117,16 @@ while IFS='|' read -r core cc flags; do
         fail "$src does not compile for $core at $opt"; core_ok=no; fi
     done
     [ -n "$cobjs" ] || continue
-    nm=${cc%gcc}nm
-    defined=$($nm -g --defined-only $cobjs | awk 'NF == 3 { print $3 }')
-    from_libgcc=$($nm -g --defined-only "$libgcc" 2>/dev/null | awk 'NF == 3 { print $3 }')
-    for sym in $($nm -u $cobjs | awk '{ print $2 }' | sort -u); do
-      echo "$defined" | grep -qx "$sym" && continue
-      echo "$sym $core" >> "$pairs"
-      echo "$from_libgcc" | grep -qx "$sym" ||
-        fail "lib/ needs $sym on $core at $opt, which $libgcc does not define (a C library symbol?)"
+    $nm -g --defined-only $cobjs | awk 'NF == 3 { print $3 }' | sort -u > "$dir/defined$opt"
+    $nm -u $cobjs | awk 'NF == 2 && $1 == "U" { print $2 }' | sort -u | comm -23 - "$dir/defined$opt" > "$dir/needed$opt"
+    sed "s/\$/ $core/" "$dir/needed$opt" >> "$pairs"
+    for sym in $(comm -23 "$dir/needed$opt" "$dir/libgcc.syms"); do
+      fail "lib/ needs $sym on $core at $opt, which $libgcc does not define (a C library symbol?)"
     done
     # A real image: libgcc gives what is needed, nothing else links in.
-    check "$core $opt: every lib/ function links with -nostdlib -lgcc" sh -c "
-      $cc $cflags -Os -c tests/cross/startup.c -o $dir/startup.o &&
-      $cc $flags -nostdlib -Wl,--gc-sections -T tests/cross/link.ld $dir/startup.o $cobjs \
-        $($nm -g --defined-only $cobjs | awk 'NF == 3 && $2 ~ /[TDRB]/ { printf " -Wl,-u,%s", $3 }') -lgcc \
-        -o $dir/image$opt.elf"
+    check "$core $opt: every lib/ function links with -nostdlib -lgcc" \
+      $cc $flags -nostdlib -Wl,--gc-sections -T tests/cross/link.ld "$dir/startup.o" $cobjs \
+        $(sed 's/^/-Wl,-u,/' "$dir/defined$opt") -lgcc -o "$dir/image$opt.elf"
   done
 done <<EOF_CORES
 $CORES
