@@ -3,7 +3,8 @@
 #   check-lib-m4   the reference vectors (decode and random access from every misalignment,
 #                  encoder round trip), the framer on streams of every length with garbage in
 #                  every chunk size 1..1460, on qemu's Cortex-M boards: mps2-an386 (Cortex-M4
-#                  soft-float -Os as check-cross builds lib/, and hard-float -O2), netduinoplus2
+#                  soft-float -Os as check-cross builds lib/, the same with -mno-unaligned-access,
+#                  and hard-float -O2), netduinoplus2
 #                  (STM32F405) and microbit (Cortex-M0, -Os and -O2); no C library in the
 #                  images, results through semihosting and qemu's exit status; and the painted
 #                  stack of every public lib/ function against -fstack-usage and README.md
@@ -54,10 +55,11 @@ $(TGT)/$(1)/test.elf: $(TGT_DRIVER) tests/target/$(4) $(TGT)/vectors_$(5).c $(LI
 endef
 $(eval $(call tgt_image,m4-os,$(TGT_M4),-Os,an386.ld,all))
 $(eval $(call tgt_image,m4f-o2,$(TGT_M4F),-O2,an386.ld,all))
+$(eval $(call tgt_image,m4na-os,$(TGT_M4) -mno-unaligned-access,-Os,an386.ld,named+8))
 $(eval $(call tgt_image,f405-os,$(TGT_M4F),-Os,f405.ld,named+2))
 $(eval $(call tgt_image,m0-os,$(TGT_M0),-Os,microbit.ld,named))
 $(eval $(call tgt_image,m0-o2,$(TGT_M0),-O2,microbit.ld,named+32))
-TGT_BOARDS := m4-os:mps2-an386 m4f-o2:mps2-an386 f405-os:netduinoplus2 m0-os:microbit m0-o2:microbit
+TGT_BOARDS := m4-os:mps2-an386 m4f-o2:mps2-an386 m4na-os:mps2-an386 f405-os:netduinoplus2 m0-os:microbit m0-o2:microbit
 
 check-lib-m4: $(foreach b,$(TGT_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/test.elf) tests/target/stack.py
 	$(call lib_suite,check-lib-m4,sh tests/target/run.sh $(TGT)/logs \
