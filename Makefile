@@ -17,19 +17,25 @@ SAN_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fr
 
 PYTHON := /usr/bin/python3
 
-# Debian packages the build and the tests use (Debian 12 names).
-DEB_DEPS := gcc make python3 gcc-arm-none-eabi binutils-arm-none-eabi clang libclang-rt-14-dev \
-            liblcm-dev liblcm-bin liblcm-java libjchart2d-java default-jdk-headless \
-            libinih-dev pkg-config can-utils python3-can python3-canmatrix \
-            qemu-system-x86 busybox-static cpio valgrind iproute2 gnuplot-nox
-# Installed with --no-install-recommends (fragments add theirs with +=).
-DEB_DEPS_NO_RECOMMENDS :=
+# Debian packages (Debian 12 names) in three tiers, each package named once
+# (check-ship lists the union and finds no duplicate):
+# 1. `make` and `make demo`: compiler, LCM (C, lcm-gen, Java), inih, a JDK for the types jar.
+DEPS_BUILD := gcc libc6-dev make pkg-config liblcm-dev liblcm-bin liblcm-java default-jdk-headless libinih-dev
+# 2. `make spy`: a Java runtime with GUI libraries, and jchart2d for lcm-spy's charts.
+DEPS_SPY := default-jre libjchart2d-java
+# 3. `make check`: everything else. Fragments add theirs with DEB_DEPS += ...
+DEB_DEPS := python3 clang libclang-rt-14-dev python3-canmatrix valgrind gnuplot-nox man-db systemd \
+            debhelper lintian
+# Installed with --no-install-recommends (fragments add theirs with +=): the ARM
+# cross compiler recommends newlib (about 390 MB), which lib/'s freestanding
+# builds never use.
+DEB_DEPS_NO_RECOMMENDS := gcc-arm-none-eabi binutils-arm-none-eabi
 
 PROGRAMS :=
 CHECKS :=
 BENCHES :=
 
-.PHONY: all check check-suites bench fuzz clean install deps demo
+.PHONY: all check check-suites bench fuzz clean install uninstall deps deps-build deps-spy deps-list demo
 all:
 
 include lib/lib.mk
@@ -39,32 +45,46 @@ include $(sort $(wildcard tests/*.mk))
 
 all: $(PROGRAMS)
 
-# Installs what is missing when root; otherwise prints the one command to run.
+# deps-build, deps-spy and deps (everything `make check` needs) install what
+# is missing when root; otherwise they print the one command to run and stop.
 # DEB_DEPS_NO_RECOMMENDS (cross toolchains, emulators) are installed without
-# their recommends, which would add hundreds of megabytes (qemu's firmware)
-# the tests do not use. Each package is named once.
+# their recommends, which would add hundreds of megabytes the tests do not use.
 deps_missing = $$(for p in $(1); do \
     dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; \
   done)
-deps:
-	@missing=$(call deps_missing,$(sort $(DEB_DEPS))); \
-	missing_nr=$(call deps_missing,$(filter-out $(DEB_DEPS),$(sort $(DEB_DEPS_NO_RECOMMENDS)))); \
+# $(call deps_install,PACKAGES,PACKAGES_WITHOUT_RECOMMENDS)
+define deps_install
+	@missing=$(call deps_missing,$(sort $(1))); \
+	missing_nr=$(call deps_missing,$(filter-out $(1),$(sort $(2)))); \
 	install=""; \
 	[ -z "$$missing" ] || install="sudo apt-get install -y $$(echo $$missing)"; \
 	[ -z "$$missing_nr" ] || \
 	  install="$${install:+$$install && }sudo apt-get install -y --no-install-recommends $$(echo $$missing_nr)"; \
 	if [ -n "$$install" ]; then \
 	  if [ "$$(id -u)" = 0 ]; then \
-	    echo "deps: installing:" $$missing $$missing_nr; \
+	    echo "$@: installing:" $$missing $$missing_nr; \
 	    apt-get update -qq || exit 1; \
 	    [ -z "$$missing" ] || DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null || exit 1; \
 	    [ -z "$$missing_nr" ] || DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
 	      $$missing_nr >/dev/null || exit 1; \
 	  else \
-	    echo "deps: missing Debian packages. Run, then make again:"; \
+	    echo "$@: missing Debian packages. Run, then make again:"; \
 	    echo "  $$install"; exit 1; \
 	  fi; \
 	fi
+endef
+deps-build:
+	$(call deps_install,$(DEPS_BUILD))
+deps-spy:
+	$(call deps_install,$(DEPS_BUILD) $(DEPS_SPY))
+deps:
+	$(call deps_install,$(DEPS_BUILD) $(DEPS_SPY) $(DEB_DEPS),$(DEB_DEPS_NO_RECOMMENDS))
+# Every name as given, one per line with its tier (check-ship looks for duplicates).
+deps-list:
+	@for p in $(DEPS_BUILD); do echo "build $$p"; done
+	@for p in $(DEPS_SPY); do echo "spy $$p"; done
+	@for p in $(DEB_DEPS); do echo "check $$p"; done
+	@for p in $(DEB_DEPS_NO_RECOMMENDS); do echo "check-no-recommends $$p"; done
 
 # Every suite runs even when one fails; the summary adds them up.
 check: deps
@@ -77,9 +97,8 @@ check-suites: $(CHECKS)
 
 bench: deps $(BENCHES)
 
+# What goes where: gateway/install.mk (and the fragments that hook into install: and uninstall:).
 install: all
-	install -d $(DESTDIR)$(BINDIR)
-	install -m 0755 $(PROGRAMS) $(DESTDIR)$(BINDIR)/
 
 clean:
 	rm -rf $(BUILD)

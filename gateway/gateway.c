@@ -75,9 +75,9 @@ static void on_mismatch(gw_robot *robot, size_t length, uint64_t rx_us)
              robot->cfg->expected);
     if (robot->mismatches_logged == 0 || rx_us >= robot->mismatch_logged_us + GW_MISMATCH_LOG_US) {
         urrt_log(URRT_LOG_WARNING,
-                 "robot %s: %s: %" PRIu64 " packets not published so far; fix \"version\" in the "
+                 "robot %s: %s: %" PRIu64 " packet%s not published so far; fix \"version\" in the "
                  "configuration (or set it to auto)",
-                 robot->cfg->name, robot->last_error, robot->mismatches);
+                 robot->cfg->name, robot->last_error, robot->mismatches, robot->mismatches == 1 ? "" : "s");
         robot->mismatch_logged_us = rx_us;
         robot->mismatches_logged = robot->mismatches;
     }

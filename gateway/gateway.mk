@@ -3,9 +3,13 @@
 
 LCM_JAR ?= /usr/share/java/lcm.jar
 JCHART2D_JAR ?= /usr/share/java/jchart2d.jar
+# The demo cannot be mistaken for production: its own robot name, its own LCM
+# group and port (the default is 239.255.76.67:7667), ttl=0 (this host only), and
+# the simulator on a free port unless DEMO_PORT says otherwise.
 DEMO_SECONDS ?= 0
-DEMO_PORT ?= 30003
-DEMO_LCM_URL ?= udpm://239.255.76.67:7667?ttl=0
+DEMO_PORT ?= 0
+DEMO_ROBOT ?= demo
+DEMO_LCM_URL ?= udpm://239.255.76.68:7668?ttl=0
 
 # ---- LCM types ------------------------------------------------------------------
 LCMTYPES := $(sort $(wildcard gateway/lcmtypes/*.lcm))
@@ -56,25 +60,41 @@ PROGRAMS += $(BUILD)/bin/urrt-gateway
 all: $(LCMTYPES_JAR)
 
 # ---- lcm-spy ---------------------------------------------------------------------------
-# Runs lcm-spy with the urrt types: `make spy` (LCM_URL=... to watch another URL).
+# Runs lcm-spy with the urrt types on the demo's URL: `make spy` (DEMO_LCM_URL=...
+# as given to `make demo`, or LCM_URL=... to watch another URL).
 .PHONY: spy
-spy: $(LCMTYPES_JAR)
-	URRT_LCMTYPES_JAR=$(LCMTYPES_JAR) gateway/urrt-spy $(if $(LCM_URL),--lcm-url='$(LCM_URL)')
+spy: deps-spy $(LCMTYPES_JAR)
+	URRT_LCMTYPES_JAR=$(LCMTYPES_JAR) gateway/urrt-spy --lcm-url='$(or $(LCM_URL),$(DEMO_LCM_URL))'
 
 # ---- install: gateway/install.mk ------------------------------------------------------
 
 # ---- make demo ---------------------------------------------------------------------------
-# urrt-sim (e-series 5.10 layout) at 500 Hz on 127.0.0.1:$(DEMO_PORT) and urrt-gateway publishing on
-# $(DEMO_LCM_URL), one summary line per second, until Ctrl-C or DEMO_SECONDS.
-demo: deps all
-	@set -u; dir=$$(mktemp -d); sim=; gw=; \
+# urrt-sim (e-series 5.10 layout, 500 Hz) on 127.0.0.1, and once it listens urrt-gateway
+# publishing robot $(DEMO_ROBOT) on $(DEMO_LCM_URL), one summary line per second, until
+# Ctrl-C or DEMO_SECONDS. A simulator that cannot start stops the demo (exit 1).
+demo: deps-build all
+	@set -u; dir=$$(mktemp -d); sim=; gw=; timer=; \
 	stop() { trap - EXIT INT TERM; \
-	  for p in $$gw $$sim; do kill $$p 2>/dev/null; done; wait 2>/dev/null; rm -rf "$$dir"; }; \
+	  for p in $$timer $$gw $$sim; do kill $$p 2>/dev/null; done; wait 2>/dev/null; rm -rf "$$dir"; }; \
 	trap stop EXIT; trap 'stop; exit 0' INT TERM; \
-	printf '[gateway]\nsummary = yes\n\n[lcm]\nurl = %s\n\n[robot arm1]\nhost = 127.0.0.1\nport = %s\n' \
-	  '$(DEMO_LCM_URL)' '$(DEMO_PORT)' > "$$dir/demo.ini"; \
-	echo "demo: urrt-sim at 500 Hz on 127.0.0.1:$(DEMO_PORT), urrt-gateway on $(DEMO_LCM_URL)"; \
-	echo "demo: watch it with 'make spy' in another terminal; Ctrl-C stops$(if $(filter-out 0,$(DEMO_SECONDS)), (or after $(DEMO_SECONDS) s))"; \
-	$(BUILD)/bin/urrt-sim --listen 127.0.0.1:$(DEMO_PORT) --version 5.10 --rate 500 & sim=$$!; \
-	$(BUILD)/bin/urrt-gateway --summary "$$dir/demo.ini" & gw=$$!; \
-	if [ '$(DEMO_SECONDS)' != 0 ]; then sleep '$(DEMO_SECONDS)'; else wait $$gw; fi
+	$(BUILD)/bin/urrt-sim --listen 127.0.0.1:$(DEMO_PORT) --port-file "$$dir/port" --controller 5.10 --rate 500 & \
+	sim=$$!; \
+	while [ ! -s "$$dir/port" ]; do \
+	  if ! kill -0 $$sim 2>/dev/null; then \
+	    echo "demo: urrt-sim could not listen on 127.0.0.1:$(DEMO_PORT) (see above): choose another port with" \
+	      "make demo DEMO_PORT=N, or DEMO_PORT=0 for any free one" >&2; exit 1; fi; \
+	  sleep 0.05; \
+	done; \
+	port=$$(cat "$$dir/port"); \
+	printf '[gateway]\nsummary = yes\n\n[lcm]\nurl = %s\n\n[robot %s]\nhost = 127.0.0.1\nport = %s\n' \
+	  '$(DEMO_LCM_URL)' '$(DEMO_ROBOT)' "$$port" > "$$dir/demo.ini"; \
+	echo "demo: urrt-sim (5.10, 500 Hz) on 127.0.0.1:$$port -> urrt-gateway -> robot $(DEMO_ROBOT) on $(DEMO_LCM_URL)"; \
+	$(BUILD)/bin/urrt-gateway "$$dir/demo.ini" & gw=$$!; \
+	if [ '$(DEMO_SECONDS)' != 0 ]; then (sleep '$(DEMO_SECONDS)'; kill $$gw 2>/dev/null) & timer=$$!; fi; \
+	echo "demo: watch it in another terminal: make spy$(if $(filter-out $(origin DEMO_LCM_URL),file), DEMO_LCM_URL='$(DEMO_LCM_URL)')" \
+	  "(lcm-spy on $(DEMO_LCM_URL)), or $(BUILD)/bin/urrt-dump -n 1 127.0.0.1:$$port (the raw stream)"; \
+	echo "demo: Ctrl-C stops$(if $(filter-out 0,$(DEMO_SECONDS)), (or after $(DEMO_SECONDS) s))"; \
+	wait $$gw; rc=$$?; gw=; \
+	echo "demo: stopped. To watch the next one: make demo in one terminal, make spy in another" \
+	  "(both take DEMO_LCM_URL; channels $(DEMO_ROBOT).STATE, .JOINTS, .TOOL, .STATUS, .GATEWAY)"; \
+	exit $$rc

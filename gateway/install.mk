@@ -17,14 +17,17 @@ LIBDIR ?= $(PREFIX)/lib
 PKGCONFIGDIR ?= $(LIBDIR)/pkgconfig
 URRT_VERSION := $(shell sed -n 's/^\#define URRT_VERSION_STRING "\(.*\)"/\1/p' lib/urrt.h)
 DIST := $(BUILD)/dist
+# Java policy: a versioned jar and an unversioned link to it.
+TYPES_JAR := urrt-lcmtypes-$(URRT_VERSION).jar
 
 DOCS := README.md $(sort $(wildcard docs/*.md))
 DOC_IMAGES := $(sort $(wildcard docs/img/*.png))
 EXAMPLES := $(sort $(wildcard docs/examples/*.ini))
-DIST_FILES := $(DIST)/urrt-spy $(DIST)/urrt-gateway.service $(DIST)/urrt.pc $(DIST)/gateway.ini
+DIST_FILES := $(DIST)/urrt-spy $(DIST)/urrt-gateway.service $(DIST)/urrt.pc $(DIST)/gateway.ini \
+              $(DIST)/$(TYPES_JAR)
 
 INSTALL_ITEMS = $(foreach f,$(PROGRAMS) $(DIST)/urrt-spy,$(f):$(BINDIR):0755) \
-  $(LCMTYPES_JAR):$(JAVADIR):0644 \
+  $(DIST)/$(TYPES_JAR):$(JAVADIR):0644 \
   $(DIST)/urrt-gateway.service:$(UNITDIR):0644 \
   gateway/urrt-gateway.example.ini:$(DATADIR)/urrt:0644 \
   $(foreach f,$(LCMTYPES),$(f):$(DATADIR)/urrt/lcmtypes:0644) \
@@ -35,6 +38,8 @@ INSTALL_ITEMS = $(foreach f,$(PROGRAMS) $(DIST)/urrt-spy,$(f):$(BINDIR):0755) \
   lib/urrt.h:$(INCLUDEDIR):0644 lib/urrt_can.h:$(INCLUDEDIR):0644 \
   $(LIBURRT):$(LIBDIR):0644 \
   $(DIST)/urrt.pc:$(PKGCONFIGDIR):0644
+# Symbolic links: TARGET:LINK (TARGET relative to the link's directory).
+INSTALL_LINKS = $(TYPES_JAR):$(JAVADIR)/urrt-lcmtypes.jar
 # Directories of our own, removed by uninstall when empty (deepest first).
 INSTALL_OWN_DIRS = $(DATADIR)/urrt/lcmtypes $(DATADIR)/urrt $(DOCDIR)/img $(DOCDIR)/examples $(DOCDIR) \
   $(SYSCONFDIR)/urrt
@@ -47,7 +52,11 @@ $(DIST)/urrt-gateway.service: gateway/urrt-gateway.service
 
 $(DIST)/urrt-spy: gateway/urrt-spy
 	@mkdir -p $(@D)
-	sed -e 's|^URRT_JAR_DEFAULT=.*|URRT_JAR_DEFAULT=$(JAVADIR)/urrt_lcmtypes.jar|' $< > $@
+	sed -e 's|^URRT_JAR_DEFAULT=.*|URRT_JAR_DEFAULT=$(JAVADIR)/urrt-lcmtypes.jar|' $< > $@
+
+$(DIST)/$(TYPES_JAR): $(LCMTYPES_JAR)
+	@mkdir -p $(@D)
+	cp $< $@
 
 # The example with its robot commented out: an unedited install refuses to
 # start and says which file to edit.
@@ -76,6 +85,7 @@ install-files: all dist-files
 	  src=$${e%%:*}; rest=$${e#*:}; dir=$${rest%:*}; mode=$${rest#*:}; \
 	  install -d $(DESTDIR)$$dir; install -m $$mode $$src $(DESTDIR)$$dir/; \
 	done
+	@for e in $(INSTALL_LINKS); do ln -sfn $${e%%:*} $(DESTDIR)$${e#*:}; done
 	install -d $(DESTDIR)$(SYSCONFDIR)/urrt
 	@# An existing configuration (edited or not) is never overwritten.
 	[ -e $(DESTDIR)$(CONFIG_FILE) ] || install -m 0644 $(DIST)/gateway.ini $(DESTDIR)$(CONFIG_FILE)
@@ -85,6 +95,7 @@ uninstall-files: dist-files
 	@for e in $(INSTALL_ITEMS); do \
 	  src=$${e%%:*}; rest=$${e#*:}; dir=$${rest%:*}; rm -f $(DESTDIR)$$dir/$${src##*/}; \
 	done
+	@for e in $(INSTALL_LINKS); do rm -f $(DESTDIR)$${e#*:}; done
 	@# The configuration goes only as installed; an edited one stays.
 	@if cmp -s $(DIST)/gateway.ini $(DESTDIR)$(CONFIG_FILE); then rm -f $(DESTDIR)$(CONFIG_FILE); \
 	elif [ -e $(DESTDIR)$(CONFIG_FILE) ]; then echo "uninstall: $(DESTDIR)$(CONFIG_FILE) was edited: kept"; fi

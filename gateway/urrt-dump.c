@@ -27,6 +27,10 @@
 /* Bytes held back from the recording until the packet they lead to is
  * complete (garbage, then the packet); past this they are written anyway. */
 #define RECORD_PENDING_MAX (1u << 20)
+/* No packet for this long: say so (then at twice the interval, up to a minute),
+ * so that a wrong port does not look like a robot that is just slow to start. */
+#define QUIET_NOTICE_FIRST_US 3000000u
+#define QUIET_NOTICE_MAX_US 60000000u
 
 typedef enum format { FORMAT_TABLE, FORMAT_CSV, FORMAT_JSON, FORMAT_GNUPLOT } format;
 
@@ -36,6 +40,8 @@ typedef struct options {
     format fmt;
     bool fields_given;
     bool field_on[URRT_FIELD_COUNT];
+    unsigned field_order[URRT_FIELD_COUNT]; /* the fields to print, in this order */
+    unsigned nfields;
     uint64_t count;
     uint64_t every;
     const char *record_path;
@@ -100,8 +106,8 @@ static void usage(FILE *out)
 "                          gnuplot: every double of the packet in wire order,\n"
 "                          printed round-trip exact, so that column N is UR's\n"
 "                          \"Gnuplot col.\" N (column 1 is the time)\n"
-"  -o, --fields A,B,...    only these fields (table, csv, json); names as in\n"
-"                          the field table, e.g. time,q_actual,robot_mode\n"
+"  -k, --fields A,B,...    only these fields, in this order (table, csv, json);\n"
+"                          names as in the field table, e.g. time,q_actual\n"
 "  -n, --count N           stop after N packets\n"
 "  -e, --every N           print every Nth packet only (all are counted)\n"
 "  -w, --record PATH       save the raw stream (every byte up to the last\n"
@@ -112,7 +118,8 @@ static void usage(FILE *out)
 "Source:\n"
 "  -f, --file PATH         read a raw capture instead of a robot; - is stdin\n"
 "      --once              end when the connection ends instead of reconnecting\n"
-"  -t, --timeout SEC       fail when no packet arrives for SEC seconds\n"
+"  -t, --timeout SEC       fail when no packet arrives for SEC seconds (without\n"
+"                          it, a notice every few seconds says none has come)\n"
 "      --connect-timeout MS   (default 2000)\n"
 "      --silence-timeout MS   treat this much silence as a lost link (default\n"
 "                             1000; 0: never)\n"
@@ -136,7 +143,7 @@ static void usage(FILE *out)
 "\n"
 "Examples:\n"
 "  " PROGRAM " 192.168.1.10:30013 -n 1                # one packet, as a table\n"
-"  " PROGRAM " -F csv -o time,q_actual,i_actual robot -n 5000 > joints.csv\n"
+"  " PROGRAM " -F csv -k time,q_actual,i_actual robot -n 5000 > joints.csv\n"
 "  " PROGRAM " -F gnuplot [::1]:30003 -w capture.bin -n 2500 > capture.dat\n"
 "  " PROGRAM " -F json --file capture.bin | head\n"
 "  nc robot 30013 | " PROGRAM " --file - -F gnuplot > live.dat\n");
@@ -169,7 +176,10 @@ static void parse_fields(const char *list, options *o)
             }
             exit(CLI_EXIT_USAGE);
         }
-        o->field_on[id] = true;
+        if (!o->field_on[id]) {
+            o->field_on[id] = true;
+            o->field_order[o->nfields++] = (unsigned)id;
+        }
         o->fields_given = true;
         p += n;
         if (*p == ',') {
@@ -186,7 +196,7 @@ static void parse_options(int argc, char **argv, options *o)
     enum { OPT_ONCE = 256, OPT_CONNECT_TIMEOUT, OPT_SILENCE_TIMEOUT, OPT_BACKOFF_MAX, OPT_NO_SUMMARY };
     static const struct option longopts[] = {
         {"format", required_argument, NULL, 'F'},
-        {"fields", required_argument, NULL, 'o'},
+        {"fields", required_argument, NULL, 'k'},
         {"count", required_argument, NULL, 'n'},
         {"every", required_argument, NULL, 'e'},
         {"record", required_argument, NULL, 'w'},
@@ -214,7 +224,7 @@ static void parse_options(int argc, char **argv, options *o)
     o->backoff_max_ms = 5000;
     o->summary = true;
     o->log_level = URRT_LOG_NOTICE;
-    while ((c = getopt_long(argc, argv, "F:o:n:e:w:f:t:vqhV", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "F:k:n:e:w:f:t:vqhV", longopts, NULL)) != -1) {
         switch (c) {
         case 'F':
             if (strcmp(optarg, "table") == 0) {
@@ -229,7 +239,7 @@ static void parse_options(int argc, char **argv, options *o)
                 usage_error("--format %s: use table, csv, json or gnuplot", optarg);
             }
             break;
-        case 'o': parse_fields(optarg, o); break;
+        case 'k': parse_fields(optarg, o); break;
         case 'n':
             if ((err = cli_parse_u64(optarg, 1, UINT64_MAX, &o->count)) != NULL) {
                 usage_error("--count %s: %s", optarg, err);
@@ -268,7 +278,13 @@ static void parse_options(int argc, char **argv, options *o)
         case 'q': o->log_level = URRT_LOG_ERR; break;
         case 'h': usage(stdout); exit(CLI_EXIT_OK);
         case 'V': printf(PROGRAM " " URRT_VERSION_STRING "\n"); exit(CLI_EXIT_OK);
-        default: fprintf(stderr, "Try '" PROGRAM " --help'.\n"); exit(CLI_EXIT_USAGE);
+        default:
+            if (optopt == 'o') {
+                /* -o was --fields before it meant --output in urrt-gateway. */
+                usage_error("-o is gone: fields are -k A,B (--fields A,B)");
+            }
+            fprintf(stderr, "Try '" PROGRAM " --help'.\n");
+            exit(CLI_EXIT_USAGE);
         }
     }
     if (o->file_path != NULL) {
@@ -305,9 +321,20 @@ static void print_number(FILE *out, double v, bool json)
     }
 }
 
-static bool field_selected(const dump *d, const urrt_state *st, unsigned id)
+/* The ids to print: those asked for, in the order asked, or else the packet's. */
+static unsigned selected_fields(const dump *d, const urrt_state *st, unsigned *ids)
 {
-    return d->opt.fields_given ? d->opt.field_on[id] : urrt_has(st, id);
+    unsigned n = 0;
+    if (d->opt.fields_given) {
+        memcpy(ids, d->opt.field_order, d->opt.nfields * sizeof *ids);
+        return d->opt.nfields;
+    }
+    for (unsigned id = 0; id < URRT_FIELD_COUNT; id++) {
+        if (urrt_has(st, id)) {
+            ids[n++] = id;
+        }
+    }
+    return n;
 }
 
 static const double *field_values(const urrt_state *st, unsigned id)
@@ -344,16 +371,11 @@ static void print_csv(dump *d, FILE *out, const urrt_state *st)
     if (!d->csv_header_done) {
         /* Without --fields the columns are those of the first packet. */
         if (!d->opt.fields_given) {
-            for (unsigned id = 0; id < URRT_FIELD_COUNT; id++) {
-                d->opt.field_on[id] = urrt_has(st, id);
-            }
+            d->opt.nfields = selected_fields(d, st, d->opt.field_order);
             d->opt.fields_given = true;
         }
-        for (unsigned id = 0; id < URRT_FIELD_COUNT; id++) {
-            const urrt_field_info *f = urrt_field((urrt_field_id)id);
-            if (!d->opt.field_on[id]) {
-                continue;
-            }
+        for (unsigned k = 0; k < d->opt.nfields; k++) {
+            const urrt_field_info *f = urrt_field((urrt_field_id)d->opt.field_order[k]);
             for (unsigned i = 0; i < f->count; i++) {
                 fprintf(out, first ? "%s" : ",%s", f->name);
                 if (f->count > 1) {
@@ -366,12 +388,10 @@ static void print_csv(dump *d, FILE *out, const urrt_state *st)
         d->csv_header_done = true;
         first = true;
     }
-    for (unsigned id = 0; id < URRT_FIELD_COUNT; id++) {
+    for (unsigned k = 0; k < d->opt.nfields; k++) {
+        unsigned id = d->opt.field_order[k];
         const urrt_field_info *f = urrt_field((urrt_field_id)id);
         const double *v = field_values(st, id);
-        if (!d->opt.field_on[id]) {
-            continue;
-        }
         for (unsigned i = 0; i < f->count; i++) {
             if (!first) {
                 fputc(',', out);
@@ -401,11 +421,14 @@ static void print_json(const dump *d, FILE *out, const urrt_state *st)
     if (st->extra_columns > 0) {
         fprintf(out, ",\"extra_columns\":%u", (unsigned)st->extra_columns);
     }
-    for (unsigned id = 0; id < URRT_FIELD_COUNT; id++) {
+    unsigned ids[URRT_FIELD_COUNT];
+    unsigned n = selected_fields(d, st, ids);
+    for (unsigned k = 0; k < n; k++) {
+        unsigned id = ids[k];
         const urrt_field_info *f = urrt_field((urrt_field_id)id);
         const double *v = field_values(st, id);
         urrt_enum_kind kind = urrt_field_enum((urrt_field_id)id, st->generation);
-        if (!field_selected(d, st, id) || !urrt_has(st, id)) {
+        if (!urrt_has(st, id)) {
             continue;
         }
         fprintf(out, ",\"%s\":", f->name);
@@ -452,13 +475,13 @@ static void print_table(const dump *d, FILE *out, const urrt_state *st)
         fprintf(out, ", %u extra columns", (unsigned)st->extra_columns);
     }
     fputc('\n', out);
-    for (unsigned id = 0; id < URRT_FIELD_COUNT; id++) {
+    unsigned ids[URRT_FIELD_COUNT];
+    unsigned n = selected_fields(d, st, ids);
+    for (unsigned k = 0; k < n; k++) {
+        unsigned id = ids[k];
         const urrt_field_info *f = urrt_field((urrt_field_id)id);
         const double *v = field_values(st, id);
         urrt_enum_kind kind = urrt_field_enum((urrt_field_id)id, st->generation);
-        if (!field_selected(d, st, id)) {
-            continue;
-        }
         fprintf(out, "  %-22s %-10s", f->name, f->unit);
         if (!urrt_has(st, id)) {
             fputs(" (not in this packet)\n", out);
@@ -675,6 +698,8 @@ static int run_link(dump *d)
     urrt_link_config cfg;
     link_ctx lc = {.d = d};
     uint64_t last_progress;
+    uint64_t quiet_interval_us = QUIET_NOTICE_FIRST_US;
+    uint64_t quiet_notice_at;
     uint64_t seen_packets = 0;
     uint64_t seen_disconnects = 0;
     int status = CLI_EXIT_OK;
@@ -692,6 +717,7 @@ static int run_link(dump *d)
     }
     urrt_link_set_tap(lc.link, on_bytes, d);
     last_progress = urrt_port_monotonic_us();
+    quiet_notice_at = last_progress + quiet_interval_us;
     while (running && !d->done) {
         short events = 0;
         int fd = urrt_link_poll_fd(lc.link, &events);
@@ -727,6 +753,16 @@ static int run_link(dump *d)
         if (ls->packets != seen_packets) {
             seen_packets = ls->packets;
             last_progress = now;
+            quiet_interval_us = QUIET_NOTICE_FIRST_US;
+            quiet_notice_at = now + quiet_interval_us;
+        }
+        if (!d->done && now >= quiet_notice_at) {
+            urrt_log(URRT_LOG_NOTICE, "%s: no packet for %.0f s (link %s, %" PRIu64 " connect failures): check the "
+                     "address and the port (30003, or the read-only 30013)%s", urrt_link_peer(lc.link),
+                     (double)(now - last_progress) / 1e6, urrt_link_state_name(urrt_link_get_state(lc.link)),
+                     ls->connect_failures, d->opt.timeout_s > 0 ? "" : "; -t SEC gives up after SEC seconds");
+            quiet_interval_us = quiet_interval_us * 2 < QUIET_NOTICE_MAX_US ? quiet_interval_us * 2 : QUIET_NOTICE_MAX_US;
+            quiet_notice_at = now + quiet_interval_us;
         }
         if (d->opt.once && !d->done && (ls->disconnects > 0 || (ls->connect_failures > 0 && ls->connects == 0))) {
             if (d->packets == 0) {

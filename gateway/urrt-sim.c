@@ -165,6 +165,12 @@ typedef struct sim {
     bool replay_done;
 } sim;
 
+/* "1 packet", "2 packets". */
+static const char *plural(uint64_t n)
+{
+    return n == 1 ? "" : "s";
+}
+
 static uint64_t now_ns(void)
 {
     struct timespec ts;
@@ -186,12 +192,13 @@ static void usage(FILE *out)
 "                           IPv6 as [::1]:30003; port 0: any free port\n"
 "      --port-file FILE     once listening, write the port and a newline to\n"
 "                           FILE (atomically: FILE.tmp, then renamed)\n"
-"      --version V          controller software version whose length to send:\n"
+"  -c, --controller V       controller software version whose length to send:\n"
 "                           1.5 1.6 1.7 1.8 3.0 ... 3.15 5.0 ... 5.10 (and later)\n"
-"      --controller V       the same, for scripts (--version alone prints ours)\n"
+"      --version V          the older spelling of --controller V (a word that\n"
+"                           follows --version is always a controller version)\n"
 "  -L, --length N           packet length in bytes, any 4+8n from 12 to %u,\n"
 "                           lengths no controller uses included (default %u)\n"
-"  -r, --rate HZ            packets per second (default 125; 500 with --version 5.x)\n"
+"  -r, --rate HZ            packets per second (default 125; 500 with a 5.x controller)\n"
 "  -s, --seed N             motion seed: same seed, same packets (default 1)\n"
 "      --clock start|monotonic|realtime  what the time column counts: seconds\n"
 "                           since the controller started (1000 s at packet 0;\n"
@@ -241,7 +248,7 @@ static void usage(FILE *out)
 "  -v, --verbose            log every client (twice: debug)\n"
 "  -q, --quiet              log errors only\n"
 "  -h, --help               this text\n"
-"  -V, --version            print the version (" URRT_VERSION_STRING ")\n"
+"  -V, --version            print the program's version (" URRT_VERSION_STRING ")\n"
 "\n"
 "At exit it logs the schedule's figures: packets, late packets (sent a period\n"
 "or more behind), skipped ones, and the lateness (mean, p99, max).\n"
@@ -251,7 +258,7 @@ static void usage(FILE *out)
 "\n"
 "Examples:\n"
 "  " PROGRAM "                                   # CB3 3.10 layout, 125 Hz, 127.0.0.1:30003\n"
-"  " PROGRAM " --version 5.10 -l 0.0.0.0:30003   # e-series 5.10 at 500 Hz, on the LAN\n"
+"  " PROGRAM " -c 5.10 -l 0.0.0.0:30003          # e-series 5.10 at 500 Hz, on the LAN\n"
 "  " PROGRAM " --length 1124 --rate 1000         # a length no controller sends\n"
 "  " PROGRAM " -l [::1]:30013 --fault close-after=500 --fault garbage-every=100\n"
 "  " PROGRAM " --start-on-connect -n 1000 -w capture.bin --clients 1\n"
@@ -403,14 +410,14 @@ static void parse_fault(const char *spec, fault_config *f)
 
 static void parse_options(int argc, char **argv, options *o)
 {
-    enum { OPT_CONTROLLER = 256, OPT_REPLAY, OPT_LOOP, OPT_START_ON_CONNECT, OPT_CLIENTS, OPT_MAX_CLIENTS,
+    enum { OPT_REPLAY = 256, OPT_LOOP, OPT_START_ON_CONNECT, OPT_CLIENTS, OPT_MAX_CLIENTS,
            OPT_RT_PRIORITY, OPT_PORT_FILE, OPT_CLOCK };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, 'l'},
         {"port-file", required_argument, NULL, OPT_PORT_FILE},
         {"clock", required_argument, NULL, OPT_CLOCK},
         {"version", optional_argument, NULL, 'V'},
-        {"controller", required_argument, NULL, OPT_CONTROLLER},
+        {"controller", required_argument, NULL, 'c'},
         {"length", required_argument, NULL, 'L'},
         {"rate", required_argument, NULL, 'r'},
         {"seed", required_argument, NULL, 's'},
@@ -440,7 +447,7 @@ static void parse_options(int argc, char **argv, options *o)
     o->seed = 1;
     o->max_clients = 16;
     o->log_level = URRT_LOG_NOTICE;
-    while ((c = getopt_long(argc, argv, "l:L:r:s:n:w:f:vqhV", longopts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, "c:l:L:r:s:n:w:f:vqhV", longopts, NULL)) != -1) {
         switch (c) {
         case 'l': listen_arg = optarg; break;
         case OPT_PORT_FILE: o->port_file = optarg; break;
@@ -456,8 +463,10 @@ static void parse_options(int argc, char **argv, options *o)
             }
             break;
         case 'V':
-            /* "--version 5.10" names a controller; "--version" alone prints ours. */
-            if (optarg == NULL && optind < argc && argv[optind][0] >= '0' && argv[optind][0] <= '9') {
+            /* urrt-sim takes no operands, so a word after --version can only be
+             * a controller version (the older spelling of --controller): it is
+             * never taken for "print the version", whatever it says. */
+            if (optarg == NULL && optind < argc && argv[optind][0] != '-') {
                 optarg = argv[optind++];
             }
             if (optarg == NULL) {
@@ -465,7 +474,7 @@ static void parse_options(int argc, char **argv, options *o)
                 exit(CLI_EXIT_OK);
             }
             /* fall through */
-        case OPT_CONTROLLER: version_arg = optarg; break;
+        case 'c': version_arg = optarg; break;
         case 'L': {
             uint32_t v;
             if ((err = cli_parse_u32(optarg, URRT_PACKET_MIN, URRT_PACKET_MAX, &v)) != NULL) {
@@ -526,18 +535,18 @@ static void parse_options(int argc, char **argv, options *o)
     if (version_arg != NULL) {
         double rate;
         if (length_given) {
-            usage_error("give --version or --length, not both");
+            usage_error("give --controller or --length, not both");
         }
         if (!length_of_version(version_arg, &o->length, &rate)) {
-            usage_error("--version %s: not a RealTime controller version (1.5-1.8, 3.0-3.15, 5.0 and later)",
-                        version_arg);
+            usage_error("--controller %s: not a RealTime controller version (1.5-1.8, 3.0-3.15, 5.0 and later); "
+                        "-V alone prints this program's version", version_arg);
         }
         if (!o->rate_given) {
             o->rate_hz = rate;
         }
     }
     if (o->replay_path != NULL && (version_arg != NULL || length_given || o->rate_given)) {
-        usage_error("--replay sends the capture's own packets at its own pace: drop --version, --length, --rate");
+        usage_error("--replay sends the capture's own packets at its own pace: drop --controller, --length, --rate");
     }
     if (o->replay_path != NULL && o->clock != SIM_CLOCK_START) {
         usage_error("--replay sends the capture's own time column: drop --clock");
@@ -621,8 +630,8 @@ static bool load_replay(sim *s, const char *path)
         return false;
     }
     rp->span_ns = due + (uint64_t)llround(delta * 1e9);
-    urrt_log(URRT_LOG_INFO, "capture %s: %zu packets over %.3f s; %" PRIu64 " bytes skipped, %zu trailing bytes dropped",
-             path, rp->count, (double)due / 1e9, fr.stats.skipped, rp->size - rp->end[rp->count - 1]);
+    urrt_log(URRT_LOG_INFO, "capture %s: %zu packet%s over %.3f s; %" PRIu64 " bytes skipped, %zu trailing bytes dropped",
+             path, rp->count, plural(rp->count), (double)due / 1e9, fr.stats.skipped, rp->size - rp->end[rp->count - 1]);
     return true;
 }
 
@@ -720,8 +729,8 @@ static bool queue_bytes(client *c, const uint8_t *data, size_t len)
 static void drop_client(sim *s, size_t i, urrt_log_level level, const char *why)
 {
     client *c = &s->clients[i];
-    urrt_log(level, "client %s %s after %" PRIu64 " packets (%" PRIu64 " bytes)", c->peer, why, c->packets,
-             c->bytes_sent);
+    urrt_log(level, "client %s %s after %" PRIu64 " packet%s (%" PRIu64 " bytes)", c->peer, why, c->packets,
+             plural(c->packets), c->bytes_sent);
     if (c->reset_when_drained) {
         struct linger lg = {.l_onoff = 1, .l_linger = 0};
         setsockopt(c->fd, SOL_SOCKET, SO_LINGER, &lg, sizeof lg);
@@ -854,7 +863,7 @@ static void emit_to_client(sim *s, client *c, const uint8_t *pkt, size_t len, ui
     if (f->stall_after != 0 && n == f->stall_after) {
         c->stalled = true;
         c->stall_until_ns = f->stall_ms ? now + f->stall_ms * 1000000ull : UINT64_MAX;
-        urrt_log(URRT_LOG_INFO, "client %s: stalling after %" PRIu64 " packets", c->peer, n);
+        urrt_log(URRT_LOG_INFO, "client %s: stalling after %" PRIu64 " packet%s", c->peer, n, plural(n));
     }
     if (f->coalesce == 0 || n % f->coalesce == 0 || c->close_when_drained) {
         c->releasable = c->len;
@@ -1013,10 +1022,10 @@ static void maybe_freeze(sim *s, uint64_t due)
     s->freezes++;
     if (f->freeze_ms != 0) {
         urrt_log(URRT_LOG_NOTICE, "freeze %" PRIu64 ": nothing to any client for %" PRIu64 " ms after %" PRIu64
-                 " packets", s->freezes, f->freeze_ms, s->packets_out);
+                 " packet%s", s->freezes, f->freeze_ms, s->packets_out, plural(s->packets_out));
     } else {
-        urrt_log(URRT_LOG_NOTICE, "freeze %" PRIu64 ": nothing to any client from now on, after %" PRIu64 " packets",
-                 s->freezes, s->packets_out);
+        urrt_log(URRT_LOG_NOTICE, "freeze %" PRIu64 ": nothing to any client from now on, after %" PRIu64 " packet%s",
+                 s->freezes, s->packets_out, plural(s->packets_out));
     }
 }
 
@@ -1152,13 +1161,13 @@ static void log_summary(const sim *s, uint64_t now)
     const latency_stats *lat = &s->lat;
     double secs = s->started ? (double)(now - s->t0_ns) / 1e9 : 0.0;
     urrt_log(URRT_LOG_NOTICE,
-             "%" PRIu64 " packets in %.3f s; late (a period or more behind) %" PRIu64 ", skipped %" PRIu64
+             "%" PRIu64 " packet%s in %.3f s; late (a period or more behind) %" PRIu64 ", skipped %" PRIu64
              "; lateness mean %.1f us, p99 <= %.0f us, max %.1f us; clients %" PRIu64 ", dropped as slow %" PRIu64
-             "; garbage bytes %" PRIu64 "; freezes %" PRIu64 " (%" PRIu64 " packets not sent)",
-             s->packets_out, secs, lat->late, lat->skipped,
+             "; garbage bytes %" PRIu64 "; freezes %" PRIu64 " (%" PRIu64 " packet%s not sent)",
+             s->packets_out, plural(s->packets_out), secs, lat->late, lat->skipped,
              lat->samples ? (double)lat->sum_ns / (double)lat->samples / 1e3 : 0.0,
              (double)percentile_ns(lat, 0.99) / 1e3, (double)lat->max_ns / 1e3, s->next_client_id, s->slow_drops,
-             s->garbage_sent, s->freezes, s->frozen_packets);
+             s->garbage_sent, s->freezes, s->frozen_packets, plural(s->frozen_packets));
 }
 
 int main(int argc, char **argv)

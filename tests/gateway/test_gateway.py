@@ -871,10 +871,10 @@ def t_install(args):
 
     p = make("install")
     files = ["usr/bin/urrt-gateway", "usr/bin/urrt-dump", "usr/bin/urrt-sim", "usr/bin/urrt-spy",
-             "usr/share/java/urrt_lcmtypes.jar", "usr/share/urrt/urrt-gateway.example.ini",
+             "usr/share/java/urrt-lcmtypes.jar", "usr/share/urrt/urrt-gateway.example.ini",
              "unit/urrt-gateway.service", "etc/urrt/gateway.ini",
              "usr/share/man/man8/urrt-gateway.8", "usr/share/man/man5/urrt-gateway.ini.5",
-             "usr/share/man/man1/urrt-dump.1", "usr/share/man/man1/urrt-sim.1",
+             "usr/share/man/man1/urrt-dump.1", "usr/share/man/man1/urrt-sim.1", "usr/share/man/man1/urrt-spy.1",
              "usr/share/doc/urrt/README.md", "usr/share/doc/urrt/gateway.md", "usr/share/doc/urrt/can.md",
              "usr/share/doc/urrt/LICENSE", "usr/share/doc/urrt/examples/canopen.ini",
              "usr/share/doc/urrt/examples/fd.ini", "usr/share/doc/urrt/examples/j1939.ini",
@@ -895,7 +895,7 @@ def t_install(args):
     check("ProtectSystem=strict" in unit and "LogsDirectory=urrt" in unit,
           "install: the read-only system leaves /var/log/urrt writable for a CAN log")
     spy = open(os.path.join(prefix, "bin", "urrt-spy")).read() if os.path.exists(prefix) else ""
-    check("URRT_JAR_DEFAULT=%s/share/java/urrt_lcmtypes.jar" % prefix in spy, "install: urrt-spy knows the jar")
+    check("URRT_JAR_DEFAULT=%s/share/java/urrt-lcmtypes.jar" % prefix in spy, "install: urrt-spy knows the jar")
     conf = os.path.join(etc, "urrt", "gateway.ini")
     c = subprocess.run([args.gateway, "--check-config", conf], capture_output=True, text=True, timeout=10)
     check(c.returncode == 2 and ("no robot: edit %s" % conf) in c.stderr,

@@ -79,7 +79,7 @@ check "dump without source: says what to give" has "$T/e1" "give HOST[:PORT] or 
 check "unknown field: usage error 2" [ $rc = 2 ]
 check "unknown field: lists the valid names" has "$T/e2" "q_actual"
 check "unknown field: names the wrong one" has "$T/e2" '"nosuch"'
-"$DUMP" -F gnuplot -o time --file /dev/null > /dev/null 2>&1; rc=$?
+"$DUMP" -F gnuplot -k time --file /dev/null > /dev/null 2>&1; rc=$?
 check "gnuplot with --fields: usage error" [ $rc = 2 ]
 "$DUMP" --file "$T/nonexistent" > /dev/null 2> "$T/e3"; rc=$?
 check "missing capture: runtime error 1" [ $rc = 1 ]
@@ -91,6 +91,15 @@ check "sim --length 1117: says 4 + 8n" has "$T/e4" "4 + 8n"
 check "unknown fault: usage error, lists faults" sh -c "[ $rc = 2 ] && grep -q garbage-every '$T/e5'"
 "$SIM" --version 4.2 2> /dev/null; rc=$?
 check "unknown controller version: usage error" [ $rc = 2 ]
+# A word after --version is a controller version (urrt-sim takes no operands), never "print ours".
+"$SIM" --version e-series > "$T/e7.out" 2> "$T/e7"; rc=$?
+check "sim --version e-series: usage error, not the program's version" \
+  sh -c "[ $rc = 2 ] && [ ! -s '$T/e7.out' ] && grep -q 'e-series: not a RealTime controller version' '$T/e7'"
+"$SIM" -c nope 2> "$T/e8"; rc=$?
+check "sim -c is --controller" sh -c "[ $rc = 2 ] && grep -q -- '--controller nope' '$T/e8'"
+"$DUMP" -o time --file /dev/null > /dev/null 2> "$T/e9"; rc=$?
+check "dump -o (once --fields, --output in urrt-gateway): usage error naming -k" \
+  sh -c "[ $rc = 2 ] && grep -q -- '-k A,B (--fields A,B)' '$T/e9'"
 "$DUMP" robot:99999 2> "$T/e6"; rc=$?
 check "port out of range: usage error" sh -c "[ $rc = 2 ] && grep -q '1 to 65535' '$T/e6'"
 
@@ -127,8 +136,8 @@ check "json 1.x: values at the 1.x columns" $RT json "$T/len812.bin" "$T/j1.txt"
 "$DUMP" --file "$T/len1220.bin" -F csv > "$T/c.txt" 2>/dev/null
 check "csv: header and every value match" $RT csv "$T/len1220.bin" "$T/c.txt"
 check "csv: multi-element names" has "$T/c.txt" "q_actual[5]"
-"$DUMP" --file "$T/len1116.bin" -F csv -o time,robot_mode,q_actual > "$T/c2.txt" 2>/dev/null
-check "csv --fields: exactly those columns" sh -c "head -n 1 '$T/c2.txt' | grep -qx 'time,q_actual\[0\],q_actual\[1\],q_actual\[2\],q_actual\[3\],q_actual\[4\],q_actual\[5\],robot_mode'"
+"$DUMP" --file "$T/len1116.bin" -F csv -k time,robot_mode,q_actual > "$T/c2.txt" 2>/dev/null
+check "csv --fields: exactly those columns, in the order asked" sh -c "head -n 1 '$T/c2.txt' | grep -qx 'time,robot_mode,q_actual\[0\],q_actual\[1\],q_actual\[2\],q_actual\[3\],q_actual\[4\],q_actual\[5\]'"
 check "csv --fields: values too" $RT csv "$T/len1116.bin" "$T/c2.txt"
 "$DUMP" --file "$T/len1116.bin" -n 1 > "$T/t.txt" 2>/dev/null
 check "table: enum names" has "$T/t.txt" "RUNNING(253) RUNNING(253)"
@@ -136,9 +145,14 @@ check "table: robot mode" has "$T/t.txt" "RUNNING(7)"
 check "table: units" has "$T/t.txt" "rad/s^2"
 check "table: bit masks" has "$T/t.txt" "0x00100 [8]"
 check "table: header" has "$T/t.txt" "packet 1: 1116 bytes, 3.x/5.x (3.10-3.13, 5.4-5.8)"
-"$DUMP" --file "$T/len812.bin" -n 1 -o robot_mode,tool_vector > "$T/t1.txt" 2>/dev/null
+"$DUMP" --file "$T/len812.bin" -n 1 -k robot_mode,tool_vector > "$T/t1.txt" 2>/dev/null
 check "table 1.x: CB2 robot mode numbering" has "$T/t1.txt" "RUNNING(0)"
-"$DUMP" --file "$T/len756.bin" -n 1 -o robot_mode > "$T/t2.txt" 2>/dev/null
+"$DUMP" --file "$T/len756.bin" -n 1 -k robot_mode > "$T/t2.txt" 2>/dev/null
+"$DUMP" --file "$T/len1116.bin" -n 1 -k robot_mode,time,robot_mode > "$T/t3.txt" 2>/dev/null
+check "table --fields: the order asked, each field once" \
+  sh -c "[ \"\$(sed -n '2,\$p' '$T/t3.txt' | awk '{print \$1}' | tr '\n' ' ')\" = 'robot_mode time ' ]"
+"$DUMP" --file "$T/len1116.bin" -n 1 -F json -k speed_scaling,time > "$T/j3.txt" 2>/dev/null
+check "json --fields: the order asked" grep -q '"speed_scaling":[^,]*,"time":' "$T/j3.txt"
 check "table 1.5: robot mode not in the packet" has "$T/t2.txt" "(not in this packet)"
 "$DUMP" --file "$T/len1116.bin" -e 10 -F gnuplot > "$T/every.txt" 2> "$T/every.sum"
 check "--every 10: 4 of 40 printed, 40 counted" sh -c "[ \$(grep -vc '^#' '$T/every.txt') = 4 ] && grep -q 'packets: 40' '$T/every.sum'"
@@ -418,6 +432,26 @@ stopsim
 # Listening on an address this machine does not have (TEST-NET-1) says what to use.
 timeout -k 3 10 "$SIM" -l "192.0.2.1:0" 2> "$T/listen.err"; rc=$?
 check "sim on a foreign address: runtime error 1 that says what to use" sh -c "[ $rc = 1 ] && grep -q 'not an address of this machine: use 127.0.0.1, 0.0.0.0' '$T/listen.err'"
+
+# One packet is "1 packet" in the simulator's log lines.
+sim --start-on-connect --count 1 --clients 1
+timeout -k 3 10 "$DUMP" "127.0.0.1:$port" --once -q --no-summary > /dev/null 2>&1
+wait "$SIMPID" 2>/dev/null
+check "sim log: after 1 packet, 1 packet in (not '1 packets')" \
+  sh -c "grep -q 'after 1 packet (' '$SIMLOG' && grep -q ': 1 packet in ' '$SIMLOG' && ! grep -q ' 1 packets' '$SIMLOG'"
+# A port that accepts and says nothing (a wrong service): urrt-dump says so
+# after 3 s instead of waiting in silence.
+timeout -k 3 15 $PYTHON -c '
+import socket, sys, os
+s = socket.socket(); s.bind(("127.0.0.1", 0)); s.listen(1)
+open(sys.argv[1] + ".tmp", "w").write("%d\n" % s.getsockname()[1]); os.rename(sys.argv[1] + ".tmp", sys.argv[1])
+c, _ = s.accept(); c.recv(1)' "$T/quiet.port" &
+Q=$!; PIDS="$PIDS $Q"
+serverport "$T/quiet.port"
+timeout -k 3 15 "$DUMP" "127.0.0.1:$port" --silence-timeout 0 -t 4 > /dev/null 2> "$T/quiet.err"; rc=$?
+kill $Q 2>/dev/null; wait $Q 2>/dev/null
+check "a silent port: a notice after 3 s says what to check, -t ends it" \
+  sh -c "[ $rc = 1 ] && grep -q 'no packet for 3 s (link .*): check the address and the port (30003' '$T/quiet.err' && grep -q 'no packet for 4 s' '$T/quiet.err'"
 
 echo "check-tools: $(( $(date +%s) - START )) s"
 finish
