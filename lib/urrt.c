@@ -399,6 +399,30 @@ static const unsigned grid_fields = 0u
 #undef URRT_X_GRID_COUNT
     ;
 
+/* Of those, the last ones, which end past the shortest 3.x grid's last
+ * column (the only ones a 3.x packet can lack), as a mask: bit e - 130 for
+ * a field ending in column e (ends differ: fields do not overlap). */
+static const unsigned grid_tail_fields = 0u
+#define URRT_X_GRID_TAIL(ID, name, count, c1, c3, unit, since, desc) \
+    + ((c3) != 0 && (c3) + (count) - 1 > URRT_3X_MIN_DOUBLES ? 1u : 0u)
+    URRT_FIELDS(URRT_X_GRID_TAIL)
+#undef URRT_X_GRID_TAIL
+    ;
+static const uint32_t grid_tail_ends = 0u
+#define URRT_X_GRID_TAIL_END(ID, name, count, c1, c3, unit, since, desc) \
+    | ((c3) != 0 && (c3) + (count) - 1 > URRT_3X_MIN_DOUBLES ? UINT32_C(1) << (((c3) + (count) - 1 - URRT_3X_MIN_DOUBLES) & 31u) : 0u)
+    URRT_FIELDS(URRT_X_GRID_TAIL_END)
+#undef URRT_X_GRID_TAIL_END
+    ;
+
+static unsigned bit_count(uint32_t x)
+{
+    x = x - ((x >> 1) & 0x55555555u);
+    x = (x & 0x33333333u) + ((x >> 2) & 0x33333333u);
+    x = (x + (x >> 4)) & 0x0F0F0F0Fu;
+    return (unsigned)((x * 0x01010101u) >> 24);
+}
+
 /*
  * Vector byte swap for the grid copy, where the compiler offers portable
  * vector extensions (GCC, clang) and the target has a byte shuffle: x86
@@ -408,6 +432,15 @@ static const unsigned grid_fields = 0u
  * 8-byte load and swap per double. Little-endian hosts only: on a
  * big-endian one (armeb, aarch64_be also have NEON) the swap would reverse
  * bytes that are already in the host's order.
+ *
+ * x86-64 built without SSSE3 (a distribution's baseline -O2 build) carries
+ * all three widths as functions compiled for their instruction sets and
+ * picks the widest the CPU has at each decode (URRT_CPU_DISPATCH), from
+ * libgcc's CPU model (__builtin_cpu_supports: a load and a bit test; libgcc
+ * fills it in a constructor that runs before any other). Define
+ * URRT_NO_CPU_DISPATCH to keep such a build to one double at a time, or
+ * URRT_X86_MAX_VECTOR_BYTES (0, 16, 32) to cap the choice (the tests run
+ * every width that way).
  */
 #if defined(URRT_LOAD_UNALIGNED) && (defined(__SSSE3__) || defined(__ARM_NEON))
 #define URRT_VECTOR 1
@@ -418,55 +451,192 @@ static const unsigned grid_fields = 0u
 #else
 #define URRT_VECTOR_BYTES 16
 #endif
-#define URRT_VECTOR_DOUBLES (URRT_VECTOR_BYTES / 8)
-typedef unsigned char urrt_bytes_v __attribute__((vector_size(URRT_VECTOR_BYTES)));
-typedef uint64_t urrt_u64_v __attribute__((vector_size(URRT_VECTOR_BYTES)));
-#if URRT_VECTOR_BYTES == 64
-#define URRT_SWAP_INDEX 7, 6, 5, 4, 3, 2, 1, 0, 15, 14, 13, 12, 11, 10, 9, 8, \
-                        23, 22, 21, 20, 19, 18, 17, 16, 31, 30, 29, 28, 27, 26, 25, 24, \
-                        39, 38, 37, 36, 35, 34, 33, 32, 47, 46, 45, 44, 43, 42, 41, 40, \
-                        55, 54, 53, 52, 51, 50, 49, 48, 63, 62, 61, 60, 59, 58, 57, 56
-#elif URRT_VECTOR_BYTES == 32
-#define URRT_SWAP_INDEX 7, 6, 5, 4, 3, 2, 1, 0, 15, 14, 13, 12, 11, 10, 9, 8, \
-                        23, 22, 21, 20, 19, 18, 17, 16, 31, 30, 29, 28, 27, 26, 25, 24
-#else
-#define URRT_SWAP_INDEX 7, 6, 5, 4, 3, 2, 1, 0, 15, 14, 13, 12, 11, 10, 9, 8
+#elif defined(URRT_LOAD_UNALIGNED) && defined(__x86_64__) && !defined(URRT_NO_CPU_DISPATCH)
+#define URRT_CPU_DISPATCH 1
+#ifndef URRT_X86_MAX_VECTOR_BYTES
+#define URRT_X86_MAX_VECTOR_BYTES 64
 #endif
+#endif
+
+#if defined(URRT_VECTOR) || defined(URRT_CPU_DISPATCH)
+#define URRT_SWAP_INDEX_16 7, 6, 5, 4, 3, 2, 1, 0, 15, 14, 13, 12, 11, 10, 9, 8
+#define URRT_SWAP_INDEX_32 URRT_SWAP_INDEX_16, 23, 22, 21, 20, 19, 18, 17, 16, 31, 30, 29, 28, 27, 26, 25, 24
+#define URRT_SWAP_INDEX_64 URRT_SWAP_INDEX_32, 39, 38, 37, 36, 35, 34, 33, 32, 47, 46, 45, 44, 43, 42, 41, 40, \
+                           55, 54, 53, 52, 51, 50, 49, 48, 63, 62, 61, 60, 59, 58, 57, 56
 #if defined(__clang__)
-#define URRT_SWAP64(v) __builtin_shufflevector((v), (v), URRT_SWAP_INDEX)
+#define URRT_SHUFFLE(v, type, ...) __builtin_shufflevector((v), (v), __VA_ARGS__)
 #else
-#define URRT_SWAP64(v) __builtin_shuffle((v), (urrt_bytes_v){URRT_SWAP_INDEX})
+#define URRT_SHUFFLE(v, type, ...) __builtin_shuffle((v), (type){__VA_ARGS__})
 #endif
+#define URRT_PASTE2(a, b) a##b
+#define URRT_PASTE(a, b) URRT_PASTE2(a, b)
+
+/*
+ * The grid copy and the NaN fill at one width, in whole vectors: the
+ * stores are aligned to the vector size except the first and the last,
+ * which overlap their neighbours instead of leaving single doubles (every
+ * length then costs the same few vectors more than its bytes; single
+ * doubles at both ends made the shortest 3.x packet, 1060 bytes, slower
+ * than 1220). Aligned stores matter: where the caller's struct crossed a
+ * 4 KiB boundary, all-unaligned stores made the decode half again as slow.
+ * Each returns how many doubles it did (0 for fewer than one vector).
+ */
+#define URRT_VECTOR_FUNCS(BYTES, ATTR)                                                       \
+    static ATTR unsigned load_doubles_##BYTES(double *dst, const uint8_t *src, unsigned n)  \
+    {                                                                                        \
+        typedef unsigned char bytes_v __attribute__((vector_size(BYTES)));                   \
+        const unsigned per = BYTES / 8u;                                                     \
+        unsigned i;                                                                          \
+        bytes_v a, b;                                                                        \
+        if (n < per) {                                                                       \
+            return 0;                                                                        \
+        }                                                                                    \
+        __builtin_memcpy(&a, src, sizeof a);                                                 \
+        a = URRT_SHUFFLE(a, bytes_v, URRT_SWAP_INDEX_##BYTES);                               \
+        __builtin_memcpy(dst, &a, sizeof a);                                                 \
+        i = (unsigned)(BYTES - ((uintptr_t)(void *)dst & (BYTES - 1u))) / 8u;                \
+        for (; i + 2u * per <= n; i += 2u * per) {                                           \
+            __builtin_memcpy(&a, src + 8u * i, sizeof a);                                    \
+            __builtin_memcpy(&b, src + 8u * i + BYTES, sizeof b);                            \
+            a = URRT_SHUFFLE(a, bytes_v, URRT_SWAP_INDEX_##BYTES);                           \
+            b = URRT_SHUFFLE(b, bytes_v, URRT_SWAP_INDEX_##BYTES);                           \
+            __builtin_memcpy(&dst[i], &a, sizeof a);                                         \
+            __builtin_memcpy(&dst[i + per], &b, sizeof b);                                   \
+        }                                                                                    \
+        if (i + per <= n) {                                                                  \
+            __builtin_memcpy(&a, src + 8u * i, sizeof a);                                    \
+            a = URRT_SHUFFLE(a, bytes_v, URRT_SWAP_INDEX_##BYTES);                           \
+            __builtin_memcpy(&dst[i], &a, sizeof a);                                         \
+            i += per;                                                                        \
+        }                                                                                    \
+        if (i < n) {                                                                         \
+            __builtin_memcpy(&a, src + 8u * (n - per), sizeof a);                            \
+            a = URRT_SHUFFLE(a, bytes_v, URRT_SWAP_INDEX_##BYTES);                           \
+            __builtin_memcpy(&dst[n - per], &a, sizeof a);                                   \
+        }                                                                                    \
+        return n;                                                                            \
+    }                                                                                        \
+    static ATTR unsigned fill_nan_##BYTES(double *p, unsigned count)                         \
+    {                                                                                        \
+        typedef uint64_t u64_v __attribute__((vector_size(BYTES)));                          \
+        const unsigned per = BYTES / 8u;                                                     \
+        u64_v nan;                                                                           \
+        unsigned i, k;                                                                       \
+        if (count < per) {                                                                   \
+            return 0;                                                                        \
+        }                                                                                    \
+        for (k = 0; k < per; k++) {                                                          \
+            nan[k] = URRT_NAN_BITS;                                                          \
+        }                                                                                    \
+        __builtin_memcpy(p, &nan, sizeof nan);                                               \
+        i = (unsigned)(BYTES - ((uintptr_t)(void *)p & (BYTES - 1u))) / 8u;                  \
+        for (; i + per <= count; i += per) {                                                 \
+            __builtin_memcpy(&p[i], &nan, sizeof nan);                                       \
+        }                                                                                    \
+        if (i < count) {                                                                     \
+            __builtin_memcpy(&p[count - per], &nan, sizeof nan);                             \
+        }                                                                                    \
+        return count;                                                                        \
+    }
+#endif
+
+#ifdef URRT_VECTOR
+#define URRT_VECTOR_FUNCS_AT(BYTES, ATTR) URRT_VECTOR_FUNCS(BYTES, ATTR)
+URRT_VECTOR_FUNCS_AT(URRT_VECTOR_BYTES, )
+#define URRT_LOAD_VECTORS(dst, src, n) URRT_PASTE(load_doubles_, URRT_VECTOR_BYTES)(dst, src, n)
+#define URRT_FILL_VECTORS(p, count) URRT_PASTE(fill_nan_, URRT_VECTOR_BYTES)(p, count)
+#endif
+
+#ifdef URRT_CPU_DISPATCH
+#if URRT_X86_MAX_VECTOR_BYTES >= 16
+URRT_VECTOR_FUNCS(16, __attribute__((target("ssse3"))))
+#endif
+#if URRT_X86_MAX_VECTOR_BYTES >= 32
+URRT_VECTOR_FUNCS(32, __attribute__((target("avx2"))))
+#endif
+#if URRT_X86_MAX_VECTOR_BYTES >= 64
+URRT_VECTOR_FUNCS(64, __attribute__((target("avx512bw"))))
+#endif
+
+static unsigned cpu_vector_bytes(void)
+{
+#if URRT_X86_MAX_VECTOR_BYTES >= 64
+    if (__builtin_cpu_supports("avx512bw")) {
+        return 64;
+    }
+#endif
+#if URRT_X86_MAX_VECTOR_BYTES >= 32
+    if (__builtin_cpu_supports("avx2")) {
+        return 32;
+    }
+#endif
+#if URRT_X86_MAX_VECTOR_BYTES >= 16
+    if (__builtin_cpu_supports("ssse3")) {
+        return 16;
+    }
+#endif
+    return 0;
+}
+
+static unsigned load_vectors(double *dst, const uint8_t *src, unsigned n)
+{
+    (void)dst;
+    (void)src;
+    (void)n;
+    switch (cpu_vector_bytes()) {
+#if URRT_X86_MAX_VECTOR_BYTES >= 64
+    case 64: return load_doubles_64(dst, src, n);
+#endif
+#if URRT_X86_MAX_VECTOR_BYTES >= 32
+    case 32: return load_doubles_32(dst, src, n);
+#endif
+#if URRT_X86_MAX_VECTOR_BYTES >= 16
+    case 16: return load_doubles_16(dst, src, n);
+#endif
+    default: return 0;
+    }
+}
+
+static unsigned fill_vectors(double *p, unsigned count)
+{
+    (void)p;
+    (void)count;
+    switch (cpu_vector_bytes()) {
+#if URRT_X86_MAX_VECTOR_BYTES >= 64
+    case 64: return fill_nan_64(p, count);
+#endif
+#if URRT_X86_MAX_VECTOR_BYTES >= 32
+    case 32: return fill_nan_32(p, count);
+#endif
+#if URRT_X86_MAX_VECTOR_BYTES >= 16
+    case 16: return fill_nan_16(p, count);
+#endif
+    default: return 0;
+    }
+}
+#define URRT_LOAD_VECTORS(dst, src, n) load_vectors(dst, src, n)
+#define URRT_FILL_VECTORS(p, count) fill_vectors(p, count)
+#endif
+
+#if defined(__x86_64__)
+unsigned urrt_x86_vector_bytes(void)
+{
+#if defined(URRT_CPU_DISPATCH)
+    return cpu_vector_bytes();
+#elif defined(URRT_VECTOR)
+    return URRT_VECTOR_BYTES;
+#else
+    return 0;
+#endif
+}
 #endif
 
 /* n big-endian doubles from src into dst. */
 static void load_doubles(double *dst, const uint8_t *src, unsigned n)
 {
     unsigned i = 0;
-#ifdef URRT_VECTOR
-    /* Single doubles up to a vector boundary of dst, so that no vector
-     * store straddles a cache line or, worse, a page: where the caller's
-     * struct crosses a 4 KiB boundary such stores made the decode half again
-     * as slow. */
-    for (; i < n && ((uintptr_t)(void *)&dst[i] & (URRT_VECTOR_BYTES - 1u)) != 0; i++) {
-        dst[i] = double_from_bits(load_be64(src + 8u * i));
-    }
-    for (; i + 2u * URRT_VECTOR_DOUBLES <= n; i += 2u * URRT_VECTOR_DOUBLES) {
-        urrt_bytes_v a, b;
-        __builtin_memcpy(&a, src + 8u * i, sizeof a);
-        __builtin_memcpy(&b, src + 8u * i + URRT_VECTOR_BYTES, sizeof b);
-        a = URRT_SWAP64(a);
-        b = URRT_SWAP64(b);
-        __builtin_memcpy(&dst[i], &a, sizeof a);
-        __builtin_memcpy(&dst[i + URRT_VECTOR_DOUBLES], &b, sizeof b);
-    }
-    if (i + URRT_VECTOR_DOUBLES <= n) {
-        urrt_bytes_v a;
-        __builtin_memcpy(&a, src + 8u * i, sizeof a);
-        a = URRT_SWAP64(a);
-        __builtin_memcpy(&dst[i], &a, sizeof a);
-        i += URRT_VECTOR_DOUBLES;
-    }
+#ifdef URRT_LOAD_VECTORS
+    i = URRT_LOAD_VECTORS(dst, src, n);
 #endif
 #ifdef URRT_LOAD_WORDS
     if (((uintptr_t)(const void *)src & 3u) == 0) {
@@ -484,19 +654,8 @@ static void load_doubles(double *dst, const uint8_t *src, unsigned n)
 static void fill_nan_fast(double *p, unsigned count)
 {
     unsigned i = 0;
-#ifdef URRT_VECTOR
-    urrt_u64_v nan;
-    unsigned k;
-    for (k = 0; k < URRT_VECTOR_DOUBLES; k++) {
-        nan[k] = URRT_NAN_BITS;
-    }
-    /* Aligned vector stores only, as in load_doubles(). */
-    for (; i < count && ((uintptr_t)(void *)&p[i] & (URRT_VECTOR_BYTES - 1u)) != 0; i++) {
-        p[i] = double_from_bits(URRT_NAN_BITS);
-    }
-    for (; i + URRT_VECTOR_DOUBLES <= count; i += URRT_VECTOR_DOUBLES) {
-        __builtin_memcpy(&p[i], &nan, sizeof nan);
-    }
+#ifdef URRT_FILL_VECTORS
+    i = URRT_FILL_VECTORS(p, count);
 #endif
     fill_nan(p + i, count - i);
 }
@@ -505,19 +664,16 @@ static void fill_nan_fast(double *p, unsigned count)
 static void decode_3x(const uint8_t *body, unsigned doubles, urrt_state *st)
 {
     unsigned known = doubles < URRT_WIRE_COLUMNS ? doubles : URRT_WIRE_COLUMNS;
-    unsigned present_fields = grid_fields;
+    unsigned present_fields;
 
     load_doubles(grid_slot(st, 1), body, known);
     /* Grid fields are in column order and end in ascending columns, so the
-     * whole ones are a prefix: walk back from the last until one fits (no
-     * step at all for 1220 bytes, four for 1116). */
-    while (present_fields > 0) {
-        const field_layout *f = &layout_table[present_fields - 1u];
-        if (f->col_3x + f->count - 1u <= known) {
-            break;
-        }
-        present_fields--;
-    }
+     * whole ones are a prefix: those before the tail, and the tail fields
+     * ending by column `known` (a bit count, no branches: walking back
+     * from the last field until one fitted cost the 1060-byte packet,
+     * seven steps, a sixth of its decode). */
+    present_fields = grid_fields - grid_tail_fields +
+                     bit_count(grid_tail_ends & ((UINT32_C(2) << (known - URRT_3X_MIN_DOUBLES)) - 1u));
     /* Absent grid columns and the 1.x-only fields that follow the grid in
      * the struct (asserted above) get NaN in one run. */
     {

@@ -215,6 +215,13 @@ const char *urrt_versions_of(uint32_t length);
  */
 int urrt_decode(const uint8_t *buf, size_t len, urrt_state *st);
 
+#if defined(__x86_64__)
+/* x86-64: the vector width in bytes urrt_decode uses on this CPU, 64
+ * (AVX-512BW), 32 (AVX2), 16 (SSSE3) or 0 (one double at a time). A build
+ * without -m flags chooses it at run time; a -march build has it fixed. */
+unsigned urrt_x86_vector_bytes(void);
+#endif
+
 /*
  * Random access without a full decode: element elem of field id, read
  * straight from the packet bytes. URRT_E_ABSENT when this packet's length

@@ -1197,6 +1197,24 @@ static void regression_encode_huge_length_is_large(void)
     CHECK_EQ_INT(urrt_encode(&st, 0xFFFFFFFFu, out, sizeof out), URRT_E_SIZE_ALIGN);
 }
 
+/* x86-64: the decode runs the vector width this build and CPU select (a
+ * baseline build picks it at run time; URRT_TEST_VECTOR_BYTES is the width
+ * a check-lib variant forced), and never one the CPU lacks. */
+static void test_vector_width(void)
+{
+#if defined(__GNUC__) && defined(__x86_64__)
+    unsigned w = urrt_x86_vector_bytes();
+    printf("decode vector width: %u bytes\n", w);
+    CHECK(w == 0 || w == 16 || w == 32 || w == 64, "vector width %u", w);
+    CHECK(w < 16 || __builtin_cpu_supports("ssse3"), "16-byte path without SSSE3");
+    CHECK(w < 32 || __builtin_cpu_supports("avx2"), "32-byte path without AVX2");
+    CHECK(w < 64 || __builtin_cpu_supports("avx512bw"), "64-byte path without AVX-512BW");
+#ifdef URRT_TEST_VECTOR_BYTES
+    CHECK(w == URRT_TEST_VECTOR_BYTES, "vector width %u, forced %u", w, (unsigned)URRT_TEST_VECTOR_BYTES);
+#endif
+#endif
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -1204,6 +1222,7 @@ int main(int argc, char **argv)
         return 2;
     }
     load_vectors(argv[1]);
+    test_vector_width();
     test_field_metadata();
     test_field_lookup();
     test_field_since_follows_lengths();
