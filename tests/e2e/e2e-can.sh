@@ -1,8 +1,9 @@
 # Runs inside the VM (tests/vm/run.sh): urrt-sim -> urrt-gateway -> vcan0,
 # recorded by candump. Markers on vcan1 (ID 0x7FF) time the events for
 # e2e-can.post, which decodes the recording through the DBC on the host.
-# candump exits when its interface goes down, so vcan0 is recorded in two
-# logs, before and after the outage. The first simulator takes its port from
+# candump -D keeps recording vcan0 through its outage (a candump started
+# after the interface came back up could miss the first heartbeat after it),
+# and its error-frame filter (#FFFFFFFF) records the injected bus-off too. The first simulator takes its port from
 # the system (--port-file), the gateway's configuration is written with it, and
 # the second simulator (the robot coming back) listens on the same port.
 . ./lib.sh
@@ -21,7 +22,7 @@ sim() {
 
 check "the DBC is written" urrt-gateway --print-dbc -o "$OUT/e2e.dbc" e2e-can.ini
 candump -L vcan1 >"$OUT/marks.log" 2>>"$OUT/candump.err" & marks=$!
-candump -L vcan0 >"$OUT/can-1.log" 2>>"$OUT/candump.err" & dump=$!
+candump -D -L vcan0,0:0,#FFFFFFFF >"$OUT/can.log" 2>>"$OUT/candump.err" & dump=$!
 sim 1 127.0.0.1:0
 sed "s/^port = .*/port = $port/" e2e-can.ini > "$OUT/e2e-can.ini"
 check "the gateway's configuration names the simulator's port ($port)" grep -q "^port = $port\$" "$OUT/e2e-can.ini"
@@ -34,8 +35,8 @@ mark 2; sim 2 "127.0.0.1:$port"                 # and comes back
 sleep 3
 ip link set vcan0 down; mark 3                  # the CAN interface goes down
 sleep 1.5
-ip link set vcan0 up; mark 4                    # and up
-candump -L vcan0 >"$OUT/can-2.log" 2>>"$OUT/candump.err" & dump=$!
+mark 4; ip link set vcan0 up                    # and up (marked first: the gateway may send
+                                                # before a slow VM has started cansend)
 sleep 3
 mark 5; can_error vcan0                         # the controller reports bus-off
 sleep 1.5
@@ -46,5 +47,5 @@ kill "$sim_pid" "$dump" "$marks" "$sub"; wait "$sim_pid" "$dump" "$marks" "$sub"
 check "the gateway stops cleanly on SIGTERM (exit $gw_rc)" [ "$gw_rc" = 0 ]
 check "the gateway reported the interface down" grep -q "vcan0.*down" "$OUT/gateway.log"
 check "the gateway reconnected to the robot" [ "$(grep -c 'connected to 127.0.0.1' "$OUT/gateway.log")" -ge 2 ]
-check "candump recorded before and after the outage" [ -s "$OUT/can-1.log" ] && [ -s "$OUT/can-2.log" ]
+check "candump recorded vcan0" [ -s "$OUT/can.log" ]
 finish

@@ -34,6 +34,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -47,11 +48,18 @@
 
 extern char **environ;
 
-/* Under TCG a syscall costs tens of microseconds; a call that blocked would
- * take the whole wait it blocked on (at least the 50 ms reopen interval
- * here). Below that, the host preempting the VM shows: 20.7 ms was seen
- * on a loaded 2-core host. */
-#define MAX_CALL_US 45000u
+/* A call into the link must never block. Its duration cannot tell: a host
+ * that preempts the VM makes a non-blocking call take 120 ms (seen under
+ * TCG on a loaded 2-core host). The kernel can: a thread that sleeps in a
+ * call gives up the CPU voluntarily (ru_nvcsw), one that is preempted does
+ * not. So every call is bracketed by the thread's voluntary context switch
+ * count, and the longest call is printed for information only. */
+static long voluntary_switches(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_THREAD, &ru);
+    return ru.ru_nvcsw;
+}
 
 /* ---- captured log messages ----------------------------------------------------- */
 
@@ -135,16 +143,25 @@ static urrt_can *open_link(const char *ifname, bool fd, bool brs)
     return open_link_hold(ifname, fd, brs, 2000);
 }
 
-/* The longest single call into the link, over the whole run. */
+/* The longest single call into the link, and the calls that slept, over
+ * the whole run. */
 static uint64_t max_call_us;
+static unsigned blocked_calls;
 
-static int timed_send(urrt_can *can, const urrt_can_frame *f)
+static void call_ended(uint64_t t0, long switches0)
 {
-    uint64_t t0 = now_us();
-    int r = urrt_can_send(can, f, t0);
     uint64_t dt = now_us() - t0;
     if (dt > max_call_us)
         max_call_us = dt;
+    blocked_calls += voluntary_switches() != switches0;
+}
+
+static int timed_send(urrt_can *can, const urrt_can_frame *f)
+{
+    long switches0 = voluntary_switches();
+    uint64_t t0 = now_us();
+    int r = urrt_can_send(can, f, t0);
+    call_ended(t0, switches0);
     return r;
 }
 
@@ -164,11 +181,10 @@ static short pump(urrt_can *can, unsigned ms)
         int n = poll(&p, fd >= 0 ? 1 : 0, timeout_ms);
         if (n > 0)
             seen |= p.revents;
+        long switches0 = voluntary_switches();
         uint64_t t0 = now_us();
         urrt_can_service(can, t0);
-        uint64_t dt = now_us() - t0;
-        if (dt > max_call_us)
-            max_call_us = dt;
+        call_ended(t0, switches0);
     }
     return seen;
 }
@@ -484,7 +500,7 @@ static int test_log(const char *dir)
     snprintf(spec, sizeof(spec), "log:%s/x.log,ifname=averyveryverylongname", dir);
     CHECK(open_link(spec, false, false) == NULL, "long ifname");
     CHECK(strstr(messages, "ifname") != NULL, "reason: %s", messages);
-    CHECK(max_call_us < MAX_CALL_US, "longest call %" PRIu64 " us", max_call_us);
+    CHECK(blocked_calls == 0, "%u calls slept (longest call %" PRIu64 " us)", blocked_calls, max_call_us);
     return check_report();
 }
 
@@ -554,7 +570,7 @@ static int test_frames(const char *dir)
     urrt_can_free(log_cc);
     close(rx0);
     close(rx1);
-    CHECK(max_call_us < MAX_CALL_US, "longest call %" PRIu64 " us", max_call_us);
+    CHECK(blocked_calls == 0, "%u calls slept (longest call %" PRIu64 " us)", blocked_calls, max_call_us);
     return check_report();
 }
 
@@ -903,7 +919,7 @@ static int test_socket(void)
     test_queue_full();
     test_socket_buffer_full();
     test_down_up();
-    CHECK(max_call_us < MAX_CALL_US, "longest call into the link %" PRIu64 " us", max_call_us);
+    CHECK(blocked_calls == 0, "no call into the link slept (%u did)", blocked_calls);
     printf("longest call into the link: %" PRIu64 " us\n", max_call_us);
     return check_report();
 }
