@@ -4,7 +4,7 @@
 #                  half of them with the other core busy; prints a table of
 #                  runs and failures per suite and per check
 RUNS ?= 20
-STRESS_SUITES ?= check-gateway check-tools check-tools-link check-tools-asan check-can-log check-vm
+STRESS_SUITES ?= check-gateway check-tools check-tools-link check-can-log check-vm
 .PHONY: check-stress
 check-stress: deps
 	@sh tests/stress/stress.sh $(BUILD) $(RUNS) $(STRESS_SUITES)
