@@ -1,4 +1,4 @@
-// SPDX-License-Identifier: MIT
+/* SPDX-License-Identifier: MIT */
 /*
  * fuzz_config.c: libFuzzer harness for the urrt-gateway configuration, an
  * untrusted input like the robot's bytes: the loader (gateway/config.c and
@@ -636,7 +636,8 @@ static void on_frame(void *ctx, const urrt_can_frame *fr)
     violated("a frame with id 0x%X that is not configured was sent", (unsigned)fr->id);
 }
 
-/* Every field present and set to v (bit masks need whole numbers). */
+/* Every field present and set to v (a bit mask field that is not a whole
+ * number goes out as NaN). */
 static void fill_state(urrt_state *st, double v)
 {
     urrt_state_clear(st);

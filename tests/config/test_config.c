@@ -1,4 +1,4 @@
-// SPDX-License-Identifier: MIT
+/* SPDX-License-Identifier: MIT */
 /*
  * test_config.c: regression tests for what the configuration fuzzer
  * (tests/config/fuzz_config.c) found in the loader, one per finding, with
