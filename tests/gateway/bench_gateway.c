@@ -39,6 +39,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -186,6 +187,15 @@ static uint64_t cpu_ns(pid_t pid)
     return sum;
 }
 
+/* This process's CPU time (every thread), in ns. */
+static uint64_t self_cpu_ns(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ((uint64_t)ru.ru_utime.tv_sec + (uint64_t)ru.ru_stime.tv_sec) * 1000000000u +
+           ((uint64_t)ru.ru_utime.tv_usec + (uint64_t)ru.ru_stime.tv_usec) * 1000u;
+}
+
 static int listen_any(uint16_t *port)
 {
     int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -269,6 +279,7 @@ static double baseline_us(void)
 /* What a session measured. */
 typedef struct {
     double cpu_per_packet_us, cpu_percent;
+    double self_cpu_percent; /* this program: the robots and the subscriber */
     double median_us[KINDS], p99_us[KINDS], max_us[KINDS];
     size_t messages[KINDS];
     uint64_t expected, received, late;
@@ -388,7 +399,7 @@ static bool run(const subject *sj, result *res)
     pthread_create(&th, NULL, subscriber, &sa);
 
     uint8_t pkt[LENGTH];
-    uint64_t start = mono_ns(), cpu0 = 0, wall0 = 0;
+    uint64_t start = mono_ns(), cpu0 = 0, wall0 = 0, self0 = 0;
     size_t row = (size_t)(s.per_robot + 1);
     for (long index = 1; index <= s.per_robot; index++) {
         uint64_t due = start + (uint64_t)index * (1000000000u / HZ);
@@ -399,6 +410,7 @@ static bool run(const subject *sj, result *res)
         }
         if (index == WARMUP + 1) {
             cpu0 = cpu_ns(pid);
+            self0 = self_cpu_ns();
             wall0 = mono_ns();
         }
         make_packet(pkt, index);
@@ -412,7 +424,7 @@ static bool run(const subject *sj, result *res)
     }
     /* Every message is in once the subject's CPU stops moving and the
      * subscriber has them all, or after a second at most. */
-    uint64_t cpu1 = cpu_ns(pid), wall1 = mono_ns();
+    uint64_t cpu1 = cpu_ns(pid), self1 = self_cpu_ns(), wall1 = mono_ns();
     res->packets = (long)(s.per_robot - WARMUP) * n;
     res->expected = sj->focused_hz == NULL ? (uint64_t)s.per_robot * (uint64_t)n * KINDS : 0;
     for (uint64_t end = mono_ns() + 1000000000u; mono_ns() < end;) {
@@ -432,6 +444,7 @@ static bool run(const subject *sj, result *res)
     if (!sj->relay) unlink(ini);
     res->cpu_per_packet_us = (double)(cpu1 - cpu0) / 1000.0 / (double)res->packets;
     res->cpu_percent = 100.0 * (double)(cpu1 - cpu0) / (double)(wall1 - wall0);
+    res->self_cpu_percent = 100.0 * (double)(self1 - self0) / (double)(wall1 - wall0);
     summarize(&s, res);
     free(s.sent_ns);
     for (int k = 0; k < KINDS; k++) free(s.lat_us[k]);
@@ -526,6 +539,7 @@ static void scaling(subject *gw)
     printf("%spackets: %ld\n", who, r.packets);
     printf("%scpu_per_packet_us: %.2f\n", who, r.cpu_per_packet_us);
     printf("%scpu_percent_of_core: %.1f\n", who, r.cpu_percent);
+    printf("%sbench_cpu_percent_of_core: %.1f\n", who, r.self_cpu_percent);
     print_latency(who, &r);
     /* All kinds together: the robots' worst message. */
     double worst = 0;
