@@ -41,6 +41,11 @@ RATE = 500
 RSS_ALLOWANCE_KIB = 256
 FD_ALLOWANCE = 1        # the robot's socket may be open at one sample and not the other
 RT_PRIORITY = 10
+# The checker's socket buffer holds 4 MiB (as far as net.core.rmem_max allows):
+# with the default 208 KiB, about 60 ms without a read overflows it, and the
+# kernel drops datagrams the gateway did send (9 packets' messages in a
+# 30-minute soak on a busy machine).
+CHECKER_URL_OPTIONS = "&recv_buf_size=4194304"
 WAIT = 30               # upper bound of any wait for an event
 
 # (name, urrt-sim fault options); "restart" kills and restarts the simulator.
@@ -343,7 +348,7 @@ def run(args):
     try:
         s.start_sim(PHASES[0][1])
         ready = s.path("lcm.ready")
-        checker = subprocess.Popen(args.checker_rt + [args.checker, url, NAME, str(BOUND_MS * 1000), str(MARGIN_MS * 1000), ready],
+        checker = subprocess.Popen(args.checker_rt + [args.checker, url + CHECKER_URL_OPTIONS, NAME, str(BOUND_MS * 1000), str(MARGIN_MS * 1000), ready],
                                    stdin=subprocess.PIPE, stdout=open(s.path("lcm.out"), "w"),
                                    stderr=open(s.path("lcm.err"), "w"), text=True)
         s.procs.append(checker)
