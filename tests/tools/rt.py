@@ -19,6 +19,8 @@ Nothing here imports or calls the C library: it is the second opinion.
   rt.py freeze-every PORT N MS RATE       runs of N packets between freezes of MS
   rt.py pace PORT RATE COUNT LIMIT        packets at RATE by the time column keep that pace
                                           by arrival (no drift), to LIMIT (a fraction)
+  rt.py same-packets A B MIN              two clients' gnuplot lines: where their time
+                                          ranges overlap (at least MIN packets), identical
   rt.py refused-port OUT                  hold a bound port that does not listen; write it to OUT
 
 Clocks: Python's time.monotonic() and time.time() read CLOCK_MONOTONIC and
@@ -447,6 +449,23 @@ def cmd_pace(port, rate, count, limit):
         fail('pace: arrival drifted %.6f s over %.3f s (%g allowed)' % (drift, span, float(limit) * span))
 
 
+def cmd_same_packets(a, b, least):
+    """Clients that connected at different times share the packets of the
+    time both were connected, byte for byte, and no other."""
+    def rows(path):
+        return [l for l in open(path) if not l.startswith('#')]
+    ra, rb = rows(a), rows(b)
+    lo = max(float(ra[0].split()[0]), float(rb[0].split()[0]))
+    hi = min(float(ra[-1].split()[0]), float(rb[-1].split()[0]))
+    ia = [l for l in ra if lo <= float(l.split()[0]) <= hi]
+    ib = [l for l in rb if lo <= float(l.split()[0]) <= hi]
+    print('rt.py: same-packets: %d and %d packets, %d while both were connected' % (len(ra), len(rb), len(ia)))
+    if ia != ib:
+        fail('same-packets: the clients got different packets while both were connected')
+    if len(ia) < int(least):
+        fail('same-packets: only %d packets while both were connected (%s wanted)' % (len(ia), least))
+
+
 def cmd_refused_port(out):
     """A port nobody listens on and nobody else can take while this runs:
     bound (without SO_REUSEADDR) but not listening, so a connect is refused."""
@@ -460,7 +479,8 @@ if __name__ == '__main__':
     cmds = {'gnuplot': cmd_gnuplot, 'json': cmd_json, 'csv': cmd_csv, 'model': cmd_model,
             'noread-server': cmd_noread_server, 'slow-client': cmd_slow_client,
             'writer-client': cmd_writer_client, 'clock': cmd_clock, 'freeze': cmd_freeze,
-            'freeze-every': cmd_freeze_every, 'pace': cmd_pace, 'refused-port': cmd_refused_port}
+            'freeze-every': cmd_freeze_every, 'pace': cmd_pace, 'same-packets': cmd_same_packets,
+            'refused-port': cmd_refused_port}
     if len(sys.argv) < 2 or sys.argv[1] not in cmds:
         print(__doc__, file=sys.stderr)
         sys.exit(2)
