@@ -11,8 +11,8 @@
  *   ALLOC_SHIM_FAIL_FROM=N     make publishes N .. N+COUNT-1 fail (ENOBUFS)
  *   ALLOC_SHIM_FAIL_COUNT=COUNT
  *   ALLOC_SHIM_DELAY_US=D      every publish on a channel ending in
- *   ALLOC_SHIM_DELAY_SUFFIX=S  S (default ".STATE") takes D us longer: a
- *                              gateway slower than its robot
+ *   ALLOC_SHIM_DELAY_SUFFIX=S  S (default ".STATE") returns D us after the
+ *                              message left: a gateway slower than its robot
  *
  * When the window closes it writes "publishes M allocs X in_publish Y
  * outside Z" to PATH: the allocations of the whole process over M
@@ -91,12 +91,6 @@ int lcm_publish(lcm_t *lcm, const char *channel, const void *data, unsigned int 
         configured = 1;
     }
     n = ++publishes;
-    if (delay_us > 0 && strlen(channel) >= strlen(delay_suffix) &&
-        strcmp(channel + strlen(channel) - strlen(delay_suffix), delay_suffix) == 0) {
-        struct timespec d = {(time_t)(delay_us / 1000000u), (long)(delay_us % 1000000u) * 1000};
-        while (nanosleep(&d, &d) != 0) {
-        }
-    }
     if (n == warmup) {
         start_allocs = allocs;
         start_in_publish = allocs_in_publish;
@@ -108,6 +102,14 @@ int lcm_publish(lcm_t *lcm, const char *channel, const void *data, unsigned int 
         in_publish++;
         r = real(lcm, channel, data, len);
         in_publish--;
+    }
+    /* After the send: the gateway is slow, but what it sends leaves when
+     * it decided to send it (its age check just before lcm_publish). */
+    if (delay_us > 0 && strlen(channel) >= strlen(delay_suffix) &&
+        strcmp(channel + strlen(channel) - strlen(delay_suffix), delay_suffix) == 0) {
+        struct timespec d = {(time_t)(delay_us / 1000000u), (long)(delay_us % 1000000u) * 1000};
+        while (nanosleep(&d, &d) != 0) {
+        }
     }
     if (warmup != UINT64_MAX && n == warmup + window && report_path != NULL) {
         uint64_t total = allocs - start_allocs, inside = allocs_in_publish - start_in_publish;

@@ -43,8 +43,11 @@ DATA_KINDS = ("STATE", "JOINTS", "TOOL", "STATUS")
 WAIT = 60
 # What the subscriber's measured age may exceed the gateway's bound by: the
 # part of the transport the gateway's floor takes as the baseline (loopback,
-# well under a millisecond) and the clocks' readings.
-AGE_MARGIN_US = 5000
+# well under a millisecond), the clocks' readings, and the gateway being
+# preempted between its age check and the send it guards (the one window no
+# check can close: a scheduling slice on a machine loaded several times
+# over; 16.6 ms was seen with the load average at 8 on 2 cores).
+AGE_MARGIN_US = 25000
 PASSED = 0
 FAILED = 0
 
