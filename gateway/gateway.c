@@ -24,7 +24,7 @@ bool gw_robot_data_fresh(const gw_robot *robot, uint64_t data_us, uint64_t now_u
 
 bool gw_robot_fresh(const gw_robot *robot, uint64_t now_us)
 {
-    if (urrt_link_get_state(robot->link) != URRT_LINK_UP || robot->last_rx_us == 0 || robot->mismatch ||
+    if (urrt_link_get_state(robot->link) != URRT_LINK_UP || robot->data_us == 0 || robot->mismatch ||
         robot->late) {
         return false;
     }
@@ -93,7 +93,7 @@ static uint64_t packet_lag(gw_robot *robot, const urrt_state *st, uint64_t rx_us
         gw_age_reset(&robot->age);
     }
     lag = gw_age_lag_us(&robot->age, rx_us, urrt_link_packet_empty_us(robot->link), has_clock,
-                                 has_clock ? (int64_t)llround(t * 1e6) : 0);
+                        has_clock ? (int64_t)llround(t * 1e6) : 0);
     return lag < rx_us ? lag : rx_us - 1; /* data_us 0 means "none" */
 }
 
@@ -119,9 +119,8 @@ static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t r
     gw_packet pkt;
     uint64_t connects = urrt_link_get_stats(robot->link)->connects;
     bool new_connection = connects != robot->connects_seen;
-    int r;
-
     uint64_t lag;
+    int r;
 
     robot->connects_seen = connects;
     if (robot->cfg->expected_length != 0 && length != robot->cfg->expected_length) {
@@ -153,7 +152,6 @@ static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t r
                  robot->late_packets);
     }
     robot->late = false;
-    robot->last_rx_us = rx_us;
     robot->data_us = rx_us - lag;
     robot->sequence++;
     pkt.bytes = bytes;

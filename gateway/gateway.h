@@ -42,8 +42,8 @@ typedef struct gw_robot {
     uint64_t sequence;         /* packets dispatched to the outputs */
     uint64_t mismatches;       /* packets not of the expected length */
     uint64_t decode_errors;
-    uint64_t last_rx_us;       /* monotonic time of the last dispatched packet, 0: none */
-    uint64_t data_us;          /* its data is no older than now - data_us (freshness.h) */
+    uint64_t data_us;          /* the last dispatched packet's data is no older than now -
+                                * data_us (freshness.h); 0: none yet */
     uint64_t newest_data_us;   /* the same for the last packet read, dispatched or not; 0: none */
     uint64_t connects_seen;    /* link connects when the last packet came */
     uint64_t mismatch_logged_us;
