@@ -341,8 +341,12 @@ stopsim
 check "two clients: 500 packets each" sh -c "grep -q 'packets: 500' '$T/m1.sum' && grep -q 'packets: 500' '$T/m2.sum'"
 # By time column: the second client may start a few hundred ms after the first.
 check "two clients: the same packets, byte for byte" timeout -k 3 10 $RT same-packets "$T/m1.txt" "$T/m2.txt" 100
-check "two clients: neither stalled by the slow one" sh -c "grep -q 'largest gap: 0.002000' '$T/m1.sum' && grep -q 'largest gap: 0.002000' '$T/m2.sum'"
+# No gap at all, unless the machine held the simulator past its 100 ms
+# catch-up limit (it then skips, and says so): then gaps of that size, far
+# below the 2 s a blocking write to the slow client would make.
+check "two clients: neither stalled by the slow one" sh -c "if grep -q 'skipped 0;' '$SIMLOG'; then grep -q 'largest gap: 0.002000' '$T/m1.sum' && grep -q 'largest gap: 0.002000' '$T/m2.sum'; else awk '/largest gap/ { g = \$4 } END { exit !(g < 0.5) }' '$T/m1.sum' && awk '/largest gap/ { g = \$4 } END { exit !(g < 0.5) }' '$T/m2.sum'; fi"
 check "slow client dropped" has "$SIMLOG" "dropped: too slow"
+echo "two clients: $(grep -h 'largest gap' "$T/m1.sum" "$T/m2.sum" | tr '\n' ' ')sim: $(grep -o 'late (a period or more behind) [0-9]*, skipped [0-9]*' "$SIMLOG")"
 
 # ---- the link never writes -------------------------------------------------------------------
 timeout -k 3 15 $PYTHON tests/tools/rt.py noread-server "$T/len1116.bin" "$T/nr.json" &
