@@ -14,17 +14,23 @@ static int64_t floor_at(const gw_age *age, uint64_t rx_us)
     return age->floor_us + (int64_t)(since / (1000000u / GW_AGE_DRIFT_PPM));
 }
 
-static uint64_t controller_lag(gw_age *age, uint64_t rx_us, int64_t controller_us)
+static uint64_t controller_lag(gw_age *age, uint64_t rx_us, int64_t controller_us, bool newest)
 {
     int64_t offset = (int64_t)rx_us - controller_us;
     int64_t floor;
 
-    if (!age->anchored || controller_us < age->last_controller_us) {
+    if (controller_us < age->last_controller_us) {
+        age->anchored = false; /* a restart: its clock started again */
+    }
+    age->last_controller_us = controller_us;
+    if (!age->anchored) {
+        if (!newest) {
+            return GW_AGE_UNKNOWN;
+        }
         age->anchored = true;
         age->floor_us = offset;
         age->floor_at_us = rx_us;
     }
-    age->last_controller_us = controller_us;
     floor = floor_at(age, rx_us);
     if (offset <= floor) {
         age->floor_us = offset;
@@ -34,9 +40,10 @@ static uint64_t controller_lag(gw_age *age, uint64_t rx_us, int64_t controller_u
     return (uint64_t)(offset - floor);
 }
 
-uint64_t gw_age_lag_us(gw_age *age, uint64_t rx_us, uint64_t empty_us, bool has_clock, int64_t controller_us)
+uint64_t gw_age_lag_us(gw_age *age, uint64_t rx_us, uint64_t empty_us, bool has_clock, int64_t controller_us,
+                       bool newest)
 {
     uint64_t host = rx_us > empty_us ? rx_us - empty_us : 0;
-    uint64_t controller = has_clock ? controller_lag(age, rx_us, controller_us) : 0;
+    uint64_t controller = has_clock ? controller_lag(age, rx_us, controller_us, newest) : 0;
     return host > controller ? host : controller;
 }

@@ -23,7 +23,10 @@
  * The packet's lag is the larger of the two; its data is taken to be from
  * rx - lag, and its age at any later instant is now - (rx - lag). A new
  * connection, or a controller clock that went back (a restart), starts the
- * floor again; there the host's clock alone bounds the first packet.
+ * floor again, from the first packet that was the newest when read: the
+ * packets of a burst before it (a controller or a network that held them
+ * back, then sent them at once) are each younger than the one before, so
+ * none of them can anchor the floor, and their lag is GW_AGE_UNKNOWN.
  *
  * Blind spot, stated so that nobody relies on it: a delay that grows before
  * the host (in the controller or the network, not in this host's socket)
@@ -40,6 +43,8 @@
 
 /* 0.1 %: crystal clocks differ by well under 100 ppm. */
 #define GW_AGE_DRIFT_PPM 1000
+/* The lag of a packet whose age cannot be judged: older than any bound. */
+#define GW_AGE_UNKNOWN UINT64_MAX
 
 typedef struct gw_age {
     bool anchored;            /* a floor exists on this connection */
@@ -53,7 +58,9 @@ void gw_age_reset(gw_age *age);
 
 /* The lag of a packet read at rx_us (microseconds, monotonic) whose first
  * byte arrived after empty_us, with the controller's time controller_us
- * (microseconds; has_clock false when the packet has no usable time). */
-uint64_t gw_age_lag_us(gw_age *age, uint64_t rx_us, uint64_t empty_us, bool has_clock, int64_t controller_us);
+ * (microseconds; has_clock false when the packet has no usable time);
+ * newest: nothing newer had arrived when it was read. */
+uint64_t gw_age_lag_us(gw_age *age, uint64_t rx_us, uint64_t empty_us, bool has_clock, int64_t controller_us,
+                       bool newest);
 
 #endif

@@ -93,14 +93,19 @@ static uint64_t packet_lag(gw_robot *robot, const urrt_state *st, uint64_t rx_us
         gw_age_reset(&robot->age);
     }
     lag = gw_age_lag_us(&robot->age, rx_us, urrt_link_packet_empty_us(robot->link), has_clock,
-                        has_clock ? (int64_t)llround(t * 1e6) : 0);
-    return lag < rx_us ? lag : rx_us - 1; /* data_us 0 means "none" */
+                        has_clock ? (int64_t)llround(t * 1e6) : 0, urrt_link_packet_newest(robot->link));
+    return lag == GW_AGE_UNKNOWN || lag < rx_us ? lag : rx_us - 1; /* data_us 0 means "none" */
 }
 
 static void on_late(gw_robot *robot, uint64_t lag_us)
 {
     robot->late_packets++;
-    if (!robot->late) {
+    if (!robot->late && lag_us == GW_AGE_UNKNOWN) {
+        urrt_log(URRT_LOG_WARNING, "robot %s: a connection began with a burst of packets: their age cannot be "
+                 "judged until the newest has come, so they are not published (late_packets %" PRIu64 "); "
+                 "something between the robot and the gateway held them back", robot->cfg->name,
+                 robot->late_packets);
+    } else if (!robot->late) {
         urrt_log(URRT_LOG_WARNING, "robot %s: data %.0f ms old when read, older than silence_timeout (%u ms): "
                  "not published (late_packets %" PRIu64 "); the gateway was stopped, starved of CPU, slower "
                  "than the robot, or the link to the robot held data back: give it a core, publish less "
@@ -142,6 +147,10 @@ static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t r
         return;
     }
     lag = packet_lag(robot, &robot->state, rx_us, new_connection);
+    if (lag == GW_AGE_UNKNOWN) {
+        on_late(robot, lag);
+        return;
+    }
     robot->newest_data_us = rx_us - lag;
     if (!gw_robot_data_fresh(robot, rx_us - lag, rx_us)) {
         on_late(robot, lag);

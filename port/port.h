@@ -148,6 +148,11 @@ const urrt_link_stats *urrt_link_get_stats(const urrt_link *link);
  * was delayed: a reader that keeps up sees about one period, one that falls
  * behind sees its backlog grow. */
 uint64_t urrt_link_packet_empty_us(const urrt_link *link);
+/* During a packet callback: whether nothing newer had arrived when the
+ * packet was read (the read emptied the socket's queue and no further
+ * packet follows in it). The first packets of a connection that come in a
+ * burst are not: their age cannot be judged until the newest has come. */
+bool urrt_link_packet_newest(const urrt_link *link);
 /* "host:port" as log lines name the robot ("[::1]:30003" for IPv6). */
 const char *urrt_link_peer(const urrt_link *link);
 

@@ -57,6 +57,8 @@ struct urrt_link {
      * byte of the packet being collected was read. */
     uint64_t empty_us;
     uint64_t packet_empty_us;
+    bool read_drained;        /* the read being delivered emptied the queue */
+    bool packet_newest;       /* nothing newer had arrived when this packet was read */
     uint64_t backoff_ms;      /* wait before the next attempt after a failure */
     bool more_to_read;        /* the read budget ran out with bytes left */
     bool announced;           /* "connecting" logged */
@@ -461,6 +463,7 @@ static void deliver(urrt_link *link, const uint8_t *data, size_t len, uint64_t n
         if (got == 1) {
             size_t plen = 0;
             const uint8_t *packet = urrt_framer_packet(&link->framer, &plen);
+            link->packet_newest = link->read_drained && len - used < plen;
             link->stats.packets++;
             link->stats.last_packet_us = now_us;
             link->stats.last_length = (uint32_t)plen;
@@ -503,6 +506,7 @@ static void read_available(urrt_link *link, urrt_packet_fn fn, void *ctx)
         uint64_t read_us = urrt_port_monotonic_us();
         if (n > 0) {
             link->last_rx_us = read_us;
+            link->read_drained = (size_t)n < sizeof buf;
             deliver(link, buf, (size_t)n, read_us, fn, ctx);
             if ((size_t)n < sizeof buf) {
                 link->empty_us = before_us;
@@ -529,6 +533,11 @@ static void read_available(urrt_link *link, urrt_packet_fn fn, void *ctx)
 uint64_t urrt_link_packet_empty_us(const urrt_link *link)
 {
     return link->packet_empty_us;
+}
+
+bool urrt_link_packet_newest(const urrt_link *link)
+{
+    return link->packet_newest;
 }
 
 void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void *ctx)
