@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # urrt: plain make. `make demo` runs the gateway against the simulator,
 # `make check` runs every test. Each directory adds its own rules in *.mk.
 PREFIX ?= /usr/local

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # gateway/can.mk: the CAN side of urrt-gateway: the mapping configuration and
 # frame scheduling (can_map) and the DBC writer (dbc). The gateway links them
 # through GATEWAY_EXTRA_OBJS, with can_out joining them to the CAN link as one

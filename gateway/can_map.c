@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* can_map: mapping configuration, checks and frame scheduling for the CAN
  * side of urrt-gateway. See can_map.h and docs/can.md. */
 #include "can_map.h"

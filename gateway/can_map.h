@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * can_map: the CAN side of urrt-gateway. Which robot fields go into which
  * CAN frames (the mapping configuration, its checks), and when each frame is

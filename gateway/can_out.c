@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* can_out.c: see can_out.h. */
 #include "can_out.h"
 

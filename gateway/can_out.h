@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * can_out.h: the CAN output of urrt-gateway. It joins the mapping
  * (can_map.h: what goes into which frame, and when) to the CAN link

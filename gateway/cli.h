@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * cli.h: small helpers the urrt programs share: argument parsing with
  * useful errors, and the signal handling of a poll loop.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* config.c: the urrt-gateway configuration file (see config.h). */
 #define _GNU_SOURCE
 #include "config.h"

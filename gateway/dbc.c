@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* dbc: writes the DBC for a CAN mapping. See dbc.h. */
 #include "dbc.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * dbc: the DBC file describing what urrt-gateway sends on CAN, written from
  * the same mapping (struct can_map) that packs the frames, so that the file

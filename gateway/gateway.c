@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* gateway.c: robots, outputs and the poll loop of urrt-gateway (gateway.h). */
 #define _GNU_SOURCE
 #include "gateway.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * gateway.h: the core of urrt-gateway: robots, outputs, one poll loop.
  *

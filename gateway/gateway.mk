@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # gateway/gateway.mk: urrt-gateway, its LCM types (C for the gateway, a jar
 # for lcm-spy), the urrt-spy launcher, the systemd unit and `make demo`.
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* lcm_out.c: the LCM output of urrt-gateway (lcm_out.h). */
 #define _GNU_SOURCE
 #include "lcm_out.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * lcm_out.h: the LCM output of urrt-gateway.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* sim_model.c: see sim_model.h. */
 #include "sim_model.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * sim_model.h: the deterministic robot behind urrt-sim.
  *

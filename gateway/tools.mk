@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # gateway/tools.mk: urrt-sim and urrt-dump, and the modules they share with
 # urrt-gateway. Other fragments link $(CLI_OBJ) (and $(SIM_MODEL_OBJ) to
 # recompute what the simulator sent) without redefining their rules.

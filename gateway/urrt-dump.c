@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * urrt-dump: see what a robot sends on its RealTime port.
  *

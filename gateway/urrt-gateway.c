@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * urrt-gateway: reads the RealTime stream of one or more Universal Robots
  * controllers and publishes it on LCM (docs/gateway.md) and as CAN frames

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * urrt-sim: a robot controller's RealTime stream, served here.
  *

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # lib/: the freestanding decoder, built alone under the strictest warnings.
 LIB_SRCS := $(wildcard lib/*.c)
 LIB_HDRS := $(wildcard lib/*.h)

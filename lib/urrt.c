@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* urrt: RealTime interface decoder. See urrt.h for the API, docs/ for the
  * wire format and the security model. */
 #include "urrt.h"

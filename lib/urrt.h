@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * urrt: a freestanding decoder for the Universal Robots "RealTime" client
  * interface (TCP ports 30003 and 30013).

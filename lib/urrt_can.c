@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* urrt_can: signal packing for CAN payloads. See urrt_can.h for the API and
  * the bit numbering, docs/can.md for the gateway built on it. */
 #include "urrt_can.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * urrt_can: table-driven packing of physical values into CAN and CAN FD
  * payloads, with the bit conventions of DBC files.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # port/: the POSIX implementation of port/port.h.
 PORT_SRCS := $(wildcard port/posix/*.c)
 PORT_OBJS := $(PORT_SRCS:port/posix/%.c=$(BUILD)/port/%.o)

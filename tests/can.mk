@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # tests/can.mk: the CAN mapping, packing and DBC.
 #   check-can      lib/urrt_can and gateway/can_map unit tests (hand vectors, saturation,
 #                  config rejections with FILE:LINE, bus load, scheduling on a fake clock)

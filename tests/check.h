@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A minimal test harness: each CHECK counts, failures say where and why,
  * and the run ends with the line "N passed, N failed". */
 #ifndef URRT_TEST_CHECK_H

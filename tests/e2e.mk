@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # tests/e2e.mk: urrt-sim -> urrt-gateway -> vcan0 -> candump on a real kernel,
 # inside the check-vm VM (tests/vm.mk); tests/e2e/e2e-can.post checks the
 # recording on the host through the gateway's DBC, and the gateway's LCM

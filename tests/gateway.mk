@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # tests/gateway.mk: urrt-gateway against urrt-sim, through LCM.
 #   check-gateway   values, decimation, two robots, restart/stall, mismatch,
 #                   zero allocations, publish errors, bad configurations, jar

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # tests/lib.mk: proof that lib/ is right and freestanding.
 #   check-lib       black-box tests against the independent Python reference (every vector
 #                   width, URRT_MAX_DOUBLES=152, and the non-GNU / big-endian code paths)

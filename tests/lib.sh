@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Sourced by shell tests: ok/fail count, finish prints "N passed, N failed".
 # RESULT (if set) receives the closing line for tests/summary.sh.
 PASSED=0; FAILED=0

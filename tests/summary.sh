@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # Adds up the "N passed, N failed" lines each suite left in DIR/NAME.result.
 # A suite that left no result counts as one failure: it crashed or never ran.
 dir=$1; shift

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # tests/tools.mk: the robot link, urrt-sim and urrt-dump.
 #   check-tools-link  the POSIX link against in-process servers, and cli.c (C)
 #   check-tools       urrt-sim and urrt-dump end to end (shell + Python reference)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # tests/vm.mk: tests on a real Linux kernel with SocketCAN, in a qemu VM
 # (tests/vm/run.sh, docs/vm.md).
 #   check-vm       boots the VM once and runs every script of VM_TESTS inside

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Columns are UR's "Gnuplot col." numbers: 1 time, 32-37 q actual,
 # 44-49 I actual, 56-58 TCP position (tool vector actual x, y, z).
 set terminal pngcairo size 1000,900 font ",10"

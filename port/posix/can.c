@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * can.c: the CAN link of port.h on Linux SocketCAN, and its candump-log
  * alternative.

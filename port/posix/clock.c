@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* clock.c: the port's clocks on POSIX. */
 #define _GNU_SOURCE
 #include <time.h>

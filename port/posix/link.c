@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * link.c: the read-only robot link on POSIX sockets.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bench-can (make bench): what the CAN mapping costs per robot packet, beside
  * what decoding that packet costs in the same run (urrt_decode of a 1220-byte

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * can_tool: drives gateway/can_map, gateway/dbc and lib/urrt_can from the
  * command line for the Python tests (tests/can/test_dbc.py), which hold

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * check-can: lib/urrt_can (bit placement by hand-worked vectors, rounding,
  * saturation, NaN, layout checks, frame bit lengths) and gateway/can_map

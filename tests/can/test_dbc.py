@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """check-can-dbc: the CAN mapping against references that share no code with it.
 
 - The DBC urrt-gateway writes is loaded with python3-canmatrix, and every

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # Proof that lib/ is freestanding: every lib/*.c compiled alone for a
 # Cortex-M4 under the library's strict warnings, linked with -nostdlib into a
 # small image (tests/cross/startup.c), and the footprint compared with the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Sizes of the caller-owned structs on the target: each array's size is
  * read back from the symbol table (arm-none-eabi-nm -S). */
 #include "urrt.h"

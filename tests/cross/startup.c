@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * A freestanding Cortex-M4 image around lib/: a vector table and a reset
  * handler that frames, decodes and random-reads packets from a static

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * can_error IFACE: writes one bus-off error frame on IFACE, as a CAN
  * controller's driver would report it. vcan has no controller, but every

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Runs inside the VM (tests/vm/run.sh): urrt-sim -> urrt-gateway -> vcan0,
 # recorded by candump. Markers on vcan1 (ID 0x7FF) time the events for
 # e2e-can.post, which decodes the recording through the DBC on the host.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * Benchmark of lib/ (make bench): nanoseconds per packet, each beside a
  * memcpy of the same bytes measured in the same run, and the ratio to it.

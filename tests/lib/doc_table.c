@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * Prints the tables of docs/protocol.md from the library's own metadata
  * (urrt_field(), urrt_enum_entries()), so the document cannot drift from the

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # Splices the output of doc_table (the field and enum tables generated from
 # lib/'s metadata) between the markers of docs/protocol.md.
 #   docs.sh DOC_TABLE DOC            rewrite DOC in place (make docs)

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # Runs the libFuzzer harness of lib/ (tests/lib/fuzz_lib.c).
 #   fuzz.sh FUZZER SEEDS WORKDIR SECONDS [--check]
 # First every seed (inputs made by the reference, tests/ref/urrt_ref.py) is

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * libFuzzer harness for lib/: asserts the invariants of docs/security.md on
  * any input. Built with clang -fsanitize=fuzzer,address,undefined, so an

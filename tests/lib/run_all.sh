@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # Runs each test binary on the vectors and adds up their
 # "N passed, N failed" lines into one.
 #   run_all.sh VECTORS BINARY...

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * Black-box tests of lib/: decode, random access, encoder, enums, bit masks,
  * field lookup and the stream framer.

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """Independent reference for the Universal Robots RealTime packet layout.
 
 Written from UR's seed table (shared/seeds/000_*.txt: the 3.x layout at 1116

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # bench-tools: how well urrt-sim keeps its schedule at 500 Hz, alone with
 # one client and with four. Prints "name: value" lines; asserts nothing.
 # The simulator takes its port from the system (--port-file).

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # check-tools: urrt-sim and urrt-dump end to end, against the independent
 # Python reference in tests/tools/rt.py. Every server, client and wait here
 # is bounded by timeout(1) or a counted loop. No fixed TCP port: every server

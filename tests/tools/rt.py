@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """Independent reference for the tools tests: a RealTime decoder written
 from the wire format alone (big-endian int32 size, then big-endian doubles),
 UR5e kinematics, and the small servers and clients the tests need.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * The POSIX robot link against servers in this process, and the shared
  * command-line helpers. Real sockets on loopback, real time; every wait is

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # In the VM of tests/vm/run.sh: the CAN link (port/posix/can.c) on a real
 # kernel. Needs vcan0 (MTU 72), vcan1 (MTU 16), sch_plug, and the files
 # can_link_test, lib.sh, counts.sh. Prints "N passed, N failed" as

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * can_link_test: black-box tests of the CAN link (port.h, port/posix/can.c).
  *

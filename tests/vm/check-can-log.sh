@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # make check-can-log: the CAN link's candump-log output, on the host (no CAN
 # needed): exact lines from can_link_test, then python-can's candump-log
 # reader (an independent parser) on the same files.

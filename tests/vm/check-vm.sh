@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: MIT
 # make check-vm: boots the VM once (tests/vm/run.sh), runs every script of
 # VM_TESTS inside with tests/vm/suite.sh, then, on the host, the checker
 # that goes with a script, if there is one: for tests/x/NAME.sh an executable

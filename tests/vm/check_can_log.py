@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: MIT
 """Reads the candump-format files that `can_link_test log DIR` wrote with
 python-can's CanutilsLogReader (an independent parser of `candump -L`) and
 compares every frame with DIR/log-expect.txt. Prints "N passed, N failed"."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Sourced after tests/lib.sh: `counted DESC CMD...` runs a test program that
 # ends with "N passed, N failed" and adds its counts to this suite's. A
 # program that crashes or leaves no such line counts as one failure.

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: MIT
 # fetch-kernel.sh: makes sure Debian's current amd64 kernel (vmlinuz plus the
 # module trees the VM tests load from) is in the cache, and prints its
 # directory. Downloads once with apt-get (the package is extracted, never

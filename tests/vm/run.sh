@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: MIT
 # run.sh: runs a shell script inside a throw-away qemu VM that has a real
 # Linux kernel with SocketCAN (Debian's linux-image-amd64, cached by
 # fetch-kernel.sh), virtual CAN interfaces up, and the given files.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # In the VM of tests/vm/run.sh, for make check-vm: runs every test script
 # named in VM_TESTS (base names, in /t), each with its own OUT directory
 # ($OUT/NAME), and adds up their closing "N passed, N failed" lines into
