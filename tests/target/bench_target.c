@@ -13,18 +13,6 @@
 #include "urrt.h"
 #include "urrt_can.h"
 
-static void put_uint(uint64_t v)
-{
-    char text[24];
-    int i = 23;
-    text[i] = '\0';
-    do {
-        text[--i] = (char)('0' + v % 10u);
-        v /= 10u;
-    } while (v != 0);
-    target_puts(text + i);
-}
-
 /* Marks for the trace: the operation runs between their calls. */
 __attribute__((noinline)) void bench_begin(void)
 {
@@ -57,7 +45,7 @@ static void report(const char *name, uint32_t ticks)
     target_puts("bench: ");
     target_puts(name);
     target_puts(" ");
-    put_uint(((uint64_t)net * 1000u + ticks_per_kinsn / 2u) / ticks_per_kinsn);
+    target_put_uint(((uint64_t)net * 1000u + ticks_per_kinsn / 2u) / ticks_per_kinsn);
     target_puts("\n");
 }
 
@@ -136,7 +124,7 @@ int main(void)
     /* known_loop: 20000 in the loop, plus the call and return (mov, bl, bx). */
     ticks_per_kinsn = (uint32_t)(((uint64_t)(ticks - overhead_ticks) * 1000u + 10001u) / 20003u);
     target_puts("bench: systick_ticks_per_1000_instructions ");
-    put_uint(ticks_per_kinsn);
+    target_put_uint(ticks_per_kinsn);
     target_puts("\n");
 
     for (i = 0; i < v1116->length; i++) {
@@ -202,7 +190,7 @@ int main(void)
         report("can_pack_tpdo1", ticks);
     }
     target_puts("bench: sink ");
-    put_uint((uint32_t)sink);
+    target_put_uint((uint32_t)sink);
     target_puts("\n");
     return 0;
 }

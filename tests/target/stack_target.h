@@ -147,7 +147,7 @@ static void test_stack(void)
         target_puts("stack: ");
         target_puts(stack_marks[i].name);
         target_puts(" ");
-        put_uint(stack_marks[i].bytes);
+        target_put_uint(stack_marks[i].bytes);
         target_puts("\n");
     }
     CHECK(stack_mark_count == 40, "public functions measured", name, stack_mark_count, 40);

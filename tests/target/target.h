@@ -15,6 +15,19 @@
 void target_puts(const char *s);
 __attribute__((noreturn)) void target_exit(int status);
 
+/* A number in decimal, without a C library's printf. */
+static inline void target_put_uint(uint64_t v)
+{
+    char text[24];
+    int i = 23;
+    text[i] = '\0';
+    do {
+        text[--i] = (char)('0' + v % 10u);
+        v /= 10u;
+    } while (v != 0);
+    target_puts(text + i);
+}
+
 #ifdef URRT_TARGET_CORTEX_M
 /* The stack: [target_stack_limit(), initial SP). */
 uintptr_t target_stack_limit(void);

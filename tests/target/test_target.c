@@ -16,18 +16,6 @@
 
 static unsigned passed, failed;
 
-static void put_uint(uint64_t v)
-{
-    char text[24];
-    int i = 23;
-    text[i] = '\0';
-    do {
-        text[--i] = (char)('0' + v % 10u);
-        v /= 10u;
-    } while (v != 0);
-    target_puts(text + i);
-}
-
 static void put_hex(uint64_t v)
 {
     char text[19];
@@ -53,7 +41,7 @@ static void check(int ok, int line, const char *what, const char *name, uint64_t
         return;
     }
     target_puts("FAIL: test_target.c:");
-    put_uint((uint64_t)line);
+    target_put_uint((uint64_t)line);
     target_puts(": ");
     target_puts(what);
     target_puts(" [");
@@ -316,18 +304,18 @@ int main(void)
         test_vector(&tv_vectors[i]);
     }
     target_puts("target: ");
-    put_uint(tv_vector_count);
+    target_put_uint(tv_vector_count);
     target_puts(" reference vectors, decode, random access and encode at 8 misalignments\n");
     test_framer();
     target_puts("target: framer, streams of lengths 12.." );
-    put_uint(URRT_PACKET_MAX);
+    target_put_uint(URRT_PACKET_MAX);
     target_puts(" with garbage, chunk sizes 1..1460\n");
 #ifdef URRT_TARGET_CORTEX_M
     test_stack();
 #endif
-    put_uint(passed);
+    target_put_uint(passed);
     target_puts(" passed, ");
-    put_uint(failed);
+    target_put_uint(failed);
     target_puts(" failed\n");
     return failed == 0 && passed > 0 ? 0 : 1;
 }
