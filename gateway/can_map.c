@@ -352,7 +352,7 @@ bool can_map_enabled(const struct can_map *map)
     return map->configured && map->finished;
 }
 
-void can_map_link_config(const struct can_map *map, urrt_can_config *cfg)
+void can_map_link_config(const struct can_map *map, urrt_canlink_config *cfg)
 {
     cfg->interface = map->interface;
     cfg->fd = map->fd;
@@ -1627,15 +1627,15 @@ static double enum_or(double v, double lo, double hi, double na)
     return v;
 }
 
-static void heartbeat_pack(const struct can_map *map, uint64_t now_us, const urrt_can_stats *stats,
+static void heartbeat_pack(const struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats,
                            uint8_t alive, urrt_can_frame *frame)
 {
     double values[CAN_MAP_HB_COUNT];
     const struct can_map_robot_rt *r = map->robot_count ? &map->robots[map->hb_robot_index] : NULL;
     /* Modes as old as stale data are not the robot's modes now. */
     bool current = r != NULL && robot_fresh(map, map->hb_robot_index, now_us, map->stale_after_ms);
-    urrt_can_stats zero;
-    const urrt_can_stats *seen = &map->hb_seen;
+    urrt_canlink_stats zero;
+    const urrt_canlink_stats *seen = &map->hb_seen;
     unsigned k;
 
     memset(&zero, 0, sizeof zero);
@@ -1673,7 +1673,7 @@ static void heartbeat_pack(const struct can_map *map, uint64_t now_us, const urr
     }
 }
 
-void can_map_heartbeat_frame(const struct can_map *map, uint64_t now_us, const urrt_can_stats *stats,
+void can_map_heartbeat_frame(const struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats,
                              urrt_can_frame *frame)
 {
     heartbeat_pack(map, now_us, stats, map->hb_alive, frame);
@@ -1705,7 +1705,7 @@ static void send_frame(struct can_map *map, struct can_map_frame *f, bool fresh,
     }
 }
 
-void can_map_due(struct can_map *map, uint64_t now_us, const urrt_can_stats *stats, can_map_emit_fn emit, void *ctx)
+void can_map_due(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats, can_map_emit_fn emit, void *ctx)
 {
     size_t i;
     if (!map->finished || !map->configured) {

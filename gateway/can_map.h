@@ -18,7 +18,7 @@
  *   loop:
  *       on a robot packet:    can_map_on_packet(&map, robot, &state, rx_us)
  *       on a robot link change: can_map_robot_link(&map, robot, up)
- *       can_map_due(&map, now, urrt_can_get_stats(can), send_fn, can)
+ *       can_map_due(&map, now, urrt_canlink_get_stats(can), send_fn, can)
  *       poll until min(can_map_deadline(&map), ...)
  *   can_map_free(&map)
  */
@@ -107,7 +107,7 @@ struct can_map_frame {
     size_t capacity;
     double load;                            /* worst-case share of the bus (0.027 = 2.7 %) */
     /* Run time. */
-    uint8_t payload[URRT_CAN_MAX_DATA];     /* signals packed from the latest packet */
+    uint8_t payload[URRT_CAN_MAX_LEN];     /* signals packed from the latest packet */
     int outcome;                            /* worst URRT_CAN_PACK_* of the latest packing */
     bool unpacked;                          /* values taken since the payload was packed */
     bool pending;                           /* every: a packet arrived since the last send */
@@ -209,8 +209,8 @@ struct can_map {
     /* [can] */
     struct can_map_loc can_loc;             /* first key of [can] */
     struct can_map_loc key_loc[CAN_MAP_CK_COUNT];
-    char *interface;                        /* "can0" or "log:PATH": for urrt_can_config */
-    bool fd;                                /* FD frames allowed: urrt_can_config.fd */
+    char *interface;                        /* "can0" or "log:PATH": for urrt_canlink_config */
+    bool fd;                                /* FD frames allowed: urrt_canlink_config.fd */
     uint32_t bitrate;
     uint32_t data_bitrate;                  /* 0: same as bitrate (no bit rate switch) */
     unsigned max_load_percent;
@@ -241,7 +241,7 @@ struct can_map {
     uint64_t hb_next_us;
     uint8_t hb_alive;
     uint64_t clamped;                       /* values packed with a non-OK outcome */
-    urrt_can_stats hb_seen;                 /* link statistics at the previous heartbeat */
+    urrt_canlink_stats hb_seen;                 /* link statistics at the previous heartbeat */
     uint64_t hb_clamped_seen;
     uint64_t hb_sent;
     enum can_map_gateway_state state;       /* as in the last heartbeat */
@@ -281,11 +281,11 @@ bool can_map_enabled(const struct can_map *map);
 
 /* The CAN link's configuration from [can]: interface, fd, and fd_brs (FD
  * frames switch to data_bitrate when it is above bitrate). cfg must hold
- * urrt_can_config_defaults() first; the other fields are left alone. The
+ * urrt_canlink_config_defaults() first; the other fields are left alone. The
  * interface string stays owned by the map. Bit rates are not set on the
  * interface (ip link does that): the map uses them for the bus load check
  * and the DBC. */
-void can_map_link_config(const struct can_map *map, urrt_can_config *cfg);
+void can_map_link_config(const struct can_map *map, urrt_canlink_config *cfg);
 
 /* One line for the log at start: "4 frames + heartbeat 0x705 on can0,
  * worst-case bus load 7.6% of 500000 bit/s (max 40%)". Returns snprintf's. */
@@ -313,7 +313,7 @@ void can_map_robot_link(struct can_map *map, size_t robot, bool up);
 /* Emits every frame due at now_us, in configuration order, then the
  * heartbeat if due. stats: the CAN link's statistics (NULL if none), for
  * the heartbeat's drop counter and error flags. */
-void can_map_due(struct can_map *map, uint64_t now_us, const urrt_can_stats *stats, can_map_emit_fn emit,
+void can_map_due(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats, can_map_emit_fn emit,
                  void *ctx);
 
 /* Monotonic time by which can_map_due must run next (CAN_MAP_NOT_SCHEDULED
@@ -325,7 +325,7 @@ enum can_map_gateway_state can_map_state(const struct can_map *map, uint64_t now
 
 /* Pack the heartbeat as it would be sent now (without advancing its alive
  * counter or flag snapshots): for status displays and tests. */
-void can_map_heartbeat_frame(const struct can_map *map, uint64_t now_us, const urrt_can_stats *stats,
+void can_map_heartbeat_frame(const struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats,
                              urrt_can_frame *frame);
 
 /* Worst-case bus time of one frame in microseconds at the map's bit rates. */

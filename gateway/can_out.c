@@ -8,7 +8,7 @@
 struct can_out {
     gateway *gw;
     struct can_map *map;
-    urrt_can *link;
+    urrt_canlink *link;
     uint64_t now_us;        /* for emit(): can_map_due passes no time */
     uint64_t refused;       /* frames the link refused (cannot happen with a checked map) */
     bool robot_up[GW_MAX_ROBOTS];
@@ -17,7 +17,7 @@ struct can_out {
 static void emit(void *ctx, const urrt_can_frame *frame)
 {
     can_out *out = ctx;
-    if (urrt_can_send(out->link, frame, out->now_us) < 0) {
+    if (urrt_canlink_send(out->link, frame, out->now_us) < 0) {
         out->refused++;
     }
 }
@@ -27,11 +27,11 @@ static void emit(void *ctx, const urrt_can_frame *frame)
  * down" flag with it. The first heartbeat after the outage carries it. */
 static void run_due(can_out *out, uint64_t now_us)
 {
-    if (urrt_can_get_state(out->link) != URRT_CAN_UP) {
+    if (urrt_canlink_get_state(out->link) != URRT_CANLINK_UP) {
         return;
     }
     out->now_us = now_us;
-    can_map_due(out->map, now_us, urrt_can_get_stats(out->link), emit, out);
+    can_map_due(out->map, now_us, urrt_canlink_get_stats(out->link), emit, out);
 }
 
 static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
@@ -55,7 +55,7 @@ static void on_tick(void *ctx, uint64_t now_us)
             can_map_robot_link(out->map, i, up);
         }
     }
-    urrt_can_service(out->link, now_us);
+    urrt_canlink_service(out->link, now_us);
     run_due(out, now_us);
 }
 
@@ -63,7 +63,7 @@ static unsigned on_poll_fds(void *ctx, struct pollfd *fds, unsigned max)
 {
     can_out *out = ctx;
     short events = 0;
-    int fd = urrt_can_poll_fd(out->link, &events);
+    int fd = urrt_canlink_poll_fd(out->link, &events);
     if (fd < 0 || max == 0) {
         return 0;
     }
@@ -76,7 +76,7 @@ static void on_service(void *ctx, const struct pollfd *fds, unsigned count, uint
 {
     can_out *out = ctx;
     if (count > 0 && fds[0].revents != 0) {
-        urrt_can_service(out->link, now_us);
+        urrt_canlink_service(out->link, now_us);
     }
 }
 
@@ -84,16 +84,16 @@ static uint64_t on_deadline(void *ctx)
 {
     can_out *out = ctx;
     uint64_t map_due = can_map_deadline(out->map);
-    uint64_t link_due = urrt_can_deadline(out->link);
+    uint64_t link_due = urrt_canlink_deadline(out->link);
     return map_due < link_due ? map_due : link_due;
 }
 
 static unsigned on_counters(void *ctx, const gw_robot *robot, gw_counter *counters, unsigned max)
 {
     can_out *out = ctx;
-    const urrt_can_stats *s = urrt_can_get_stats(out->link);
+    const urrt_canlink_stats *s = urrt_canlink_get_stats(out->link);
     const gw_counter all[] = {
-        {"can_up", urrt_can_get_state(out->link) == URRT_CAN_UP},
+        {"can_up", urrt_canlink_get_state(out->link) == URRT_CANLINK_UP},
         {"can_sent", s->sent},
         {"can_dropped", s->dropped},
         {"can_send_errors", s->send_errors + out->refused},
@@ -114,10 +114,10 @@ static unsigned on_counters(void *ctx, const gw_robot *robot, gw_counter *counte
 static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *buf, size_t size)
 {
     can_out *out = ctx;
-    const urrt_can_stats *s = urrt_can_get_stats(out->link);
+    const urrt_canlink_stats *s = urrt_canlink_get_stats(out->link);
     (void)robot;
     return snprintf(buf, size, " | CAN %s %s, sent %llu, dropped %llu, bus-off %llu",
-                    urrt_can_get_state(out->link) == URRT_CAN_UP ? "up" : "DOWN",
+                    urrt_canlink_get_state(out->link) == URRT_CANLINK_UP ? "up" : "DOWN",
                     can_map_state_name(can_map_state(out->map, now_us)), (unsigned long long)s->sent,
                     (unsigned long long)s->dropped, (unsigned long long)s->bus_off);
 }
@@ -125,21 +125,21 @@ static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *b
 static void on_close(void *ctx)
 {
     can_out *out = ctx;
-    urrt_can_free(out->link);
+    urrt_canlink_free(out->link);
     free(out);
 }
 
 can_out *can_out_new(gateway *gw, struct can_map *map)
 {
-    urrt_can_config cfg;
+    urrt_canlink_config cfg;
     can_out *out = calloc(1, sizeof *out);
     if (out == NULL) {
         urrt_log(URRT_LOG_ERR, "CAN output: out of memory");
         return NULL;
     }
-    urrt_can_config_defaults(&cfg);
+    urrt_canlink_config_defaults(&cfg);
     can_map_link_config(map, &cfg);
-    out->link = urrt_can_new(&cfg);
+    out->link = urrt_canlink_new(&cfg);
     if (out->link == NULL) {
         free(out);
         return NULL;

@@ -108,6 +108,16 @@ unsigned urrt_can_fd_length_round_up(unsigned len);
 
 bool urrt_can_id_valid(uint32_t id, bool extended);
 
+/* A frame as the CAN core (urrt_cantx.h) produces it and a CAN link sends
+ * it; port.h's SocketCAN link takes this type. */
+typedef struct urrt_can_frame {
+    uint32_t id;    /* 11-bit, or 29-bit when extended */
+    bool extended;
+    bool fd;        /* CAN FD: len 0-8, 12, 16, 20, 24, 32, 48 or 64 */
+    uint8_t len;
+    uint8_t data[URRT_CAN_MAX_LEN];
+} urrt_can_frame;
+
 /*
  * Worst-case length of a frame on the wire in bits, worst-case bit stuffing
  * included, with the 3-bit interframe space.

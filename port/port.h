@@ -20,6 +20,7 @@
 #include <stdint.h>
 
 #include "urrt.h"
+#include "urrt_can.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -205,36 +206,26 @@ void urrt_link_set_tap(urrt_link *link, urrt_bytes_fn fn, void *ctx);
  * ID in 3 hex digits (11-bit) or 8 (29-bit), DATA in upper-case hex,
  * wall-clock time.
  */
-#define URRT_CAN_MAX_DATA 64
-
-typedef struct urrt_can_frame {
-    uint32_t id;    /* 11-bit, or 29-bit when extended */
-    bool extended;
-    bool fd;        /* CAN FD: len 0-8, 12, 16, 20, 24, 32, 48 or 64 */
-    uint8_t len;
-    uint8_t data[URRT_CAN_MAX_DATA];
-} urrt_can_frame;
-
-typedef struct urrt_can_config {
+typedef struct urrt_canlink_config {
     const char *interface;     /* "can0", or "log:PATH[,ifname=NAME]" ("log:-" is stdout) */
     bool fd;                   /* FD frames allowed: needs an interface with the FD MTU */
     bool fd_brs;               /* FD frames use the bit rate switch (data phase bitrate) */
     uint32_t reopen_interval_ms;
     uint32_t retry_interval_ms; /* held frames retried at least this often */
     uint32_t hold_max_ms;       /* a held frame older than this is stale: dropped */
-} urrt_can_config;
+} urrt_canlink_config;
 
 /* Defaults: no FD, reopen every 1000 ms, retry every 5 ms, hold 100 ms. */
-void urrt_can_config_defaults(urrt_can_config *cfg);
+void urrt_canlink_config_defaults(urrt_canlink_config *cfg);
 
-typedef enum urrt_can_state {
-    URRT_CAN_DOWN = 0,         /* not open, or the interface is down; reopening */
-    URRT_CAN_UP
-} urrt_can_state;
+typedef enum urrt_canlink_state {
+    URRT_CANLINK_DOWN = 0,         /* not open, or the interface is down; reopening */
+    URRT_CANLINK_UP
+} urrt_canlink_state;
 
-const char *urrt_can_state_name(urrt_can_state state);
+const char *urrt_canlink_state_name(urrt_canlink_state state);
 
-typedef struct urrt_can_stats {
+typedef struct urrt_canlink_stats {
     uint64_t sent;             /* frames the driver (or the log file) took */
     uint64_t dropped;          /* values replaced before they could be sent, too old, or discarded by an outage */
     uint64_t send_errors;      /* frames lost to an unexpected error (logged) */
@@ -246,39 +237,39 @@ typedef struct urrt_can_stats {
     uint64_t restarts;
     uint32_t last_error_class; /* CAN_ERR_* class bits of the last error frame */
     uint32_t pending;          /* frames held for a retry right now */
-} urrt_can_stats;
+} urrt_canlink_stats;
 
-typedef struct urrt_can urrt_can;
+typedef struct urrt_canlink urrt_canlink;
 
 /* NULL with a logged reason when the configuration cannot work: no such
  * interface, not a CAN interface, an FD link on an interface without the FD
  * MTU, a log file that cannot be created. An interface that exists but is
- * down gives a link in URRT_CAN_DOWN that opens when the interface comes up. */
-urrt_can *urrt_can_new(const urrt_can_config *cfg);
-void urrt_can_free(urrt_can *can);
+ * down gives a link in URRT_CANLINK_DOWN that opens when the interface comes up. */
+urrt_canlink *urrt_canlink_new(const urrt_canlink_config *cfg);
+void urrt_canlink_free(urrt_canlink *can);
 
 /* Sends a frame now, never blocking. 1: the driver (or the log) took it;
  * 0: held for a retry, or dropped and counted because the link is down;
  * URRT_E_ARG for a frame the link can never send (FD frame on a classic
  * link, a length FD does not have, an ID out of range). */
-int urrt_can_send(urrt_can *can, const urrt_can_frame *frame, uint64_t now_us);
+int urrt_canlink_send(urrt_canlink *can, const urrt_can_frame *frame, uint64_t now_us);
 
 /* The descriptor to wait on and the events (POLLIN, plus POLLOUT while
  * frames wait for socket buffer space), or -1 when there is none (down, or
  * a log file). It changes across reopens: ask again before each wait. */
-int urrt_can_poll_fd(const urrt_can *can, short *events);
+int urrt_canlink_poll_fd(const urrt_canlink *can, short *events);
 
-/* Monotonic time by which urrt_can_service must run again at the latest
+/* Monotonic time by which urrt_canlink_service must run again at the latest
  * (UINT64_MAX when nothing is due). */
-uint64_t urrt_can_deadline(const urrt_can *can);
+uint64_t urrt_canlink_deadline(const urrt_canlink *can);
 
 /* Does what is due: reads error frames (bounded per call), notices the
  * interface going down, retries and expires held frames, reopens. Never
  * blocks. */
-void urrt_can_service(urrt_can *can, uint64_t now_us);
+void urrt_canlink_service(urrt_canlink *can, uint64_t now_us);
 
-urrt_can_state urrt_can_get_state(const urrt_can *can);
-const urrt_can_stats *urrt_can_get_stats(const urrt_can *can);
+urrt_canlink_state urrt_canlink_get_state(const urrt_canlink *can);
+const urrt_canlink_stats *urrt_canlink_get_stats(const urrt_canlink *can);
 
 #ifdef __cplusplus
 }

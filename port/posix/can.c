@@ -61,13 +61,13 @@ typedef struct held_frame {
     uint64_t since_us;   /* when this value was handed in: its age decides its expiry */
 } held_frame;
 
-struct urrt_can {
-    urrt_can_config cfg;
+struct urrt_canlink {
+    urrt_canlink_config cfg;
     char ifname[IFNAMSIZ];       /* SocketCAN interface, or the log's IFNAME column */
     char *log_path;              /* NULL for a socket link */
     int fd;                      /* socket or log file; -1 when closed */
     bool log_is_stdout;
-    urrt_can_state state;
+    urrt_canlink_state state;
     bool reported_down;          /* the current outage has been logged */
     const char *down_reason;     /* last reason logged, to log a change once */
     uint64_t down_since_us;
@@ -80,10 +80,10 @@ struct urrt_can {
     int last_send_errno;         /* logged once until it changes */
     held_frame *held;            /* insertion order = retry order */
     size_t n_held, cap_held;
-    urrt_can_stats stats;
+    urrt_canlink_stats stats;
 };
 
-void urrt_can_config_defaults(urrt_can_config *cfg)
+void urrt_canlink_config_defaults(urrt_canlink_config *cfg)
 {
     memset(cfg, 0, sizeof(*cfg));
     cfg->interface = "can0";
@@ -94,11 +94,11 @@ void urrt_can_config_defaults(urrt_can_config *cfg)
     cfg->hold_max_ms = 100;
 }
 
-const char *urrt_can_state_name(urrt_can_state state)
+const char *urrt_canlink_state_name(urrt_canlink_state state)
 {
     switch (state) {
-    case URRT_CAN_DOWN: return "down";
-    case URRT_CAN_UP: return "up";
+    case URRT_CANLINK_DOWN: return "down";
+    case URRT_CANLINK_UP: return "up";
     }
     return "?";
 }
@@ -116,7 +116,7 @@ static bool fd_length_valid(uint8_t len)
     return false;
 }
 
-static bool frame_valid(const urrt_can *can, const urrt_can_frame *f)
+static bool frame_valid(const urrt_canlink *can, const urrt_can_frame *f)
 {
     if (f->extended ? f->id > CAN_EFF_MASK : f->id > CAN_SFF_MASK)
         return false;
@@ -167,10 +167,10 @@ static size_t format_log_line(char *out, size_t size, const char *ifname, uint64
     return pos;
 }
 
-static int log_write(urrt_can *can, const urrt_can_frame *f)
+static int log_write(urrt_canlink *can, const urrt_can_frame *f)
 {
     /* "(" 10 "." 6 ") " IFNAMSIZ " " 8 "##" 1 128 "\n" */
-    char line[32 + IFNAMSIZ + 16 + 2 * URRT_CAN_MAX_DATA];
+    char line[32 + IFNAMSIZ + 16 + 2 * URRT_CAN_MAX_LEN];
     size_t len = format_log_line(line, sizeof(line), can->ifname, urrt_port_realtime_us(), f,
                                  can->cfg.fd_brs);
     size_t done = 0;
@@ -196,7 +196,7 @@ static int log_write(urrt_can *can, const urrt_can_frame *f)
 }
 
 /* "log:PATH[,ifname=NAME]" */
-static bool parse_log_interface(urrt_can *can, const char *spec)
+static bool parse_log_interface(urrt_canlink *can, const char *spec)
 {
     const char *path = spec + strlen(LOG_PREFIX);
     const char *opt = strstr(path, LOG_IFNAME_OPT);
@@ -220,7 +220,7 @@ static bool parse_log_interface(urrt_can *can, const char *spec)
     return can->log_path != NULL;
 }
 
-static bool open_log(urrt_can *can)
+static bool open_log(urrt_canlink *can)
 {
     if (strcmp(can->log_path, "-") == 0) {
         can->fd = STDOUT_FILENO;
@@ -232,14 +232,14 @@ static bool open_log(urrt_can *can)
             return false;
         }
     }
-    can->state = URRT_CAN_UP;
+    can->state = URRT_CANLINK_UP;
     can->stats.opens++;
     return true;
 }
 
 /* ---- held frames --------------------------------------------------------------- */
 
-static held_frame *find_held(urrt_can *can, const urrt_can_frame *f)
+static held_frame *find_held(urrt_canlink *can, const urrt_can_frame *f)
 {
     for (size_t i = 0; i < can->n_held; i++)
         if (same_id(&can->held[i].frame, f))
@@ -247,14 +247,14 @@ static held_frame *find_held(urrt_can *can, const urrt_can_frame *f)
     return NULL;
 }
 
-static void remove_held(urrt_can *can, size_t i)
+static void remove_held(urrt_canlink *can, size_t i)
 {
     memmove(&can->held[i], &can->held[i + 1], (can->n_held - i - 1) * sizeof(can->held[0]));
     can->n_held--;
     can->stats.pending = (uint32_t)can->n_held;
 }
 
-static void hold(urrt_can *can, const urrt_can_frame *f, uint64_t now_us)
+static void hold(urrt_canlink *can, const urrt_can_frame *f, uint64_t now_us)
 {
     held_frame *h = find_held(can, f);
     if (h != NULL) {
@@ -279,14 +279,14 @@ static void hold(urrt_can *can, const urrt_can_frame *f, uint64_t now_us)
     can->stats.pending = (uint32_t)can->n_held;
 }
 
-static void discard_held(urrt_can *can)
+static void discard_held(urrt_canlink *can)
 {
     can->stats.dropped += can->n_held;
     can->n_held = 0;
     can->stats.pending = 0;
 }
 
-static void expire_held(urrt_can *can, uint64_t now_us)
+static void expire_held(urrt_canlink *can, uint64_t now_us)
 {
     uint64_t max_us = (uint64_t)can->cfg.hold_max_ms * 1000u;
     size_t kept = 0;
@@ -302,7 +302,7 @@ static void expire_held(urrt_can *can, uint64_t now_us)
 
 /* ---- the socket ---------------------------------------------------------------- */
 
-static void log_down(urrt_can *can, urrt_log_level level, const char *reason, const char *detail)
+static void log_down(urrt_canlink *can, urrt_log_level level, const char *reason, const char *detail)
 {
     if (can->reported_down && can->down_reason == reason)
         return;
@@ -316,22 +316,22 @@ static void log_down(urrt_can *can, urrt_log_level level, const char *reason, co
     can->down_reason = reason;
 }
 
-static void close_socket(urrt_can *can)
+static void close_socket(urrt_canlink *can)
 {
     if (can->fd >= 0)
         close(can->fd);
     can->fd = -1;
 }
 
-static void go_down(urrt_can *can, uint64_t now_us, const char *reason, int err)
+static void go_down(urrt_canlink *can, uint64_t now_us, const char *reason, int err)
 {
     close_socket(can);
-    if (can->state == URRT_CAN_UP) {
+    if (can->state == URRT_CANLINK_UP) {
         can->stats.down_events++;
         can->down_since_us = now_us;
         can->dropped_at_down = can->stats.dropped;
     }
-    can->state = URRT_CAN_DOWN;
+    can->state = URRT_CANLINK_DOWN;
     discard_held(can);
     can->busy = false;
     can->wait_writable = false;
@@ -347,7 +347,7 @@ static bool is_down_errno(int err)
 /* The interface facts that decide whether a socket can work. At creation a
  * missing or unsuitable interface is a configuration error (-1); later it is
  * part of an outage (0, logged once). Returns 1 when usable and up. */
-static int check_interface(urrt_can *can, int sock, bool at_creation, unsigned *ifindex)
+static int check_interface(urrt_canlink *can, int sock, bool at_creation, unsigned *ifindex)
 {
     struct ifreq ifr;
     memset(&ifr, 0, sizeof(ifr));
@@ -402,7 +402,7 @@ static int check_interface(urrt_can *can, int sock, bool at_creation, unsigned *
 
 /* Opens and binds the socket when the interface is up. Returns as
  * check_interface does. */
-static int open_socket(urrt_can *can, uint64_t now_us, bool at_creation)
+static int open_socket(urrt_canlink *can, uint64_t now_us, bool at_creation)
 {
     int sock = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
     if (sock < 0) {
@@ -453,7 +453,7 @@ static int open_socket(urrt_can *can, uint64_t now_us, bool at_creation)
     }
 
     can->fd = sock;
-    can->state = URRT_CAN_UP;
+    can->state = URRT_CANLINK_UP;
     can->stats.opens++;
     if (can->reported_down && !at_creation)
         urrt_log(URRT_LOG_NOTICE, "CAN %s: up again after %.1f s; %llu frames dropped meanwhile",
@@ -466,7 +466,7 @@ static int open_socket(urrt_can *can, uint64_t now_us, bool at_creation)
     return 1;
 }
 
-static void reopen(urrt_can *can, uint64_t now_us)
+static void reopen(urrt_canlink *can, uint64_t now_us)
 {
     if (open_socket(can, now_us, false) <= 0)
         can->reopen_at_us = now_us + (uint64_t)can->cfg.reopen_interval_ms * 1000u;
@@ -474,7 +474,7 @@ static void reopen(urrt_can *can, uint64_t now_us)
 
 /* 1 written; 0 refused for now (held by the caller); -1 the link went down or
  * the frame was lost to an unexpected error. */
-static int write_frame(urrt_can *can, const urrt_can_frame *f, uint64_t now_us)
+static int write_frame(urrt_canlink *can, const urrt_can_frame *f, uint64_t now_us)
 {
     union {
         struct can_frame cc;
@@ -531,7 +531,7 @@ static int write_frame(urrt_can *can, const urrt_can_frame *f, uint64_t now_us)
 }
 
 /* A write went through with nothing left held: the end of a busy spell. */
-static void note_accepting(urrt_can *can)
+static void note_accepting(urrt_canlink *can)
 {
     if (!can->busy)
         return;
@@ -543,14 +543,14 @@ static void note_accepting(urrt_can *can)
 
 /* Sends held frames in the order they were first held, until the driver
  * refuses one. */
-static void flush_held(urrt_can *can, uint64_t now_us)
+static void flush_held(urrt_canlink *can, uint64_t now_us)
 {
-    while (can->n_held > 0 && can->state == URRT_CAN_UP) {
+    while (can->n_held > 0 && can->state == URRT_CANLINK_UP) {
         urrt_can_frame f = can->held[0].frame;
         int r = write_frame(can, &f, now_us);
         if (r == 0)
             return;
-        if (can->state != URRT_CAN_UP)
+        if (can->state != URRT_CANLINK_UP)
             return; /* went down: held frames already discarded */
         remove_held(can, 0);
         if (r > 0 && can->n_held == 0)
@@ -558,7 +558,7 @@ static void flush_held(urrt_can *can, uint64_t now_us)
     }
 }
 
-static void note_error_frame(urrt_can *can, const struct can_frame *cf)
+static void note_error_frame(urrt_canlink *can, const struct can_frame *cf)
 {
     uint32_t class = cf->can_id & CAN_ERR_MASK;
     can->stats.error_frames++;
@@ -577,9 +577,9 @@ static void note_error_frame(urrt_can *can, const struct can_frame *cf)
                  (unsigned)class, cf->data[0], cf->data[1], cf->data[2], cf->data[3]);
 }
 
-static void read_socket(urrt_can *can, uint64_t now_us)
+static void read_socket(urrt_canlink *can, uint64_t now_us)
 {
-    for (int i = 0; i < MAX_READS_PER_SERVICE && can->state == URRT_CAN_UP; i++) {
+    for (int i = 0; i < MAX_READS_PER_SERVICE && can->state == URRT_CANLINK_UP; i++) {
         struct canfd_frame buf;
         ssize_t r = recv(can->fd, &buf, sizeof(buf), MSG_DONTWAIT);
         if (r < 0) {
@@ -599,23 +599,23 @@ static void read_socket(urrt_can *can, uint64_t now_us)
 
 /* ---- the API ------------------------------------------------------------------- */
 
-urrt_can *urrt_can_new(const urrt_can_config *cfg)
+urrt_canlink *urrt_canlink_new(const urrt_canlink_config *cfg)
 {
     if (cfg == NULL || cfg->interface == NULL || cfg->interface[0] == '\0') {
         urrt_log(URRT_LOG_ERR, "CAN link: no interface configured");
         return NULL;
     }
-    urrt_can *can = calloc(1, sizeof(*can));
+    urrt_canlink *can = calloc(1, sizeof(*can));
     if (can == NULL)
         return NULL;
     can->cfg = *cfg;
     can->cfg.interface = NULL; /* not owned; ifname/log_path hold what we need */
     can->fd = -1;
-    can->state = URRT_CAN_DOWN;
+    can->state = URRT_CANLINK_DOWN;
 
     if (strncmp(cfg->interface, LOG_PREFIX, strlen(LOG_PREFIX)) == 0) {
         if (!parse_log_interface(can, cfg->interface) || !open_log(can)) {
-            urrt_can_free(can);
+            urrt_canlink_free(can);
             return NULL;
         }
         return can;
@@ -641,7 +641,7 @@ urrt_can *urrt_can_new(const urrt_can_config *cfg)
     return can;
 }
 
-void urrt_can_free(urrt_can *can)
+void urrt_canlink_free(urrt_canlink *can)
 {
     if (can == NULL)
         return;
@@ -656,13 +656,13 @@ void urrt_can_free(urrt_can *can)
     free(can);
 }
 
-int urrt_can_send(urrt_can *can, const urrt_can_frame *frame, uint64_t now_us)
+int urrt_canlink_send(urrt_canlink *can, const urrt_can_frame *frame, uint64_t now_us)
 {
     if (can == NULL || frame == NULL || !frame_valid(can, frame))
         return URRT_E_ARG;
     if (can->log_path != NULL)
         return log_write(can, frame);
-    if (can->state != URRT_CAN_UP) {
+    if (can->state != URRT_CANLINK_UP) {
         can->stats.dropped++;
         return 0;
     }
@@ -672,7 +672,7 @@ int urrt_can_send(urrt_can *can, const urrt_can_frame *frame, uint64_t now_us)
          * place (and its turn), then everything waiting gets a chance. */
         hold(can, frame, now_us);
         flush_held(can, now_us);
-        return find_held(can, frame) == NULL && can->state == URRT_CAN_UP ? 1 : 0;
+        return find_held(can, frame) == NULL && can->state == URRT_CANLINK_UP ? 1 : 0;
     }
     int r = write_frame(can, frame, now_us);
     if (r == 0) {
@@ -680,7 +680,7 @@ int urrt_can_send(urrt_can *can, const urrt_can_frame *frame, uint64_t now_us)
         return 0;
     }
     if (r < 0) {
-        if (can->state != URRT_CAN_UP)
+        if (can->state != URRT_CANLINK_UP)
             can->stats.dropped++;
         return 0;
     }
@@ -691,22 +691,22 @@ int urrt_can_send(urrt_can *can, const urrt_can_frame *frame, uint64_t now_us)
     return 1;
 }
 
-int urrt_can_poll_fd(const urrt_can *can, short *events)
+int urrt_canlink_poll_fd(const urrt_canlink *can, short *events)
 {
     if (events != NULL)
         *events = 0;
-    if (can == NULL || can->log_path != NULL || can->state != URRT_CAN_UP)
+    if (can == NULL || can->log_path != NULL || can->state != URRT_CANLINK_UP)
         return -1;
     if (events != NULL)
         *events = (short)(POLLIN | (can->n_held > 0 && can->wait_writable ? POLLOUT : 0));
     return can->fd;
 }
 
-uint64_t urrt_can_deadline(const urrt_can *can)
+uint64_t urrt_canlink_deadline(const urrt_canlink *can)
 {
     if (can == NULL || can->log_path != NULL)
         return UINT64_MAX;
-    if (can->state != URRT_CAN_UP)
+    if (can->state != URRT_CANLINK_UP)
         return can->reopen_at_us;
     if (can->n_held == 0)
         return UINT64_MAX;
@@ -720,29 +720,29 @@ uint64_t urrt_can_deadline(const urrt_can *can)
     return deadline;
 }
 
-void urrt_can_service(urrt_can *can, uint64_t now_us)
+void urrt_canlink_service(urrt_canlink *can, uint64_t now_us)
 {
     if (can == NULL || can->log_path != NULL)
         return;
-    if (can->state != URRT_CAN_UP) {
+    if (can->state != URRT_CANLINK_UP) {
         if (now_us >= can->reopen_at_us)
             reopen(can, now_us);
         return;
     }
     read_socket(can, now_us);
-    if (can->state != URRT_CAN_UP || can->n_held == 0)
+    if (can->state != URRT_CANLINK_UP || can->n_held == 0)
         return;
     expire_held(can, now_us);
     if (can->n_held > 0 && (now_us >= can->retry_at_us || can->wait_writable))
         flush_held(can, now_us);
 }
 
-urrt_can_state urrt_can_get_state(const urrt_can *can)
+urrt_canlink_state urrt_canlink_get_state(const urrt_canlink *can)
 {
     return can->state;
 }
 
-const urrt_can_stats *urrt_can_get_stats(const urrt_can *can)
+const urrt_canlink_stats *urrt_canlink_get_stats(const urrt_canlink *can)
 {
     return &can->stats;
 }

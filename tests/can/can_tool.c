@@ -101,7 +101,7 @@ static int cmd_pack(struct can_map *map)
         char *save = NULL;
         char *tok = strtok_r(line, " \t\r\n", &save);
         struct can_map_frame *f;
-        uint8_t data[URRT_CAN_MAX_DATA] = {0};
+        uint8_t data[URRT_CAN_MAX_LEN] = {0};
         char outcomes[2048] = "";
         if (tok == NULL) {
             continue;
@@ -136,7 +136,7 @@ static int cmd_unpack(struct can_map *map)
         char *name = strtok_r(line, " \t\r\n", &save);
         char *hex = strtok_r(NULL, " \t\r\n", &save);
         struct can_map_frame *f;
-        uint8_t data[URRT_CAN_MAX_DATA] = {0};
+        uint8_t data[URRT_CAN_MAX_LEN] = {0};
         size_t i;
         if (name == NULL) {
             continue;
@@ -197,7 +197,7 @@ static int cmd_run(struct can_map *map)
 {
     char line[8192];
     struct run_ctx run = {0};
-    urrt_can_stats stats;
+    urrt_canlink_stats stats;
     urrt_state st;
     memset(&stats, 0, sizeof stats);
     while (fgets(line, sizeof line, stdin) != NULL) {

@@ -584,7 +584,7 @@ static void test_config_good(void)
     }
     CHECK(can_map_enabled(&map), "enabled");
     {
-        urrt_can_config cfg;
+        urrt_canlink_config cfg;
         char line[256];
         memset(&cfg, 0, sizeof cfg);
         cfg.reopen_interval_ms = 1234;
@@ -1133,7 +1133,7 @@ static void test_validity_and_heartbeat(void)
 {
     struct can_map map;
     char err[4096] = "";
-    urrt_can_stats stats;
+    urrt_canlink_stats stats;
     size_t i;
     int rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
     CHECK(rc == 0, "%s", err);

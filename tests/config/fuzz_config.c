@@ -656,7 +656,7 @@ static void run_schedule(struct can_map *map)
 {
     static const double values[] = {0.0, 1.5, -7.0, 1e300, -1e300, 4294967296.0, NAN, INFINITY};
     struct emitted e = {map, 0};
-    urrt_can_stats stats;
+    urrt_canlink_stats stats;
     uint64_t now = 1000000;
     memset(&stats, 0, sizeof stats);
     can_map_start(map, now);

@@ -124,22 +124,22 @@ static urrt_can_frame make_frame(uint32_t id, bool ext, bool fd, uint8_t len, ui
     return f;
 }
 
-static urrt_can *open_link_hold(const char *ifname, bool fd, bool brs, uint32_t hold_max_ms)
+static urrt_canlink *open_link_hold(const char *ifname, bool fd, bool brs, uint32_t hold_max_ms)
 {
-    urrt_can_config cfg;
-    urrt_can_config_defaults(&cfg);
+    urrt_canlink_config cfg;
+    urrt_canlink_config_defaults(&cfg);
     cfg.interface = ifname;
     cfg.fd = fd;
     cfg.fd_brs = brs;
     cfg.reopen_interval_ms = 50;
     cfg.retry_interval_ms = 5;
     cfg.hold_max_ms = hold_max_ms;
-    return urrt_can_new(&cfg);
+    return urrt_canlink_new(&cfg);
 }
 
 /* Held values stay fresh for 2 s: longer than any wait here, even on a
  * loaded host under TCG, except where expiry is the point. */
-static urrt_can *open_link(const char *ifname, bool fd, bool brs)
+static urrt_canlink *open_link(const char *ifname, bool fd, bool brs)
 {
     return open_link_hold(ifname, fd, brs, 2000);
 }
@@ -157,25 +157,25 @@ static void call_ended(uint64_t t0, long switches0)
     blocked_calls += voluntary_switches() != switches0;
 }
 
-static int timed_send(urrt_can *can, const urrt_can_frame *f)
+static int timed_send(urrt_canlink *can, const urrt_can_frame *f)
 {
     long switches0 = voluntary_switches();
     uint64_t t0 = now_us();
-    int r = urrt_can_send(can, f, t0);
+    int r = urrt_canlink_send(can, f, t0);
     call_ended(t0, switches0);
     return r;
 }
 
 /* Runs the link's share of a poll loop for ms milliseconds. Returns the
  * poll events seen on its descriptor (ORed). */
-static short pump(urrt_can *can, unsigned ms)
+static short pump(urrt_canlink *can, unsigned ms)
 {
     uint64_t end = now_us() + ms * 1000u;
     short seen = 0;
     for (uint64_t t = now_us(); t < end; t = now_us()) {
         short events;
-        int fd = urrt_can_poll_fd(can, &events);
-        uint64_t deadline = urrt_can_deadline(can);
+        int fd = urrt_canlink_poll_fd(can, &events);
+        uint64_t deadline = urrt_canlink_deadline(can);
         uint64_t until = deadline < end ? deadline : end;
         int timeout_ms = until > t ? (int)((until - t + 999) / 1000) : 0;
         struct pollfd p = { .fd = fd, .events = events };
@@ -184,7 +184,7 @@ static short pump(urrt_can *can, unsigned ms)
             seen |= p.revents;
         long switches0 = voluntary_switches();
         uint64_t t0 = now_us();
-        urrt_can_service(can, t0);
+        urrt_canlink_service(can, t0);
         call_ended(t0, switches0);
     }
     return seen;
@@ -193,18 +193,18 @@ static short pump(urrt_can *can, unsigned ms)
 /* Pumps until the link is in state (or nothing is held, for want_idle) or
  * limit_ms pass: waits that depend on the host's speed end as soon as they
  * can and still have a bound. */
-static short pump_until_state(urrt_can *can, urrt_can_state state, unsigned limit_ms)
+static short pump_until_state(urrt_canlink *can, urrt_canlink_state state, unsigned limit_ms)
 {
     short seen = 0;
-    for (unsigned waited = 0; urrt_can_get_state(can) != state && waited < limit_ms; waited += 10)
+    for (unsigned waited = 0; urrt_canlink_get_state(can) != state && waited < limit_ms; waited += 10)
         seen |= pump(can, 10);
     return seen;
 }
 
-static short pump_until_idle(urrt_can *can, unsigned limit_ms)
+static short pump_until_idle(urrt_canlink *can, unsigned limit_ms)
 {
     short seen = 0;
-    for (unsigned waited = 0; urrt_can_get_stats(can)->pending != 0 && waited < limit_ms; waited += 10)
+    for (unsigned waited = 0; urrt_canlink_get_stats(can)->pending != 0 && waited < limit_ms; waited += 10)
         seen |= pump(can, 10);
     return seen;
 }
@@ -414,19 +414,19 @@ static int test_log(const char *dir)
 
     /* An FD link with the bit rate switch, interface column vcan0. */
     snprintf(spec, sizeof(spec), "log:%s,ifname=vcan0", path_fd);
-    urrt_can *fd = open_link(spec, true, true);
+    urrt_canlink *fd = open_link(spec, true, true);
     CHECK(fd != NULL, "log link %s", spec);
     /* A classic link with the default interface column. */
     snprintf(spec, sizeof(spec), "log:%s", path_cc);
-    urrt_can *cc = open_link(spec, false, false);
+    urrt_canlink *cc = open_link(spec, false, false);
     CHECK(cc != NULL, "log link %s", spec);
     if (fd == NULL || cc == NULL)
         return check_report();
 
     short events;
-    CHECK_EQ_INT(urrt_can_poll_fd(fd, &events), -1);
-    CHECK(urrt_can_deadline(fd) == UINT64_MAX, "a log link has nothing due");
-    CHECK_EQ_INT(urrt_can_get_state(fd), URRT_CAN_UP);
+    CHECK_EQ_INT(urrt_canlink_poll_fd(fd, &events), -1);
+    CHECK(urrt_canlink_deadline(fd) == UINT64_MAX, "a log link has nothing due");
+    CHECK_EQ_INT(urrt_canlink_get_state(fd), URRT_CANLINK_UP);
 
     enum { N_FD = sizeof(log_fd_cases) / sizeof(log_fd_cases[0]),
            N_CC = sizeof(log_classic_cases) / sizeof(log_classic_cases[0]) };
@@ -446,24 +446,24 @@ static int test_log(const char *dir)
 
     /* Frames no link can send. */
     urrt_can_frame bad = make_frame(0x100, false, true, 8, 0);
-    CHECK_EQ_INT(urrt_can_send(cc, &bad, now_us()), URRT_E_ARG); /* FD on a classic link */
+    CHECK_EQ_INT(urrt_canlink_send(cc, &bad, now_us()), URRT_E_ARG); /* FD on a classic link */
     bad = make_frame(0x100, false, false, 9, 0);
-    CHECK_EQ_INT(urrt_can_send(cc, &bad, now_us()), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_canlink_send(cc, &bad, now_us()), URRT_E_ARG);
     bad = make_frame(0x100, false, true, 13, 0);
-    CHECK_EQ_INT(urrt_can_send(fd, &bad, now_us()), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_canlink_send(fd, &bad, now_us()), URRT_E_ARG);
     bad = make_frame(0x100, false, true, 64, 0);
     bad.len = 65;
-    CHECK_EQ_INT(urrt_can_send(fd, &bad, now_us()), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_canlink_send(fd, &bad, now_us()), URRT_E_ARG);
     bad = make_frame(0x800, false, false, 1, 0);
-    CHECK_EQ_INT(urrt_can_send(cc, &bad, now_us()), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_canlink_send(cc, &bad, now_us()), URRT_E_ARG);
     bad = make_frame(0x20000000, true, false, 1, 0);
-    CHECK_EQ_INT(urrt_can_send(cc, &bad, now_us()), URRT_E_ARG);
-    CHECK_EQ_INT(urrt_can_send(cc, NULL, now_us()), URRT_E_ARG);
-    CHECK_EQ_INT(urrt_can_get_stats(fd)->sent, N_FD);
-    CHECK_EQ_INT(urrt_can_get_stats(cc)->sent, N_CC);
-    CHECK_EQ_INT(urrt_can_get_stats(cc)->dropped, 0);
-    urrt_can_free(fd);
-    urrt_can_free(cc);
+    CHECK_EQ_INT(urrt_canlink_send(cc, &bad, now_us()), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_canlink_send(cc, NULL, now_us()), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_canlink_get_stats(fd)->sent, N_FD);
+    CHECK_EQ_INT(urrt_canlink_get_stats(cc)->sent, N_CC);
+    CHECK_EQ_INT(urrt_canlink_get_stats(cc)->dropped, 0);
+    urrt_canlink_free(fd);
+    urrt_canlink_free(cc);
 
     /* log:- writes to stdout: point stdout at a file for the moment. */
     fflush(stdout);
@@ -471,16 +471,16 @@ static int test_log(const char *dir)
     int out = open(path_out, O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(out, STDOUT_FILENO);
     close(out);
-    urrt_can *so = open_link("log:-,ifname=can1", false, false);
+    urrt_canlink *so = open_link("log:-,ifname=can1", false, false);
     urrt_can_frame f = case_frame(&(log_case){ 0x5A5, false, false, 4, "c3d4e5f6", NULL });
-    int r = so ? urrt_can_send(so, &f, now_us()) : -99;
-    urrt_can_free(so);
+    int r = so ? urrt_canlink_send(so, &f, now_us()) : -99;
+    urrt_canlink_free(so);
     int still_open = fcntl(STDOUT_FILENO, F_GETFD);
     dup2(saved, STDOUT_FILENO);
     close(saved);
     CHECK(so != NULL, "log:- link");
     CHECK_EQ_INT(r, 1);
-    CHECK(still_open >= 0, "stdout stays open after urrt_can_free");
+    CHECK(still_open >= 0, "stdout stays open after urrt_canlink_free");
     expect_line(expect, "log-stdout.log", &f, false);
     fclose(expect);
 
@@ -513,17 +513,17 @@ static int test_frames(const char *dir)
     snprintf(spec0, sizeof(spec0), "log:%s/frames-vcan0.log,ifname=vcan0", dir);
     snprintf(spec1, sizeof(spec1), "log:%s/frames-vcan1.log,ifname=vcan1", dir);
     int rx0 = rx_open("vcan0"), rx1 = rx_open("vcan1");
-    urrt_can *fd = open_link("vcan0", true, true);
-    urrt_can *fd_nobrs = open_link("vcan0", true, false);
-    urrt_can *cc = open_link("vcan1", false, false);
-    urrt_can *log_fd = open_link(spec0, true, true);
-    urrt_can *log_cc = open_link(spec1, false, false);
+    urrt_canlink *fd = open_link("vcan0", true, true);
+    urrt_canlink *fd_nobrs = open_link("vcan0", true, false);
+    urrt_canlink *cc = open_link("vcan1", false, false);
+    urrt_canlink *log_fd = open_link(spec0, true, true);
+    urrt_canlink *log_cc = open_link(spec1, false, false);
     CHECK(rx0 >= 0 && rx1 >= 0, "receivers");
     CHECK(fd && fd_nobrs && cc && log_fd && log_cc, "links");
     if (!(rx0 >= 0 && rx1 >= 0 && fd && fd_nobrs && cc && log_fd && log_cc))
         return check_report();
-    CHECK_EQ_INT(urrt_can_get_state(fd), URRT_CAN_UP);
-    CHECK_EQ_INT(urrt_can_get_stats(fd)->opens, 1);
+    CHECK_EQ_INT(urrt_canlink_get_state(fd), URRT_CANLINK_UP);
+    CHECK_EQ_INT(urrt_canlink_get_stats(fd)->opens, 1);
 
     enum { N_FD = sizeof(fd_set_) / sizeof(fd_set_[0]), N_CC = sizeof(classic_set) / sizeof(classic_set[0]) };
     urrt_can_frame sent0[N_FD + 1], sent1[N_CC];
@@ -541,7 +541,7 @@ static int test_frames(const char *dir)
         CHECK_EQ_INT(timed_send(log_cc, &sent1[i]), 1);
     }
     urrt_can_frame fd_on_cc = make_frame(0x100, false, true, 8, 0);
-    CHECK_EQ_INT(urrt_can_send(cc, &fd_on_cc, now_us()), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_canlink_send(cc, &fd_on_cc, now_us()), URRT_E_ARG);
 
     rx_frame rx[32];
     size_t n = rx_collect(rx0, rx, 32, 100);
@@ -554,21 +554,21 @@ static int test_frames(const char *dir)
     for (size_t i = 0; i < n && i < N_CC; i++)
         CHECK(rx_matches(&rx[i], &sent1[i], false), "vcan1 frame %zu: id %X len %u", i, (unsigned)rx[i].f.can_id,
               rx[i].f.len);
-    CHECK_EQ_INT(urrt_can_get_stats(fd)->sent, N_FD);
-    CHECK_EQ_INT(urrt_can_get_stats(cc)->sent, N_CC);
-    CHECK_EQ_INT(urrt_can_get_stats(cc)->dropped, 0);
+    CHECK_EQ_INT(urrt_canlink_get_stats(fd)->sent, N_FD);
+    CHECK_EQ_INT(urrt_canlink_get_stats(cc)->sent, N_CC);
+    CHECK_EQ_INT(urrt_canlink_get_stats(cc)->dropped, 0);
 
     /* The frame without BRS goes to the log too, from a log link without BRS. */
-    urrt_can_free(log_fd);
+    urrt_canlink_free(log_fd);
     snprintf(spec0, sizeof(spec0), "log:%s/frames-vcan0-nobrs.log,ifname=vcan0", dir);
     log_fd = open_link(spec0, true, false);
     CHECK(log_fd != NULL && timed_send(log_fd, &sent0[N_FD]) == 1, "log without BRS");
 
-    urrt_can_free(fd);
-    urrt_can_free(fd_nobrs);
-    urrt_can_free(cc);
-    urrt_can_free(log_fd);
-    urrt_can_free(log_cc);
+    urrt_canlink_free(fd);
+    urrt_canlink_free(fd_nobrs);
+    urrt_canlink_free(cc);
+    urrt_canlink_free(log_fd);
+    urrt_canlink_free(log_cc);
     close(rx0);
     close(rx1);
     CHECK(blocked_calls == 0, "%u calls slept (longest call %" PRIu64 " us)", blocked_calls, max_call_us);
@@ -593,14 +593,14 @@ static void test_refusals(void)
     messages_clear();
     CHECK(open_link("averyveryverylongname", false, false) == NULL, "name too long");
     /* A classic link on an FD interface is fine. */
-    urrt_can *cc = open_link("vcan0", false, false);
-    CHECK(cc != NULL && urrt_can_get_state(cc) == URRT_CAN_UP, "classic link on vcan0");
-    urrt_can_free(cc);
+    urrt_canlink *cc = open_link("vcan0", false, false);
+    CHECK(cc != NULL && urrt_canlink_get_state(cc) == URRT_CANLINK_UP, "classic link on vcan0");
+    urrt_canlink_free(cc);
 }
 
 static void test_no_data_frames(void)
 {
-    urrt_can *can = open_link("vcan0", true, false);
+    urrt_canlink *can = open_link("vcan0", true, false);
     int tx = rx_open("vcan0");
     CHECK(can != NULL && tx >= 0, "link and sender");
     if (can == NULL || tx < 0)
@@ -610,19 +610,19 @@ static void test_no_data_frames(void)
         CHECK(write(tx, &f, sizeof(f)) == (ssize_t)sizeof(f), "sender write: %s", strerror(errno));
     }
     short events;
-    int fd = urrt_can_poll_fd(can, &events);
+    int fd = urrt_canlink_poll_fd(can, &events);
     CHECK(fd >= 0 && (events & POLLIN), "waits for POLLIN (error frames)");
     struct pollfd p = { .fd = fd, .events = events };
     CHECK_EQ_INT(poll(&p, 1, 200), 0); /* 20 data frames on the bus, none for the link */
     pump(can, 20);
-    CHECK_EQ_INT(urrt_can_get_stats(can)->error_frames, 0);
+    CHECK_EQ_INT(urrt_canlink_get_stats(can)->error_frames, 0);
     close(tx);
-    urrt_can_free(can);
+    urrt_canlink_free(can);
 }
 
 static void test_error_frames(void)
 {
-    urrt_can *can = open_link("vcan0", false, false);
+    urrt_canlink *can = open_link("vcan0", false, false);
     int tx = rx_open("vcan0");
     CHECK(can != NULL && tx >= 0, "link and injector");
     if (can == NULL || tx < 0)
@@ -642,16 +642,16 @@ static void test_error_frames(void)
     messages_clear();
     short seen = pump(can, 100);
     CHECK(seen & POLLIN, "error frames wake the loop");
-    const urrt_can_stats *st = urrt_can_get_stats(can);
+    const urrt_canlink_stats *st = urrt_canlink_get_stats(can);
     CHECK_EQ_INT(st->error_frames, 3);
     CHECK_EQ_INT(st->bus_off, 1);
     CHECK_EQ_INT(st->restarts, 1);
     CHECK_EQ_INT(st->last_error_class, CAN_ERR_CRTL);
     CHECK(strstr(messages, "bus-off") != NULL, "bus-off logged: %s", messages);
     CHECK(strstr(messages, "restarted") != NULL, "restart logged: %s", messages);
-    CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_UP);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
     close(tx);
-    urrt_can_free(can);
+    urrt_canlink_free(can);
 }
 
 /* ENOBUFS, as a controller that cannot get frames onto the bus causes it: the
@@ -659,12 +659,12 @@ static void test_error_frames(void)
 static void test_queue_full(void)
 {
     RUN("tc", "qdisc", "add", "dev", "vcan1", "root", "plug", "limit", "160"); /* 10 classic frames */
-    urrt_can *can = open_link("vcan1", false, false);
+    urrt_canlink *can = open_link("vcan1", false, false);
     int rx = rx_open("vcan1");
     CHECK(can != NULL && rx >= 0, "link and receiver");
     if (can == NULL || rx < 0)
         return;
-    const urrt_can_stats *st = urrt_can_get_stats(can);
+    const urrt_canlink_stats *st = urrt_canlink_get_stats(can);
     for (uint32_t i = 0; i < 10; i++) {
         urrt_can_frame f = make_frame(0x200 + i, false, false, 8, (uint8_t)i);
         CHECK_EQ_INT(timed_send(can, &f), 1);
@@ -687,7 +687,7 @@ static void test_queue_full(void)
     CHECK_EQ_INT(st->pending, 2);
     CHECK_EQ_INT(st->dropped, 998);
     CHECK(st->busy >= 1000, "busy %" PRIu64, st->busy);
-    CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_UP);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
     CHECK_EQ_INT(count_substr(messages, "transmit queue full"), 1);
     /* 40 more IDs, one the 29-bit twin of 0x20A: each gets a slot of its own
      * (and the slot table grows past its first allocation). */
@@ -701,9 +701,9 @@ static void test_queue_full(void)
     CHECK_EQ_INT(st->pending, 42);
     CHECK_EQ_INT(st->dropped, 998);
     short events;
-    urrt_can_poll_fd(can, &events);
+    urrt_canlink_poll_fd(can, &events);
     CHECK(!(events & POLLOUT), "no POLLOUT wait on ENOBUFS: the socket would report writable at once");
-    CHECK(urrt_can_deadline(can) <= now_us() + 5000u + 1000u, "a retry is scheduled");
+    CHECK(urrt_canlink_deadline(can) <= now_us() + 5000u + 1000u, "a retry is scheduled");
 
     /* The queue drains: the held frames go out, the newest value of each,
      * once. */
@@ -729,19 +729,19 @@ static void test_queue_full(void)
     CHECK(b != NULL && rx_matches(b, &last_b, false), "0x20B carries the newest value");
 
     /* A value held longer than hold_max_ms is stale: dropped, never sent. */
-    urrt_can_free(can);
+    urrt_canlink_free(can);
     can = open_link_hold("vcan1", false, false, 200);
     CHECK(can != NULL, "link with hold_max_ms 200");
     if (can == NULL)
         return;
-    st = urrt_can_get_stats(can);
+    st = urrt_canlink_get_stats(can);
     RUN("tc", "qdisc", "del", "dev", "vcan1", "root");
     RUN("tc", "qdisc", "add", "dev", "vcan1", "root", "plug", "limit", "16");
     urrt_can_frame first = make_frame(0x300, false, false, 1, 1), stale = make_frame(0x301, false, false, 1, 2);
     CHECK_EQ_INT(timed_send(can, &first), 1);
     CHECK_EQ_INT(timed_send(can, &stale), 0);
     uint64_t dropped = st->dropped;
-    CHECK(urrt_can_deadline(can) <= now_us() + 200000u + 1000u, "the held frame's expiry is a deadline");
+    CHECK(urrt_canlink_deadline(can) <= now_us() + 200000u + 1000u, "the held frame's expiry is a deadline");
     pump(can, 350); /* hold_max_ms 200 */
     CHECK_EQ_INT(st->pending, 0);
     CHECK_EQ_INT(st->dropped, dropped + 1);
@@ -753,7 +753,7 @@ static void test_queue_full(void)
 
     RUN("tc", "qdisc", "del", "dev", "vcan1", "root");
     close(rx);
-    urrt_can_free(can);
+    urrt_canlink_free(can);
 }
 
 /* EAGAIN: the socket's own buffer is full (the kernel keeps charging a
@@ -761,16 +761,16 @@ static void test_queue_full(void)
 static void test_socket_buffer_full(void)
 {
     RUN("tc", "qdisc", "add", "dev", "vcan1", "root", "plug", "limit", "1000000");
-    urrt_can *can = open_link("vcan1", false, false);
+    urrt_canlink *can = open_link("vcan1", false, false);
     int rx = rx_open("vcan1");
     CHECK(can != NULL && rx >= 0, "link and receiver");
     if (can == NULL || rx < 0)
         return;
     short events;
-    int fd = urrt_can_poll_fd(can, &events);
+    int fd = urrt_canlink_poll_fd(can, &events);
     int tiny = 1; /* the kernel's minimum: a few frames */
     CHECK(setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &tiny, sizeof(tiny)) == 0, "SO_SNDBUF");
-    const urrt_can_stats *st = urrt_can_get_stats(can);
+    const urrt_canlink_stats *st = urrt_canlink_get_stats(can);
     uint64_t t0 = now_us();
     urrt_can_frame last[4];
     int refused = 0;
@@ -784,7 +784,7 @@ static void test_socket_buffer_full(void)
     CHECK_EQ_INT(st->pending, 4);
     CHECK_EQ_INT(st->sent + st->dropped + st->pending, 2000);
     CHECK(flood_us < 2000000u, "2000 sends took %" PRIu64 " us", flood_us);
-    fd = urrt_can_poll_fd(can, &events);
+    fd = urrt_canlink_poll_fd(can, &events);
     CHECK(events & POLLOUT, "waits for POLLOUT after EAGAIN");
     struct pollfd p = { .fd = fd, .events = POLLOUT };
     CHECK_EQ_INT(poll(&p, 1, 100), 0); /* still full: no spin */
@@ -804,17 +804,17 @@ static void test_socket_buffer_full(void)
     }
     RUN("tc", "qdisc", "del", "dev", "vcan1", "root");
     close(rx);
-    urrt_can_free(can);
+    urrt_canlink_free(can);
 }
 
 static void test_down_up(void)
 {
-    urrt_can *can = open_link("vcan0", true, false);
+    urrt_canlink *can = open_link("vcan0", true, false);
     int rx = rx_open("vcan0");
     CHECK(can != NULL && rx >= 0, "link and receiver");
     if (can == NULL || rx < 0)
         return;
-    const urrt_can_stats *st = urrt_can_get_stats(can);
+    const urrt_canlink_stats *st = urrt_canlink_get_stats(can);
     rx_frame got[64];
 
     /* A frame held in the slot when the interface goes down is discarded. */
@@ -825,14 +825,14 @@ static void test_down_up(void)
     CHECK_EQ_INT(st->pending, 1);
     messages_clear();
     RUN("ip", "link", "set", "vcan0", "down");
-    short seen = pump_until_state(can, URRT_CAN_DOWN, 2000);
+    short seen = pump_until_state(can, URRT_CANLINK_DOWN, 2000);
     CHECK(seen & (POLLERR | POLLIN), "the down event wakes the loop");
-    CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_DOWN);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_DOWN);
     CHECK_EQ_INT(st->down_events, 1);
     CHECK_EQ_INT(st->pending, 0);
     CHECK_EQ_INT(st->dropped, 1);
     short events;
-    CHECK_EQ_INT(urrt_can_poll_fd(can, &events), -1);
+    CHECK_EQ_INT(urrt_canlink_poll_fd(can, &events), -1);
     CHECK(strstr(messages, "vcan0: down") != NULL, "down logged: %s", messages);
     /* Sent while down: dropped and counted, never replayed. */
     for (int i = 0; i < 5; i++) {
@@ -846,8 +846,8 @@ static void test_down_up(void)
     RUN("tc", "qdisc", "del", "dev", "vcan0", "root");
     RUN("ip", "link", "set", "vcan0", "up");
     rx_collect(rx, got, 64, 50); /* the receiver's own error and the plugged frame */
-    pump_until_state(can, URRT_CAN_UP, 2000);
-    CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_UP);
+    pump_until_state(can, URRT_CANLINK_UP, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
     CHECK_EQ_INT(st->opens, 2);
     CHECK(strstr(messages, "up again") != NULL, "recovery logged: %s", messages);
     urrt_can_frame f3 = make_frame(0x503, false, true, 12, 3);
@@ -859,15 +859,15 @@ static void test_down_up(void)
     /* Removed and created again: a new ifindex, found by name. */
     messages_clear();
     RUN("ip", "link", "del", "vcan0");
-    pump_until_state(can, URRT_CAN_DOWN, 2000);
-    CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_DOWN);
+    pump_until_state(can, URRT_CANLINK_DOWN, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_DOWN);
     CHECK_EQ_INT(st->down_events, 2);
     CHECK(strstr(messages, "removed") != NULL, "removal logged: %s", messages);
     RUN("ip", "link", "add", "dev", "vcan0", "type", "vcan");
     RUN("ip", "link", "set", "vcan0", "mtu", "72");
     RUN("ip", "link", "set", "vcan0", "up");
-    pump_until_state(can, URRT_CAN_UP, 2000);
-    CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_UP);
+    pump_until_state(can, URRT_CANLINK_UP, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
     CHECK_EQ_INT(st->opens, 3);
     close(rx);
     rx = rx_open("vcan0");
@@ -883,15 +883,15 @@ static void test_down_up(void)
     for (int waited = 0; strstr(messages, "mtu 72") == NULL && waited < 2000; waited += 10)
         pump(can, 10); /* until a reopen attempt has seen the interface up */
     pump(can, 100);
-    CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_DOWN);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_DOWN);
     CHECK(strstr(messages, "mtu 72") != NULL, "MTU reason logged: %s", messages);
     RUN("ip", "link", "set", "vcan0", "down");
     RUN("ip", "link", "set", "vcan0", "mtu", "72");
     RUN("ip", "link", "set", "vcan0", "up");
-    pump_until_state(can, URRT_CAN_UP, 2000);
-    CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_UP);
+    pump_until_state(can, URRT_CANLINK_UP, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
     close(rx);
-    urrt_can_free(can);
+    urrt_canlink_free(can);
 
     /* Created while the interface is down: a link that opens later. */
     RUN("ip", "link", "set", "vcan1", "down");
@@ -900,16 +900,16 @@ static void test_down_up(void)
     CHECK(can != NULL, "a link on a down interface");
     if (can == NULL)
         return;
-    CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_DOWN);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_DOWN);
     CHECK(strstr(messages, "vcan1: down (interface is down)") != NULL, "logged: %s", messages);
     pump(can, 120);
-    CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_DOWN);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_DOWN);
     RUN("ip", "link", "set", "vcan1", "up");
-    pump_until_state(can, URRT_CAN_UP, 2000);
-    CHECK_EQ_INT(urrt_can_get_state(can), URRT_CAN_UP);
-    CHECK_EQ_INT(urrt_can_get_stats(can)->opens, 1);
-    CHECK_EQ_INT(urrt_can_get_stats(can)->down_events, 0);
-    urrt_can_free(can);
+    pump_until_state(can, URRT_CANLINK_UP, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
+    CHECK_EQ_INT(urrt_canlink_get_stats(can)->opens, 1);
+    CHECK_EQ_INT(urrt_canlink_get_stats(can)->down_events, 0);
+    urrt_canlink_free(can);
 }
 
 static int test_socket(void)
