@@ -338,17 +338,6 @@ static unsigned selected_fields(const dump *d, const urrt_state *st, unsigned *i
     return n;
 }
 
-static const double *field_values(const urrt_state *st, unsigned id)
-{
-    /* The field table's order is the struct's: walk the members by offset. */
-    static const size_t offsets[URRT_FIELD_COUNT] = {
-#define X_OFFSET(ID, name, count, c1, c3, unit, since, desc) offsetof(urrt_state, name),
-        URRT_FIELDS(X_OFFSET)
-#undef X_OFFSET
-    };
-    return (const double *)(const void *)((const char *)st + offsets[id]);
-}
-
 static void print_gnuplot(const dump *d, FILE *out, const uint8_t *pkt, size_t len)
 {
     unsigned doubles = (unsigned)(len - URRT_HEADER_SIZE) / 8u;
@@ -392,7 +381,7 @@ static void print_csv(dump *d, FILE *out, const urrt_state *st)
     for (unsigned k = 0; k < d->opt.nfields; k++) {
         unsigned id = d->opt.field_order[k];
         const urrt_field_info *f = urrt_field((urrt_field_id)id);
-        const double *v = field_values(st, id);
+        const double *v = urrt_field_values(st, id);
         for (unsigned i = 0; i < f->count; i++) {
             if (!first) {
                 fputc(',', out);
@@ -427,7 +416,7 @@ static void print_json(const dump *d, FILE *out, const urrt_state *st)
     for (unsigned k = 0; k < n; k++) {
         unsigned id = ids[k];
         const urrt_field_info *f = urrt_field((urrt_field_id)id);
-        const double *v = field_values(st, id);
+        const double *v = urrt_field_values(st, id);
         urrt_enum_kind kind = urrt_field_enum((urrt_field_id)id, st->generation);
         if (!urrt_has(st, id)) {
             continue;
@@ -481,7 +470,7 @@ static void print_table(const dump *d, FILE *out, const urrt_state *st)
     for (unsigned k = 0; k < n; k++) {
         unsigned id = ids[k];
         const urrt_field_info *f = urrt_field((urrt_field_id)id);
-        const double *v = field_values(st, id);
+        const double *v = urrt_field_values(st, id);
         urrt_enum_kind kind = urrt_field_enum((urrt_field_id)id, st->generation);
         fprintf(out, "  %-22s %-10s", f->name, f->unit);
         if (!urrt_has(st, id)) {

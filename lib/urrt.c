@@ -368,6 +368,14 @@ static const double *field_slot_const(const urrt_state *st, unsigned id)
     return (const double *)(const void *)((const unsigned char *)st + field_offsets[id]);
 }
 
+const double *urrt_field_values(const urrt_state *st, urrt_field_id id)
+{
+    if (st == NULL || (unsigned)id >= (unsigned)URRT_FIELD_COUNT) {
+        return NULL;
+    }
+    return field_slot_const(st, (unsigned)id);
+}
+
 static void fill_nan(double *p, unsigned count)
 {
     double nan = double_from_bits(URRT_NAN_BITS);

@@ -194,6 +194,11 @@ typedef struct urrt_state {
 
 #define urrt_has(st, id) ((((st)->present) >> (unsigned)(id)) & 1u)
 
+/* The values of field id in *st (urrt_field(id)->count of them), for code
+ * that selects fields by id (configuration, mappings); NULL for an id out
+ * of range. Absent fields hold NaN, as above. */
+const double *urrt_field_values(const urrt_state *st, urrt_field_id id);
+
 /*
  * Validate the header of a packet in buf (len bytes available). Returns the
  * declared size (>= URRT_PACKET_MIN) or a negative urrt_result. A declared

@@ -9,7 +9,7 @@
 #   bench-can      ns per packet for the CAN mapping beside urrt_decode of the same packet
 
 CANT := $(BUILD)/tests/can
-CAN_TEST_SRCS := gateway/can_map.c gateway/dbc.c
+CAN_TEST_SRCS := gateway/can_map.c gateway/can_run.c gateway/dbc.c
 CAN_TEST_CFLAGS := $(PROG_WARN) $(CPPFLAGS) -Igateway -Itests
 
 CHECKS += check-can check-can-san check-can-dbc
