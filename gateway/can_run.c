@@ -4,6 +4,59 @@
 
 #include <math.h>
 #include <string.h>
+
+/* ---- the heartbeat layout ----------------------------------------------------- */
+
+#define HB_SIG(start_, length_, type_, min_, max_) \
+    {1.0, 0.0, (min_), (max_), 0, (start_), (length_), URRT_CAN_INTEL, (type_), 0}
+
+const struct can_map_hb_signal can_map_heartbeat_layout[CAN_MAP_HB_COUNT] = {
+    [CAN_MAP_HB_STATE] = {"state", HB_SIG(0, 4, URRT_CAN_UNSIGNED, 0, 15), "", CAN_MAP_HB_VALUES_STATE,
+                          "Gateway state: 0 starting, 1 ok, 2 data stale, 3 robot disconnected"},
+    [CAN_MAP_HB_ALIVE] = {"alive_counter", HB_SIG(4, 4, URRT_CAN_UNSIGNED, 0, 15), "", CAN_MAP_HB_VALUES_NONE,
+                          "Incremented (modulo 16) with every heartbeat"},
+    [CAN_MAP_HB_ROBOT_MODE] = {"robot_mode", HB_SIG(8, 8, URRT_CAN_SIGNED, -128, 127), "",
+                               CAN_MAP_HB_VALUES_ROBOT_MODE,
+                               "Robot mode of the heartbeat robot as it sends it (numbering per generation); "
+                               "-128: not available (no data, or older than stale_after_ms)"},
+    [CAN_MAP_HB_SAFETY_MODE] = {"safety_mode", HB_SIG(16, 8, URRT_CAN_UNSIGNED, 0, 255), "",
+                                CAN_MAP_HB_VALUES_SAFETY_MODE,
+                                "Safety mode of the heartbeat robot; 0: not available (1.x, no data, or older "
+                                "than stale_after_ms)"},
+    [CAN_MAP_HB_GENERATION] = {"generation", HB_SIG(24, 2, URRT_CAN_UNSIGNED, 0, 3), "",
+                               CAN_MAP_HB_VALUES_GENERATION,
+                               "Controller generation of the heartbeat robot: 0 unknown, 1 CB1/CB2 (1.x), "
+                               "3 CB3/e-series (3.x/5.x)"},
+    [CAN_MAP_HB_BUS_OFF] = {"bus_off", HB_SIG(26, 1, URRT_CAN_UNSIGNED, 0, 1), "", CAN_MAP_HB_VALUES_FLAG,
+                            "The CAN controller went bus-off since the previous heartbeat"},
+    [CAN_MAP_HB_CAN_ERRORS] = {"can_errors", HB_SIG(27, 1, URRT_CAN_UNSIGNED, 0, 1), "", CAN_MAP_HB_VALUES_FLAG,
+                               "CAN error frames since the previous heartbeat"},
+    [CAN_MAP_HB_CAN_DOWN] = {"can_down", HB_SIG(28, 1, URRT_CAN_UNSIGNED, 0, 1), "", CAN_MAP_HB_VALUES_FLAG,
+                             "The CAN interface went down since the previous heartbeat"},
+    [CAN_MAP_HB_SEND_ERRORS] = {"send_errors", HB_SIG(29, 1, URRT_CAN_UNSIGNED, 0, 1), "",
+                                CAN_MAP_HB_VALUES_FLAG, "Frames refused by the CAN link since the previous heartbeat"},
+    [CAN_MAP_HB_TX_DROPPED] = {"tx_dropped", HB_SIG(30, 1, URRT_CAN_UNSIGNED, 0, 1), "", CAN_MAP_HB_VALUES_FLAG,
+                               "Frames dropped on a full transmit queue since the previous heartbeat"},
+    [CAN_MAP_HB_CLAMPED] = {"clamped", HB_SIG(31, 1, URRT_CAN_UNSIGNED, 0, 1), "", CAN_MAP_HB_VALUES_FLAG,
+                            "A mapped value saturated or was NaN since the previous heartbeat"},
+    [CAN_MAP_HB_DATA_AGE] = {"data_age", HB_SIG(32, 16, URRT_CAN_UNSIGNED, 0, 65535), "ms",
+                             CAN_MAP_HB_VALUES_NONE,
+                             "Age of the heartbeat robot's latest packet, saturated at 65534; 65535: no data yet"},
+    [CAN_MAP_HB_DROPS] = {"drops", HB_SIG(48, 16, URRT_CAN_UNSIGNED, 0, 65535), "", CAN_MAP_HB_VALUES_NONE,
+                          "Frames dropped by the CAN link since start, modulo 65536"},
+};
+
+const char *can_map_state_name(enum can_map_gateway_state state)
+{
+    switch (state) {
+    case CAN_MAP_STATE_STARTING: return "STARTING";
+    case CAN_MAP_STATE_OK: return "OK";
+    case CAN_MAP_STATE_DATA_STALE: return "DATA_STALE";
+    case CAN_MAP_STATE_DISCONNECTED: return "ROBOT_DISCONNECTED";
+    default: return "UNKNOWN";
+    }
+}
+
 /* ---- run time ------------------------------------------------------------------------ */
 
 static const size_t field_offsets[URRT_FIELD_COUNT] = {
