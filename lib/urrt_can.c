@@ -519,16 +519,11 @@ static int finite_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw
     }
 }
 
-int urrt_can_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
+/* urrt_can_to_raw for a descriptor known to be valid. */
+static int to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
 {
     int outcome;
     int raw_outcome;
-    if (sig == NULL || raw == NULL) {
-        return URRT_E_ARG;
-    }
-    if (!descriptor_valid(sig)) {
-        return URRT_CAN_E_SIGNAL;
-    }
     if (value != value) {
         if ((sig->flags & URRT_CAN_SIG_INVALID_RAW) != 0u) {
             *raw = sig->invalid_raw;
@@ -546,6 +541,17 @@ int urrt_can_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
     outcome = clamp_to_limits(sig, &value); /* infinities end here too */
     raw_outcome = finite_to_raw(sig, value, raw);
     return outcome > raw_outcome ? outcome : raw_outcome;
+}
+
+int urrt_can_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
+{
+    if (sig == NULL || raw == NULL) {
+        return URRT_E_ARG;
+    }
+    if (!descriptor_valid(sig)) {
+        return URRT_CAN_E_SIGNAL;
+    }
+    return to_raw(sig, value, raw);
 }
 
 double urrt_can_from_raw(const urrt_can_signal *sig, uint64_t raw)
@@ -601,6 +607,19 @@ int urrt_can_pack(const urrt_can_signal *sig, double value, uint8_t *data, unsig
     }
     (void)move_bits(sig, data, raw, true);
     return outcome;
+}
+
+int urrt_can_pack_checked(const urrt_can_signal *sig, double value, uint8_t *data)
+{
+    uint64_t raw;
+    int outcome = to_raw(sig, value, &raw);
+    (void)move_bits(sig, data, raw, true);
+    return outcome;
+}
+
+void urrt_can_put_raw_checked(const urrt_can_signal *sig, uint64_t raw, uint8_t *data)
+{
+    (void)move_bits(sig, data, raw, true);
 }
 
 int urrt_can_unpack(const urrt_can_signal *sig, const uint8_t *data, unsigned frame_len, double *value)

@@ -1,0 +1,611 @@
+/* SPDX-License-Identifier: MIT */
+/* urrt_cantx: see urrt_cantx.h. Freestanding C99, like urrt.c. */
+#include "urrt_cantx.h"
+
+#include <stdint.h>
+
+#define NAN_BITS UINT64_C(0x7FF8000000000000)
+
+static const urrt_cantx_link zero_link;
+
+static double nan_value(void)
+{
+    union {
+        uint64_t u;
+        double d;
+    } b;
+    b.u = NAN_BITS;
+    return b.d;
+}
+
+const char *urrt_cantx_strerror(int result)
+{
+    switch (result) {
+    case URRT_CANTX_E_SOURCE: return "a signal's source is out of range or of the wrong shape";
+    case URRT_CANTX_E_ROBOT: return "a frame's robot index is out of range";
+    case URRT_CANTX_E_POLICY: return "a frame's stale policy is unknown or needs what the frame lacks";
+    case URRT_CANTX_E_DUPLICATE: return "two frames have the same id";
+    case URRT_CANTX_E_STORAGE: return "the values array is shorter than the tables' signals";
+    default: return urrt_can_strerror(result);
+    }
+}
+
+/* ---- checks, once ------------------------------------------------------------- */
+
+#define NONE SIZE_MAX
+
+static int check_sources(const urrt_cantx_frame *f, size_t *bad_signal)
+{
+    unsigned alive = 0;
+    unsigned valid = 0;
+    size_t i;
+    for (i = 0; i < f->signal_count; i++) {
+        const urrt_cantx_source *src = &f->sources[i];
+        const urrt_can_signal *sig = &f->signals[i];
+        bool ok;
+        switch ((urrt_cantx_kind)src->kind) {
+        case URRT_CANTX_FIELD:
+        case URRT_CANTX_FIELD_MASK: {
+            const urrt_field_info *info = urrt_field((urrt_field_id)src->field);
+            ok = info != NULL && src->elem < info->count;
+            break;
+        }
+        case URRT_CANTX_ALIVE:
+            ok = ++alive == 1u && sig->type == (uint8_t)URRT_CAN_UNSIGNED && sig->length <= 8u;
+            break;
+        case URRT_CANTX_VALID:
+            ok = ++valid == 1u && sig->type == (uint8_t)URRT_CAN_UNSIGNED && sig->length == 1u;
+            break;
+        case URRT_CANTX_FILLED: ok = f->fill != NULL; break;
+        default: ok = false; break;
+        }
+        if (!ok) {
+            *bad_signal = i;
+            return URRT_CANTX_E_SOURCE;
+        }
+    }
+    return 0;
+}
+
+static bool has_kind(const urrt_cantx_frame *f, urrt_cantx_kind kind)
+{
+    size_t i;
+    for (i = 0; i < f->signal_count; i++) {
+        if (f->sources[i].kind == (uint8_t)kind) {
+            return true;
+        }
+    }
+    return false;
+}
+
+static int check_policy(const urrt_cantx_frame *f)
+{
+    switch ((urrt_cantx_stale)f->stale) {
+    case URRT_CANTX_STALE_STOP: return 0;
+    case URRT_CANTX_STALE_INVALID:
+        /* A frame sent per packet stops with the packets: it has no
+         * stale frames to mark. */
+        return has_kind(f, URRT_CANTX_VALID) && f->period_us != URRT_CANTX_EVERY_PACKET ? 0 : URRT_CANTX_E_POLICY;
+    case URRT_CANTX_STALE_IGNORE: return f->period_us != URRT_CANTX_EVERY_PACKET ? 0 : URRT_CANTX_E_POLICY;
+    default: return URRT_CANTX_E_POLICY;
+    }
+}
+
+static int check_frame(const urrt_cantx_tables *t, size_t index, size_t *bad_signal)
+{
+    const urrt_cantx_frame *f = &t->frames[index];
+    bool extended = (f->flags & URRT_CANTX_EXTENDED) != 0u;
+    size_t i;
+    size_t second;
+    int rc;
+    if (!urrt_can_id_valid(f->id, extended)) {
+        return URRT_CAN_E_ID;
+    }
+    if (!urrt_can_length_valid(f->len, (f->flags & URRT_CANTX_FD) != 0u)) {
+        return URRT_CAN_E_FRAME_LENGTH;
+    }
+    if (f->signal_count > 0u && (f->signals == NULL || f->sources == NULL)) {
+        return URRT_E_ARG;
+    }
+    rc = urrt_can_layout_check(f->signals, f->signal_count, f->len, bad_signal, &second);
+    if (rc == 0) {
+        *bad_signal = NONE;
+        rc = check_sources(f, bad_signal);
+    }
+    if (rc < 0) {
+        return rc;
+    }
+    if (f->robot >= t->robot_count) {
+        return URRT_CANTX_E_ROBOT;
+    }
+    rc = check_policy(f);
+    for (i = 0; rc == 0 && i < index; i++) {
+        const urrt_cantx_frame *g = &t->frames[i];
+        if (g->id == f->id && ((g->flags ^ f->flags) & URRT_CANTX_EXTENDED) == 0u) {
+            rc = URRT_CANTX_E_DUPLICATE;
+        }
+    }
+    return rc;
+}
+
+size_t urrt_cantx_value_count(const urrt_cantx_tables *tables)
+{
+    size_t n = 0;
+    size_t i;
+    for (i = 0; tables != NULL && tables->frames != NULL && i < tables->frame_count; i++) {
+        n += tables->frames[i].signal_count;
+    }
+    return n;
+}
+
+int urrt_cantx_init(urrt_cantx *tx, const urrt_cantx_tables *tables, urrt_cantx_frame_state *frame_states,
+                    urrt_cantx_robot *robots, double *values, size_t value_count, size_t *bad_frame,
+                    size_t *bad_signal)
+{
+    size_t frame = NONE;
+    size_t signal = NONE;
+    size_t first = 0;
+    int rc = 0;
+    size_t i;
+    if (tx == NULL || tables == NULL || (tables->frame_count > 0u && (tables->frames == NULL || frame_states == NULL)) ||
+        robots == NULL || tables->robot_count == 0u || tables->robot_count > 255u) {
+        rc = URRT_E_ARG;
+    }
+    for (i = 0; rc == 0 && i < tables->frame_count; i++) {
+        signal = NONE;
+        rc = check_frame(tables, i, &signal);
+        frame = i;
+    }
+    if (rc == 0) {
+        frame = NONE;
+        size_t needed = urrt_cantx_value_count(tables);
+        if (needed > value_count || needed > UINT16_MAX ||
+            (value_count > 0u && values == NULL)) {
+            rc = URRT_CANTX_E_STORAGE;
+        }
+    }
+    if (bad_frame != NULL) {
+        *bad_frame = rc == 0 ? NONE : frame;
+    }
+    if (bad_signal != NULL) {
+        *bad_signal = rc == 0 ? NONE : signal;
+    }
+    if (rc < 0) {
+        return rc;
+    }
+    tx->tables = tables;
+    tx->frames = frame_states;
+    tx->robots = robots;
+    tx->values = values;
+    tx->user = NULL;
+    tx->link = zero_link;
+    tx->link_seen = zero_link;
+    tx->clamped = 0;
+    tx->clamped_seen = 0;
+    for (i = 0; i < tables->frame_count; i++) {
+        frame_states[i].first_value = (uint16_t)first;
+        first += tables->frames[i].signal_count;
+    }
+    tx->started = false;
+    return 0;
+}
+
+/* ---- values in, payloads out -------------------------------------------------- */
+
+static double field_value(const urrt_state *st, const urrt_cantx_source *src)
+{
+    double v;
+    uint64_t mask;
+    if (st == NULL || !urrt_has(st, src->field)) {
+        return nan_value();
+    }
+    v = urrt_field_values(st, (urrt_field_id)src->field)[src->elem];
+    if (src->kind != (uint8_t)URRT_CANTX_FIELD_MASK) {
+        return v;
+    }
+    return urrt_bitmask(v, &mask) < 0 ? nan_value() : (double)mask;
+}
+
+/* A packet costs these loads only: the values are packed once, when the
+ * frame next goes out (or a heartbeat reports clamping). */
+static void take_fields(urrt_cantx *tx, size_t index, const urrt_state *st)
+{
+    const urrt_cantx_frame *f = &tx->tables->frames[index];
+    urrt_cantx_frame_state *fs = &tx->frames[index];
+    double *values = tx->values + fs->first_value;
+    size_t i;
+    for (i = 0; i < f->signal_count; i++) {
+        uint8_t kind = f->sources[i].kind;
+        if (kind == (uint8_t)URRT_CANTX_FIELD || kind == (uint8_t)URRT_CANTX_FIELD_MASK) {
+            values[i] = field_value(st, &f->sources[i]);
+        }
+    }
+    fs->unpacked = true;
+}
+
+static void pack_fields(urrt_cantx *tx, size_t index)
+{
+    const urrt_cantx_frame *f = &tx->tables->frames[index];
+    urrt_cantx_frame_state *fs = &tx->frames[index];
+    const double *values = tx->values + fs->first_value;
+    int worst = URRT_CAN_PACK_OK;
+    size_t i;
+    if (!fs->unpacked) {
+        return;
+    }
+    fs->unpacked = false;
+    for (i = 0; i < f->len; i++) {
+        fs->payload[i] = 0;
+    }
+    for (i = 0; i < f->signal_count; i++) {
+        uint8_t kind = f->sources[i].kind;
+        int outcome;
+        if (kind != (uint8_t)URRT_CANTX_FIELD && kind != (uint8_t)URRT_CANTX_FIELD_MASK) {
+            continue;
+        }
+        outcome = urrt_can_pack_checked(&f->signals[i], values[i], fs->payload);
+        if (outcome != URRT_CAN_PACK_OK) {
+            tx->clamped++;
+            worst = outcome > worst ? outcome : worst;
+        }
+    }
+    fs->outcome = (int8_t)worst;
+}
+
+/* The frame as it goes out at now_us: the packed fields, then the filled
+ * values, the alive counter and the validity bit. */
+static void build(urrt_cantx *tx, size_t index, uint64_t now_us, bool fresh, bool sending, urrt_can_frame *out)
+{
+    const urrt_cantx_frame *f = &tx->tables->frames[index];
+    urrt_cantx_frame_state *fs = &tx->frames[index];
+    double *values = tx->values + fs->first_value;
+    bool valid;
+    size_t i;
+    pack_fields(tx, index);
+    valid = fresh && fs->outcome == URRT_CAN_PACK_OK;
+    out->id = f->id;
+    out->extended = (f->flags & URRT_CANTX_EXTENDED) != 0u;
+    out->fd = (f->flags & URRT_CANTX_FD) != 0u;
+    out->len = f->len;
+    for (i = 0; i < URRT_CAN_MAX_LEN; i++) {
+        out->data[i] = i < f->len ? fs->payload[i] : 0u;
+    }
+    if (f->fill != NULL) {
+        f->fill(tx, index, now_us, sending, values);
+    }
+    for (i = 0; i < f->signal_count; i++) {
+        const urrt_can_signal *sig = &f->signals[i];
+        switch ((urrt_cantx_kind)f->sources[i].kind) {
+        case URRT_CANTX_ALIVE: urrt_can_put_raw_checked(sig, fs->alive, out->data); break;
+        case URRT_CANTX_VALID: urrt_can_put_raw_checked(sig, valid ? 1u : 0u, out->data); break;
+        case URRT_CANTX_FILLED: (void)urrt_can_pack_checked(sig, values[i], out->data); break;
+        default: break;
+        }
+    }
+}
+
+static void send_frame(urrt_cantx *tx, size_t index, uint64_t now_us, bool fresh, urrt_cantx_emit_fn emit, void *ctx)
+{
+    urrt_cantx_frame_state *fs = &tx->frames[index];
+    urrt_can_frame out;
+    build(tx, index, now_us, fresh, true, &out);
+    fs->alive++;
+    fs->sent++;
+    fs->sent_invalid += !(fresh && fs->outcome == URRT_CAN_PACK_OK);
+    if (emit != NULL) {
+        emit(ctx, &out, now_us);
+    }
+}
+
+void urrt_cantx_peek(urrt_cantx *tx, size_t frame, uint64_t now_us, urrt_can_frame *out)
+{
+    const urrt_cantx_frame *f;
+    if (tx == NULL || out == NULL || frame >= tx->tables->frame_count) {
+        return;
+    }
+    f = &tx->tables->frames[frame];
+    build(tx, frame, now_us, urrt_cantx_fresh(tx, f->robot, now_us, f->stale_after_us), false, out);
+}
+
+/* ---- the schedule ------------------------------------------------------------- */
+
+
+void urrt_cantx_start(urrt_cantx *tx, uint64_t now_us)
+{
+    const urrt_cantx_tables *t = tx->tables;
+    size_t i;
+    tx->started = true;
+    tx->start_us = now_us;
+    for (i = 0; i < t->robot_count; i++) {
+        urrt_cantx_robot *r = &tx->robots[i];
+        r->has_data = false;
+        r->up = false;
+        r->data_us = 0;
+        r->robot_mode = nan_value();
+        r->safety_mode = nan_value();
+        r->generation = (uint8_t)URRT_GEN_UNKNOWN;
+    }
+    for (i = 0; i < t->frame_count; i++) {
+        const urrt_cantx_frame *f = &t->frames[i];
+        urrt_cantx_frame_state *fs = &tx->frames[i];
+        take_fields(tx, i, NULL);
+        pack_fields(tx, i);
+        fs->pending = false;
+        fs->alive = 0;
+        fs->sent = 0;
+        fs->sent_invalid = 0;
+        fs->stale_stops = 0;
+        fs->stopped = f->stale == (uint8_t)URRT_CANTX_STALE_STOP;
+        fs->next_due_us = f->period_us == URRT_CANTX_EVERY_PACKET || fs->stopped ? URRT_CANTX_NEVER : now_us;
+    }
+    tx->clamped = 0; /* the NaNs above are no packet's values */
+    tx->clamped_seen = 0;
+    tx->link_seen = zero_link; /* the first heartbeat reports what came before */
+}
+
+void urrt_cantx_robot_link(urrt_cantx *tx, size_t robot, bool up)
+{
+    if (tx != NULL && robot < tx->tables->robot_count) {
+        tx->robots[robot].up = up;
+    }
+}
+
+void urrt_cantx_set_link(urrt_cantx *tx, const urrt_cantx_link *link)
+{
+    if (tx != NULL && link != NULL) {
+        tx->link = *link;
+    }
+}
+
+void urrt_cantx_on_packet(urrt_cantx *tx, size_t robot, const urrt_state *st, uint64_t data_us)
+{
+    const urrt_cantx_tables *t;
+    urrt_cantx_robot *r;
+    size_t i;
+    if (tx == NULL || st == NULL || robot >= tx->tables->robot_count) {
+        return;
+    }
+    t = tx->tables;
+    if (!tx->started) {
+        urrt_cantx_start(tx, data_us);
+    }
+    r = &tx->robots[robot];
+    r->has_data = true;
+    r->up = true;
+    r->data_us = data_us;
+    r->robot_mode = urrt_has(st, URRT_F_ROBOT_MODE) ? st->robot_mode[0] : nan_value();
+    r->safety_mode = urrt_has(st, URRT_F_SAFETY_MODE) ? st->safety_mode[0] : nan_value();
+    r->generation = (uint8_t)st->generation;
+    for (i = 0; i < t->frame_count; i++) {
+        urrt_cantx_frame_state *fs = &tx->frames[i];
+        if (t->frames[i].robot != robot) {
+            continue;
+        }
+        take_fields(tx, i, st);
+        if (t->frames[i].period_us == URRT_CANTX_EVERY_PACKET) {
+            fs->pending = true;
+        } else if (fs->stopped) {
+            /* Fresh data again: resume now, then keep the period. */
+            fs->stopped = false;
+            fs->next_due_us = data_us;
+        }
+    }
+}
+
+bool urrt_cantx_fresh(const urrt_cantx *tx, size_t robot, uint64_t now_us, uint32_t max_age_us)
+{
+    const urrt_cantx_robot *r;
+    if (tx == NULL || robot >= tx->tables->robot_count) {
+        return false;
+    }
+    r = &tx->robots[robot];
+    return r->has_data && (now_us < r->data_us || now_us - r->data_us <= max_age_us);
+}
+
+/* A frame sent per packet goes out once per packet, while that packet is
+ * fresh: one that waited past its bound (the CAN link was down) is dropped. */
+static size_t run_every(urrt_cantx *tx, size_t i, uint64_t now_us, bool fresh, urrt_cantx_emit_fn emit, void *ctx)
+{
+    urrt_cantx_frame_state *fs = &tx->frames[i];
+    if (!fs->pending) {
+        return 0;
+    }
+    fs->pending = false;
+    if (!fresh) {
+        fs->stale_stops++;
+        return 0;
+    }
+    send_frame(tx, i, now_us, true, emit, ctx);
+    return 1;
+}
+
+static size_t run_periodic(urrt_cantx *tx, size_t i, uint64_t now_us, bool fresh, urrt_cantx_emit_fn emit,
+                           void *ctx)
+{
+    const urrt_cantx_frame *f = &tx->tables->frames[i];
+    urrt_cantx_frame_state *fs = &tx->frames[i];
+    if (fs->next_due_us == URRT_CANTX_NEVER || now_us < fs->next_due_us) {
+        return 0;
+    }
+    if (!fresh && f->stale == (uint8_t)URRT_CANTX_STALE_STOP) {
+        fs->stopped = true;
+        fs->stale_stops++;
+        fs->next_due_us = URRT_CANTX_NEVER;
+        return 0;
+    }
+    send_frame(tx, i, now_us, fresh, emit, ctx);
+    /* Keep the cadence; after a stall, skip the missed slots rather than
+     * send a burst. */
+    fs->next_due_us += f->period_us;
+    if (fs->next_due_us <= now_us) {
+        fs->next_due_us = now_us + f->period_us;
+    }
+    return 1;
+}
+
+size_t urrt_cantx_run(urrt_cantx *tx, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    size_t sent = 0;
+    size_t i;
+    if (tx == NULL) {
+        return 0;
+    }
+    if (!tx->started) {
+        urrt_cantx_start(tx, now_us);
+    }
+    for (i = 0; i < tx->tables->frame_count; i++) {
+        const urrt_cantx_frame *f = &tx->tables->frames[i];
+        bool fresh = urrt_cantx_fresh(tx, f->robot, now_us, f->stale_after_us);
+        sent += f->period_us == URRT_CANTX_EVERY_PACKET ? run_every(tx, i, now_us, fresh, emit, ctx)
+                                                         : run_periodic(tx, i, now_us, fresh, emit, ctx);
+    }
+    return sent;
+}
+
+uint64_t urrt_cantx_deadline(const urrt_cantx *tx)
+{
+    uint64_t next = URRT_CANTX_NEVER;
+    size_t i;
+    if (tx == NULL || !tx->started) {
+        return URRT_CANTX_NEVER;
+    }
+    for (i = 0; i < tx->tables->frame_count; i++) {
+        const urrt_cantx_frame_state *fs = &tx->frames[i];
+        if (fs->pending) {
+            return 0; /* now */
+        }
+        next = fs->next_due_us < next ? fs->next_due_us : next;
+    }
+    return next;
+}
+
+/* ---- the heartbeat ------------------------------------------------------------ */
+
+#define HB_SIG(start_, length_, type_, min_, max_) \
+    {1.0, 0.0, (min_), (max_), 0, (start_), (length_), URRT_CAN_INTEL, (type_), 0}
+
+const urrt_can_signal urrt_cantx_heartbeat_signals[URRT_CANTX_HB_COUNT] = {
+    [URRT_CANTX_HB_STATE] = HB_SIG(0, 4, URRT_CAN_UNSIGNED, 0, 15),
+    [URRT_CANTX_HB_ALIVE] = HB_SIG(4, 4, URRT_CAN_UNSIGNED, 0, 15),
+    [URRT_CANTX_HB_ROBOT_MODE] = HB_SIG(8, 8, URRT_CAN_SIGNED, -128, 127),
+    [URRT_CANTX_HB_SAFETY_MODE] = HB_SIG(16, 8, URRT_CAN_UNSIGNED, 0, 255),
+    [URRT_CANTX_HB_GENERATION] = HB_SIG(24, 2, URRT_CAN_UNSIGNED, 0, 3),
+    [URRT_CANTX_HB_BUS_OFF] = HB_SIG(26, 1, URRT_CAN_UNSIGNED, 0, 1),
+    [URRT_CANTX_HB_CAN_ERRORS] = HB_SIG(27, 1, URRT_CAN_UNSIGNED, 0, 1),
+    [URRT_CANTX_HB_CAN_DOWN] = HB_SIG(28, 1, URRT_CAN_UNSIGNED, 0, 1),
+    [URRT_CANTX_HB_SEND_ERRORS] = HB_SIG(29, 1, URRT_CAN_UNSIGNED, 0, 1),
+    [URRT_CANTX_HB_TX_DROPPED] = HB_SIG(30, 1, URRT_CAN_UNSIGNED, 0, 1),
+    [URRT_CANTX_HB_CLAMPED] = HB_SIG(31, 1, URRT_CAN_UNSIGNED, 0, 1),
+    [URRT_CANTX_HB_DATA_AGE] = HB_SIG(32, 16, URRT_CAN_UNSIGNED, 0, 65535),
+    [URRT_CANTX_HB_DROPS] = HB_SIG(48, 16, URRT_CAN_UNSIGNED, 0, 65535),
+};
+
+#define FILLED {(uint8_t)URRT_CANTX_FILLED, 0, 0}
+const urrt_cantx_source urrt_cantx_heartbeat_sources[URRT_CANTX_HB_COUNT] = {
+    FILLED, {(uint8_t)URRT_CANTX_ALIVE, 0, 0}, FILLED, FILLED, FILLED, FILLED, FILLED,
+    FILLED, FILLED, FILLED, FILLED, FILLED, FILLED,
+};
+
+const char *urrt_cantx_state_name(urrt_cantx_state state)
+{
+    switch (state) {
+    case URRT_CANTX_STARTING: return "STARTING";
+    case URRT_CANTX_OK: return "OK";
+    case URRT_CANTX_DATA_STALE: return "DATA_STALE";
+    case URRT_CANTX_DISCONNECTED: return "ROBOT_DISCONNECTED";
+    default: return "UNKNOWN";
+    }
+}
+
+static urrt_cantx_state robot_state(const urrt_cantx *tx, size_t i, uint64_t now_us, uint32_t stale_after_us)
+{
+    const urrt_cantx_robot *r = &tx->robots[i];
+    bool starting = tx->started && now_us - tx->start_us < tx->tables->startup_us;
+    if (!r->has_data) {
+        return starting ? URRT_CANTX_STARTING : r->up ? URRT_CANTX_DATA_STALE : URRT_CANTX_DISCONNECTED;
+    }
+    if (!r->up) {
+        return URRT_CANTX_DISCONNECTED;
+    }
+    return urrt_cantx_fresh(tx, i, now_us, stale_after_us) ? URRT_CANTX_OK : URRT_CANTX_DATA_STALE;
+}
+
+/* Severity: disconnected, stale, starting, ok. */
+static unsigned severity(urrt_cantx_state s)
+{
+    switch (s) {
+    case URRT_CANTX_DISCONNECTED: return 3;
+    case URRT_CANTX_DATA_STALE: return 2;
+    case URRT_CANTX_STARTING: return 1;
+    default: return 0;
+    }
+}
+
+urrt_cantx_state urrt_cantx_gateway_state(const urrt_cantx *tx, size_t hb, uint64_t now_us)
+{
+    urrt_cantx_state worst = URRT_CANTX_OK;
+    uint32_t stale_after_us;
+    size_t i;
+    if (tx == NULL || hb >= tx->tables->frame_count) {
+        return URRT_CANTX_STARTING;
+    }
+    stale_after_us = tx->tables->frames[hb].stale_after_us;
+    for (i = 0; i < tx->tables->robot_count; i++) {
+        urrt_cantx_state s = robot_state(tx, i, now_us, stale_after_us);
+        worst = severity(s) > severity(worst) ? s : worst;
+    }
+    return worst;
+}
+
+/* v if it is an integer in [lo, hi], else na. */
+static double enum_or(double v, double lo, double hi, double na)
+{
+    if (!(v >= lo && v <= hi) || v != (double)(long)v) {
+        return na;
+    }
+    return v;
+}
+
+static double age_ms(const urrt_cantx_robot *r, uint64_t now_us)
+{
+    uint64_t age_us = now_us > r->data_us ? now_us - r->data_us : 0u;
+    uint32_t saturated_us = (URRT_CANTX_HB_AGE_NA - 1u) * 1000u;
+    if (!r->has_data) {
+        return URRT_CANTX_HB_AGE_NA;
+    }
+    /* A 32-bit division: a Cortex-M0 has no 64-bit one in hardware. */
+    return age_us >= saturated_us ? URRT_CANTX_HB_AGE_NA - 1u : (double)((uint32_t)age_us / 1000u);
+}
+
+void urrt_cantx_heartbeat_fill(urrt_cantx *tx, size_t frame, uint64_t now_us, bool sending, double *values)
+{
+    const urrt_cantx_frame *f = &tx->tables->frames[frame];
+    const urrt_cantx_robot *r = &tx->robots[f->robot];
+    const urrt_cantx_link *now = &tx->link;
+    const urrt_cantx_link *seen = &tx->link_seen;
+    /* Modes as old as stale data are not the robot's modes now. */
+    bool current = urrt_cantx_fresh(tx, f->robot, now_us, f->stale_after_us);
+    size_t i;
+    /* The clamped flag covers every value taken so far. */
+    for (i = 0; i < tx->tables->frame_count; i++) {
+        pack_fields(tx, i);
+    }
+    values[URRT_CANTX_HB_STATE] = urrt_cantx_gateway_state(tx, frame, now_us);
+    values[URRT_CANTX_HB_ROBOT_MODE] =
+        current ? enum_or(r->robot_mode, -127, 127, URRT_CANTX_HB_ROBOT_MODE_NA) : URRT_CANTX_HB_ROBOT_MODE_NA;
+    values[URRT_CANTX_HB_SAFETY_MODE] =
+        current ? enum_or(r->safety_mode, 1, 255, URRT_CANTX_HB_SAFETY_MODE_NA) : URRT_CANTX_HB_SAFETY_MODE_NA;
+    values[URRT_CANTX_HB_GENERATION] = r->generation;
+    values[URRT_CANTX_HB_BUS_OFF] = now->bus_off != seen->bus_off;
+    values[URRT_CANTX_HB_CAN_ERRORS] = now->error_frames != seen->error_frames;
+    values[URRT_CANTX_HB_CAN_DOWN] = now->down_events != seen->down_events;
+    values[URRT_CANTX_HB_SEND_ERRORS] = now->send_errors != seen->send_errors;
+    values[URRT_CANTX_HB_TX_DROPPED] = now->dropped != seen->dropped;
+    values[URRT_CANTX_HB_CLAMPED] = tx->clamped != tx->clamped_seen;
+    values[URRT_CANTX_HB_DATA_AGE] = age_ms(r, now_us);
+    values[URRT_CANTX_HB_DROPS] = (double)(uint16_t)now->dropped;
+    if (sending) {
+        tx->link_seen = tx->link;
+        tx->clamped_seen = tx->clamped;
+    }
+}
