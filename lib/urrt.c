@@ -260,22 +260,138 @@ static bool plausible_length(uint32_t size)
     return size >= URRT_PACKET_MIN && size <= URRT_PACKET_MAX && (size - URRT_HEADER_SIZE) % 8u == 0;
 }
 
+/* The rates of protocol-facts.md: 125 Hz on CB2/CB3 (and so 1.5 on CB1), 500 Hz on e-series. */
+#define CB_US 8000u
+#define E_US 2000u
+
+static const urrt_controller controller_table[] = {
+    {540, {{0, 0, 0, 0}, {0, 0, 0, 0}}, "early 1.x (before 1.5)"},
+    {692, {{0, 0, 0, 0}, {0, 0, 0, 0}}, "early 1.x (before 1.5)"},
+    {756, {{1, 5, 6, CB_US}, {0, 0, 0, 0}}, "1.5-1.6"},
+    {764, {{1, 6, 7, CB_US}, {0, 0, 0, 0}}, "1.6-1.7"},
+    {812, {{1, 8, 8, CB_US}, {0, 0, 0, 0}}, "1.8"},
+    {1044, {{3, 0, 1, CB_US}, {0, 0, 0, 0}}, "3.0-3.1"},
+    {1060, {{3, 2, 4, CB_US}, {0, 0, 0, 0}}, "3.2-3.4"},
+    {1108, {{3, 5, 9, CB_US}, {5, 0, 3, E_US}}, "3.5-3.9, 5.0-5.3"},
+    {1116, {{3, 10, 13, CB_US}, {5, 4, 8, E_US}}, "3.10-3.13, 5.4-5.8"},
+    {1140, {{3, 14, 15, CB_US}, {5, 9, 9, E_US}}, "3.14-3.15, 5.9"},
+    {1220, {{5, 10, URRT_MINOR_LATER, E_US}, {0, 0, 0, 0}}, "5.10 or later"},
+};
+#define CONTROLLER_ROWS (sizeof controller_table / sizeof controller_table[0])
+#define RANGES_PER_ROW (sizeof controller_table[0].ranges / sizeof controller_table[0].ranges[0])
+
+const urrt_controller *urrt_controllers(size_t *count)
+{
+    if (count != NULL) {
+        *count = CONTROLLER_ROWS;
+    }
+    return controller_table;
+}
+
+const urrt_controller *urrt_controller_of_length(uint32_t length)
+{
+    size_t i;
+    for (i = 0; i < CONTROLLER_ROWS; i++) {
+        if (controller_table[i].length == length) {
+            return &controller_table[i];
+        }
+    }
+    return NULL;
+}
+
 const char *urrt_versions_of(uint32_t length)
 {
-    switch (length) {
-    case 540:
-    case 692: return "early 1.x (before 1.5)";
-    case 756: return "1.5-1.6";
-    case 764: return "1.6-1.7";
-    case 812: return "1.8";
-    case 1044: return "3.0-3.1";
-    case 1060: return "3.2-3.4";
-    case 1108: return "3.5-3.9, 5.0-5.3";
-    case 1116: return "3.10-3.13, 5.4-5.8";
-    case 1140: return "3.14-3.15, 5.9";
-    case 1220: return "5.10 or later";
-    default: return NULL;
+    const urrt_controller *c = urrt_controller_of_length(length);
+    return c != NULL ? c->versions : NULL;
+}
+
+/* One group of decimal digits at *pos, its value capped at 255 (no version
+ * number comes near it). False for an empty group. */
+static bool version_number(const char *text, size_t len, size_t *pos, unsigned *value)
+{
+    size_t start = *pos;
+    *value = 0;
+    while (*pos < len && text[*pos] >= '0' && text[*pos] <= '9') {
+        unsigned v = *value * 10u + (unsigned)(text[*pos] - '0');
+        *value = v > 255u ? 255u : v;
+        (*pos)++;
     }
+    return *pos > start;
+}
+
+/* MAJOR.MINOR[.PATCH[.BUILD]]: the first two numbers decide. */
+static bool parse_version(const char *text, size_t len, unsigned *major, unsigned *minor)
+{
+    size_t pos = 0;
+    unsigned groups = 0, ignored;
+    if (!version_number(text, len, &pos, major)) {
+        return false;
+    }
+    while (pos < len && groups < 3u && text[pos] == '.') {
+        pos++;
+        if (!version_number(text, len, &pos, groups == 0 ? minor : &ignored)) {
+            return false;
+        }
+        groups++;
+    }
+    return pos == len && groups >= 1u;
+}
+
+static bool range_holds(const urrt_version_range *r, unsigned major, unsigned minor)
+{
+    return r->major != 0 && r->major == major && minor >= r->minor_first &&
+           (r->minor_last == URRT_MINOR_LATER || minor <= r->minor_last);
+}
+
+int urrt_controller_find(const char *text, size_t len, const urrt_controller **found, size_t max,
+                         uint32_t *period_us)
+{
+    unsigned major, minor;
+    size_t i, j;
+    int rows = 0;
+    if (text == NULL || !parse_version(text, len, &major, &minor)) {
+        return URRT_E_ARG;
+    }
+    for (i = 0; i < CONTROLLER_ROWS; i++) {
+        for (j = 0; j < RANGES_PER_ROW; j++) {
+            const urrt_version_range *r = &controller_table[i].ranges[j];
+            if (!range_holds(r, major, minor)) {
+                continue;
+            }
+            if (found != NULL && (size_t)rows < max) {
+                found[rows] = &controller_table[i];
+            }
+            if (period_us != NULL) {
+                *period_us = r->period_us;
+            }
+            rows++;
+        }
+    }
+    return rows;
+}
+
+uint32_t urrt_period_min_us(uint32_t length)
+{
+    const urrt_controller *own = urrt_controller_of_length(length);
+    urrt_generation gen = urrt_generation_of(length);
+    uint32_t best = 0;
+    size_t i, j;
+    if (own != NULL && own->ranges[0].major == 0) {
+        own = NULL; /* early 1.x: no versions to ask, ask the generation */
+    }
+    for (i = 0; i < CONTROLLER_ROWS; i++) {
+        const urrt_controller *c = &controller_table[i];
+        if (own != NULL ? c != own : gen != URRT_GEN_UNKNOWN && urrt_generation_of(c->length) != gen) {
+            continue;
+        }
+        for (j = 0; j < RANGES_PER_ROW; j++) {
+            uint32_t p = c->ranges[j].period_us;
+            if (c->ranges[j].major != 0 && (best == 0 || p < best)) {
+                best = p;
+            }
+        }
+    }
+    return best;
 }
 
 urrt_generation urrt_generation_of(uint32_t length)
@@ -856,6 +972,79 @@ int urrt_encode(const urrt_state *st, uint32_t length, uint8_t *out, size_t out_
     return (int)length;
 }
 
+/* ---- controller time ------------------------------------------------------ */
+
+/* A 128-bit unsigned number as two words: enough for a 53-bit mantissa
+ * times 15625 (2^67). */
+typedef struct {
+    uint64_t hi, lo;
+} wide_u128;
+
+static void wide_add(wide_u128 *w, uint64_t hi, uint64_t lo)
+{
+    w->lo += lo;
+    w->hi += hi + (w->lo < lo ? 1u : 0u);
+}
+
+/* x * 15625 (10^6 = 15625 * 2^6), x < 2^53, by shifts and adds: a 64-bit
+ * multiply is a libgcc call on Cortex-M0+ (Thumb-1 has no long multiply). */
+static wide_u128 times_15625(uint64_t x)
+{
+    static const unsigned char shifts[] = {13, 12, 11, 10, 8, 3}; /* 15625 = 0b11110100001001 */
+    wide_u128 w = {0, x};
+    unsigned i;
+    for (i = 0; i < sizeof shifts; i++) {
+        wide_add(&w, x >> (64u - shifts[i]), x << shifts[i]);
+    }
+    return w;
+}
+
+int urrt_time_us(double seconds, int64_t *us)
+{
+    const uint64_t max = (uint64_t)URRT_TIME_US_MAX;
+    uint64_t u = bits_from_double(seconds);
+    unsigned exponent = (unsigned)((u >> 52) & 0x7FFu);
+    uint64_t mantissa = u & ((UINT64_C(1) << 52) - 1u);
+    int shift; /* microseconds = mantissa * 15625 * 2^shift */
+    wide_u128 w;
+    uint64_t result;
+
+    if (us == NULL) {
+        return URRT_E_ARG;
+    }
+    if ((exponent == 0x7FFu && mantissa != 0) || ((u >> 63) != 0 && (u << 1) != 0)) {
+        *us = 0; /* NaN, or below zero (-0.0 is zero) */
+        return URRT_E_RANGE;
+    }
+    if (exponent >= 1023u + 34u) {
+        *us = URRT_TIME_US_MAX; /* 2^34 s and up, infinity included: past the maximum */
+        return URRT_E_RANGE;
+    }
+    if (exponent != 0) {
+        mantissa |= UINT64_C(1) << 52;
+    }
+    /* Below 2^34 s the shift is negative: 1075 - 6 - 34 = 1035 of it at most. */
+    shift = (exponent != 0 ? (int)exponent : 1) - 1075 + 6;
+    if (shift < -68) {
+        result = 0; /* below half a microsecond: mantissa * 15625 < 2^67 */
+    } else {
+        unsigned s = (unsigned)-shift; /* 13..68: add a half, then shift */
+        w = times_15625(mantissa);
+        if (s - 1u < 64u) {
+            wide_add(&w, 0, UINT64_C(1) << (s - 1u));
+        } else {
+            wide_add(&w, UINT64_C(1) << (s - 65u), 0);
+        }
+        result = s >= 64u ? w.hi >> (s - 64u) : (w.lo >> s) | (w.hi << (64u - s));
+    }
+    if (result > max) {
+        *us = URRT_TIME_US_MAX;
+        return URRT_E_RANGE;
+    }
+    *us = (int64_t)result;
+    return URRT_OK;
+}
+
 /* ---- bit masks and enumerations ------------------------------------------ */
 
 int urrt_bitmask(double value, uint64_t *mask)
@@ -1030,7 +1219,7 @@ static bool header_acceptable(const urrt_framer *fr, uint32_t size)
     if (fr->last_length == 0 && !fr->out_of_sync) {
         return true;
     }
-    return urrt_versions_of(size) != NULL;
+    return urrt_controller_of_length(size) != NULL;
 }
 
 static void reject_byte(urrt_framer *fr)

@@ -210,9 +210,74 @@ int urrt_packet_length(const uint8_t *buf, size_t len);
  * URRT_GEN_UNKNOWN. */
 urrt_generation urrt_generation_of(uint32_t length);
 
-/* Controller software versions a size implies ("3.10-3.13, 5.4-5.8"), or
- * NULL for a size no known controller sends. */
+/*
+ * Controller software versions, the one table of what each sends: one row
+ * per message size, with the versions that send it as text and as numbers,
+ * and the period each sends it at (125 Hz on CB1-CB3, 500 Hz on e-series).
+ * docs/protocol.md gives the sources.
+ *
+ * 1.6 controllers sent 756 or 764 bytes (the sources disagree), so 1.6 is
+ * in two rows and urrt_controller_find() reports both: callers refuse the
+ * version and name the candidate sizes, never pick one.
+ */
+#define URRT_MINOR_LATER 255u /* minor_last: and every later minor */
+
+typedef struct urrt_version_range {
+    uint8_t major;       /* 1, 3 or 5; 0 marks an unused slot */
+    uint8_t minor_first;
+    uint8_t minor_last;  /* URRT_MINOR_LATER: no upper end */
+    uint16_t period_us;  /* 8000 (125 Hz) or 2000 (500 Hz, e-series) */
+} urrt_version_range;
+
+/* The text is held in the row, not pointed to: a pointer would bring the
+ * whole string pool of urrt.c (field names and descriptions, ~3 KiB) into a
+ * firmware whose framer looks up lengths in this table. */
+typedef struct urrt_controller {
+    uint32_t length;
+    urrt_version_range ranges[2];     /* none for the sizes of early 1.x */
+    char versions[24];                /* "3.5-3.9, 5.0-5.3": the ranges as text */
+} urrt_controller;
+
+/* The table, in increasing length; *count receives the number of rows. */
+const urrt_controller *urrt_controllers(size_t *count);
+
+/* The row of a message size, NULL for a size no known controller sends. */
+const urrt_controller *urrt_controller_of_length(uint32_t length);
+
+/* Its versions as text ("3.10-3.13, 5.4-5.8"), or NULL: a view of the table. */
 const char *urrt_versions_of(uint32_t length);
+
+/*
+ * The rows that list a controller version given as text of len bytes,
+ * MAJOR.MINOR with an optional .PATCH (and .BUILD), digits only ("5.10",
+ * "3.15.4"): writes up to max of them to found and the period that version
+ * sends at to *period_us (either may be NULL). Returns the number of rows:
+ * 0 for a version no row lists, 1, or 2 where the sources disagree (1.6:
+ * 756 or 764 bytes). URRT_E_ARG for text that is not a version.
+ */
+int urrt_controller_find(const char *text, size_t len, const urrt_controller **found, size_t max,
+                         uint32_t *period_us);
+
+/*
+ * The shortest period, in microseconds, at which packets of a size come:
+ * of the versions that send it; for a size no version is known to send (or
+ * 0, "any"), of every version of the size's generation (of all versions for
+ * URRT_GEN_UNKNOWN). A scheduler that must keep up with a robot plans for it.
+ */
+uint32_t urrt_period_min_us(uint32_t length);
+
+/*
+ * The controller's clock (column 1, seconds since it started) in whole
+ * microseconds, rounded to nearest (halves away from zero), computed on the
+ * bits (no floating-point arithmetic). Returns URRT_OK with the value, or
+ * URRT_E_RANGE with it saturated: 0 for NaN and negative times, which no
+ * controller sends, and URRT_TIME_US_MAX for times past it (285 years:
+ * about where a double stops resolving a microsecond; the headroom to
+ * INT64_MAX lets callers add periods without overflow). Callers that need a
+ * trustworthy clock check the result; callers that need a number take it.
+ */
+#define URRT_TIME_US_MAX (INT64_C(1) << 53)
+int urrt_time_us(double seconds, int64_t *us);
 
 /*
  * Decode the packet at buf into *st. Returns the packet's size (bytes

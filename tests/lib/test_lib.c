@@ -1216,6 +1216,141 @@ static void test_vector_width(void)
 #endif
 }
 
+/* ---- controller versions and time ---------------------------------------- */
+
+/* Every version of protocol-facts.md's length table, with its size and rate
+ * (125 Hz on CB2/CB3, 500 Hz on e-series), typed here from that page. */
+static const struct {
+    const char *version;
+    uint32_t length;
+    uint32_t period_us;
+} version_facts[] = {
+    {"1.5", 756, 8000},   {"1.7", 764, 8000},   {"1.8", 812, 8000},    {"3.0", 1044, 8000},
+    {"3.1", 1044, 8000},  {"3.2", 1060, 8000},  {"3.4", 1060, 8000},   {"3.5", 1108, 8000},
+    {"3.9", 1108, 8000},  {"5.0", 1108, 2000},  {"5.3", 1108, 2000},   {"3.10", 1116, 8000},
+    {"3.13", 1116, 8000}, {"5.4", 1116, 2000},  {"5.8", 1116, 2000},   {"3.14", 1140, 8000},
+    {"3.15", 1140, 8000}, {"5.9", 1140, 2000},  {"5.10", 1220, 2000},  {"5.25", 1220, 2000},
+    {"3.15.4", 1140, 8000}, {"5.10.1.2", 1220, 2000}, {"5.300", 1220, 2000},
+};
+
+static void test_controller_versions(void)
+{
+    for (size_t i = 0; i < sizeof version_facts / sizeof version_facts[0]; i++) {
+        const urrt_controller *found[2] = {NULL, NULL};
+        uint32_t period = 0;
+        const char *v = version_facts[i].version;
+        int n = urrt_controller_find(v, strlen(v), found, 2, &period);
+        CHECK(n == 1 && found[0] != NULL && found[0]->length == version_facts[i].length,
+              "version %s: %d rows, length %u, expected %u", v, n, found[0] ? found[0]->length : 0,
+              version_facts[i].length);
+        CHECK(period == version_facts[i].period_us, "version %s: period %u us, expected %u", v, period,
+              version_facts[i].period_us);
+    }
+    /* 1.6: the sources say 756 or 764; both are reported, in length order. */
+    {
+        const urrt_controller *found[2] = {NULL, NULL};
+        uint32_t period = 0;
+        CHECK_EQ_INT(urrt_controller_find("1.6", 3, found, 2, &period), 2);
+        CHECK(found[0] && found[1] && found[0]->length == 756 && found[1]->length == 764, "1.6: 756 and 764");
+        CHECK(period == 8000, "1.6: period %u", period);
+        CHECK_EQ_INT(urrt_controller_find("1.6", 3, found, 1, NULL), 2); /* max 1: counts all, writes one */
+    }
+    /* Versions no row lists, and text that is no version. */
+    static const char *unknown[] = {"1.4", "1.9", "2.0", "3.16", "4.0", "6.0", "10.0", "0.0"};
+    for (size_t i = 0; i < sizeof unknown / sizeof unknown[0]; i++) {
+        CHECK(urrt_controller_find(unknown[i], strlen(unknown[i]), NULL, 0, NULL) == 0, "%s: no row", unknown[i]);
+    }
+    static const char *malformed[] = {"", "5", "5.", ".5", "5.x", "5.10x", "x5.10", "5..10", "5.10.", "-5.1",
+                                      " 5.10", "5.10 ", "5,10", "1.2.3.4.5", "1e3.1"};
+    for (size_t i = 0; i < sizeof malformed / sizeof malformed[0]; i++) {
+        CHECK(urrt_controller_find(malformed[i], strlen(malformed[i]), NULL, 0, NULL) == URRT_E_ARG,
+              "\"%s\": not a version", malformed[i]);
+    }
+    CHECK_EQ_INT(urrt_controller_find(NULL, 0, NULL, 0, NULL), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_controller_find("5.10 and more", 4, NULL, 0, NULL), 1); /* len bounds the text */
+
+    /* Periods by length: of the versions that send it, else of its generation. */
+    static const struct { uint32_t length, period_us; } periods[] = {
+        {756, 8000}, {812, 8000}, {1044, 8000}, {1060, 8000}, {1108, 2000}, {1220, 2000},
+        {540, 8000}, {692, 8000}, {716, 8000} /* an unknown 1.x size */, {1228, 2000}, {900, 2000}, {0, 2000},
+    };
+    for (size_t i = 0; i < sizeof periods / sizeof periods[0]; i++) {
+        CHECK(urrt_period_min_us(periods[i].length) == periods[i].period_us, "period of %u: %u, expected %u",
+              periods[i].length, urrt_period_min_us(periods[i].length), periods[i].period_us);
+    }
+
+    /* The table: increasing lengths, each row's text naming its ranges, each
+     * row the one its length finds. */
+    size_t count = 0;
+    const urrt_controller *rows = urrt_controllers(&count);
+    CHECK(rows != NULL && count == 11, "%zu rows", count);
+    for (size_t i = 0; rows != NULL && i < count; i++) {
+        char text[64] = "";
+        CHECK(i == 0 || rows[i].length > rows[i - 1].length, "row %zu: lengths increase", i);
+        CHECK(urrt_controller_of_length(rows[i].length) == &rows[i], "row %zu: found by its length", i);
+        for (size_t j = 0; j < 2 && rows[i].ranges[j].major != 0; j++) {
+            const urrt_version_range *r = &rows[i].ranges[j];
+            size_t n = strlen(text);
+            if (r->minor_last == URRT_MINOR_LATER) {
+                snprintf(text + n, sizeof text - n, "%s%u.%u or later", j ? ", " : "", r->major, r->minor_first);
+            } else if (r->minor_first == r->minor_last) {
+                snprintf(text + n, sizeof text - n, "%s%u.%u", j ? ", " : "", r->major, r->minor_first);
+            } else {
+                snprintf(text + n, sizeof text - n, "%s%u.%u-%u.%u", j ? ", " : "", r->major, r->minor_first,
+                         r->major, r->minor_last);
+            }
+        }
+        if (rows[i].ranges[0].major == 0) {
+            CHECK_EQ_STR(rows[i].versions, "early 1.x (before 1.5)");
+        } else {
+            CHECK(strcmp(rows[i].versions, text) == 0, "row %u: text \"%s\", ranges say \"%s\"", rows[i].length,
+                  rows[i].versions, text);
+        }
+    }
+    CHECK(urrt_controller_of_length(1116) != NULL && urrt_controller_of_length(1117) == NULL, "of_length");
+    CHECK(urrt_controllers(NULL) == rows, "count may be NULL");
+}
+
+static void test_time_us(void)
+{
+    static const struct { double seconds; int64_t us; } cases[] = {
+        {0.0, 0}, {-0.0, 0}, {1.0, 1000000}, {951.592, 951592000}, {951.6, 951600000},
+        {0.0078125, 7813} /* 1/128 s: 7812.5 us exactly, a half rounds away from zero */,
+        {0.0000005, 0} /* the double is 4.99999999999999977e-07 */, {0.00000051, 1}, {0.0000015, 2},
+        {1e-300, 0}, {4.9e-324, 0} /* the smallest subnormal */, {0.001, 1000}, {0.008, 8000},
+        {123456.789012, 123456789012}, {4.0 - 1e-15, 4000000}, {1.0e9, 1000000000000000},
+        {9007199254.740992, INT64_C(9007199254740992)} /* 2^53 us: the maximum */,
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        int64_t us = -1;
+        CHECK(urrt_time_us(cases[i].seconds, &us) == URRT_OK && us == cases[i].us,
+              "time %.17g s: %" PRId64 " us, expected %" PRId64, cases[i].seconds, us, cases[i].us);
+    }
+    /* Every 997th packet of a day at 125 Hz, against rounding in long double. */
+    for (int64_t k = 0; k < 86400 * 125; k += 997) {
+        double t = (double)k * 0.008 + 0.0000004;
+        int64_t us = -1;
+        int64_t expect = (int64_t)llroundl((long double)t * 1000000.0L);
+        CHECK(urrt_time_us(t, &us) == URRT_OK && us == expect, "time %.17g: %" PRId64 ", expected %" PRId64, t,
+              us, expect);
+    }
+    /* Out of range: saturated, and said so. */
+    static const struct { double seconds; int64_t us; } saturated[] = {
+        {9007199254.7409935, URRT_TIME_US_MAX} /* the next double: just past 2^53 us */, {1e10, URRT_TIME_US_MAX},
+        {17179869184.0, URRT_TIME_US_MAX} /* 2^34 s */, {1e300, URRT_TIME_US_MAX}, {INFINITY, URRT_TIME_US_MAX},
+        {-1e-300, 0}, {-0.5, 0}, {-1.0, 0}, {-INFINITY, 0}, {NAN, 0}, {-NAN, 0},
+    };
+    for (size_t i = 0; i < sizeof saturated / sizeof saturated[0]; i++) {
+        int64_t us = 42;
+        CHECK(urrt_time_us(saturated[i].seconds, &us) == URRT_E_RANGE && us == saturated[i].us,
+              "time %g: %" PRId64 ", expected URRT_E_RANGE and %" PRId64, saturated[i].seconds, us,
+              saturated[i].us);
+    }
+    CHECK(URRT_TIME_US_MAX == INT64_C(9007199254740992), "URRT_TIME_US_MAX is 2^53");
+    CHECK_EQ_INT(urrt_time_us(double_of(UINT64_C(0x7FF0000000000001)), &(int64_t){0}), URRT_E_RANGE);
+    CHECK_EQ_INT(urrt_time_us(1.0, NULL), URRT_E_ARG);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -1231,6 +1366,8 @@ int main(int argc, char **argv)
     test_bitmask();
     test_enums();
     test_bad_arguments();
+    test_controller_versions();
+    test_time_us();
     test_state_clear_and_encoder();
     test_bad_sizes();
     test_real_capture();
