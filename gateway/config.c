@@ -456,38 +456,30 @@ static void lcm_finish(config_ctx *ctx, gw_config *cfg)
 
 /* ---- [robot NAME] ------------------------------------------------------------------ */
 
-/* What a version number implies: the message size, and the packet rate. */
-static bool version_length(const char *text, uint32_t *length, unsigned *rate_hz, const char **why)
+/* What a version number implies, from lib's controller table: the message
+ * size, and the packet rate. A version the sources give two sizes for (1.6)
+ * is refused with both. */
+static bool version_length(config_ctx *ctx, const char *text, uint32_t *length, unsigned *rate_hz)
 {
-    unsigned major, minor;
-    int used = 0;
-    static const struct { unsigned major, from, to; uint32_t length; } table[] = {
-        {1, 5, 5, 756}, {1, 7, 7, 764}, {1, 8, 8, 812},
-        {3, 0, 1, 1044}, {3, 2, 4, 1060}, {3, 5, 9, 1108}, {3, 10, 13, 1116}, {3, 14, 15, 1140},
-        {5, 0, 3, 1108}, {5, 4, 8, 1116}, {5, 9, 9, 1140}, {5, 10, 99, 1220},
-    };
-    *why = NULL;
-    if (sscanf(text, "%u.%u%n", &major, &minor, &used) != 2 ||
-        (text[used] != '\0' && text[used] != '.')) {
-        return false;
+    const urrt_controller *found[2];
+    uint32_t period_us = 0;
+    int n = urrt_controller_find(text, strlen(text), found, 2, &period_us);
+    if (n == 1) {
+        *length = found[0]->length;
+        *rate_hz = 1000000u / period_us;
+        return true;
     }
-    for (const char *p = text + used; *p != '\0'; p++) {
-        if (!isdigit((unsigned char)*p) && *p != '.') {
-            return false;
-        }
+    if (n == 2) {
+        config_error(ctx, ctx->line, "version \"%s\": %s controllers sent %u or %u bytes: give the length instead "
+                     "(version = %u or %u)", text, text, (unsigned)found[0]->length, (unsigned)found[1]->length,
+                     (unsigned)found[0]->length, (unsigned)found[1]->length);
+    } else if (n == 0) {
+        config_error(ctx, ctx->line, "version \"%s\": no known controller version: give the message size in "
+                     "bytes instead (e.g. version = 1220)", text);
+    } else {
+        config_error(ctx, ctx->line, "version \"%s\": expected auto, a controller version such as 5.10, or a "
+                     "message size in bytes", text);
     }
-    if (major == 1 && minor == 6) {
-        *why = "1.6 controllers sent 756 or 764 bytes: give the length instead (version = 756 or 764)";
-        return false;
-    }
-    for (size_t i = 0; i < sizeof table / sizeof table[0]; i++) {
-        if (table[i].major == major && minor >= table[i].from && minor <= table[i].to) {
-            *length = table[i].length;
-            *rate_hz = major == 5 ? 500 : 125;
-            return true;
-        }
-    }
-    *why = "no known controller version: give the message size in bytes instead (e.g. version = 1220)";
     return false;
 }
 
@@ -561,15 +553,12 @@ static bool robot_key(config_ctx *ctx, gw_config *cfg, const char *key, const ch
         return true;
     }
     if (strcmp(key, "version") == 0) {
-        const char *why;
         uint32_t length = 0;
-        unsigned rate = GW_ROBOT_MAX_RATE_HZ;
+        unsigned rate = 1000000u / urrt_period_min_us(0);
         if (strcmp(value, "auto") == 0) {
             length = 0;
         } else if (strchr(value, '.') != NULL) {
-            if (!version_length(value, &length, &rate, &why)) {
-                config_error(ctx, ctx->line, "version \"%s\": %s", value,
-                             why ? why : "expected auto, a controller version such as 5.10, or a message size in bytes");
+            if (!version_length(ctx, value, &length, &rate)) {
                 return false;
             }
         } else {
@@ -584,7 +573,7 @@ static bool robot_key(config_ctx *ctx, gw_config *cfg, const char *key, const ch
                 return false;
             }
             length = (uint32_t)v;
-            rate = urrt_generation_of(length) == URRT_GEN_1X ? 125 : GW_ROBOT_MAX_RATE_HZ;
+            rate = 1000000u / urrt_period_min_us(length);
         }
         robot->expected_length = length;
         robot->max_rate_hz = rate;

@@ -87,14 +87,14 @@ static void on_mismatch(gw_robot *robot, size_t length, uint64_t rx_us)
 /* The lag of a packet's data when read (freshness.h), on both clocks. */
 static uint64_t packet_lag(gw_robot *robot, const urrt_state *st, uint64_t rx_us, bool new_connection)
 {
-    double t = st->time[0];
-    bool has_clock = urrt_has(st, URRT_F_TIME) && isfinite(t) && fabs(t) < 9e12;
+    int64_t t_us = 0;
+    bool has_clock = urrt_has(st, URRT_F_TIME) && urrt_time_us(st->time[0], &t_us) == URRT_OK;
     uint64_t lag;
     if (new_connection) {
         gw_age_reset(&robot->age);
     }
     lag = gw_age_lag_us(&robot->age, rx_us, urrt_link_packet_empty_us(robot->link), has_clock,
-                        has_clock ? (int64_t)llround(t * 1e6) : 0, urrt_link_packet_newest(robot->link));
+                        has_clock ? t_us : 0, urrt_link_packet_newest(robot->link));
     return lag == GW_AGE_UNKNOWN || lag < rx_us ? lag : rx_us - 1; /* data_us 0 means "none" */
 }
 

@@ -332,10 +332,12 @@ static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
     lcm_out *out = ctx;
     lcm_robot *lr = &out->robots[robot->index];
     const gw_rate *rates = out->cfg->rate;
-    double t = pkt->state->time[0];
+    int64_t t_us;
     /* The controller's clock paces decimation; should it be unreadable, the
      * host's clock does. */
-    int64_t t_us = isfinite(t) && fabs(t) < 9e12 ? (int64_t)llround(t * 1e6) : (int64_t)pkt->rx_us;
+    if (urrt_time_us(pkt->state->time[0], &t_us) != URRT_OK) {
+        t_us = (int64_t)pkt->rx_us;
+    }
 
     if (due(&rates[GW_KIND_STATE], lr, GW_KIND_STATE, t_us)) {
         publish_data(out, robot, GW_KIND_STATE, encode_state(out, pkt), pkt);

@@ -280,36 +280,28 @@ static void usage_error(const char *fmt, ...)
     exit(CLI_EXIT_USAGE);
 }
 
-/* Controller software version -> packet length and default rate. */
-static bool length_of_version(const char *text, uint32_t *length, double *rate)
+/* Controller software version -> packet length and default rate, from
+ * lib's controller table. NULL, or why the version is refused (why_buf
+ * holds it). */
+static const char *length_of_version(const char *text, uint32_t *length, double *rate, char *why_buf,
+                                     size_t why_size)
 {
-    unsigned major, minor;
-    char tail;
-    if (sscanf(text, "%u.%u%c", &major, &minor, &tail) != 2) {
-        return false;
+    const urrt_controller *found[2];
+    uint32_t period_us = 0;
+    int n = urrt_controller_find(text, strlen(text), found, 2, &period_us);
+    if (n == 1) {
+        *length = found[0]->length;
+        *rate = 1e6 / period_us;
+        return NULL;
     }
-    *rate = major >= 5 ? 500.0 : 125.0;
-    if (major == 1) {
-        if (minor == 5) {
-            *length = 756;
-        } else if (minor == 6 || minor == 7) {
-            *length = 764; /* 1.6 is disputed: 756 or 764 */
-        } else if (minor == 8) {
-            *length = 812;
-        } else {
-            return false;
-        }
-        return true;
+    if (n == 2) {
+        snprintf(why_buf, why_size, "%s controllers sent %u or %u bytes: give --length %u or --length %u", text,
+                 (unsigned)found[0]->length, (unsigned)found[1]->length, (unsigned)found[0]->length,
+                 (unsigned)found[1]->length);
+        return why_buf;
     }
-    if (major == 3) {
-        *length = minor <= 1 ? 1044 : minor <= 4 ? 1060 : minor <= 9 ? 1108 : minor <= 13 ? 1116 : minor <= 15 ? 1140 : 0;
-        return *length != 0;
-    }
-    if (major == 5) {
-        *length = minor <= 3 ? 1108 : minor <= 8 ? 1116 : minor == 9 ? 1140 : 1220;
-        return true;
-    }
-    return false;
+    return "not a RealTime controller version (1.5-1.8, 3.0-3.15, 5.0 and later); "
+           "-V alone prints this program's version";
 }
 
 static void parse_fault(const char *spec, fault_config *f)
@@ -535,12 +527,13 @@ static void parse_options(int argc, char **argv, options *o)
     }
     if (version_arg != NULL) {
         double rate;
+        char why_buf[128];
+        const char *why;
         if (length_given) {
             usage_error("give --controller or --length, not both");
         }
-        if (!length_of_version(version_arg, &o->length, &rate)) {
-            usage_error("--controller %s: not a RealTime controller version (1.5-1.8, 3.0-3.15, 5.0 and later); "
-                        "-V alone prints this program's version", version_arg);
+        if ((why = length_of_version(version_arg, &o->length, &rate, why_buf, sizeof why_buf)) != NULL) {
+            usage_error("--controller %s: %s", version_arg, why);
         }
         if (!o->rate_given) {
             o->rate_hz = rate;
