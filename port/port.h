@@ -1,15 +1,26 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * port.h: what the urrt programs need from the operating system.
+ * port.h: the robot link (urrt_link_*), the CAN link (urrt_canlink_*), the
+ * clock and logging.
  *
- * This is the seam a firmware replaces: the programs in gateway/ call only
- * what is declared here (plus LCM on POSIX), and port/posix/ implements it
- * for Linux. A firmware gateway implements the same functions on its own TCP
- * stack, CAN controller and timer, or drops the parts it has no use for.
+ * These are the parts of a gateway that sit on an operating system's
+ * network, CAN and timer services, the seam a firmware replaces: port/posix/
+ * implements them for Linux (non-blocking TCP sockets, SocketCAN or a
+ * candump log file, clock_gettime, stderr), and a firmware gateway
+ * implements the same functions on its own TCP stack, CAN controller and
+ * timer, or drops the parts it has no use for (docs/porting.md).
  *
- * Nothing here blocks unless it says so: the programs run one poll loop over
- * every link, and each link says which descriptor to wait on and by when it
- * must be serviced again.
+ * It is not everything the programs take from the system. urrt-gateway,
+ * urrt-dump and urrt-sim are POSIX programs: they run their own poll() loop,
+ * handle signals, read and write files, urrt-gateway publishes on LCM, and
+ * urrt-sim opens its listening sockets and reads the clocks itself. A
+ * firmware does not port those programs; it keeps lib/, writes its own main
+ * loop, and uses this header's contracts for its link, CAN and clock.
+ *
+ * Nothing here blocks. The wait interface is POSIX's: each link names a
+ * descriptor and poll() events to wait for (-1: none) and a deadline by
+ * which it must be serviced again; a port without descriptors returns -1
+ * and is driven by the deadlines (and its stack's receive events) alone.
  */
 #ifndef URRT_PORT_H
 #define URRT_PORT_H

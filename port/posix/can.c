@@ -105,24 +105,15 @@ const char *urrt_canlink_state_name(urrt_canlink_state state)
 
 /* ---- frames ---------------------------------------------------------------- */
 
-static bool fd_length_valid(uint8_t len)
-{
-    static const uint8_t lengths[] = { 12, 16, 20, 24, 32, 48, 64 };
-    if (len <= 8)
-        return true;
-    for (size_t i = 0; i < sizeof(lengths); i++)
-        if (len == lengths[i])
-            return true;
-    return false;
-}
-
+/* The limits are lib's (urrt_can.h); the link adds only that FD frames need
+ * an FD link. */
 static bool frame_valid(const urrt_canlink *can, const urrt_can_frame *f)
 {
-    if (f->extended ? f->id > CAN_EFF_MASK : f->id > CAN_SFF_MASK)
+    if (!urrt_can_id_valid(f->id, f->extended))
         return false;
-    if (f->fd)
-        return can->cfg.fd && fd_length_valid(f->len);
-    return f->len <= CAN_MAX_DLEN;
+    if (f->fd && !can->cfg.fd)
+        return false;
+    return urrt_can_length_valid(f->len, f->fd);
 }
 
 static bool same_id(const urrt_can_frame *a, const urrt_can_frame *b)
