@@ -1165,158 +1165,200 @@ static void log_summary(const sim *s, uint64_t now)
              s->garbage_sent, s->freezes, s->frozen_packets, plural(s->frozen_packets));
 }
 
-int main(int argc, char **argv)
+/* Real-time priority on request; a normal one with a warning if refused. */
+static void set_priority(const options *o)
 {
-    static sim s; /* large (packet buffers, histogram): not on the stack */
-    struct pollfd pfds[MAX_CLIENTS_LIMIT + 1];
-    int status = CLI_EXIT_OK;
-
-    parse_options(argc, argv, &s.opt);
-    urrt_log_init(PROGRAM, s.opt.log_level);
-    cli_handle_signals(&running);
     /* The default 50 us timer slack would be a quarter of a 500 Hz period. */
     prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);
-    if (s.opt.rt_priority != 0) {
-        struct sched_param sp = {.sched_priority = (int)s.opt.rt_priority};
+    if (o->rt_priority != 0) {
+        struct sched_param sp = {.sched_priority = (int)o->rt_priority};
         if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0) {
             urrt_log(URRT_LOG_WARNING, "cannot run under SCHED_FIFO (%s): running with normal priority; "
                      "give the program CAP_SYS_NICE or run it as root", strerror(errno));
         }
     }
+}
 
-    if (s.opt.replay_path != NULL) {
-        if (!load_replay(&s, s.opt.replay_path)) {
-            return CLI_EXIT_RUNTIME;
-        }
-        s.replaying = true;
-        s.opt.length = 0;
+static void log_serving(const sim *s)
+{
+    char where[300];
+    cli_format_host_port(s->opt.listen_host, s->opt.listen_port, where, sizeof where);
+    if (s->replaying) {
+        urrt_log(URRT_LOG_NOTICE, "replaying %s on %s%s", s->opt.replay_path, where, s->opt.loop ? " in a loop" : "");
     } else {
-        sim_model_init(&s.model, s.opt.seed, s.opt.rate_hz);
+        const char *v = urrt_versions_of(s->opt.length);
+        urrt_log(URRT_LOG_NOTICE, "serving %" PRIu32 "-byte packets (%s) at %g Hz on %s, seed %" PRIu64,
+                 s->opt.length, v ? v : "no controller sends this length", s->opt.rate_hz, where, s->opt.seed);
     }
-    s.period_ns = (uint64_t)llround(1e9 / s.opt.rate_hz);
-    if (s.opt.record_path != NULL) {
-        s.record = fopen(s.opt.record_path, "wb");
-        if (s.record == NULL) {
-            urrt_log(URRT_LOG_ERR, "cannot create the recording %s: %s", s.opt.record_path, strerror(errno));
-            return CLI_EXIT_RUNTIME;
+}
+
+/* The source of packets, the recording, the listener; false (logged) if
+ * one of them cannot be had. */
+static bool sim_start(sim *s)
+{
+    if (s->opt.replay_path != NULL) {
+        if (!load_replay(s, s->opt.replay_path)) {
+            return false;
+        }
+        s->replaying = true;
+        s->opt.length = 0;
+    } else {
+        sim_model_init(&s->model, s->opt.seed, s->opt.rate_hz);
+    }
+    s->period_ns = (uint64_t)llround(1e9 / s->opt.rate_hz);
+    if (s->opt.record_path != NULL) {
+        s->record = fopen(s->opt.record_path, "wb");
+        if (s->record == NULL) {
+            urrt_log(URRT_LOG_ERR, "cannot create the recording %s: %s", s->opt.record_path, strerror(errno));
+            return false;
         }
     }
-    s.listen_fd = open_listener(&s.opt);
-    if (s.listen_fd < 0) {
-        return CLI_EXIT_RUNTIME;
+    s->listen_fd = open_listener(&s->opt);
+    if (s->listen_fd < 0) {
+        return false;
     }
-    s.opt.listen_port = bound_port(s.listen_fd);
-    {
-        char where[300];
-        cli_format_host_port(s.opt.listen_host, s.opt.listen_port, where, sizeof where);
-        if (s.replaying) {
-            urrt_log(URRT_LOG_NOTICE, "replaying %s on %s%s", s.opt.replay_path, where, s.opt.loop ? " in a loop" : "");
-        } else {
-            const char *v = urrt_versions_of(s.opt.length);
-            urrt_log(URRT_LOG_NOTICE, "serving %" PRIu32 "-byte packets (%s) at %g Hz on %s, seed %" PRIu64,
-                     s.opt.length, v ? v : "no controller sends this length", s.opt.rate_hz, where, s.opt.seed);
-        }
-    }
+    s->opt.listen_port = bound_port(s->listen_fd);
+    log_serving(s);
     /* After the log line, so that a reader woken by the file finds it too. */
-    if (s.opt.port_file != NULL && !write_port_file(s.opt.port_file, s.opt.listen_port)) {
-        return CLI_EXIT_RUNTIME;
+    if (s->opt.port_file != NULL && !write_port_file(s->opt.port_file, s->opt.listen_port)) {
+        return false;
     }
     /* A capture starts from its first packet for the first client. */
-    if (!s.opt.start_on_connect && !s.replaying) {
-        s.started = true;
-        s.t0_ns = now_ns();
+    if (!s->opt.start_on_connect && !s->replaying) {
+        s->started = true;
+        s->t0_ns = now_ns();
     }
+    return true;
+}
 
+static bool sim_finished(const sim *s)
+{
+    return (s->opt.clients_to_serve != 0 && s->clients_done >= s->opt.clients_to_serve && s->nclients == 0) ||
+           (s->replay_done && s->nclients == 0);
+}
+
+/* The descriptors to wait on (the listener first, then each client) and,
+ * in *wake, the time of the next packet, paced write or slow-client verdict. */
+static size_t poll_set(const sim *s, uint64_t now, struct pollfd *pfds, uint64_t *wake)
+{
+    size_t nfds = 0;
+    *wake = s->started && !s->replay_done ? s->t0_ns + due_offset(s, s->next) : UINT64_MAX;
+    pfds[nfds++] = (struct pollfd){.fd = s->listen_fd, .events = POLLIN};
+    for (size_t i = 0; i < s->nclients; i++) {
+        const client *c = &s->clients[i];
+        short ev = POLLIN;
+        if (c->releasable > 0) {
+            if (s->opt.fault.tiny_writes != 0 && c->next_write_ns > now) {
+                *wake = c->next_write_ns < *wake ? c->next_write_ns : *wake;
+            } else {
+                ev |= POLLOUT;
+            }
+        }
+        if (c->full_since_ns != 0) {
+            uint64_t give_up = c->full_since_ns + SLOW_CLIENT_NS + 1;
+            *wake = give_up < *wake ? give_up : *wake;
+        }
+        pfds[nfds++] = (struct pollfd){.fd = c->fd, .events = ev};
+    }
+    return nfds;
+}
+
+static int wait_until(struct pollfd *pfds, size_t nfds, uint64_t wake, uint64_t now)
+{
+    struct timespec ts, *tsp = NULL;
+    if (wake != UINT64_MAX) {
+        uint64_t d = wake > now ? wake - now : 0;
+        ts.tv_sec = (time_t)(d / 1000000000ull);
+        ts.tv_nsec = (long)(d % 1000000000ull);
+        tsp = &ts;
+    }
+    return ppoll(pfds, nfds, tsp, NULL);
+}
+
+/* Reads and writes what poll reported, then accepts new clients. */
+static void serve_ready(sim *s, const struct pollfd *pfds, size_t nfds, uint64_t now)
+{
+    /* Clients by descriptor: dropping one reorders the array. */
+    for (size_t k = nfds; k-- > 1;) {
+        if (pfds[k].revents == 0) {
+            continue;
+        }
+        for (size_t i = 0; i < s->nclients; i++) {
+            if (s->clients[i].fd != pfds[k].fd) {
+                continue;
+            }
+            if ((pfds[k].revents & (POLLIN | POLLERR | POLLHUP)) && !read_client(s, i)) {
+                break;
+            }
+            if (pfds[k].revents & POLLOUT) {
+                (void)flush_client(s, i, now);
+            }
+            break;
+        }
+    }
+    if (pfds[0].revents & POLLIN) {
+        accept_clients(s, now);
+    }
+}
+
+/* The loop: send what is due, wait, serve. Returns the exit status. */
+static int serve(sim *s)
+{
+    static struct pollfd pfds[MAX_CLIENTS_LIMIT + 1];
     while (running) {
         uint64_t now = now_ns();
-        uint64_t wake = UINT64_MAX;
-        size_t nfds = 0;
-        int rc;
+        uint64_t wake;
+        size_t nfds;
 
-        run_schedule(&s, now);
-        for (size_t i = 0; i < s.nclients;) {
-            if (flush_client(&s, i, now)) {
+        run_schedule(s, now);
+        for (size_t i = 0; i < s->nclients;) {
+            if (flush_client(s, i, now)) {
                 i++;
             }
         }
-        if ((s.opt.clients_to_serve != 0 && s.clients_done >= s.opt.clients_to_serve && s.nclients == 0) ||
-            (s.replay_done && s.nclients == 0)) {
+        if (sim_finished(s)) {
             break;
         }
-
-        if (s.started && !s.replay_done) {
-            wake = s.t0_ns + due_offset(&s, s.next);
-        }
-        pfds[nfds++] = (struct pollfd){.fd = s.listen_fd, .events = POLLIN};
-        for (size_t i = 0; i < s.nclients; i++) {
-            client *c = &s.clients[i];
-            short ev = POLLIN;
-            if (c->releasable > 0) {
-                if (s.opt.fault.tiny_writes != 0 && c->next_write_ns > now) {
-                    wake = c->next_write_ns < wake ? c->next_write_ns : wake;
-                } else {
-                    ev |= POLLOUT;
-                }
-            }
-            if (c->full_since_ns != 0) {
-                uint64_t give_up = c->full_since_ns + SLOW_CLIENT_NS + 1;
-                wake = give_up < wake ? give_up : wake;
-            }
-            pfds[nfds++] = (struct pollfd){.fd = c->fd, .events = ev};
-        }
-        {
-            struct timespec ts, *tsp = NULL;
-            if (wake != UINT64_MAX) {
-                uint64_t d = wake > now ? wake - now : 0;
-                ts.tv_sec = (time_t)(d / 1000000000ull);
-                ts.tv_nsec = (long)(d % 1000000000ull);
-                tsp = &ts;
-            }
-            rc = ppoll(pfds, nfds, tsp, NULL);
-        }
-        if (rc < 0) {
+        nfds = poll_set(s, now, pfds, &wake);
+        if (wait_until(pfds, nfds, wake, now) < 0) {
             if (errno == EINTR) {
                 continue;
             }
             urrt_log(URRT_LOG_ERR, "poll: %s", strerror(errno));
-            status = CLI_EXIT_RUNTIME;
-            break;
+            return CLI_EXIT_RUNTIME;
         }
-        now = now_ns();
-        /* Clients by descriptor: dropping one reorders the array. */
-        for (size_t k = nfds; k-- > 1;) {
-            if (pfds[k].revents == 0) {
-                continue;
-            }
-            for (size_t i = 0; i < s.nclients; i++) {
-                if (s.clients[i].fd == pfds[k].fd) {
-                    if (pfds[k].revents & (POLLIN | POLLERR | POLLHUP)) {
-                        if (!read_client(&s, i)) {
-                            break;
-                        }
-                    }
-                    if (pfds[k].revents & POLLOUT) {
-                        (void)flush_client(&s, i, now);
-                    }
-                    break;
-                }
-            }
-        }
-        if (pfds[0].revents & POLLIN) {
-            accept_clients(&s, now);
-        }
+        serve_ready(s, pfds, nfds, now_ns());
     }
+    return CLI_EXIT_OK;
+}
+
+static int sim_stop(sim *s, int status)
+{
     if (cli_stop_signal() != 0) {
         urrt_log(URRT_LOG_INFO, "stopping on %s", strsignal(cli_stop_signal()));
     }
-    log_summary(&s, now_ns());
-    while (s.nclients > 0) {
-        drop_client(&s, s.nclients - 1, URRT_LOG_DEBUG, "closed at exit");
+    log_summary(s, now_ns());
+    while (s->nclients > 0) {
+        drop_client(s, s->nclients - 1, URRT_LOG_DEBUG, "closed at exit");
     }
-    if (s.record != NULL && fclose(s.record) != 0) {
-        urrt_log(URRT_LOG_ERR, "cannot write the recording %s: %s", s.opt.record_path, strerror(errno));
+    if (s->record != NULL && fclose(s->record) != 0) {
+        urrt_log(URRT_LOG_ERR, "cannot write the recording %s: %s", s->opt.record_path, strerror(errno));
         status = CLI_EXIT_RUNTIME;
     }
-    close(s.listen_fd);
+    close(s->listen_fd);
     return status;
+}
+
+int main(int argc, char **argv)
+{
+    static sim s; /* large (packet buffers, histogram): not on the stack */
+
+    parse_options(argc, argv, &s.opt);
+    urrt_log_init(PROGRAM, s.opt.log_level);
+    cli_handle_signals(&running);
+    set_priority(&s.opt);
+    if (!sim_start(&s)) {
+        return CLI_EXIT_RUNTIME;
+    }
+    return sim_stop(&s, serve(&s));
 }
