@@ -305,13 +305,90 @@ static const char *length_of_version(const char *text, uint32_t *length, double 
            "-V alone prints this program's version";
 }
 
+/* The number after "NAME=" in a --fault, between min and max; a usage
+ * error otherwise. */
+static uint64_t fault_value(const char *name, const char *value, uint64_t min, uint64_t max)
+{
+    uint64_t v;
+    const char *err;
+    if (value == NULL) {
+        usage_error("fault %s needs a value: %s=N", name, name);
+    }
+    if ((err = cli_parse_u64(value, min, max, &v)) != NULL) {
+        usage_error("fault %s=%s: %s (from %llu to %llu)", name, value, err, (unsigned long long)min,
+                    (unsigned long long)max);
+    }
+    return v;
+}
+
+/* The first part of a --fault: the kind and its count. */
+static void parse_fault_kind(const char *kind, const char *value, fault_config *f)
+{
+    if (strcmp(kind, "close-after") == 0) {
+        f->close_after = fault_value(kind, value, 1, UINT64_MAX);
+    } else if (strcmp(kind, "reset-after") == 0) {
+        f->reset_after = fault_value(kind, value, 1, UINT64_MAX);
+    } else if (strcmp(kind, "truncate-after") == 0) {
+        /* stored as the packet that is cut */
+        f->truncate_after = fault_value(kind, value, 0, UINT64_MAX - 1) + 1;
+    } else if (strcmp(kind, "garbage-every") == 0) {
+        f->garbage_every = fault_value(kind, value, 1, UINT64_MAX);
+        f->garbage_bytes = 37;
+    } else if (strcmp(kind, "tiny-writes") == 0) {
+        f->tiny_writes = value != NULL ? (uint32_t)fault_value(kind, value, 1, 4096) : 7;
+    } else if (strcmp(kind, "coalesce") == 0) {
+        f->coalesce = fault_value(kind, value, 2, 1000);
+    } else if (strcmp(kind, "stall-after") == 0) {
+        f->stall_after = fault_value(kind, value, 1, UINT64_MAX);
+    } else if (strcmp(kind, "odd-length") == 0) {
+        f->odd_every = fault_value(kind, value, 1, UINT64_MAX);
+    } else if (strcmp(kind, "freeze-after") == 0) {
+        f->freeze_after = fault_value(kind, value, 1, UINT64_MAX);
+    } else if (strcmp(kind, "freeze-every") == 0) {
+        f->freeze_every = fault_value(kind, value, 1, UINT64_MAX);
+    } else {
+        usage_error("unknown fault \"%s\": use close-after, reset-after, truncate-after, garbage-every, "
+                    "tiny-writes, coalesce, stall-after, odd-length, freeze-after or freeze-every",
+                    kind);
+    }
+}
+
+/* A ",KEY=VALUE" after the kind: the parameters some kinds take. */
+static void parse_fault_param(const char *spec, const char *kind, const char *key, const char *value,
+                              fault_config *f)
+{
+    if (strcmp(kind, "garbage-every") == 0 && strcmp(key, "bytes") == 0) {
+        f->garbage_bytes = (uint32_t)fault_value(key, value, 1, 65536);
+    } else if (strcmp(kind, "stall-after") == 0 && strcmp(key, "for") == 0) {
+        f->stall_ms = fault_value(key, value, 1, 86400000);
+    } else if ((strcmp(kind, "freeze-after") == 0 || strcmp(kind, "freeze-every") == 0) &&
+               strcmp(key, "for") == 0) {
+        f->freeze_ms = fault_value(key, value, 1, 86400000);
+    } else if (strcmp(kind, "odd-length") == 0 && strcmp(key, "length") == 0) {
+        f->odd_length = (uint32_t)fault_value(key, value, URRT_PACKET_MIN, URRT_PACKET_MAX);
+        if ((f->odd_length - URRT_HEADER_SIZE) % 8 != 0) {
+            usage_error("odd-length length=%s: must be 4 + 8n", value);
+        }
+    } else {
+        usage_error("fault \"%s\": unknown parameter \"%s\"", spec, key);
+    }
+}
+
+/* "NAME[=VALUE]": splits off the value (NULL when there is none). */
+static char *split_value(char *tok)
+{
+    char *value = strchr(tok, '=');
+    if (value != NULL) {
+        *value++ = '\0';
+    }
+    return value;
+}
+
 static void parse_fault(const char *spec, fault_config *f)
 {
     char buf[128];
     char *save = NULL;
-    char *tok;
-    char *kind, *value;
-    const char *err;
+    char *kind, *tok;
 
     if (strlen(spec) >= sizeof buf) {
         usage_error("fault \"%s\" is too long", spec);
@@ -321,79 +398,12 @@ static void parse_fault(const char *spec, fault_config *f)
     if (kind == NULL) {
         usage_error("empty --fault");
     }
-    value = strchr(kind, '=');
-    if (value != NULL) {
-        *value++ = '\0';
+    parse_fault_kind(kind, split_value(kind), f);
+    /* A kind takes one parameter at most. */
+    for (int params = 0; (tok = strtok_r(NULL, ",", &save)) != NULL; params++) {
+        char *value = split_value(tok);
+        parse_fault_param(spec, params == 0 ? kind : "", tok, value, f);
     }
-#define NEED_VALUE(field, min, max)                                                              \
-    do {                                                                                         \
-        uint64_t v_;                                                                             \
-        if (value == NULL) {                                                                     \
-            usage_error("fault %s needs a value: %s=N", kind, kind);                             \
-        }                                                                                        \
-        if ((err = cli_parse_u64(value, (min), (max), &v_)) != NULL) {                           \
-            usage_error("fault %s=%s: %s (from %llu to %llu)", kind, value, err,                 \
-                        (unsigned long long)(min), (unsigned long long)(max));                   \
-        }                                                                                        \
-        (field) = v_;                                                                            \
-    } while (0)
-    if (strcmp(kind, "close-after") == 0) {
-        NEED_VALUE(f->close_after, 1, UINT64_MAX);
-    } else if (strcmp(kind, "reset-after") == 0) {
-        NEED_VALUE(f->reset_after, 1, UINT64_MAX);
-    } else if (strcmp(kind, "truncate-after") == 0) {
-        NEED_VALUE(f->truncate_after, 0, UINT64_MAX);
-        f->truncate_after++; /* stored as the packet that is cut */
-    } else if (strcmp(kind, "garbage-every") == 0) {
-        NEED_VALUE(f->garbage_every, 1, UINT64_MAX);
-        f->garbage_bytes = 37;
-    } else if (strcmp(kind, "tiny-writes") == 0) {
-        f->tiny_writes = 7;
-        if (value != NULL) {
-            NEED_VALUE(f->tiny_writes, 1, 4096);
-        }
-    } else if (strcmp(kind, "coalesce") == 0) {
-        NEED_VALUE(f->coalesce, 2, 1000);
-    } else if (strcmp(kind, "stall-after") == 0) {
-        NEED_VALUE(f->stall_after, 1, UINT64_MAX);
-    } else if (strcmp(kind, "odd-length") == 0) {
-        NEED_VALUE(f->odd_every, 1, UINT64_MAX);
-    } else if (strcmp(kind, "freeze-after") == 0) {
-        NEED_VALUE(f->freeze_after, 1, UINT64_MAX);
-    } else if (strcmp(kind, "freeze-every") == 0) {
-        NEED_VALUE(f->freeze_every, 1, UINT64_MAX);
-    } else {
-        usage_error("unknown fault \"%s\": use close-after, reset-after, truncate-after, garbage-every, "
-                    "tiny-writes, coalesce, stall-after, odd-length, freeze-after or freeze-every",
-                    kind);
-    }
-    while ((tok = strtok_r(NULL, ",", &save)) != NULL) {
-        char *key = tok;
-        value = strchr(tok, '=');
-        if (value != NULL) {
-            *value++ = '\0';
-        }
-        if (strcmp(kind, "garbage-every") == 0 && strcmp(key, "bytes") == 0) {
-            kind = key;
-            NEED_VALUE(f->garbage_bytes, 1, 65536);
-        } else if (strcmp(kind, "stall-after") == 0 && strcmp(key, "for") == 0) {
-            kind = key;
-            NEED_VALUE(f->stall_ms, 1, 86400000);
-        } else if ((strcmp(kind, "freeze-after") == 0 || strcmp(kind, "freeze-every") == 0) &&
-                   strcmp(key, "for") == 0) {
-            kind = key;
-            NEED_VALUE(f->freeze_ms, 1, 86400000);
-        } else if (strcmp(kind, "odd-length") == 0 && strcmp(key, "length") == 0) {
-            kind = key;
-            NEED_VALUE(f->odd_length, URRT_PACKET_MIN, URRT_PACKET_MAX);
-            if ((f->odd_length - URRT_HEADER_SIZE) % 8 != 0) {
-                usage_error("odd-length length=%s: must be 4 + 8n", value);
-            }
-        } else {
-            usage_error("fault \"%s\": unknown parameter \"%s\"", spec, key);
-        }
-    }
-#undef NEED_VALUE
     if (f->freeze_after != 0 && f->freeze_every != 0) {
         usage_error("give freeze-after or freeze-every, not both");
     }
