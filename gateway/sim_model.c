@@ -268,113 +268,142 @@ static double square_wave(double t, double period)
     return fmod(floor(t / (period / 2.0)), 2.0);
 }
 
-void sim_model_state(const sim_model *m, uint64_t index, urrt_generation gen, urrt_state *st)
-{
-    const double t = (double)index / m->rate_hz;
-    const double ta = t - SIM_MODEL_LAG_S;
+/* One packet's motion: targets at t, actuals SIM_MODEL_LAG_S later, and
+ * the noise channels drawn so far (their order fixes every value). */
+typedef struct motion {
+    uint64_t index;
+    double t, ta;
     double qt[6], qdt[6], qddt[6], qa[6], qda[6], qdda[6];
-    double tau_t[6], tau_a[6];
     double speed_t[6], speed_a[6], accel[3];
-    double elbow_before[3], elbow_after[3], scratch[6];
-    chain c;
+    unsigned ch;
+} motion;
+
+static double next_noise(const sim_model *m, motion *mo)
+{
+    return noise(m, mo->index, mo->ch++);
+}
+
+/* Joint targets and actuals, torques, currents, voltages, temperatures.
+ * Returns the sum of the actual currents' magnitudes. */
+static double fill_joints(const sim_model *m, motion *mo, urrt_state *st)
+{
+    double tau_t[6], tau_a[6];
     double current_sum = 0.0;
-    unsigned ch = 0;
-
-    urrt_state_clear(st);
-    st->time[0] = sim_model_time(m, index);
-
-    sim_model_joints(m, t, qt, qdt, qddt);
-    sim_model_joints(m, ta, qa, qda, qdda);
-    joint_torques(qt, qdt, qddt, tau_t);
-    joint_torques(qa, qda, qdda, tau_a);
+    joint_torques(mo->qt, mo->qdt, mo->qddt, tau_t);
+    joint_torques(mo->qa, mo->qda, mo->qdda, tau_a);
     for (int j = 0; j < 6; j++) {
-        st->q_target[j] = qt[j];
-        st->qd_target[j] = qdt[j];
-        st->qdd_target[j] = qddt[j];
+        st->q_target[j] = mo->qt[j];
+        st->qd_target[j] = mo->qdt[j];
+        st->qdd_target[j] = mo->qddt[j];
         st->m_target[j] = tau_t[j];
         st->i_target[j] = tau_t[j] / torque_constant[j];
-        st->q_actual[j] = qa[j];
-        st->qd_actual[j] = qda[j];
-        st->i_actual[j] = tau_a[j] / torque_constant[j] + 0.03 * noise(m, index, ch++);
-        st->i_control[j] = st->i_actual[j] + 0.01 * noise(m, index, ch++);
-        st->v_actual[j] = 47.6 + 0.05 * noise(m, index, ch++) - 0.02 * fabs(st->i_actual[j]);
+        st->q_actual[j] = mo->qa[j];
+        st->qd_actual[j] = mo->qda[j];
+        st->i_actual[j] = tau_a[j] / torque_constant[j] + 0.03 * next_noise(m, mo);
+        st->i_control[j] = st->i_actual[j] + 0.01 * next_noise(m, mo);
+        st->v_actual[j] = 47.6 + 0.05 * next_noise(m, mo) - 0.02 * fabs(st->i_actual[j]);
         current_sum += fabs(st->i_actual[j]);
         /* Warm up over the first quarter hour, then breathe with the load. */
-        st->motor_temperatures[j] = m->temp_base[j] + 8.0 * (1.0 - exp(-t / 900.0)) +
-                                    0.3 * sin(2.0 * M_PI * t / 300.0 + j);
+        st->motor_temperatures[j] = m->temp_base[j] + 8.0 * (1.0 - exp(-mo->t / 900.0)) +
+                                    0.3 * sin(2.0 * M_PI * mo->t / 300.0 + j);
         st->joint_modes[j] = 253.0;
     }
+    return current_sum;
+}
 
-    sim_model_fk(qt, st->tool_vector_target, NULL);
-    sim_model_fk(qa, st->tool_vector_actual, NULL);
-    tcp_motion(m, t, speed_t, accel);
-    tcp_motion(m, ta, speed_a, scratch);
+/* TCP pose and speed, target and actual (and the 1.x names for them). */
+static void fill_tcp(const sim_model *m, motion *mo, urrt_state *st)
+{
+    double scratch[3];
+    sim_model_fk(mo->qt, st->tool_vector_target, NULL);
+    sim_model_fk(mo->qa, st->tool_vector_actual, NULL);
+    tcp_motion(m, mo->t, mo->speed_t, mo->accel);
+    tcp_motion(m, mo->ta, mo->speed_a, scratch);
     for (int k = 0; k < 6; k++) {
-        st->tcp_speed_target[k] = speed_t[k];
-        st->tcp_speed_actual[k] = speed_a[k];
+        st->tcp_speed_target[k] = mo->speed_t[k];
+        st->tcp_speed_actual[k] = mo->speed_a[k];
         st->tool_vector[k] = st->tool_vector_actual[k];
-        st->tcp_speed[k] = speed_a[k];
+        st->tcp_speed[k] = mo->speed_a[k];
     }
+}
 
-    /* The force sensor feels the payload's weight and inertia, plus noise. */
-    forward(qa, &c);
-    {
-        double f[3] = {PAYLOAD_MASS * accel[0], PAYLOAD_MASS * accel[1], PAYLOAD_MASS * (accel[2] + G)};
-        double r[3];
-        for (int k = 0; k < 3; k++) {
-            r[k] = c.rot[k][0] * payload_cog[0] + c.rot[k][1] * payload_cog[1] + c.rot[k][2] * payload_cog[2];
-        }
-        st->tcp_force[0] = f[0] + 0.4 * noise(m, index, ch++);
-        st->tcp_force[1] = f[1] + 0.4 * noise(m, index, ch++);
-        st->tcp_force[2] = f[2] + 0.4 * noise(m, index, ch++);
-        st->tcp_force[3] = r[1] * f[2] - r[2] * f[1] + 0.02 * noise(m, index, ch++);
-        st->tcp_force[4] = r[2] * f[0] - r[0] * f[2] + 0.02 * noise(m, index, ch++);
-        st->tcp_force[5] = r[0] * f[1] - r[1] * f[0] + 0.02 * noise(m, index, ch++);
-        /* The accelerometer measures specific force in the tool frame. */
-        for (int k = 0; k < 3; k++) {
-            st->tool_accelerometer[k] = c.rot[0][k] * accel[0] + c.rot[1][k] * accel[1] +
-                                        c.rot[2][k] * (accel[2] + G) + 0.05 * noise(m, index, ch++);
-        }
+/* The force sensor feels the payload's weight and inertia, plus noise. */
+static void fill_force(const sim_model *m, motion *mo, urrt_state *st)
+{
+    const double *accel = mo->accel;
+    double f[3] = {PAYLOAD_MASS * accel[0], PAYLOAD_MASS * accel[1], PAYLOAD_MASS * (accel[2] + G)};
+    double r[3];
+    chain c;
+    forward(mo->qa, &c);
+    for (int k = 0; k < 3; k++) {
+        r[k] = c.rot[k][0] * payload_cog[0] + c.rot[k][1] * payload_cog[1] + c.rot[k][2] * payload_cog[2];
     }
+    st->tcp_force[0] = f[0] + 0.4 * next_noise(m, mo);
+    st->tcp_force[1] = f[1] + 0.4 * next_noise(m, mo);
+    st->tcp_force[2] = f[2] + 0.4 * next_noise(m, mo);
+    st->tcp_force[3] = r[1] * f[2] - r[2] * f[1] + 0.02 * next_noise(m, mo);
+    st->tcp_force[4] = r[2] * f[0] - r[0] * f[2] + 0.02 * next_noise(m, mo);
+    st->tcp_force[5] = r[0] * f[1] - r[1] * f[0] + 0.02 * next_noise(m, mo);
+    /* The accelerometer measures specific force in the tool frame. */
+    for (int k = 0; k < 3; k++) {
+        st->tool_accelerometer[k] = c.rot[0][k] * accel[0] + c.rot[1][k] * accel[1] +
+                                    c.rot[2][k] * (accel[2] + G) + 0.05 * next_noise(m, mo);
+    }
+}
 
+/* Digital I/O, the controller's own figures and the modes. */
+static void fill_status(const sim_model *m, motion *mo, urrt_generation gen, urrt_state *st)
+{
+    const double t = mo->t;
     /* Inputs: a few sensors switching at their own pace, tool input 0 too. */
     st->digital_input_bits[0] = square_wave(t, 2.0) * 1 + square_wave(t, 5.0) * 2 + square_wave(t + 0.3, 1.4) * 4 +
                                 16.0 + square_wave(t, 6.0) * 65536.0;
     /* Outputs: a gripper following joint 6's direction, a lamp blinking. */
-    st->digital_outputs[0] = (qdt[5] > 0.0 ? 1.0 : 0.0) + square_wave(t, 8.0) * 2 + 256.0;
-    st->controller_timer[0] = 0.0004 + 0.0001 * noise(m, index, ch++);
+    st->digital_outputs[0] = (mo->qdt[5] > 0.0 ? 1.0 : 0.0) + square_wave(t, 8.0) * 2 + 256.0;
+    st->controller_timer[0] = 0.0004 + 0.0001 * next_noise(m, mo);
     st->test_value[0] = 0.0;
     st->robot_mode[0] = gen == URRT_GEN_1X ? 0.0 /* CB2 RUNNING */ : 7.0 /* RUNNING */;
     st->safety_mode[0] = 1.0;   /* NORMAL */
     st->safety_status[0] = 1.0; /* NORMAL */
     st->program_state[0] = 2.0; /* PLAYING */
     st->speed_scaling[0] = 1.0;
-    {
-        double v2 = speed_a[0] * speed_a[0] + speed_a[1] * speed_a[1] + speed_a[2] * speed_a[2];
-        /* Roughly the moving mass of forearm, wrist and payload. */
-        st->linear_momentum_norm[0] = (link_mass[2] + link_mass[3] + link_mass[4] + link_mass[5] + PAYLOAD_MASS) *
-                                      sqrt(v2);
-    }
-    st->v_main[0] = 48.2 + 0.05 * noise(m, index, ch++);
-    st->v_robot[0] = 48.0 + 0.05 * noise(m, index, ch++) - 0.01 * current_sum;
-    st->i_robot[0] = 0.6 + 0.35 * current_sum + 0.02 * noise(m, index, ch++);
+}
 
-    sim_model_fk(qa, scratch, st->elbow_position);
-    {
-        const double h = 1e-4;
-        double q[6];
-        sim_model_joints(m, ta - h, q, NULL, NULL);
-        sim_model_fk(q, scratch, elbow_before);
-        sim_model_joints(m, ta + h, q, NULL, NULL);
-        sim_model_fk(q, scratch, elbow_after);
-        for (int k = 0; k < 3; k++) {
-            st->elbow_velocity[k] = (elbow_after[k] - elbow_before[k]) / (2.0 * h);
-        }
-    }
+/* Momentum and the supply: voltages sag and current rises with the load. */
+static void fill_power(const sim_model *m, motion *mo, double current_sum, urrt_state *st)
+{
+    const double *v = mo->speed_a;
+    /* Roughly the moving mass of forearm, wrist and payload. */
+    st->linear_momentum_norm[0] = (link_mass[2] + link_mass[3] + link_mass[4] + link_mass[5] + PAYLOAD_MASS) *
+                                  sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    st->v_main[0] = 48.2 + 0.05 * next_noise(m, mo);
+    st->v_robot[0] = 48.0 + 0.05 * next_noise(m, mo) - 0.01 * current_sum;
+    st->i_robot[0] = 0.6 + 0.35 * current_sum + 0.02 * next_noise(m, mo);
+}
 
+/* The elbow's position, and its velocity by central difference. */
+static void fill_elbow(const sim_model *m, const motion *mo, urrt_state *st)
+{
+    const double h = 1e-4;
+    double q[6], scratch[6], before[3], after[3];
+    sim_model_fk(mo->qa, scratch, st->elbow_position);
+    sim_model_joints(m, mo->ta - h, q, NULL, NULL);
+    sim_model_fk(q, scratch, before);
+    sim_model_joints(m, mo->ta + h, q, NULL, NULL);
+    sim_model_fk(q, scratch, after);
+    for (int k = 0; k < 3; k++) {
+        st->elbow_velocity[k] = (after[k] - before[k]) / (2.0 * h);
+    }
+}
+
+/* Reserved and unused columns, and the payload the arm carries. */
+static void fill_constants(urrt_state *st)
+{
+    static const double inertia[6] = {0.0021, 0.0021, 0.0012, 0.0, 0.0, 0.0};
     for (int k = 0; k < 6; k++) {
         st->reserved_103[k] = 0.0;
         st->reserved_112[k] = 0.0;
+        st->payload_inertia[k] = inertia[k];
     }
     for (int k = 0; k < 15; k++) {
         st->unused_53[k] = 0.0;
@@ -386,10 +415,24 @@ void sim_model_state(const sim_model *m, uint64_t index, urrt_generation gen, ur
         st->payload_cog[k] = payload_cog[k];
     }
     st->payload_mass[0] = PAYLOAD_MASS;
-    st->payload_inertia[0] = 0.0021;
-    st->payload_inertia[1] = 0.0021;
-    st->payload_inertia[2] = 0.0012;
-    st->payload_inertia[3] = 0.0;
-    st->payload_inertia[4] = 0.0;
-    st->payload_inertia[5] = 0.0;
+}
+
+void sim_model_state(const sim_model *m, uint64_t index, urrt_generation gen, urrt_state *st)
+{
+    motion mo = {.index = index, .t = (double)index / m->rate_hz, .ch = 0};
+    double current_sum;
+
+    mo.ta = mo.t - SIM_MODEL_LAG_S;
+    urrt_state_clear(st);
+    st->time[0] = sim_model_time(m, index);
+    sim_model_joints(m, mo.t, mo.qt, mo.qdt, mo.qddt);
+    sim_model_joints(m, mo.ta, mo.qa, mo.qda, mo.qdda);
+    /* The order of the fills is the order of the noise channels. */
+    current_sum = fill_joints(m, &mo, st);
+    fill_tcp(m, &mo, st);
+    fill_force(m, &mo, st);
+    fill_status(m, &mo, gen, st);
+    fill_power(m, &mo, current_sum, st);
+    fill_elbow(m, &mo, st);
+    fill_constants(st);
 }
