@@ -683,17 +683,10 @@ static void snapshot_link(void *ctx, const uint8_t *pkt, size_t len, uint64_t rx
     lc->d->lstats = *urrt_link_get_stats(lc->link);
 }
 
-static int run_link(dump *d)
+static urrt_link *open_link(dump *d)
 {
     urrt_link_config cfg;
-    link_ctx lc = {.d = d};
-    uint64_t last_progress;
-    uint64_t quiet_interval_us = QUIET_NOTICE_FIRST_US;
-    uint64_t quiet_notice_at;
-    uint64_t seen_packets = 0;
-    uint64_t seen_disconnects = 0;
-    int status = CLI_EXIT_OK;
-
+    urrt_link *link;
     urrt_link_config_defaults(&cfg);
     cfg.host = d->opt.host;
     cfg.port = d->opt.port;
@@ -701,72 +694,121 @@ static int run_link(dump *d)
     cfg.connect_timeout_ms = d->opt.connect_timeout_ms;
     cfg.silence_timeout_ms = d->opt.silence_timeout_ms;
     cfg.backoff_max_ms = d->opt.backoff_max_ms;
-    lc.link = urrt_link_new(&cfg);
+    link = urrt_link_new(&cfg);
+    if (link != NULL) {
+        urrt_link_set_tap(link, on_bytes, d);
+    }
+    return link;
+}
+
+/* Waits for the link's descriptor until its deadline, a second at most.
+ * False (logged) on a poll error other than EINTR. */
+static bool wait_link(const urrt_link *link)
+{
+    short events = 0;
+    int fd = urrt_link_poll_fd(link, &events);
+    uint64_t now = urrt_port_monotonic_us();
+    uint64_t deadline = urrt_link_deadline(link);
+    int timeout_ms = 1000;
+    struct pollfd pfd = {.fd = fd, .events = events};
+
+    if (deadline <= now) {
+        timeout_ms = 0;
+    } else if (deadline - now < 1000000u) {
+        timeout_ms = (int)((deadline - now + 999u) / 1000u);
+    }
+    if (poll(&pfd, fd >= 0 ? 1 : 0, timeout_ms) < 0 && errno != EINTR) {
+        urrt_log(URRT_LOG_ERR, "poll: %s", strerror(errno));
+        return false;
+    }
+    return true;
+}
+
+/* Progress as the loop watches it: when the last packet came, and when to
+ * say that none has come for a while (at growing intervals). */
+typedef struct progress {
+    uint64_t last_us;
+    uint64_t quiet_interval_us;
+    uint64_t quiet_notice_at;
+    uint64_t seen_packets;
+    uint64_t seen_disconnects;
+} progress;
+
+static void watch_progress(dump *d, const urrt_link *link, progress *p, uint64_t now)
+{
+    const urrt_link_stats *ls = urrt_link_get_stats(link);
+    if (ls->disconnects != p->seen_disconnects) {
+        /* Bytes of a packet the connection ended inside: the next
+         * connection starts a new packet, so they never complete one
+         * and stay out of the recording. */
+        p->seen_disconnects = ls->disconnects;
+        d->pending_len = 0;
+    }
+    if (ls->packets != p->seen_packets) {
+        p->seen_packets = ls->packets;
+        p->last_us = now;
+        p->quiet_interval_us = QUIET_NOTICE_FIRST_US;
+        p->quiet_notice_at = now + p->quiet_interval_us;
+    }
+    if (!d->done && now >= p->quiet_notice_at) {
+        urrt_log(URRT_LOG_NOTICE, "%s: no packet for %.0f s (link %s, %" PRIu64 " connect failures): check the "
+                 "address and the port (30003, or the read-only 30013)%s", urrt_link_peer(link),
+                 (double)(now - p->last_us) / 1e6, urrt_link_state_name(urrt_link_get_state(link)),
+                 ls->connect_failures, d->opt.timeout_s > 0 ? "" : "; -t SEC gives up after SEC seconds");
+        p->quiet_interval_us = p->quiet_interval_us * 2 < QUIET_NOTICE_MAX_US ? p->quiet_interval_us * 2
+                                                                              : QUIET_NOTICE_MAX_US;
+        p->quiet_notice_at = now + p->quiet_interval_us;
+    }
+}
+
+/* Whether to stop waiting for packets (--once after the connection ended
+ * or failed, -t after a silence that long); *status says if that failed. */
+static bool give_up(const dump *d, const urrt_link *link, const progress *p, uint64_t now, int *status)
+{
+    const urrt_link_stats *ls = urrt_link_get_stats(link);
+    if (d->opt.once && !d->done && (ls->disconnects > 0 || (ls->connect_failures > 0 && ls->connects == 0))) {
+        if (d->packets == 0) {
+            urrt_log(URRT_LOG_ERR, "%s: no RealTime packet (%s, see above); check the address and port, "
+                     "or drop --once to keep trying",
+                     urrt_link_peer(link), ls->connects == 0 ? "no connection" : "the connection ended first");
+            *status = CLI_EXIT_RUNTIME;
+        }
+        return true;
+    }
+    if (d->opt.timeout_s > 0 && !d->done && (double)(now - p->last_us) / 1e6 >= d->opt.timeout_s) {
+        urrt_log(URRT_LOG_ERR, "%s: no packet for %g s (link %s); giving up", urrt_link_peer(link),
+                 d->opt.timeout_s, urrt_link_state_name(urrt_link_get_state(link)));
+        *status = CLI_EXIT_RUNTIME;
+        return true;
+    }
+    return false;
+}
+
+static int run_link(dump *d)
+{
+    link_ctx lc = {.d = d};
+    progress p = {.quiet_interval_us = QUIET_NOTICE_FIRST_US};
+    int status = CLI_EXIT_OK;
+
+    lc.link = open_link(d);
     if (lc.link == NULL) {
         return CLI_EXIT_RUNTIME;
     }
-    urrt_link_set_tap(lc.link, on_bytes, d);
-    last_progress = urrt_port_monotonic_us();
-    quiet_notice_at = last_progress + quiet_interval_us;
+    p.last_us = urrt_port_monotonic_us();
+    p.quiet_notice_at = p.last_us + p.quiet_interval_us;
     while (running && !d->done) {
-        short events = 0;
-        int fd = urrt_link_poll_fd(lc.link, &events);
-        uint64_t now = urrt_port_monotonic_us();
-        uint64_t deadline = urrt_link_deadline(lc.link);
-        int timeout_ms = 1000;
-        struct pollfd pfd = {.fd = fd, .events = events};
-        const urrt_link_stats *ls;
-
-        if (deadline <= now) {
-            timeout_ms = 0;
-        } else if (deadline - now < 1000000u) {
-            timeout_ms = (int)((deadline - now + 999u) / 1000u);
-        }
-        if (poll(&pfd, fd >= 0 ? 1 : 0, timeout_ms) < 0 && errno != EINTR) {
-            urrt_log(URRT_LOG_ERR, "poll: %s", strerror(errno));
+        uint64_t now;
+        if (!wait_link(lc.link)) {
             status = CLI_EXIT_RUNTIME;
             break;
         }
         now = urrt_port_monotonic_us();
         urrt_link_service(lc.link, now, snapshot_link, &lc);
-        ls = urrt_link_get_stats(lc.link);
         if (!d->done) {
-            d->lstats = *ls;
+            d->lstats = *urrt_link_get_stats(lc.link);
         }
-        if (ls->disconnects != seen_disconnects) {
-            /* Bytes of a packet the connection ended inside: the next
-             * connection starts a new packet, so they never complete one
-             * and stay out of the recording. */
-            seen_disconnects = ls->disconnects;
-            d->pending_len = 0;
-        }
-        if (ls->packets != seen_packets) {
-            seen_packets = ls->packets;
-            last_progress = now;
-            quiet_interval_us = QUIET_NOTICE_FIRST_US;
-            quiet_notice_at = now + quiet_interval_us;
-        }
-        if (!d->done && now >= quiet_notice_at) {
-            urrt_log(URRT_LOG_NOTICE, "%s: no packet for %.0f s (link %s, %" PRIu64 " connect failures): check the "
-                     "address and the port (30003, or the read-only 30013)%s", urrt_link_peer(lc.link),
-                     (double)(now - last_progress) / 1e6, urrt_link_state_name(urrt_link_get_state(lc.link)),
-                     ls->connect_failures, d->opt.timeout_s > 0 ? "" : "; -t SEC gives up after SEC seconds");
-            quiet_interval_us = quiet_interval_us * 2 < QUIET_NOTICE_MAX_US ? quiet_interval_us * 2 : QUIET_NOTICE_MAX_US;
-            quiet_notice_at = now + quiet_interval_us;
-        }
-        if (d->opt.once && !d->done && (ls->disconnects > 0 || (ls->connect_failures > 0 && ls->connects == 0))) {
-            if (d->packets == 0) {
-                urrt_log(URRT_LOG_ERR, "%s: no RealTime packet (%s, see above); check the address and port, "
-                         "or drop --once to keep trying",
-                         urrt_link_peer(lc.link), ls->connects == 0 ? "no connection" : "the connection ended first");
-                status = CLI_EXIT_RUNTIME;
-            }
-            break;
-        }
-        if (d->opt.timeout_s > 0 && !d->done && (double)(now - last_progress) / 1e6 >= d->opt.timeout_s) {
-            urrt_log(URRT_LOG_ERR, "%s: no packet for %g s (link %s); giving up", urrt_link_peer(lc.link),
-                     d->opt.timeout_s, urrt_link_state_name(urrt_link_get_state(lc.link)));
-            status = CLI_EXIT_RUNTIME;
+        watch_progress(d, lc.link, &p, now);
+        if (give_up(d, lc.link, &p, now, &status)) {
             break;
         }
     }
