@@ -6,7 +6,25 @@
 
 #define NAN_BITS UINT64_C(0x7FF8000000000000)
 
-static const urrt_cantx_link zero_link;
+/* Field by field: a struct assignment may become a memcpy call, which a
+ * firmware without a C library cannot link. */
+static void link_copy(urrt_cantx_link *to, const urrt_cantx_link *from)
+{
+    to->bus_off = from->bus_off;
+    to->error_frames = from->error_frames;
+    to->down_events = from->down_events;
+    to->send_errors = from->send_errors;
+    to->dropped = from->dropped;
+}
+
+static void link_zero(urrt_cantx_link *link)
+{
+    link->bus_off = 0;
+    link->error_frames = 0;
+    link->down_events = 0;
+    link->send_errors = 0;
+    link->dropped = 0;
+}
 
 static double nan_value(void)
 {
@@ -178,8 +196,8 @@ int urrt_cantx_init(urrt_cantx *tx, const urrt_cantx_tables *tables, urrt_cantx_
     tx->robots = robots;
     tx->values = values;
     tx->user = NULL;
-    tx->link = zero_link;
-    tx->link_seen = zero_link;
+    link_zero(&tx->link);
+    link_zero(&tx->link_seen);
     tx->clamped = 0;
     tx->clamped_seen = 0;
     for (i = 0; i < tables->frame_count; i++) {
@@ -340,7 +358,7 @@ void urrt_cantx_start(urrt_cantx *tx, uint64_t now_us)
     }
     tx->clamped = 0; /* the NaNs above are no packet's values */
     tx->clamped_seen = 0;
-    tx->link_seen = zero_link; /* the first heartbeat reports what came before */
+    link_zero(&tx->link_seen); /* the first heartbeat reports what came before */
 }
 
 void urrt_cantx_robot_link(urrt_cantx *tx, size_t robot, bool up)
@@ -353,7 +371,7 @@ void urrt_cantx_robot_link(urrt_cantx *tx, size_t robot, bool up)
 void urrt_cantx_set_link(urrt_cantx *tx, const urrt_cantx_link *link)
 {
     if (tx != NULL && link != NULL) {
-        tx->link = *link;
+        link_copy(&tx->link, link);
     }
 }
 
@@ -560,7 +578,7 @@ urrt_cantx_state urrt_cantx_gateway_state(const urrt_cantx *tx, size_t hb, uint6
 /* v if it is an integer in [lo, hi], else na. */
 static double enum_or(double v, double lo, double hi, double na)
 {
-    if (!(v >= lo && v <= hi) || v != (double)(long)v) {
+    if (!(v >= lo && v <= hi) || v != (double)(int64_t)v) {
         return na;
     }
     return v;
@@ -605,7 +623,7 @@ void urrt_cantx_heartbeat_fill(urrt_cantx *tx, size_t frame, uint64_t now_us, bo
     values[URRT_CANTX_HB_DATA_AGE] = age_ms(r, now_us);
     values[URRT_CANTX_HB_DROPS] = (double)(uint16_t)now->dropped;
     if (sending) {
-        tx->link_seen = tx->link;
+        link_copy(&tx->link_seen, &tx->link);
         tx->clamped_seen = tx->clamped;
     }
 }

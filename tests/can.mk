@@ -9,7 +9,9 @@
 #   bench-can      ns per packet for the CAN mapping beside urrt_decode of the same packet
 
 CANT := $(BUILD)/tests/can
-CAN_TEST_SRCS := gateway/can_map.c gateway/can_run.c gateway/dbc.c
+CAN_TEST_SRCS := gateway/can_map.c gateway/can_run.c gateway/dbc.c gateway/conf.c
+# can_map reads values with conf.o (built by gateway/tools.mk).
+CAN_TEST_OBJS := $(CAN_GATEWAY_OBJS) $(BUILD)/gateway/conf.o
 CAN_TEST_CFLAGS := $(PROG_WARN) $(CPPFLAGS) -Igateway -Itests
 
 CHECKS += check-can check-can-san check-can-dbc
@@ -24,17 +26,17 @@ define can_suite
 	  grep -q '^[0-9]* passed, 0 failed$$' $(BUILD)/results/$(1).result || rc=1; exit $$rc
 endef
 
-$(CANT)/test_can: tests/can/test_can.c tests/check.h $(CAN_GATEWAY_OBJS) $(LIBURRT)
+$(CANT)/test_can: tests/can/test_can.c tests/check.h $(CAN_TEST_OBJS) $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_GATEWAY_OBJS) $(LIBURRT) -linih -lm -o $@
+	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_TEST_OBJS) $(LIBURRT) -linih -lm -o $@
 
-$(CANT)/test_can_san: tests/can/test_can.c tests/check.h $(CAN_TEST_SRCS) $(CAN_GATEWAY_HDRS) $(LIB_SRCS)
+$(CANT)/test_can_san: tests/can/test_can.c tests/check.h $(CAN_TEST_SRCS) $(CAN_GATEWAY_HDRS) gateway/conf.h $(LIB_SRCS)
 	@mkdir -p $(@D)
 	$(CC) $(CAN_TEST_CFLAGS) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $< $(CAN_TEST_SRCS) $(LIB_SRCS) -linih -lm -o $@
 
-$(CANT)/can_tool: tests/can/can_tool.c $(CAN_GATEWAY_OBJS) $(LIBURRT)
+$(CANT)/can_tool: tests/can/can_tool.c $(CAN_TEST_OBJS) $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_GATEWAY_OBJS) $(LIBURRT) -linih -lm -o $@
+	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_TEST_OBJS) $(LIBURRT) -linih -lm -o $@
 
 check-can: $(CANT)/test_can
 	$(call can_suite,check-can,$(CANT)/test_can)
@@ -49,9 +51,29 @@ check-can-dbc: $(CANT)/can_tool
 BENCHES += bench-can
 .PHONY: bench-can
 
-$(CANT)/bench_can: tests/can/bench_can.c $(CAN_GATEWAY_OBJS) $(LIBURRT)
+$(CANT)/bench_can: tests/can/bench_can.c $(CAN_TEST_OBJS) $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_GATEWAY_OBJS) $(LIBURRT) -linih -lm -o $@
+	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_TEST_OBJS) $(LIBURRT) -linih -lm -o $@
 
 bench-can: $(CANT)/bench_can
 	@$(CANT)/bench_can docs/examples/canopen.ini
+
+# ---- the CAN core alone (lib/urrt_cantx), here and on the emulated cores -------------
+#   check-cantx      tests/can/test_cantx.c on the host (check-lib-m4 runs it on Cortex-M)
+#   check-cantx-san  the same under ASan + UBSan
+CHECKS += check-cantx check-cantx-san
+.PHONY: check-cantx check-cantx-san
+
+$(CANT)/test_cantx: tests/can/test_cantx.c $(LIBURRT)
+	@mkdir -p $(@D)
+	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(LIBURRT) -lm -o $@
+
+$(CANT)/test_cantx_san: tests/can/test_cantx.c $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(CAN_TEST_CFLAGS) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $< $(LIB_SRCS) -lm -o $@
+
+check-cantx: $(CANT)/test_cantx
+	$(call can_suite,check-cantx,$(CANT)/test_cantx)
+
+check-cantx-san: $(CANT)/test_cantx_san
+	$(call can_suite,check-cantx-san,$(CANT)/test_cantx_san)

@@ -7,7 +7,9 @@
 #                  and hard-float -O2), netduinoplus2
 #                  (STM32F405) and microbit (Cortex-M0, -Os and -O2); no C library in the
 #                  images, results through semihosting and qemu's exit status; and the painted
-#                  stack of every public lib/ function against -fstack-usage and README.md
+#                  stack of every public lib/ function against -fstack-usage and README.md;
+#                  the CAN core's tests (tests/can/test_cantx.c) on the M4 (soft and hard float)
+#                  and the M0
 #   check-lib-be   tests/lib/test_lib.c on big-endian s390x, powerpc and mips (with the lib/urrt_can
 #                  tests of tests/can/test_can.c) and on little-endian NEON (aarch64, armhf)
 #                  under qemu-user; on big-endian NEON (aarch64_be, armeb; freestanding)
@@ -61,10 +63,26 @@ $(eval $(call tgt_image,m0-os,$(TGT_M0),-Os,microbit.ld,named))
 $(eval $(call tgt_image,m0-o2,$(TGT_M0),-O2,microbit.ld,named+32))
 TGT_BOARDS := m4-os:mps2-an386 m4f-o2:mps2-an386 m4na-os:mps2-an386 f405-os:netduinoplus2 m0-os:microbit m0-o2:microbit
 
-check-lib-m4: $(foreach b,$(TGT_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/test.elf) tests/target/stack.py
+# The CAN core's tests (tests/can/test_cantx.c) as images of their own, on the
+# lib/ objects of an image above: $(call tgt_cantx,NAME,CPU FLAGS,OPT,LINKER SCRIPT).
+define tgt_cantx
+$(TGT)/$(1)/cantx.elf: tests/can/test_cantx.c tests/target/cm.c tests/target/target.h tests/target/$(4) \
+  $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
+	$(TGT_CM) $(2) $(3) $(TGT_FLAGS) -DURRT_TARGET_CORTEX_M tests/target/cm.c $$< \
+	  $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -T tests/target/$(4) $(TGT_LINK) -o $$@
+endef
+$(eval $(call tgt_cantx,m4-os,$(TGT_M4),-Os,an386.ld))
+$(eval $(call tgt_cantx,m4f-o2,$(TGT_M4F),-O2,an386.ld))
+$(eval $(call tgt_cantx,m0-os,$(TGT_M0),-Os,microbit.ld))
+TGT_CANTX := m4-os:mps2-an386 m4f-o2:mps2-an386 m0-os:microbit
+
+check-lib-m4: $(foreach b,$(TGT_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/test.elf) tests/target/stack.py \
+  $(foreach b,$(TGT_CANTX),$(TGT)/$(firstword $(subst :, ,$(b)))/cantx.elf)
 	$(call lib_suite,check-lib-m4,sh tests/target/run.sh $(TGT)/logs \
 	  $(foreach b,$(TGT_BOARDS),$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M) -M $(lastword $(subst :, ,$(b))) \
 	    -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/test.elf") \
+	  $(foreach b,$(TGT_CANTX),cantx-$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M) -M $(lastword $(subst :, ,$(b))) \
+	    -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/cantx.elf") \
 	  stack-m4-os="$(PYTHON) tests/target/stack.py $(TGT)/logs/m4-os.log README.md $(TGT)/m4-os/lib/*.ci")
 
 # ---- big-endian and NEON under qemu-user ---------------------------------------------
