@@ -243,84 +243,112 @@ static void print_summary(gateway *gw, uint64_t now_us)
     fflush(stdout);
 }
 
+/* One wait's descriptors: each link's (or none) and each output's run. */
+typedef struct gw_poll {
+    struct pollfd fds[GW_MAX_POLL];
+    unsigned nfds;
+    unsigned link_fd[GW_MAX_ROBOTS]; /* index in fds, UINT32_MAX for none */
+    unsigned output_first[GW_MAX_OUTPUTS], output_count[GW_MAX_OUTPUTS];
+} gw_poll;
+
+/* Fills p from the links and outputs; returns the earliest of their
+ * deadlines, the summary's and the tick's. */
+static uint64_t poll_set(gateway *gw, gw_poll *p, uint64_t now)
+{
+    uint64_t deadline = now + GW_TICK_MAX_US;
+    p->nfds = 0;
+    for (unsigned i = 0; i < gw->robot_count; i++) {
+        short events = 0;
+        int fd = urrt_link_poll_fd(gw->robots[i].link, &events);
+        uint64_t d = urrt_link_deadline(gw->robots[i].link);
+        p->link_fd[i] = UINT32_MAX;
+        if (fd >= 0 && p->nfds < GW_MAX_POLL) {
+            p->link_fd[i] = p->nfds;
+            p->fds[p->nfds++] = (struct pollfd){.fd = fd, .events = events};
+        }
+        deadline = d < deadline ? d : deadline;
+    }
+    for (unsigned o = 0; o < gw->output_count; o++) {
+        const gw_output *out = &gw->outputs[o];
+        p->output_first[o] = p->nfds;
+        p->output_count[o] = out->poll_fds != NULL ? out->poll_fds(out->ctx, p->fds + p->nfds, GW_MAX_POLL - p->nfds)
+                                                   : 0;
+        p->nfds += p->output_count[o];
+        if (out->deadline != NULL) {
+            uint64_t d = out->deadline(out->ctx);
+            deadline = d < deadline ? d : deadline;
+        }
+    }
+    if (gw->summary && gw->next_summary_us < deadline) {
+        deadline = gw->next_summary_us;
+    }
+    return deadline;
+}
+
+/* Waits until something is ready or the deadline; after a failed poll
+ * nothing counts as ready. */
+static void wait_ready(gw_poll *p, uint64_t deadline, uint64_t now)
+{
+    /* Round up: waking a little late is harmless, early wakes spin. */
+    int timeout_ms = deadline <= now ? 0 : (int)((deadline - now + 999u) / 1000u);
+    if (poll(p->fds, p->nfds, timeout_ms) < 0) {
+        if (errno != EINTR) {
+            urrt_log(URRT_LOG_ERR, "poll: %s", strerror(errno));
+        }
+        for (unsigned i = 0; i < p->nfds; i++) {
+            p->fds[i].revents = 0;
+        }
+    }
+}
+
+static void service_links(gateway *gw, const gw_poll *p, uint64_t now)
+{
+    for (unsigned i = 0; i < gw->robot_count; i++) {
+        gw_robot *robot = &gw->robots[i];
+        bool signalled = p->link_fd[i] != UINT32_MAX && p->fds[p->link_fd[i]].revents != 0;
+        if (signalled || urrt_link_deadline(robot->link) <= now ||
+            urrt_link_get_state(robot->link) != URRT_LINK_UP) {
+            urrt_link_service(robot->link, now, on_packet, robot);
+        }
+    }
+}
+
+static void service_outputs(gateway *gw, gw_poll *p, uint64_t now)
+{
+    for (unsigned o = 0; o < gw->output_count; o++) {
+        const gw_output *out = &gw->outputs[o];
+        if (out->service != NULL) {
+            out->service(out->ctx, p->fds + p->output_first[o], p->output_count[o], now);
+        }
+        out->tick(out->ctx, now);
+    }
+}
+
+static void summary_if_due(gateway *gw, uint64_t now)
+{
+    if (gw->summary && now >= gw->next_summary_us) {
+        print_summary(gw, now);
+        gw->next_summary_us += 1000000u;
+        if (gw->next_summary_us <= now) {
+            gw->next_summary_us = now + 1000000u;
+        }
+    }
+}
+
 void gw_run(gateway *gw, volatile sig_atomic_t *running)
 {
-    struct pollfd fds[GW_MAX_POLL];
-    unsigned link_fd[GW_MAX_ROBOTS];
-    unsigned output_first[GW_MAX_OUTPUTS], output_count[GW_MAX_OUTPUTS];
+    gw_poll p;
     uint64_t now = urrt_port_monotonic_us();
 
     gw->next_summary_us = now + 1000000u;
     while (*running) {
-        unsigned nfds = 0;
-        uint64_t deadline = now + GW_TICK_MAX_US;
-        int timeout_ms, ready;
-
-        for (unsigned i = 0; i < gw->robot_count; i++) {
-            short events = 0;
-            int fd = urrt_link_poll_fd(gw->robots[i].link, &events);
-            uint64_t d = urrt_link_deadline(gw->robots[i].link);
-            link_fd[i] = UINT32_MAX;
-            if (fd >= 0 && nfds < GW_MAX_POLL) {
-                link_fd[i] = nfds;
-                fds[nfds++] = (struct pollfd){.fd = fd, .events = events};
-            }
-            if (d < deadline) {
-                deadline = d;
-            }
-        }
-        for (unsigned o = 0; o < gw->output_count; o++) {
-            const gw_output *out = &gw->outputs[o];
-            output_first[o] = nfds;
-            output_count[o] = out->poll_fds != NULL ? out->poll_fds(out->ctx, fds + nfds, GW_MAX_POLL - nfds) : 0;
-            nfds += output_count[o];
-            if (out->deadline != NULL) {
-                uint64_t d = out->deadline(out->ctx);
-                if (d < deadline) {
-                    deadline = d;
-                }
-            }
-        }
-        if (gw->summary && gw->next_summary_us < deadline) {
-            deadline = gw->next_summary_us;
-        }
-        /* Round up: waking a little late is harmless, early wakes spin. */
-        timeout_ms = deadline <= now ? 0 : (int)((deadline - now + 999u) / 1000u);
-        ready = poll(fds, nfds, timeout_ms);
-        if (ready < 0 && errno != EINTR) {
-            urrt_log(URRT_LOG_ERR, "poll: %s", strerror(errno));
-        }
-        now = urrt_port_monotonic_us();
-        if (ready < 0) {
-            for (unsigned i = 0; i < nfds; i++) {
-                fds[i].revents = 0;
-            }
-        }
-        for (unsigned i = 0; i < gw->robot_count; i++) {
-            gw_robot *robot = &gw->robots[i];
-            bool signalled = link_fd[i] != UINT32_MAX && fds[link_fd[i]].revents != 0;
-            if (signalled || urrt_link_deadline(robot->link) <= now ||
-                urrt_link_get_state(robot->link) != URRT_LINK_UP) {
-                urrt_link_service(robot->link, now, on_packet, robot);
-            }
-        }
+        wait_ready(&p, poll_set(gw, &p, now), now);
+        service_links(gw, &p, urrt_port_monotonic_us());
         /* The outputs judge freshness after the reads: a report must not
          * say "stale" about an instant before the packets just read. */
         now = urrt_port_monotonic_us();
-        for (unsigned o = 0; o < gw->output_count; o++) {
-            const gw_output *out = &gw->outputs[o];
-            if (out->service != NULL) {
-                out->service(out->ctx, fds + output_first[o], output_count[o], now);
-            }
-            out->tick(out->ctx, now);
-        }
-        if (gw->summary && now >= gw->next_summary_us) {
-            print_summary(gw, now);
-            gw->next_summary_us += 1000000u;
-            if (gw->next_summary_us <= now) {
-                gw->next_summary_us = now + 1000000u;
-            }
-        }
+        service_outputs(gw, &p, now);
+        summary_if_due(gw, now);
         gw->loops++;
     }
 }
