@@ -8,16 +8,16 @@
 struct can_out {
     gateway *gw;
     struct can_map *map;
+    urrt_cantx *tx;         /* the map's CAN core */
     urrt_canlink *link;
-    uint64_t now_us;        /* for emit(): can_map_due passes no time */
     uint64_t refused;       /* frames the link refused (cannot happen with a checked map) */
     bool robot_up[GW_MAX_ROBOTS];
 };
 
-static void emit(void *ctx, const urrt_can_frame *frame)
+static void emit(void *ctx, const urrt_can_frame *frame, uint64_t now_us)
 {
     can_out *out = ctx;
-    if (urrt_canlink_send(out->link, frame, out->now_us) < 0) {
+    if (urrt_canlink_send(out->link, frame, now_us) < 0) {
         out->refused++;
     }
 }
@@ -30,17 +30,16 @@ static void run_due(can_out *out, uint64_t now_us)
     if (urrt_canlink_get_state(out->link) != URRT_CANLINK_UP) {
         return;
     }
-    out->now_us = now_us;
     can_map_due(out->map, now_us, urrt_canlink_get_stats(out->link), emit, out);
 }
 
 static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
 {
     can_out *out = ctx;
-    /* The map judges staleness by the data's age, not by the read: a
+    /* The core judges staleness by the data's age, not by the read: a
      * backlog read just now is as old as its data. Frames are due by the
      * clock now, just before they are sent. */
-    can_map_on_packet(out->map, robot->index, pkt->state, pkt->data_us);
+    urrt_cantx_on_packet(out->tx, robot->index, pkt->state, pkt->data_us);
     out->robot_up[robot->index] = true;
     run_due(out, urrt_port_monotonic_us());
 }
@@ -52,7 +51,7 @@ static void on_tick(void *ctx, uint64_t now_us)
         bool up = urrt_link_get_state(out->gw->robots[i].link) == URRT_LINK_UP;
         if (up != out->robot_up[i]) {
             out->robot_up[i] = up;
-            can_map_robot_link(out->map, i, up);
+            urrt_cantx_robot_link(out->tx, i, up);
         }
     }
     urrt_canlink_service(out->link, now_us);
@@ -83,7 +82,7 @@ static void on_service(void *ctx, const struct pollfd *fds, unsigned count, uint
 static uint64_t on_deadline(void *ctx)
 {
     can_out *out = ctx;
-    uint64_t map_due = can_map_deadline(out->map);
+    uint64_t map_due = urrt_cantx_deadline(out->tx);
     uint64_t link_due = urrt_canlink_deadline(out->link);
     return map_due < link_due ? map_due : link_due;
 }
@@ -101,7 +100,7 @@ static unsigned on_counters(void *ctx, const gw_robot *robot, gw_counter *counte
         {"can_error_frames", s->error_frames},
         {"can_bus_off", s->bus_off},
         {"can_restarts", s->restarts},
-        {"can_clamped", out->map->clamped},
+        {"can_clamped", can_map_clamped(out->map)},
     };
     unsigned n = 0;
     (void)robot;
@@ -118,7 +117,7 @@ static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *b
     (void)robot;
     return snprintf(buf, size, " | CAN %s %s, sent %llu, dropped %llu, bus-off %llu",
                     urrt_canlink_get_state(out->link) == URRT_CANLINK_UP ? "up" : "DOWN",
-                    can_map_state_name(can_map_state(out->map, now_us)), (unsigned long long)s->sent,
+                    urrt_cantx_state_name(can_map_state(out->map, now_us)), (unsigned long long)s->sent,
                     (unsigned long long)s->dropped, (unsigned long long)s->bus_off);
 }
 
@@ -147,6 +146,13 @@ can_out *can_out_new(gateway *gw, struct can_map *map)
     out->gw = gw;
     out->map = map;
     can_map_start(map, urrt_port_monotonic_us());
+    out->tx = can_map_tx(map);
+    if (out->tx == NULL) {
+        urrt_log(URRT_LOG_ERR, "CAN output: the frame tables could not be built (out of memory?)");
+        urrt_canlink_free(out->link);
+        free(out);
+        return NULL;
+    }
     return out;
 }
 

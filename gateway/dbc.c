@@ -218,10 +218,10 @@ int dbc_write(FILE *out, const struct can_map *map, const char *source)
         }
         fprintf(out, "\n");
     }
-    fprintf(out, "BO_ %lu %s: %u %s\n", hb, CAN_MAP_HEARTBEAT_NAME, CAN_MAP_HB_LEN, map->node);
-    for (k = 0; k < CAN_MAP_HB_COUNT; k++) {
+    fprintf(out, "BO_ %lu %s: %u %s\n", hb, CAN_MAP_HEARTBEAT_NAME, URRT_CANTX_HB_LEN, map->node);
+    for (k = 0; k < URRT_CANTX_HB_COUNT; k++) {
         const struct can_map_hb_signal *h = &can_map_heartbeat_layout[k];
-        put_signal(out, h->name, &h->sig, h->unit, map->receiver);
+        put_signal(out, h->name, &urrt_cantx_heartbeat_signals[k], h->unit, map->receiver);
     }
     fprintf(out, "\n\n");
 
@@ -280,7 +280,7 @@ int dbc_write(FILE *out, const struct can_map *map, const char *source)
     fprintf(out, "CM_ BO_ %lu \"Gateway heartbeat, every %u ms. Robot ", hb, (unsigned)map->hb_period_ms);
     put_text(out, map->hb_robot_index < map->robot_count ? map->robots[map->hb_robot_index].name : map->hb_robot);
     fprintf(out, "; data stale after %u ms.\";\n", (unsigned)map->stale_after_ms);
-    for (k = 0; k < CAN_MAP_HB_COUNT; k++) {
+    for (k = 0; k < URRT_CANTX_HB_COUNT; k++) {
         fprintf(out, "CM_ SG_ %lu %s \"", hb, can_map_heartbeat_layout[k].name);
         put_text(out, can_map_heartbeat_layout[k].comment);
         fprintf(out, "\";\n");
@@ -338,25 +338,25 @@ int dbc_write(FILE *out, const struct can_map *map, const char *source)
             }
         }
     }
-    for (k = 0; k < CAN_MAP_HB_COUNT; k++) {
+    for (k = 0; k < URRT_CANTX_HB_COUNT; k++) {
         const struct can_map_hb_signal *h = &can_map_heartbeat_layout[k];
         switch (h->values) {
         case CAN_MAP_HB_VALUES_STATE: {
             int s;
             fprintf(out, "VAL_ %lu %s", hb, h->name);
-            for (s = CAN_MAP_STATE_STARTING; s <= CAN_MAP_STATE_DISCONNECTED; s++) {
-                fprintf(out, " %d \"%s\"", s, can_map_state_name((enum can_map_gateway_state)s));
+            for (s = URRT_CANTX_STARTING; s <= URRT_CANTX_DISCONNECTED; s++) {
+                fprintf(out, " %d \"%s\"", s, urrt_cantx_state_name((urrt_cantx_state)s));
             }
             fprintf(out, " ;\n");
             break;
         }
         case CAN_MAP_HB_VALUES_ROBOT_MODE:
-            put_enum_values(out, hb, h->name, &h->sig,
+            put_enum_values(out, hb, h->name, &urrt_cantx_heartbeat_signals[k],
                             map->generation == URRT_GEN_1X ? URRT_ENUM_ROBOT_MODE_1X : URRT_ENUM_ROBOT_MODE,
-                            CAN_MAP_HB_ROBOT_MODE_NA, "NOT_AVAILABLE");
+                            URRT_CANTX_HB_ROBOT_MODE_NA, "NOT_AVAILABLE");
             break;
         case CAN_MAP_HB_VALUES_SAFETY_MODE:
-            put_enum_values(out, hb, h->name, &h->sig, URRT_ENUM_SAFETY_MODE, CAN_MAP_HB_SAFETY_MODE_NA,
+            put_enum_values(out, hb, h->name, &urrt_cantx_heartbeat_signals[k], URRT_ENUM_SAFETY_MODE, URRT_CANTX_HB_SAFETY_MODE_NA,
                             "NOT_AVAILABLE");
             break;
         case CAN_MAP_HB_VALUES_GENERATION:

@@ -12,7 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "can_ctables.h"
 #include "can_out.h"
+#include "can_replay.h"
 #include "cli.h"
 #include "config.h"
 #include "dbc.h"
@@ -105,35 +107,61 @@ static void print_plan(const gw_config *cfg, const char *url)
     }
 }
 
-static int write_dbc(const gw_config *cfg, const char *path)
+/* What --print-dbc and --print-c-tables write. */
+typedef int (*writer_fn)(FILE *out, struct can_map *map, const char *source);
+
+static int dbc_writer(FILE *out, struct can_map *map, const char *source)
+{
+    return dbc_write(out, map, source);
+}
+
+static int write_output(gw_config *cfg, const char *path, writer_fn write, const char *what)
 {
     FILE *out = stdout;
     bool ok;
     if (!can_map_enabled(&cfg->can)) {
-        fprintf(stderr, "urrt-gateway: %s has no [can] section or [frame NAME]: nothing to describe\n", cfg->path);
+        fprintf(stderr, "urrt-gateway: %s has no [can] section or [frame NAME]: no %s to write\n", cfg->path, what);
         return CLI_EXIT_USAGE;
     }
     if (path != NULL && (out = fopen(path, "w")) == NULL) {
         fprintf(stderr, "urrt-gateway: cannot write %s: %s\n", path, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
-    ok = dbc_write(out, &cfg->can, cfg->path) == 0;
+    ok = write(out, &cfg->can, cfg->path) == 0;
     ok = fflush(out) == 0 && ok;
     if (out != stdout) {
         ok = fclose(out) == 0 && ok;
     }
     if (!ok) {
-        fprintf(stderr, "urrt-gateway: writing the DBC to %s failed: %s\n", path ? path : "stdout", strerror(errno));
+        fprintf(stderr, "urrt-gateway: writing the %s to %s failed: %s\n", what, path ? path : "stdout",
+                strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
     return CLI_EXIT_OK;
 }
 
-int main(int argc, char **argv)
+typedef struct options {
+    bool check_only;
+    bool summary;
+    bool print_dbc;
+    bool print_c_tables;
+    const char *output_path;
+    const char *url_override;
+    const char *replay_path;
+    const char *config_path;
+    urrt_log_level level;
+    bool level_given;
+} options;
+
+/* CLI_EXIT_* to stop with, or -1 to go on. */
+static int parse_options(int argc, char **argv, options *o)
 {
-    static const struct option options[] = {
+    enum { OPT_C_TABLES = 256, OPT_REPLAY };
+    static const struct option longopts[] = {
         {"check-config", no_argument, NULL, 'c'},
         {"print-dbc", no_argument, NULL, 'd'},
+        {"print-c-tables", no_argument, NULL, OPT_C_TABLES},
+        {"replay", required_argument, NULL, OPT_REPLAY},
         {"output", required_argument, NULL, 'o'},
         {"summary", no_argument, NULL, 's'},
         {"lcm-url", required_argument, NULL, 'u'},
@@ -142,31 +170,24 @@ int main(int argc, char **argv)
         {"version", no_argument, NULL, 'V'},
         {NULL, 0, NULL, 0},
     };
-    bool check_only = false, summary = false, print_dbc = false;
-    const char *output_path = NULL;
-    const char *url_override = NULL;
-    urrt_log_level level = URRT_LOG_NOTICE;
-    bool level_given = false;
-    gw_config cfg;
-    gateway gw;
-    lcm_out *lcm;
-    gw_output output;
     int opt;
-
-    urrt_log_init(argv[0], URRT_LOG_NOTICE);
-    while ((opt = getopt_long(argc, argv, "cdo:su:l:hV", options, NULL)) != -1) {
+    memset(o, 0, sizeof *o);
+    o->level = URRT_LOG_NOTICE;
+    while ((opt = getopt_long(argc, argv, "cdo:su:l:hV", longopts, NULL)) != -1) {
         switch (opt) {
-        case 'c': check_only = true; break;
-        case 'd': print_dbc = true; break;
-        case 'o': output_path = optarg; break;
-        case 's': summary = true; break;
-        case 'u': url_override = optarg; break;
+        case 'c': o->check_only = true; break;
+        case 'd': o->print_dbc = true; break;
+        case OPT_C_TABLES: o->print_c_tables = true; break;
+        case OPT_REPLAY: o->replay_path = optarg; break;
+        case 'o': o->output_path = optarg; break;
+        case 's': o->summary = true; break;
+        case 'u': o->url_override = optarg; break;
         case 'l':
-            if (!gw_parse_log_level(optarg, &level)) {
+            if (!gw_parse_log_level(optarg, &o->level)) {
                 fprintf(stderr, "urrt-gateway: --log-level %s: use err, warning, notice, info or debug\n", optarg);
                 return CLI_EXIT_USAGE;
             }
-            level_given = true;
+            o->level_given = true;
             break;
         case 'h': usage(stdout); return CLI_EXIT_OK;
         case 'V':
@@ -183,78 +204,117 @@ int main(int argc, char **argv)
                 optind == argc ? "no CONFIG file given" : "only one CONFIG file is read");
         return CLI_EXIT_USAGE;
     }
-    if (gw_config_load(&cfg, argv[optind], stderr) != 0) {
-        fprintf(stderr, "urrt-gateway: %s is not valid; see `urrt-gateway --help` for the grammar\n", argv[optind]);
-        gw_config_free(&cfg);
+    if ((int)o->print_dbc + (int)o->print_c_tables + (int)o->check_only + (o->replay_path != NULL) > 1) {
+        fprintf(stderr, "urrt-gateway: --check-config, --print-dbc, --print-c-tables and --replay are "
+                        "separate jobs: give one\nTry 'urrt-gateway --help'.\n");
         return CLI_EXIT_USAGE;
     }
-    if ((summary || cfg.summary) && !print_dbc && can_map_enabled(&cfg.can) &&
-        strncmp(cfg.can.interface, "log:-", 5) == 0 &&
-        (cfg.can.interface[5] == '\0' || cfg.can.interface[5] == ',')) {
-        /* Summary lines in the CAN log would stop canplayer replaying it. */
-        fprintf(stderr, "%s:%d: interface = %s and the summary both write to stdout: log the frames to a file "
-                "(log:PATH) or turn the summary off\n", cfg.path, cfg.can.key_loc[CAN_MAP_CK_INTERFACE].line,
-                cfg.can.interface);
-        gw_config_free(&cfg);
+    if (o->output_path != NULL && !o->print_dbc && !o->print_c_tables) {
+        fprintf(stderr, "urrt-gateway: --output goes with --print-dbc or --print-c-tables\n"
+                        "Try 'urrt-gateway --help'.\n");
         return CLI_EXIT_USAGE;
     }
-    if (url_override != NULL) {
-        free(cfg.lcm.url);
-        cfg.lcm.url = strdup(url_override);
-    }
-    if (output_path != NULL && !print_dbc) {
-        fprintf(stderr, "urrt-gateway: --output goes with --print-dbc\nTry 'urrt-gateway --help'.\n");
-        gw_config_free(&cfg);
-        return CLI_EXIT_USAGE;
-    }
-    if (print_dbc) {
-        int rc = write_dbc(&cfg, output_path);
-        gw_config_free(&cfg);
-        return rc;
-    }
-    if (check_only) {
-        print_plan(&cfg, cfg.lcm.url);
-        gw_config_free(&cfg);
-        return CLI_EXIT_OK;
-    }
-    urrt_log_set_level(level_given ? level : cfg.log_level);
-    cli_handle_signals(&running);
+    o->config_path = argv[optind];
+    return -1;
+}
 
-    if (!gw_init(&gw, &cfg)) {
-        gw_config_free(&cfg);
+/* Summary lines in a CAN log on stdout would stop canplayer replaying it. */
+static bool summary_clashes(const gw_config *cfg, const options *o)
+{
+    const char *iface = cfg->can.interface;
+    return (o->summary || cfg->summary) && o->replay_path == NULL && !o->print_dbc && !o->print_c_tables &&
+           can_map_enabled(&cfg->can) && strncmp(iface, "log:-", 5) == 0 && (iface[5] == '\0' || iface[5] == ',');
+}
+
+/* CLI_EXIT_* to stop with (cfg freed), or -1 with cfg loaded. */
+static int load_config(gw_config *cfg, const options *o)
+{
+    char err[512];
+    if (gw_config_load(cfg, o->config_path, stderr) != 0) {
+        fprintf(stderr, "urrt-gateway: %s is not valid; see `urrt-gateway --help` for the grammar\n", o->config_path);
+        gw_config_free(cfg);
+        return CLI_EXIT_USAGE;
+    }
+    if (can_map_enabled(&cfg->can) && can_map_build(&cfg->can, err, sizeof err) != 0) {
+        fprintf(stderr, "%s: %s\n", cfg->path, err);
+        gw_config_free(cfg);
+        return CLI_EXIT_USAGE;
+    }
+    if (summary_clashes(cfg, o)) {
+        fprintf(stderr, "%s:%d: interface = %s and the summary both write to stdout: log the frames to a file "
+                "(log:PATH) or turn the summary off\n", cfg->path, cfg->can.key_loc[CAN_MAP_CK_INTERFACE].line,
+                cfg->can.interface);
+        gw_config_free(cfg);
+        return CLI_EXIT_USAGE;
+    }
+    if (o->url_override != NULL) {
+        free(cfg->lcm.url);
+        cfg->lcm.url = strdup(o->url_override);
+    }
+    return -1;
+}
+
+/* The gateway itself: until SIGINT or SIGTERM. */
+static int run(gw_config *cfg, const options *o)
+{
+    gateway gw;
+    lcm_out *lcm;
+    gw_output output;
+    cli_handle_signals(&running);
+    if (!gw_init(&gw, cfg)) {
         return CLI_EXIT_RUNTIME;
     }
-    gw.summary = gw.summary || summary;
-    lcm = lcm_out_new(&gw, &cfg.lcm);
-    if (lcm == NULL) {
+    gw.summary = gw.summary || o->summary;
+    if ((lcm = lcm_out_new(&gw, &cfg->lcm)) == NULL) {
         urrt_log(URRT_LOG_ERR, "out of memory");
         gw_close(&gw);
-        gw_config_free(&cfg);
         return CLI_EXIT_RUNTIME;
     }
     output = lcm_out_output(lcm);
     gw_add_output(&gw, &output);
-    if (can_map_enabled(&cfg.can)) {
+    if (can_map_enabled(&cfg->can)) {
         char line[256];
-        can_out *can = can_out_new(&gw, &cfg.can);
+        can_out *can = can_out_new(&gw, &cfg->can);
         if (can == NULL) {
-            urrt_log(URRT_LOG_ERR, "the CAN output cannot start (see above); fix [can] in %s", cfg.path);
+            urrt_log(URRT_LOG_ERR, "the CAN output cannot start (see above); fix [can] in %s", cfg->path);
             gw_close(&gw);
-            gw_config_free(&cfg);
             return CLI_EXIT_RUNTIME;
         }
         output = can_out_output(can);
         gw_add_output(&gw, &output);
-        can_map_describe(&cfg.can, line, sizeof line);
+        can_map_describe(&cfg->can, line, sizeof line);
         urrt_log(URRT_LOG_NOTICE, "CAN: %s", line);
     }
-    urrt_log(URRT_LOG_NOTICE, "started: %u robot%s, LCM %s", cfg.robot_count, cfg.robot_count == 1 ? "" : "s",
-             cfg.lcm.url);
-
+    urrt_log(URRT_LOG_NOTICE, "started: %u robot%s, LCM %s", cfg->robot_count, cfg->robot_count == 1 ? "" : "s",
+             cfg->lcm.url);
     gw_run(&gw, &running);
-
     urrt_log(URRT_LOG_NOTICE, "stopping (signal %d)", cli_stop_signal());
     gw_close(&gw);
-    gw_config_free(&cfg);
     return CLI_EXIT_OK;
+}
+
+int main(int argc, char **argv)
+{
+    options o;
+    gw_config cfg;
+    int rc;
+    urrt_log_init(argv[0], URRT_LOG_NOTICE);
+    if ((rc = parse_options(argc, argv, &o)) >= 0 || (rc = load_config(&cfg, &o)) >= 0) {
+        return rc;
+    }
+    urrt_log_set_level(o.level_given ? o.level : cfg.log_level);
+    if (o.print_dbc) {
+        rc = write_output(&cfg, o.output_path, dbc_writer, "DBC");
+    } else if (o.print_c_tables) {
+        rc = write_output(&cfg, o.output_path, can_ctables_write, "C tables");
+    } else if (o.replay_path != NULL) {
+        rc = can_replay(&cfg.can, o.replay_path);
+    } else if (o.check_only) {
+        print_plan(&cfg, cfg.lcm.url);
+        rc = CLI_EXIT_OK;
+    } else {
+        rc = run(&cfg, &o);
+    }
+    gw_config_free(&cfg);
+    return rc;
 }

@@ -61,8 +61,9 @@ static int on_key(void *user, const char *section, const char *key, const char *
     return 1;
 }
 
-static void count_frame(void *ctx, const urrt_can_frame *f)
+static void count_frame(void *ctx, const urrt_can_frame *f, uint64_t now_us)
 {
+    (void)now_us;
     *(uint64_t *)ctx += 1;
     sink += f->data[0];
 }
@@ -111,7 +112,7 @@ int main(int argc, char **argv)
         double t0 = now_ns();
         for (i = 0; i < ITERATIONS; i++) {
             now += 2000; /* 500 Hz */
-            can_map_on_packet(&map, 0, &st, now);
+            urrt_cantx_on_packet(can_map_tx(&map), 0, &st, now);
             can_map_due(&map, now, NULL, count_frame, &frames);
         }
         double t1 = now_ns();

@@ -167,8 +167,9 @@ struct run_ctx {
     uint64_t now;
 };
 
-static void print_frame(void *ctx, const urrt_can_frame *fr)
+static void print_frame(void *ctx, const urrt_can_frame *fr, uint64_t now_us)
 {
+    (void)now_us;
     struct run_ctx *run = ctx;
     printf("%" PRIu64 " ", run->now);
     if (fr->extended) {
@@ -232,12 +233,12 @@ static int cmd_run(struct can_map *map)
                     ((double *)(void *)((char *)&st + off))[elem] = strtod(eq + 1, NULL);
                     st.present |= UINT64_C(1) << id;
                 }
-                can_map_on_packet(map, robot, &st, run.now);
+                urrt_cantx_on_packet(can_map_tx(map), robot, &st, run.now);
             }
             can_map_due(map, run.now, &stats, print_frame, &run);
         } else if (strcmp(cmd, "link") == 0) {
             size_t robot = robot_by_name(map, strtok_r(NULL, " \t\r\n", &save));
-            can_map_robot_link(map, robot, strcmp(strtok_r(NULL, " \t\r\n", &save), "up") == 0);
+            urrt_cantx_robot_link(can_map_tx(map), robot, strcmp(strtok_r(NULL, " \t\r\n", &save), "up") == 0);
         } else if (strcmp(cmd, "stats") == 0) {
             uint64_t *slots[] = {&stats.dropped, &stats.bus_off, &stats.error_frames, &stats.down_events,
                                  &stats.send_errors};

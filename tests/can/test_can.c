@@ -910,20 +910,20 @@ struct capture {
     struct sent s[MAX_SENT];
 };
 
-static void capture_frame(void *ctx, const urrt_can_frame *f)
+static void capture_frame(void *ctx, const urrt_can_frame *f, uint64_t now_us)
 {
     struct capture *c = ctx;
     if (c->n < MAX_SENT) {
-        c->s[c->n].t = c->now;
+        c->s[c->n].t = now_us;
         c->s[c->n].f = *f;
         c->n++;
     }
 }
 
-static double hb_value(const urrt_can_frame *f, enum can_map_hb_signal_id k)
+static double hb_value(const urrt_can_frame *f, enum urrt_cantx_hb_signal k)
 {
     double v = NAN;
-    urrt_can_unpack(&can_map_heartbeat_layout[k].sig, f->data, f->len, &v);
+    urrt_can_unpack(&urrt_cantx_heartbeat_signals[k], f->data, f->len, &v);
     return v;
 }
 
@@ -946,7 +946,7 @@ static void packet(struct can_map *map, uint64_t t, double q0, double mode, bool
     st.q_actual[0] = q0;
     st.present = (UINT64_C(1) << URRT_F_TIME) | (UINT64_C(1) << URRT_F_ROBOT_MODE) |
                  (UINT64_C(1) << URRT_F_SAFETY_MODE) | (with_q ? UINT64_C(1) << URRT_F_Q_ACTUAL : 0);
-    can_map_on_packet(map, 0, &st, t);
+    urrt_cantx_on_packet(can_map_tx(map), 0, &st, t);
 }
 
 static const char *const sched_config =
@@ -990,7 +990,7 @@ static void test_schedule(void)
         return;
     }
     memset(&cap, 0, sizeof cap);
-    CHECK(can_map_deadline(&map) == CAN_MAP_NOT_SCHEDULED, "no deadline before start");
+    CHECK(urrt_cantx_deadline(can_map_tx(&map)) == URRT_CANTX_NEVER, "no deadline before start");
     can_map_start(&map, 0);
     /* Packets every 8 ms from 1 ms to 97 ms; due() every millisecond to 300 ms. */
     for (t = 0; t < 300000; t += 1000) {
@@ -1003,7 +1003,7 @@ static void test_schedule(void)
         can_map_due(&map, t, NULL, capture_frame, &cap);
         if (t == 50000) {
             /* Next: fast at 60, slow at 61 (started at the first packet, 1 ms), heartbeat at 100. */
-            CHECK_EQ_INT(can_map_deadline(&map), 60000);
+            CHECK_EQ_INT(urrt_cantx_deadline(can_map_tx(&map)), 60000);
         }
     }
     (void)last_packet;
@@ -1036,25 +1036,25 @@ static void test_schedule(void)
             break;
         case 0x701:
             CHECK(s->t == hb * 100000, "heartbeat %zu at %llu", hb, (unsigned long long)s->t);
-            CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_ALIVE), hb);
+            CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ALIVE), hb);
             if (hb == 0) {
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_STATE), CAN_MAP_STATE_STARTING);
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_ROBOT_MODE), CAN_MAP_HB_ROBOT_MODE_NA);
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_SAFETY_MODE), CAN_MAP_HB_SAFETY_MODE_NA);
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_DATA_AGE), 65535);
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_GENERATION), 0);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_STARTING);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), URRT_CANTX_HB_ROBOT_MODE_NA);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), URRT_CANTX_HB_SAFETY_MODE_NA);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 65535);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_GENERATION), 0);
             } else if (hb == 1) {
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_STATE), CAN_MAP_STATE_OK);
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_ROBOT_MODE), 7);
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_SAFETY_MODE), 1);
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_DATA_AGE), 3); /* last packet at 97 ms */
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_GENERATION), 3);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_OK);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), 7);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), 1);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 3); /* last packet at 97 ms */
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_GENERATION), 3);
             } else {
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_STATE), CAN_MAP_STATE_DATA_STALE);
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_DATA_AGE), 103);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_DATA_STALE);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 103);
                 /* Modes as old as the data are not current: not available. */
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_ROBOT_MODE), CAN_MAP_HB_ROBOT_MODE_NA);
-                CHECK_EQ_INT(hb_value(&s->f, CAN_MAP_HB_SAFETY_MODE), CAN_MAP_HB_SAFETY_MODE_NA);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), URRT_CANTX_HB_ROBOT_MODE_NA);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), URRT_CANTX_HB_SAFETY_MODE_NA);
             }
             CHECK(s->f.len == 8 && !s->f.fd && !s->f.extended, "heartbeat frame shape");
             hb++;
@@ -1105,7 +1105,7 @@ static void test_schedule(void)
         }
         CHECK(nfast == 1 && nhb == 1 && cap.n == 2, "after a stall: %zu fast, %zu heartbeats, %zu frames", nfast, nhb,
               cap.n);
-        CHECK_EQ_INT(can_map_deadline(&map), 1010000);
+        CHECK_EQ_INT(urrt_cantx_deadline(can_map_tx(&map)), 1010000);
     }
     /* An every-packet frame left pending while the CAN link was down (the
      * gateway calls no due() then) must not carry stale data out when the
@@ -1188,12 +1188,12 @@ static void test_validity_and_heartbeat(void)
     CHECK(i < cap.n, "heartbeat at 100 ms");
     if (i < cap.n) {
         const urrt_can_frame *f = &cap.s[i].f;
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_DROPS), 70000 % 65536);
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_TX_DROPPED), 1);
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_BUS_OFF), 1);
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_CAN_ERRORS), 0);
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_CLAMPED), 1); /* 40 rad and NaN since start */
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_DATA_AGE), 1);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_DROPS), 70000 % 65536);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_TX_DROPPED), 1);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_BUS_OFF), 1);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_CAN_ERRORS), 0);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_CLAMPED), 1); /* 40 rad and NaN since start */
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_DATA_AGE), 1);
     }
     stats.error_frames = 3;
     stats.down_events = 1;
@@ -1206,32 +1206,32 @@ static void test_validity_and_heartbeat(void)
     }
     if (i < cap.n) {
         const urrt_can_frame *f = &cap.s[i].f;
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_DROPS), 70000 % 65536);
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_TX_DROPPED), 0);
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_BUS_OFF), 0);
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_CAN_ERRORS), 1);
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_CAN_DOWN), 1);
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_SEND_ERRORS), 1);
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_CLAMPED), 0);
-        CHECK_EQ_INT(hb_value(f, CAN_MAP_HB_STATE), CAN_MAP_STATE_OK);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_DROPS), 70000 % 65536);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_TX_DROPPED), 0);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_BUS_OFF), 0);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_CAN_ERRORS), 1);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_CAN_DOWN), 1);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_SEND_ERRORS), 1);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_CLAMPED), 0);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_STATE), URRT_CANTX_OK);
     } else {
         CHECK(false, "heartbeat at 200 ms");
     }
     /* The link goes down: disconnected, whatever the age. */
-    can_map_robot_link(&map, 0, false);
-    CHECK_EQ_INT(can_map_state(&map, 200500), CAN_MAP_STATE_DISCONNECTED);
+    urrt_cantx_robot_link(can_map_tx(&map), 0, false);
+    CHECK_EQ_INT(can_map_state(&map, 200500), URRT_CANTX_DISCONNECTED);
     {
         urrt_can_frame f;
         can_map_heartbeat_frame(&map, 200500, &stats, &f);
-        CHECK_EQ_INT(hb_value(&f, CAN_MAP_HB_STATE), CAN_MAP_STATE_DISCONNECTED);
+        CHECK_EQ_INT(hb_value(&f, URRT_CANTX_HB_STATE), URRT_CANTX_DISCONNECTED);
         CHECK(f.id == 0x701 && f.len == 8, "heartbeat_frame id and length");
     }
     /* Data age saturates at 65534 ms. */
-    CHECK_EQ_INT(can_map_state(&map, 100000000), CAN_MAP_STATE_DISCONNECTED);
+    CHECK_EQ_INT(can_map_state(&map, 100000000), URRT_CANTX_DISCONNECTED);
     {
         urrt_can_frame f;
         can_map_heartbeat_frame(&map, 100000000, &stats, &f);
-        CHECK_EQ_INT(hb_value(&f, CAN_MAP_HB_DATA_AGE), 65534);
+        CHECK_EQ_INT(hb_value(&f, URRT_CANTX_HB_DATA_AGE), 65534);
     }
     can_map_free(&map);
 
@@ -1239,10 +1239,10 @@ static void test_validity_and_heartbeat(void)
      * (link not up) or stale (link up but silent). */
     rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
     can_map_start(&map, 1000);
-    CHECK_EQ_INT(can_map_state(&map, 1000 + 4999000), CAN_MAP_STATE_STARTING);
-    CHECK_EQ_INT(can_map_state(&map, 1000 + 5000000), CAN_MAP_STATE_DISCONNECTED);
-    can_map_robot_link(&map, 0, true);
-    CHECK_EQ_INT(can_map_state(&map, 1000 + 5000000), CAN_MAP_STATE_DATA_STALE);
+    CHECK_EQ_INT(can_map_state(&map, 1000 + 4999000), URRT_CANTX_STARTING);
+    CHECK_EQ_INT(can_map_state(&map, 1000 + 5000000), URRT_CANTX_DISCONNECTED);
+    urrt_cantx_robot_link(can_map_tx(&map), 0, true);
+    CHECK_EQ_INT(can_map_state(&map, 1000 + 5000000), URRT_CANTX_DATA_STALE);
     can_map_free(&map);
 }
 
@@ -1268,8 +1268,8 @@ static void test_heartbeat_rate(void)
         uint64_t d;
         cap.now = t;
         can_map_due(&map, t, NULL, capture_frame, &cap);
-        d = can_map_deadline(&map);
-        CHECK(d > t && d != CAN_MAP_NOT_SCHEDULED, "deadline %llu after %llu", (unsigned long long)d,
+        d = urrt_cantx_deadline(can_map_tx(&map));
+        CHECK(d > t && d != URRT_CANTX_NEVER, "deadline %llu after %llu", (unsigned long long)d,
               (unsigned long long)t);
         t = d + 700; /* late by 0.7 ms */
     }

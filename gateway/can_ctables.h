@@ -1,0 +1,21 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * can_ctables: `urrt-gateway --print-c-tables`. The CAN frames of a
+ * configuration as C source of lib/urrt_cantx.h tables (the very tables
+ * urrt-gateway runs on, can_map_tx), with their storage and an init
+ * function, so that a firmware sends the same frames without a mapping
+ * written by hand. docs/firmware.md shows one in use.
+ */
+#ifndef URRT_GATEWAY_CAN_CTABLES_H
+#define URRT_GATEWAY_CAN_CTABLES_H
+
+#include <stdio.h>
+
+#include "can_map.h"
+
+/* Writes the C source for a finished map (source: the configuration's
+ * path, for the header comment). 0, or -1 when the tables cannot be built
+ * or the stream failed. */
+int can_ctables_write(FILE *out, struct can_map *map, const char *source);
+
+#endif
