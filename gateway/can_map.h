@@ -11,8 +11,10 @@
  *
  * Life cycle:
  *   struct can_map map;  can_map_init(&map);
- *   for each key of [can] and [frame NAME] sections:
- *       can_map_ini(&map, section, key, value, file, line, err, sizeof err)
+ *   the configuration front end (config.c) reads [can] with can_map_can_keys
+ *   and [frame NAME] with can_map_frame_keys, through can_map_can_begin,
+ *   can_map_frame_begin and can_map_set; a caller without it (tests,
+ *   tools) feeds keys to can_map_ini
  *   can_map_finish(&map, robots, robot_count, err, sizeof err)
  *   can_map_start(&map, now)
  *   loop:
@@ -29,9 +31,11 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "conf.h"
 #include "port.h"
 #include "urrt.h"
 #include "urrt_can.h"
+#include "urrt_cantx.h"
 
 #define CAN_MAP_NAME_MAX 32           /* DBC names: C identifiers of at most 32 characters */
 #define CAN_MAP_UNIT_MAX 24
@@ -45,7 +49,6 @@
 #define CAN_MAP_DEFAULT_HEARTBEAT_MS 100u
 #define CAN_MAP_DEFAULT_MAX_LOAD 50u  /* percent */
 #define CAN_MAP_FASTEST_ROBOT_US 2000u /* e-series, 500 Hz: used where a robot's rate is unknown */
-#define CAN_MAP_NOT_SCHEDULED UINT64_MAX
 
 /* Where a key came from, for "FILE:LINE: reason". line 0: not given. */
 struct can_map_loc {
@@ -68,7 +71,6 @@ struct can_map_signal {
     unsigned elem;
     bool bitmask;            /* field coded as a bit mask (unit "bits"): sent as the integer mask */
     struct can_map_loc loc;
-    double value;            /* run time: the latest packet's value, packed when the frame is sent */
 };
 
 enum can_map_stale_policy {
@@ -80,7 +82,7 @@ enum can_map_stale_policy {
 enum can_map_frame_key {
     CAN_MAP_FK_ID, CAN_MAP_FK_EXTENDED, CAN_MAP_FK_FD, CAN_MAP_FK_LENGTH, CAN_MAP_FK_PERIOD,
     CAN_MAP_FK_ROBOT, CAN_MAP_FK_ALIVE, CAN_MAP_FK_VALID, CAN_MAP_FK_STALE_AFTER,
-    CAN_MAP_FK_STALE_POLICY, CAN_MAP_FK_COMMENT, CAN_MAP_FK_COUNT
+    CAN_MAP_FK_STALE_POLICY, CAN_MAP_FK_COMMENT, CAN_MAP_FK_SIGNAL, CAN_MAP_FK_COUNT
 };
 
 struct can_map_frame {
@@ -106,17 +108,6 @@ struct can_map_frame {
     size_t count;
     size_t capacity;
     double load;                            /* worst-case share of the bus (0.027 = 2.7 %) */
-    /* Run time. */
-    uint8_t payload[URRT_CAN_MAX_LEN];     /* signals packed from the latest packet */
-    int outcome;                            /* worst URRT_CAN_PACK_* of the latest packing */
-    bool unpacked;                          /* values taken since the payload was packed */
-    bool pending;                           /* every: a packet arrived since the last send */
-    bool stopped;                           /* periodic, stop policy: waiting for fresh data */
-    uint64_t next_due_us;                   /* periodic: CAN_MAP_NOT_SCHEDULED while stopped */
-    uint8_t alive;
-    uint64_t sent;
-    uint64_t sent_invalid;                  /* sent with the validity bit cleared */
-    uint64_t stale_stops;                   /* times the frame stopped for stale data */
 };
 
 /* Keys of the [can] section. */
@@ -134,68 +125,34 @@ struct can_map_robot {
     uint32_t period_us;
 };
 
-/* Gateway state in the heartbeat, ordered by value as on the bus. */
-enum can_map_gateway_state {
-    CAN_MAP_STATE_STARTING = 0,      /* no data yet from a robot, within CAN_MAP_STARTUP_MS */
-    CAN_MAP_STATE_OK = 1,
-    CAN_MAP_STATE_DATA_STALE = 2,    /* a robot's data older than [can] stale_after_ms */
-    CAN_MAP_STATE_DISCONNECTED = 3   /* a robot's link is down */
-};
-
-/* Error flags in the heartbeat: each says "happened since the previous
- * heartbeat", so a receiver can latch them. */
-#define CAN_MAP_FLAG_BUS_OFF 0x01u      /* the controller went bus-off */
-#define CAN_MAP_FLAG_CAN_ERRORS 0x02u   /* CAN error frames (error passive, warnings, ...) */
-#define CAN_MAP_FLAG_CAN_DOWN 0x04u     /* the interface went down (and is being reopened) */
-#define CAN_MAP_FLAG_SEND_ERRORS 0x08u  /* frames the link refused */
-#define CAN_MAP_FLAG_TX_DROPPED 0x10u   /* frames dropped on a full queue (see drop counter) */
-#define CAN_MAP_FLAG_CLAMPED 0x20u      /* a value saturated or was NaN */
-
-/* Heartbeat signals, in the order of can_map_heartbeat_layout. */
-enum can_map_hb_signal_id {
-    CAN_MAP_HB_STATE, CAN_MAP_HB_ALIVE, CAN_MAP_HB_ROBOT_MODE, CAN_MAP_HB_SAFETY_MODE,
-    CAN_MAP_HB_GENERATION, CAN_MAP_HB_BUS_OFF, CAN_MAP_HB_CAN_ERRORS, CAN_MAP_HB_CAN_DOWN,
-    CAN_MAP_HB_SEND_ERRORS, CAN_MAP_HB_TX_DROPPED, CAN_MAP_HB_CLAMPED, CAN_MAP_HB_DATA_AGE,
-    CAN_MAP_HB_DROPS, CAN_MAP_HB_COUNT
-};
-
 /* What a heartbeat signal's value table is. */
 enum can_map_hb_values {
     CAN_MAP_HB_VALUES_NONE = 0,
-    CAN_MAP_HB_VALUES_STATE,       /* enum can_map_gateway_state */
+    CAN_MAP_HB_VALUES_STATE,       /* urrt_cantx_state */
     CAN_MAP_HB_VALUES_ROBOT_MODE,  /* robot mode of [can] robot_generation, plus not-available */
     CAN_MAP_HB_VALUES_SAFETY_MODE, /* safety mode, plus not-available */
     CAN_MAP_HB_VALUES_GENERATION,
     CAN_MAP_HB_VALUES_FLAG
 };
 
+/* What the DBC says of heartbeat signal k; its place and scaling are
+ * urrt_cantx_heartbeat_signals[k] (lib/urrt_cantx.h). */
 struct can_map_hb_signal {
     const char *name;
-    urrt_can_signal sig;
     const char *unit;
     enum can_map_hb_values values;
     const char *comment;
 };
-
-/* The heartbeat frame's layout, written once: the gateway packs it, the DBC
- * writer describes it, the tests decode it. 8 bytes, classic CAN. */
-#define CAN_MAP_HB_LEN 8u
-#define CAN_MAP_HB_ROBOT_MODE_NA (-128) /* robot mode not available */
-#define CAN_MAP_HB_SAFETY_MODE_NA 0     /* safety mode not available (1.x, or no data) */
-#define CAN_MAP_HB_AGE_NA 65535u        /* no data yet (ages saturate at 65534) */
-extern const struct can_map_hb_signal can_map_heartbeat_layout[CAN_MAP_HB_COUNT];
-const char *can_map_state_name(enum can_map_gateway_state state);
+extern const struct can_map_hb_signal can_map_heartbeat_layout[URRT_CANTX_HB_COUNT];
 
 struct can_map_robot_rt {
     char name[64];
     uint32_t period_us;
-    bool has_data;
-    bool up;
-    uint64_t last_rx_us;
-    double robot_mode;
-    double safety_mode;
-    urrt_generation generation;
 };
+
+/* The keys of [can] and of [frame NAME], in the order of their enums. */
+extern const struct conf_key can_map_can_keys[CAN_MAP_CK_COUNT];
+extern const struct conf_key can_map_frame_keys[CAN_MAP_FK_COUNT];
 
 /* Receives each problem can_map_ini and can_map_finish find, as file, line
  * and reason (without "FILE:LINE: "), for a caller with its own error list. */
@@ -235,16 +192,8 @@ struct can_map {
     /* File names seen, each stored once (struct can_map_loc points here). */
     char **files;
     size_t file_count;
-    /* Run time. */
-    bool started;
-    uint64_t start_us;
-    uint64_t hb_next_us;
-    uint8_t hb_alive;
-    uint64_t clamped;                       /* values packed with a non-OK outcome */
-    urrt_canlink_stats hb_seen;                 /* link statistics at the previous heartbeat */
-    uint64_t hb_clamped_seen;
-    uint64_t hb_sent;
-    enum can_map_gateway_state state;       /* as in the last heartbeat */
+    /* Run time: lib/urrt_cantx.h over tables built from the above (can_run.c). */
+    struct can_map_run *run;
 };
 
 void can_map_init(struct can_map *map);
@@ -254,13 +203,24 @@ void can_map_free(struct can_map *map);
  * still receive the text. */
 void can_map_set_reporter(struct can_map *map, can_map_report_fn fn, void *ctx);
 
+/* The front end's calls: a [can] section begins; a [frame NAME] section
+ * begins (NULL, with the reason in why, for a name that is not a C
+ * identifier of at most 32 characters, the heartbeat's, or taken); a key of
+ * either (frame NULL: [can]), looked up in its table by the caller, parsed
+ * by the table and its place kept for later messages. */
+void can_map_can_begin(struct can_map *map, struct conf_at at);
+struct can_map_frame *can_map_frame_begin(struct can_map *map, const char *name, struct conf_at at, char *why,
+                                          size_t n);
+bool can_map_set(struct can_map *map, struct can_map_frame *frame, const struct conf_key *key, const char *value,
+                 struct conf_at at, char *why, size_t n);
+
 /*
- * One key of the configuration file, as the INI parser reads it. Handles
- * the sections "can" and "frame NAME" (NAME a C identifier of at most 32
- * characters). Returns 1 when the key was handled, 0 when the section is
- * not the CAN map's (the caller's own), -1 on an error, with
- * "FILE:LINE: reason" in err. Repeated keys are errors except "signal",
- * which adds one signal per line.
+ * One key of the configuration file, for a caller without the front end
+ * (tests, tools): the same tables. Handles the sections "can" and "frame
+ * NAME" (a second [frame NAME] continues the first). Returns 1 when the key
+ * was handled, 0 when the section is not the CAN map's (the caller's own),
+ * -1 on an error, with "FILE:LINE: reason" in err. Repeated keys are errors
+ * except "signal", which adds one signal per line.
  */
 int can_map_ini(struct can_map *map, const char *section, const char *key, const char *value, const char *file,
                 int line, char *err, size_t errlen);
@@ -293,40 +253,41 @@ int can_map_describe(const struct can_map *map, char *buf, size_t size);
 
 /* ---- run time ------------------------------------------------------------------ */
 
-typedef void (*can_map_emit_fn)(void *ctx, const urrt_can_frame *frame);
+/*
+ * The map as lib/urrt_cantx.h tables: its frames in configuration order, then
+ * the heartbeat. Built once, after can_map_finish; 0, or -1 with the reason
+ * in err (a table lib/ refuses: a check missing above). can_map_start builds
+ * them if the caller did not. can_map_free frees them.
+ */
+int can_map_build(struct can_map *map, char *err, size_t errlen);
+void can_map_run_free(struct can_map *map);
 
-/* Resets the run-time state: the heartbeat is due at now_us, frames with
- * the invalid policy are due at now_us (flagged invalid until data comes).
- * can_map_due calls it on its first call if the gateway did not. */
+/* The CAN core over the built tables (NULL before can_map_build), and the
+ * heartbeat's index in them. */
+urrt_cantx *can_map_tx(struct can_map *map);
+size_t can_map_heartbeat_index(const struct can_map *map);
+
+/* Restarts the schedule at now_us (urrt_cantx_start). */
 void can_map_start(struct can_map *map, uint64_t now_us);
 
-/* A decoded packet of robot `robot` (index into the robots given to
- * can_map_finish) whose data is no older than now - data_us (its read time,
- * less any lag the gateway measured: gateway/freshness.h): packs every
- * frame of that robot. Staleness is judged from data_us. A packet means
- * the robot's link is up. */
-void can_map_on_packet(struct can_map *map, size_t robot, const urrt_state *st, uint64_t data_us);
+/* The CAN link's counters, as the heartbeat's flags need them. */
+void can_map_link_stats(struct can_map *map, const urrt_canlink_stats *stats);
 
-/* The robot's link went up or down (down: the heartbeat says disconnected). */
-void can_map_robot_link(struct can_map *map, size_t robot, bool up);
+/* Values packed with an outcome other than OK, since start. */
+uint64_t can_map_clamped(const struct can_map *map);
 
-/* Emits every frame due at now_us, in configuration order, then the
- * heartbeat if due. stats: the CAN link's statistics (NULL if none), for
- * the heartbeat's drop counter and error flags. */
-void can_map_due(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats, can_map_emit_fn emit,
+/* The CAN link's counters (NULL: unchanged), then every frame due at now_us
+ * through emit (urrt_cantx_run). Starts the schedule on its first call. */
+void can_map_due(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats, urrt_cantx_emit_fn emit,
                  void *ctx);
 
-/* Monotonic time by which can_map_due must run next (CAN_MAP_NOT_SCHEDULED
- * if never, e.g. before can_map_start). A time at or before now means now. */
-uint64_t can_map_deadline(const struct can_map *map);
+/* The heartbeat as it would go out at now_us with these link counters,
+ * without sending it (urrt_cantx_peek): for status displays and tests. */
+void can_map_heartbeat_frame(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats,
+                             urrt_can_frame *frame);
 
 /* The heartbeat's gateway state at now_us. */
-enum can_map_gateway_state can_map_state(const struct can_map *map, uint64_t now_us);
-
-/* Pack the heartbeat as it would be sent now (without advancing its alive
- * counter or flag snapshots): for status displays and tests. */
-void can_map_heartbeat_frame(const struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats,
-                             urrt_can_frame *frame);
+urrt_cantx_state can_map_state(const struct can_map *map, uint64_t now_us);
 
 /* Worst-case bus time of one frame in microseconds at the map's bit rates. */
 double can_map_frame_time_us(const struct can_map *map, unsigned len, bool extended, bool fd);

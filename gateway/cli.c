@@ -3,8 +3,6 @@
 #define _GNU_SOURCE
 #include "cli.h"
 
-#include <errno.h>
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -79,64 +77,22 @@ void cli_format_host_port(const char *host, uint16_t port, char *out, size_t out
     snprintf(out, out_size, strchr(host, ':') != NULL ? "[%s]:%u" : "%s:%u", host, (unsigned)port);
 }
 
+/* The programs are single-threaded: one buffer for the reason. */
+static char cli_why[CONF_WHY_MAX];
+
 const char *cli_parse_u64(const char *text, uint64_t min, uint64_t max, uint64_t *out)
 {
-    char *end;
-    unsigned long long v;
-    if (text == NULL || text[0] == '\0') {
-        return "empty number";
-    }
-    if (text[0] == '-' || text[0] == '+' || text[0] == ' ') {
-        return "not a whole number without a sign";
-    }
-    errno = 0;
-    v = strtoull(text, &end, 0);
-    if (*end != '\0') {
-        return "not a whole number";
-    }
-    if (errno == ERANGE || v > max) {
-        return "too large";
-    }
-    if (v < min) {
-        return "too small";
-    }
-    *out = v;
-    return NULL;
+    return conf_uint(text, min, max, out, cli_why, sizeof cli_why) ? NULL : cli_why;
 }
 
 const char *cli_parse_u32(const char *text, uint32_t min, uint32_t max, uint32_t *out)
 {
-    uint64_t v;
-    const char *err = cli_parse_u64(text, min, max, &v);
-    if (err == NULL) {
-        *out = (uint32_t)v;
-    }
-    return err;
+    return conf_u32(text, min, max, out, cli_why, sizeof cli_why) ? NULL : cli_why;
 }
 
 const char *cli_parse_double(const char *text, double min, double max, double *out)
 {
-    char *end;
-    double v;
-    if (text == NULL || text[0] == '\0') {
-        return "empty number";
-    }
-    errno = 0;
-    v = strtod(text, &end);
-    if (end == text || *end != '\0') {
-        return "not a number";
-    }
-    if (!isfinite(v) || errno == ERANGE) {
-        return "out of range";
-    }
-    if (v < min) {
-        return "too small";
-    }
-    if (v > max) {
-        return "too large";
-    }
-    *out = v;
-    return NULL;
+    return conf_number(text, min, max, out, cli_why, sizeof cli_why) ? NULL : cli_why;
 }
 
 static volatile sig_atomic_t *running_flag;

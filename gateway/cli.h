@@ -3,8 +3,10 @@
  * cli.h: small helpers the urrt programs share: argument parsing with
  * useful errors, and the signal handling of a poll loop.
  *
- * Parsers return NULL on success or a short English reason ("not a number",
- * "above 65535") for the caller to put in its message.
+ * Values on a command line are read by conf.h's parsers (included here),
+ * as in the gateway's configuration file: the same integer, duration and
+ * boolean grammar everywhere. The address parsers return NULL on success or
+ * a short English reason for the caller to put in its message.
  */
 #ifndef URRT_CLI_H
 #define URRT_CLI_H
@@ -12,6 +14,8 @@
 #include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
+
+#include "conf.h"
 
 /* Exit codes every program documents in --help. */
 enum {
@@ -35,10 +39,11 @@ const char *cli_parse_listen_address(const char *arg, uint16_t default_port, cha
 /* "host:port", or "[host]:port" when host holds a colon. */
 void cli_format_host_port(const char *host, uint16_t port, char *out, size_t out_size);
 
-/* A whole decimal number (or 0x hex) in [min, max]; no sign, no trailing text. */
+/* conf_uint, conf_u32 and conf_number with the reason as the result (NULL:
+ * success), valid until the next call: for the address parsers and older
+ * callers. */
 const char *cli_parse_u64(const char *text, uint64_t min, uint64_t max, uint64_t *out);
 const char *cli_parse_u32(const char *text, uint32_t min, uint32_t max, uint32_t *out);
-/* A finite number in [min, max]. */
 const char *cli_parse_double(const char *text, double min, double max, double *out);
 
 /*

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* config.c: the urrt-gateway configuration file (see config.h). */
+/* config.c: the urrt-gateway configuration file (see config.h). Values are
+ * read by conf.h's parsers, keys described by tables: one per section. */
 #define _GNU_SOURCE
 #include "config.h"
 
@@ -14,7 +15,13 @@
 
 #define CONFIG_MAX_KEYS 64
 
+/* Messages are printed causes first: what is wrong on a line (syntax, an
+ * unknown section or key, a bad value) before what the whole file then
+ * lacks ("[robot a] has no host", "no robot"), each group in line order. */
+enum { RANK_LINE = 0, RANK_FILE = 1 };
+
 typedef struct config_message {
+    int rank;
     int line;
     int order;
     char *text;
@@ -24,14 +31,16 @@ struct config_ctx {
     const char *path;
     FILE *err;
     int errors;
-    config_message *messages;   /* printed in line order at the end */
+    config_message *messages;   /* printed by rank and line at the end */
+    int rank;                 /* RANK_FILE once the whole-file checks run */
     int line;                 /* line the reader handed to inih last */
-    int last_error_line;
     FILE *file;
     gw_config *cfg;
     const config_section *section; /* NULL before the first header or after a bad one */
     bool section_ok;          /* keys of a bad section are skipped: one error is enough */
     char section_raw[256];    /* the text between the brackets, as inih sees it */
+    char section_label[64 + 1 + 256]; /* "robot arm1": kind and name, blanks trimmed */
+    struct can_map_frame *frame; /* of the current [frame NAME] */
     struct { char name[64]; int line; } keys[CONFIG_MAX_KEYS];
     unsigned key_count;
     int *seen_line;           /* per table entry: line of its first header, 0 if none */
@@ -45,7 +54,7 @@ const char *gw_kind_name(gw_kind kind)
     return (unsigned)kind < GW_KIND_COUNT ? kind_names[kind] : "?";
 }
 
-/* ---- errors and value parsers ---------------------------------------------- */
+/* ---- the one error channel ------------------------------------------------------ */
 
 int config_line(const config_ctx *ctx)
 {
@@ -62,24 +71,22 @@ void config_error(config_ctx *ctx, int line, const char *fmt, ...)
         text = NULL;
     }
     va_end(ap);
-    if (line > 0) {
-        ctx->last_error_line = line;
-    }
     grown = realloc(ctx->messages, (size_t)(ctx->errors + 1) * sizeof *ctx->messages);
     if (grown == NULL || text == NULL) {
         fprintf(stderr, "urrt-gateway: out of memory reading the configuration\n");
         exit(1);
     }
     ctx->messages = grown;
-    ctx->messages[ctx->errors].line = line;
-    ctx->messages[ctx->errors].text = text;
-    ctx->messages[ctx->errors].order = ctx->errors;
+    ctx->messages[ctx->errors] = (config_message){ctx->rank, line, ctx->errors, text};
     ctx->errors++;
 }
 
-static int by_line(const void *a, const void *b)
+static int by_rank_and_line(const void *a, const void *b)
 {
     const config_message *x = a, *y = b;
+    if (x->rank != y->rank) {
+        return x->rank - y->rank;
+    }
     return x->line != y->line ? (x->line > y->line) - (x->line < y->line) : x->order - y->order;
 }
 
@@ -101,10 +108,10 @@ static void put_message(FILE *out, const char *text)
 
 static void print_errors(config_ctx *ctx)
 {
-    /* File-wide messages (line 0) first, then in line order. No message:
-     * no array, and qsort must not be given NULL. */
+    /* Within a rank, file-wide messages (line 0) first, then in line order.
+     * No message: no array, and qsort must not be given NULL. */
     if (ctx->errors > 0) {
-        qsort(ctx->messages, (size_t)ctx->errors, sizeof *ctx->messages, by_line);
+        qsort(ctx->messages, (size_t)ctx->errors, sizeof *ctx->messages, by_rank_and_line);
     }
     for (int i = 0; i < ctx->errors; i++) {
         if (ctx->messages[i].line > 0) {
@@ -119,122 +126,16 @@ static void print_errors(config_ctx *ctx)
     ctx->messages = NULL;
 }
 
-bool config_uint(config_ctx *ctx, const char *what, const char *value, unsigned long min,
-                 unsigned long max, unsigned long *out)
-{
-    char *end;
-    unsigned long v;
-    errno = 0;
-    v = strtoul(value, &end, 10);
-    if (!isdigit((unsigned char)value[0]) || *end != '\0' || errno != 0 || v < min || v > max) {
-        config_error(ctx, ctx->line, "%s must be a whole number from %lu to %lu, not \"%s\"", what,
-                     min, max, value);
-        return false;
-    }
-    *out = v;
-    return true;
-}
+static bool bad(char *why, size_t n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 
-static bool parse_number(const char *value, double *out, const char **rest)
+/* Writes the reason of a bad value; false, for "return bad(...)". */
+static bool bad(char *why, size_t n, const char *fmt, ...)
 {
-    char *end;
-    double v;
-    if (!isdigit((unsigned char)value[0]) && value[0] != '.') {
-        return false;
-    }
-    errno = 0;
-    v = strtod(value, &end);
-    if (end == value || errno != 0 || !isfinite(v)) {
-        return false;
-    }
-    while (*end == ' ' || *end == '\t') {
-        end++;
-    }
-    *out = v;
-    *rest = end;
-    return true;
-}
-
-bool config_duration_ms(config_ctx *ctx, const char *what, const char *value, uint32_t min_ms,
-                        uint32_t max_ms, uint32_t *out)
-{
-    double v, ms;
-    const char *unit;
-    if (!parse_number(value, &v, &unit) || (strcmp(unit, "ms") != 0 && strcmp(unit, "s") != 0)) {
-        config_error(ctx, ctx->line, "%s must be a duration with a unit, e.g. \"250 ms\" or \"2 s\", not \"%s\"",
-                     what, value);
-        return false;
-    }
-    ms = strcmp(unit, "s") == 0 ? v * 1000.0 : v;
-    if (ms < min_ms || ms > max_ms || ms != floor(ms)) {
-        config_error(ctx, ctx->line, "%s must be a whole number of milliseconds from %u ms to %u ms, not \"%s\"",
-                     what, (unsigned)min_ms, (unsigned)max_ms, value);
-        return false;
-    }
-    *out = (uint32_t)ms;
-    return true;
-}
-
-bool config_rate(config_ctx *ctx, const char *what, const char *value, gw_rate *out)
-{
-    double hz;
-    const char *unit;
-    if (strcmp(value, "every") == 0) {
-        out->mode = GW_RATE_EVERY;
-        out->hz = 0;
-        return true;
-    }
-    if (strcmp(value, "off") == 0) {
-        out->mode = GW_RATE_OFF;
-        out->hz = 0;
-        return true;
-    }
-    if (!parse_number(value, &hz, &unit) || strcmp(unit, "Hz") != 0) {
-        config_error(ctx, ctx->line, "%s must be \"every\", \"off\" or a rate such as \"50 Hz\", not \"%s\"",
-                     what, value);
-        return false;
-    }
-    if (hz < 0.01 || hz > GW_ROBOT_MAX_RATE_HZ) {
-        config_error(ctx, ctx->line, "%s %s is out of range: from 0.01 Hz to %u Hz (the fastest robot)",
-                     what, value, GW_ROBOT_MAX_RATE_HZ);
-        return false;
-    }
-    out->mode = GW_RATE_HZ;
-    out->hz = hz;
-    return true;
-}
-
-bool config_bool(config_ctx *ctx, const char *what, const char *value, bool *out)
-{
-    static const char *const yes[] = {"yes", "true", "on", "1"};
-    static const char *const no[] = {"no", "false", "off", "0"};
-    for (unsigned i = 0; i < 4; i++) {
-        if (strcmp(value, yes[i]) == 0) {
-            *out = true;
-            return true;
-        }
-        if (strcmp(value, no[i]) == 0) {
-            *out = false;
-            return true;
-        }
-    }
-    config_error(ctx, ctx->line, "%s must be yes or no, not \"%s\"", what, value);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(why, n, fmt, ap);
+    va_end(ap);
     return false;
-}
-
-bool config_identifier(config_ctx *ctx, const char *what, const char *value, bool dots)
-{
-    size_t n = strlen(value);
-    bool ok = n >= 1 && n <= 64;
-    for (size_t i = 0; ok && i < n; i++) {
-        unsigned char c = (unsigned char)value[i];
-        ok = isalnum(c) || c == '_' || c == '-' || (dots && c == '.' && i > 0 && i + 1 < n);
-    }
-    if (!ok) {
-        config_error(ctx, ctx->line, "%s \"%s\" must be 1 to 64 letters, digits, '_' or '-'%s", what,
-                     value, dots ? " (or '.' inside)" : "");
-    }
-    return ok;
 }
 
 static char *xstrdup(const char *s)
@@ -270,152 +171,179 @@ bool gw_parse_log_level(const char *text, urrt_log_level *level)
     return false;
 }
 
-static bool gateway_key(config_ctx *ctx, gw_config *cfg, const char *key, const char *value)
+static bool set_log_level(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
+                          size_t n)
 {
-    if (strcmp(key, "log_level") == 0) {
-        if (!gw_parse_log_level(value, &cfg->log_level)) {
-            config_error(ctx, ctx->line, "log_level must be err, warning, notice, info or debug, not \"%s\"", value);
-            return false;
-        }
-        return true;
-    }
-    if (strcmp(key, "summary") == 0) {
-        return config_bool(ctx, "summary", value, &cfg->summary);
-    }
-    config_error(ctx, ctx->line, "unknown key \"%s\" in [gateway] (keys: log_level, summary)", key);
-    return false;
+    gw_config *cfg = obj;
+    (void)key, (void)at;
+    return gw_parse_log_level(value, &cfg->log_level) ||
+           bad(why, n, "log_level must be err, warning, notice, info or debug, not \"%s\"", value);
 }
+
+static const struct conf_key gateway_keys[] = {
+    {"log_level", CONF_FN, 0, 0, 0, 0, set_log_level, NULL, false},
+    {"summary", CONF_BOOL, CONF_FIELD(gw_config, summary), 0, 0, NULL,
+     "%1$s must be yes or no (or true/false, on/off, 1/0), not \"%2$s\"", false},
+};
 
 /* ---- [lcm] ------------------------------------------------------------------------ */
 
-/* udpm://GROUP:PORT?opt=v&...: the group must be IPv4 multicast, the options
- * those LCM's udpm provider knows. Other providers are checked for the
- * scheme only: LCM validates them when the gateway starts. */
-static bool check_lcm_url(config_ctx *ctx, const char *url)
+/* ?ttl=N&recv_buf_size=N&transmit_only=...: the options LCM's udpm knows. */
+static bool check_udpm_options(const char *url, const char *options, char *why, size_t n)
 {
-    static const char *const providers[] = {"udpm", "file", "memq", "tcpq", "mpudpm"};
-    const char *sep = strstr(url, "://");
-    bool known = false;
-    for (const char *c = url; *c != '\0'; c++) {
-        if ((unsigned char)*c < 0x20 || *c == 0x7f) {
-            /* It is printed at start and by --check-config. */
-            config_error(ctx, ctx->line, "url \"%s\": no control characters", url);
-            return false;
+    char opts[256];
+    uint64_t v;
+    snprintf(opts, sizeof opts, "%s", options);
+    for (char *save = NULL, *opt = strtok_r(opts, "&", &save); opt != NULL; opt = strtok_r(NULL, "&", &save)) {
+        char *eq = strchr(opt, '=');
+        if (eq == NULL) {
+            return bad(why, n, "url \"%s\": option \"%s\" has no value", url, opt);
         }
-    }
-    if (sep == NULL) {
-        config_error(ctx, ctx->line, "url \"%s\" is not an LCM URL (provider://address?options), e.g. %s",
-                     url, GW_DEFAULT_LCM_URL);
-        return false;
-    }
-    for (size_t i = 0; i < sizeof providers / sizeof providers[0]; i++) {
-        known |= strlen(providers[i]) == (size_t)(sep - url) && strncmp(url, providers[i], (size_t)(sep - url)) == 0;
-    }
-    if (!known) {
-        config_error(ctx, ctx->line, "url \"%s\": unknown LCM provider \"%.*s\" (udpm, file, memq, tcpq, mpudpm)",
-                     url, (int)(sep - url), url);
-        return false;
-    }
-    if (strncmp(url, "udpm://", 7) == 0) {
-        unsigned a, b, c, d, port;
-        int used = 0;
-        const char *p = url + 7;
-        if (*p != '\0' && *p != '?') {
-            if (sscanf(p, "%3u.%3u.%3u.%3u:%5u%n", &a, &b, &c, &d, &port, &used) != 5 ||
-                (p[used] != '\0' && p[used] != '?') || a > 255 || b > 255 || c > 255 || d > 255 ||
-                port == 0 || port > 65535) {
-                config_error(ctx, ctx->line, "url \"%s\": udpm needs GROUP:PORT, e.g. 239.255.76.67:7667", url);
-                return false;
+        *eq = '\0';
+        if (strcmp(opt, "ttl") == 0) {
+            if (!conf_uint(eq + 1, 0, 255, &v, NULL, 0)) {
+                return bad(why, n, "url \"%s\": ttl must be 0 to 255 (0: this host only, 1: the LAN)", url);
             }
-            if (a < 224 || a > 239) {
-                config_error(ctx, ctx->line, "url \"%s\": %u.%u.%u.%u is not a multicast group (224.0.0.0 to 239.255.255.255)",
-                             url, a, b, c, d);
-                return false;
+        } else if (strcmp(opt, "recv_buf_size") == 0) {
+            if (!conf_uint(eq + 1, 1, UINT32_MAX, &v, NULL, 0)) {
+                return bad(why, n, "url \"%s\": recv_buf_size must be a number of bytes", url);
             }
-            p += used;
-        }
-        if (*p == '?') {
-            char opts[256];
-            snprintf(opts, sizeof opts, "%s", p + 1);
-            for (char *save = NULL, *opt = strtok_r(opts, "&", &save); opt != NULL; opt = strtok_r(NULL, "&", &save)) {
-                char *eq = strchr(opt, '=');
-                char *end;
-                unsigned long v;
-                if (eq == NULL) {
-                    config_error(ctx, ctx->line, "url \"%s\": option \"%s\" has no value", url, opt);
-                    return false;
-                }
-                *eq = '\0';
-                errno = 0;
-                v = strtoul(eq + 1, &end, 10);
-                if (strcmp(opt, "ttl") == 0) {
-                    if (*end != '\0' || eq[1] == '\0' || v > 255) {
-                        config_error(ctx, ctx->line, "url \"%s\": ttl must be 0 to 255 (0: this host only, 1: the LAN)", url);
-                        return false;
-                    }
-                } else if (strcmp(opt, "recv_buf_size") == 0) {
-                    if (*end != '\0' || eq[1] == '\0' || errno != 0 || v == 0) {
-                        config_error(ctx, ctx->line, "url \"%s\": recv_buf_size must be a number of bytes", url);
-                        return false;
-                    }
-                } else if (strcmp(opt, "transmit_only") != 0) {
-                    config_error(ctx, ctx->line, "url \"%s\": unknown udpm option \"%s\" (ttl, recv_buf_size, transmit_only)",
-                                 url, opt);
-                    return false;
-                }
-            }
+        } else if (strcmp(opt, "transmit_only") != 0) {
+            return bad(why, n, "url \"%s\": unknown udpm option \"%s\" (ttl, recv_buf_size, transmit_only)", url, opt);
         }
     }
     return true;
 }
 
-static bool lcm_key(config_ctx *ctx, gw_config *cfg, const char *key, const char *value)
+/* udpm://GROUP:PORT?opt=v&...: the group must be IPv4 multicast. */
+static bool check_udpm(const char *url, char *why, size_t n)
 {
-    gw_lcm_config *lcm = &cfg->lcm;
-    if (strcmp(key, "url") == 0) {
-        if (!check_lcm_url(ctx, value)) {
-            return false;
+    unsigned a, b, c, d, port;
+    int used = 0;
+    const char *p = url + 7;
+    if (*p != '\0' && *p != '?') {
+        if (sscanf(p, "%3u.%3u.%3u.%3u:%5u%n", &a, &b, &c, &d, &port, &used) != 5 ||
+            (p[used] != '\0' && p[used] != '?') || a > 255 || b > 255 || c > 255 || d > 255 || port == 0 ||
+            port > 65535) {
+            return bad(why, n, "url \"%s\": udpm needs GROUP:PORT, e.g. 239.255.76.67:7667", url);
         }
-        replace_string(&lcm->url, value);
-        lcm->url_line = ctx->line;
+        if (a < 224 || a > 239) {
+            return bad(why, n, "url \"%s\": %u.%u.%u.%u is not a multicast group (224.0.0.0 to 239.255.255.255)",
+                       url, a, b, c, d);
+        }
+        p += used;
+    }
+    return *p != '?' || check_udpm_options(url, p + 1, why, n);
+}
+
+/* PROVIDER://...: udpm is checked here; other providers for the scheme
+ * only: LCM validates them when the gateway starts. */
+static bool set_lcm_url(void *obj, const struct conf_key *key, const char *url, struct conf_at at, char *why,
+                        size_t n)
+{
+    static const char *const providers[] = {"udpm", "file", "memq", "tcpq", "mpudpm"};
+    gw_lcm_config *lcm = obj;
+    const char *sep = strstr(url, "://");
+    bool known = false;
+    (void)key;
+    if (!conf_printable(url, NULL, 0)) {
+        /* It is printed at start and by --check-config. */
+        return bad(why, n, "url \"%s\": no control characters", url);
+    }
+    if (sep == NULL) {
+        return bad(why, n, "url \"%s\" is not an LCM URL (provider://address?options), e.g. %s", url,
+                   GW_DEFAULT_LCM_URL);
+    }
+    for (size_t i = 0; i < sizeof providers / sizeof providers[0]; i++) {
+        known |= strlen(providers[i]) == (size_t)(sep - url) && strncmp(url, providers[i], (size_t)(sep - url)) == 0;
+    }
+    if (!known) {
+        return bad(why, n, "url \"%s\": unknown LCM provider \"%.*s\" (udpm, file, memq, tcpq, mpudpm)", url,
+                   (int)(sep - url), url);
+    }
+    if (strncmp(url, "udpm://", 7) == 0 && !check_udpm(url, why, n)) {
+        return false;
+    }
+    replace_string(&lcm->url, url);
+    lcm->url_line = at.line;
+    return true;
+}
+
+/* "every", "off" or "N Hz". */
+static bool parse_rate(const char *key, const char *value, gw_rate *out, char *why, size_t n)
+{
+    char number[64];
+    size_t len = strcspn(value, " \tH");
+    const char *unit = value + len + strspn(value + len, " \t");
+    if (strcmp(value, "every") == 0 || strcmp(value, "off") == 0) {
+        *out = (gw_rate){value[0] == 'e' ? GW_RATE_EVERY : GW_RATE_OFF, 0};
         return true;
     }
-    for (unsigned k = 0; k < GW_KIND_COUNT; k++) {
-        size_t n = strlen(kind_names[k]);
-        if (strncmp(key, kind_names[k], n) != 0) {
-            continue;
-        }
-        if (strcmp(key + n, "_channel") == 0) {
-            if (!config_identifier(ctx, key, value, true)) {
-                return false;
-            }
-            replace_string(&lcm->channel[k], value);
-            lcm->channel_line[k] = ctx->line;
-            return true;
-        }
-        if (strcmp(key + n, "_rate") == 0) {
-            gw_rate rate;
-            if (!config_rate(ctx, key, value, &rate)) {
-                return false;
-            }
-            if (k == GW_KIND_GATEWAY && rate.mode == GW_RATE_EVERY) {
-                config_error(ctx, ctx->line, "gateway_rate is a report rate: \"off\" or N Hz (default 1 Hz), not \"every\"");
-                return false;
-            }
-            if (k == GW_KIND_GATEWAY && rate.mode == GW_RATE_HZ && rate.hz > 100) {
-                config_error(ctx, ctx->line, "gateway_rate %s is out of range: at most 100 Hz", value);
-                return false;
-            }
-            lcm->rate[k] = rate;
-            lcm->rate_line[k] = ctx->line;
-            return true;
-        }
+    snprintf(number, sizeof number, "%.*s", (int)(len < sizeof number ? len : sizeof number - 1), value);
+    if (!conf_number(number, -INFINITY, INFINITY, &out->hz, NULL, 0) || strcmp(unit, "Hz") != 0) {
+        return bad(why, n, "%s must be \"every\", \"off\" or a rate such as \"50 Hz\", not \"%s\"", key, value);
     }
-    config_error(ctx, ctx->line,
-                 "unknown key \"%s\" in [lcm] (keys: url, and KIND_channel, KIND_rate for KIND in "
-                 "state, joints, tool, status, gateway)", key);
-    return false;
+    if (out->hz < 0.01 || out->hz > GW_ROBOT_MAX_RATE_HZ) {
+        return bad(why, n, "%s %s is out of range: from 0.01 Hz to %u Hz (the fastest robot)", key, value,
+                   GW_ROBOT_MAX_RATE_HZ);
+    }
+    out->mode = GW_RATE_HZ;
+    return true;
 }
+
+/* KIND_channel, KIND_rate: the kind from the key's name. */
+static unsigned kind_of(const char *key)
+{
+    unsigned k = 0;
+    while (k < GW_KIND_COUNT - 1 && strncmp(key, kind_names[k], strlen(kind_names[k])) != 0) {
+        k++;
+    }
+    return k;
+}
+
+static bool set_lcm_channel(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
+                            size_t n)
+{
+    gw_lcm_config *lcm = obj;
+    unsigned k = kind_of(key->name);
+    char reason[CONF_WHY_MAX];
+    if (!conf_name(value, CONF_NAME_DASH | CONF_NAME_DOTS, 64, reason, sizeof reason)) {
+        return bad(why, n, "%s \"%s\" %s", key->name, value, reason);
+    }
+    replace_string(&lcm->channel[k], value);
+    lcm->channel_line[k] = at.line;
+    return true;
+}
+
+static bool set_lcm_rate(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
+                         size_t n)
+{
+    gw_lcm_config *lcm = obj;
+    unsigned k = kind_of(key->name);
+    gw_rate rate;
+    if (!parse_rate(key->name, value, &rate, why, n)) {
+        return false;
+    }
+    if (k == GW_KIND_GATEWAY && rate.mode == GW_RATE_EVERY) {
+        return bad(why, n, "gateway_rate is a report rate: \"off\" or N Hz (default 1 Hz), not \"every\"");
+    }
+    if (k == GW_KIND_GATEWAY && rate.mode == GW_RATE_HZ && rate.hz > 100) {
+        return bad(why, n, "gateway_rate %s is out of range: at most 100 Hz", value);
+    }
+    lcm->rate[k] = rate;
+    lcm->rate_line[k] = at.line;
+    return true;
+}
+
+#define LCM_KIND_KEYS(kind)                                                    \
+    {kind "_channel", CONF_FN, 0, 0, 0, 0, set_lcm_channel, NULL, false},      \
+    {kind "_rate", CONF_FN, 0, 0, 0, 0, set_lcm_rate, NULL, false}
+
+static const struct conf_key lcm_keys[] = {
+    {"url", CONF_FN, 0, 0, 0, 0, set_lcm_url, NULL, false},
+    LCM_KIND_KEYS("state"), LCM_KIND_KEYS("joints"), LCM_KIND_KEYS("tool"), LCM_KIND_KEYS("status"),
+    LCM_KIND_KEYS("gateway"),
+};
 
 static void lcm_finish(config_ctx *ctx, gw_config *cfg)
 {
@@ -459,34 +387,110 @@ static void lcm_finish(config_ctx *ctx, gw_config *cfg)
 /* What a version number implies, from lib's controller table: the message
  * size, and the packet rate. A version the sources give two sizes for (1.6)
  * is refused with both. */
-static bool version_length(config_ctx *ctx, const char *text, uint32_t *length, unsigned *rate_hz)
+static bool version_length(const char *text, uint32_t *length, unsigned *rate_hz, char *why, size_t n)
 {
     const urrt_controller *found[2];
     uint32_t period_us = 0;
-    int n = urrt_controller_find(text, strlen(text), found, 2, &period_us);
-    if (n == 1) {
+    int count = urrt_controller_find(text, strlen(text), found, 2, &period_us);
+    if (count == 1) {
         *length = found[0]->length;
         *rate_hz = 1000000u / period_us;
         return true;
     }
-    if (n == 2) {
-        config_error(ctx, ctx->line, "version \"%s\": %s controllers sent %u or %u bytes: give the length instead "
-                     "(version = %u or %u)", text, text, (unsigned)found[0]->length, (unsigned)found[1]->length,
-                     (unsigned)found[0]->length, (unsigned)found[1]->length);
-    } else if (n == 0) {
-        config_error(ctx, ctx->line, "version \"%s\": no known controller version: give the message size in "
-                     "bytes instead (e.g. version = 1220)", text);
-    } else {
-        config_error(ctx, ctx->line, "version \"%s\": expected auto, a controller version such as 5.10, or a "
-                     "message size in bytes", text);
+    if (count == 2) {
+        return bad(why, n, "version \"%s\": %s controllers sent %u or %u bytes: give the length instead "
+                   "(version = %u or %u)", text, text, (unsigned)found[0]->length, (unsigned)found[1]->length,
+                   (unsigned)found[0]->length, (unsigned)found[1]->length);
     }
-    return false;
+    if (count == 0) {
+        return bad(why, n, "version \"%s\": no known controller version: give the message size in bytes instead "
+                   "(e.g. version = 1220)", text);
+    }
+    return bad(why, n, "version \"%s\": expected auto, a controller version such as 5.10, or a message size in "
+               "bytes", text);
 }
+
+static bool set_version(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
+                        size_t n)
+{
+    gw_robot_config *robot = obj;
+    uint32_t length = 0;
+    unsigned rate = 1000000u / urrt_period_min_us(0);
+    char reason[CONF_WHY_MAX];
+    (void)key;
+    if (strchr(value, '.') != NULL) {
+        if (!version_length(value, &length, &rate, why, n)) {
+            return false;
+        }
+    } else if (strcmp(value, "auto") != 0) {
+        if (!conf_u32(value, URRT_PACKET_MIN, URRT_PACKET_MAX, &length, reason, sizeof reason) ||
+            (length - URRT_HEADER_SIZE) % 8 != 0) {
+            return bad(why, n, "version \"%s\": expected auto, a controller version such as 5.10, or a message "
+                       "size in bytes (4 + 8n, %d to %d)%s%s", value, URRT_PACKET_MIN, URRT_PACKET_MAX,
+                       strncmp(reason, "a leading", 9) == 0 ? ": " : "",
+                       strncmp(reason, "a leading", 9) == 0 ? reason : "");
+        }
+        rate = 1000000u / urrt_period_min_us(length);
+    }
+    robot->expected_length = length;
+    robot->max_rate_hz = rate;
+    replace_string(&robot->expected, value);
+    robot->version_line = at.line;
+    return true;
+}
+
+/* A host name, IPv4 or IPv6 address; HOST:PORT and [V6]:PORT are refused
+ * here rather than by the resolver at run time, again and again. */
+static bool set_host(void *obj, const struct conf_key *key, const char *host, struct conf_at at, char *why, size_t n)
+{
+    gw_robot_config *robot = obj;
+    size_t len = strlen(host);
+    const char *colon = strchr(host, ':');
+    const char *close = strchr(host, ']');
+    bool ok = len >= 1 && len <= 253;
+    (void)key;
+    if (host[0] == '[' && close != NULL) {
+        return bad(why, n, "host \"%s\": write the address without brackets (host = %.*s)%s%s%s", host,
+                   (int)(close - host - 1), host + 1, close[1] == ':' ? " and the port apart (port = " : "",
+                   close[1] == ':' ? close + 2 : "", close[1] == ':' ? ")" : "");
+    }
+    if (colon != NULL && strchr(colon + 1, ':') == NULL) {
+        return bad(why, n, "host \"%s\" is HOST:PORT: write host = %.*s and port = %s", host, (int)(colon - host),
+                   host, colon + 1);
+    }
+    for (size_t i = 0; ok && i < len; i++) {
+        unsigned char c = (unsigned char)host[i];
+        ok = colon != NULL ? (isalnum(c) || c == ':' || c == '.' || c == '%') : (isalnum(c) || c == '-' || c == '.');
+    }
+    if (!ok) {
+        return bad(why, n, "host \"%s\" is not a host name, IPv4 or IPv6 address", host);
+    }
+    replace_string(&robot->host, host);
+    robot->host_line = at.line;
+    return true;
+}
+
+#define LINK_FIELD(member) CONF_FIELD(gw_robot_config, link.member)
+
+static const struct conf_key robot_keys[] = {
+    {"host", CONF_FN, 0, 0, 0, 0, set_host, NULL, false},
+    {"port", CONF_UINT, CONF_FIELD(gw_robot_config, port), 1, 65535, NULL,
+     "%1$s must be a whole number from 1 to 65535, not \"%2$s\"", false},
+    {"version", CONF_FN, 0, 0, 0, 0, set_version, NULL, false},
+    {"connect_timeout", CONF_MS, LINK_FIELD(connect_timeout_ms), 10, 600000, NULL, NULL, false},
+    /* A 125 Hz controller sends every 8 ms: less than 20 ms would drop a
+     * healthy link on ordinary jitter. */
+    {"silence_timeout", CONF_MS, LINK_FIELD(silence_timeout_ms), 20, 600000, NULL, NULL, false},
+    {"backoff_initial", CONF_MS, LINK_FIELD(backoff_initial_ms), 10, 600000, NULL, NULL, false},
+    {"backoff_max", CONF_MS, LINK_FIELD(backoff_max_ms), 10, 600000, NULL, NULL, false},
+};
 
 static bool robot_begin(config_ctx *ctx, gw_config *cfg, const char *name)
 {
     gw_robot_config *robot, *grown;
-    if (!config_identifier(ctx, "robot name", name, false)) {
+    char why[CONF_WHY_MAX];
+    if (!conf_name(name, CONF_NAME_DASH, 64, why, sizeof why)) {
+        config_error(ctx, ctx->line, "robot name \"%s\" %s", name, why);
         return false;
     }
     for (unsigned i = 0; i < cfg->robot_count; i++) {
@@ -517,90 +521,6 @@ static bool robot_begin(config_ctx *ctx, gw_config *cfg, const char *name)
     return true;
 }
 
-static bool check_host(config_ctx *ctx, const char *host)
-{
-    size_t n = strlen(host);
-    bool ipv6 = strchr(host, ':') != NULL;
-    bool ok = n >= 1 && n <= 253;
-    for (size_t i = 0; ok && i < n; i++) {
-        unsigned char c = (unsigned char)host[i];
-        ok = ipv6 ? (isxdigit(c) || c == ':' || c == '.' || c == '%' || isalnum(c))
-                  : (isalnum(c) || c == '-' || c == '.');
-    }
-    if (!ok) {
-        config_error(ctx, ctx->line, "host \"%s\" is not a host name, IPv4 or IPv6 address", host);
-    }
-    return ok;
-}
-
-static bool robot_key(config_ctx *ctx, gw_config *cfg, const char *key, const char *value)
-{
-    gw_robot_config *robot = &cfg->robots[cfg->robot_count - 1];
-    unsigned long v;
-    if (strcmp(key, "host") == 0) {
-        if (!check_host(ctx, value)) {
-            return false;
-        }
-        replace_string(&robot->host, value);
-        robot->host_line = ctx->line;
-        return true;
-    }
-    if (strcmp(key, "port") == 0) {
-        if (!config_uint(ctx, "port", value, 1, 65535, &v)) {
-            return false;
-        }
-        robot->port = (uint16_t)v;
-        return true;
-    }
-    if (strcmp(key, "version") == 0) {
-        uint32_t length = 0;
-        unsigned rate = 1000000u / urrt_period_min_us(0);
-        if (strcmp(value, "auto") == 0) {
-            length = 0;
-        } else if (strchr(value, '.') != NULL) {
-            if (!version_length(ctx, value, &length, &rate)) {
-                return false;
-            }
-        } else {
-            char *end;
-            errno = 0;
-            v = strtoul(value, &end, 10);
-            if (!isdigit((unsigned char)value[0]) || *end != '\0' || errno != 0 || v < URRT_PACKET_MIN ||
-                v > URRT_PACKET_MAX || (v - URRT_HEADER_SIZE) % 8 != 0) {
-                config_error(ctx, ctx->line,
-                             "version \"%s\": expected auto, a controller version such as 5.10, or a message "
-                             "size in bytes (4 + 8n, %d to %d)", value, URRT_PACKET_MIN, URRT_PACKET_MAX);
-                return false;
-            }
-            length = (uint32_t)v;
-            rate = 1000000u / urrt_period_min_us(length);
-        }
-        robot->expected_length = length;
-        robot->max_rate_hz = rate;
-        replace_string(&robot->expected, value);
-        robot->version_line = ctx->line;
-        return true;
-    }
-    if (strcmp(key, "connect_timeout") == 0) {
-        return config_duration_ms(ctx, key, value, 10, 600000, &robot->link.connect_timeout_ms);
-    }
-    if (strcmp(key, "silence_timeout") == 0) {
-        /* A 125 Hz controller sends every 8 ms: less than 20 ms would drop a
-         * healthy link on ordinary jitter. */
-        return config_duration_ms(ctx, key, value, 20, 600000, &robot->link.silence_timeout_ms);
-    }
-    if (strcmp(key, "backoff_initial") == 0) {
-        return config_duration_ms(ctx, key, value, 10, 600000, &robot->link.backoff_initial_ms);
-    }
-    if (strcmp(key, "backoff_max") == 0) {
-        return config_duration_ms(ctx, key, value, 10, 600000, &robot->link.backoff_max_ms);
-    }
-    config_error(ctx, ctx->line,
-                 "unknown key \"%s\" in [robot %s] (keys: host, port, version, connect_timeout, "
-                 "silence_timeout, backoff_initial, backoff_max)", key, robot->name);
-    return false;
-}
-
 static void robot_finish(config_ctx *ctx, gw_config *cfg)
 {
     if (cfg->robot_count == 0) {
@@ -624,10 +544,7 @@ static void robot_finish(config_ctx *ctx, gw_config *cfg)
     }
 }
 
-/* ---- the section table ---------------------------------------------------------- */
-
-/* One entry per section kind. CAN adds {"can", ...} and {"frame", true, ...}. */
-/* ---- [can] and [frame NAME]: the CAN mapping (can_map.h checks them) ---- */
+/* ---- [can] and [frame NAME]: the CAN mapping (can_map.h has their tables) ---- */
 
 static void report_can_problem(void *user, const char *file, int line, const char *reason)
 {
@@ -635,10 +552,28 @@ static void report_can_problem(void *user, const char *file, int line, const cha
     config_error(user, line, "%s", reason);
 }
 
-static bool can_section_key(config_ctx *ctx, gw_config *cfg, const char *key, const char *value)
+static bool can_begin(config_ctx *ctx, gw_config *cfg, const char *name)
 {
-    /* Problems reach config_error() through the reporter: no text buffer. */
-    return can_map_ini(&cfg->can, ctx->section_raw, key, value, ctx->path, ctx->line, NULL, 0) == 1;
+    (void)name;
+    ctx->frame = NULL;
+    can_map_can_begin(&cfg->can, (struct conf_at){ctx->path, ctx->line});
+    return true;
+}
+
+static bool frame_begin(config_ctx *ctx, gw_config *cfg, const char *name)
+{
+    char why[CONF_WHY_MAX];
+    ctx->frame = can_map_frame_begin(&cfg->can, name, (struct conf_at){ctx->path, ctx->line}, why, sizeof why);
+    if (ctx->frame == NULL) {
+        config_error(ctx, ctx->line, "%s", why);
+    }
+    return ctx->frame != NULL;
+}
+
+static bool can_set(config_ctx *ctx, gw_config *cfg, const struct conf_key *key, const char *value, char *why,
+                    size_t n)
+{
+    return can_map_set(&cfg->can, ctx->frame, key, value, (struct conf_at){ctx->path, ctx->line}, why, n);
 }
 
 static void can_finish(config_ctx *ctx, gw_config *cfg)
@@ -652,64 +587,99 @@ static void can_finish(config_ctx *ctx, gw_config *cfg)
     can_map_finish(&cfg->can, robots, cfg->robot_count, NULL, 0);
 }
 
+/* ---- the section table ---------------------------------------------------------- */
+
+static void *gateway_object(config_ctx *ctx, gw_config *cfg)
+{
+    (void)ctx;
+    return cfg;
+}
+
+static void *lcm_object(config_ctx *ctx, gw_config *cfg)
+{
+    (void)ctx;
+    return &cfg->lcm;
+}
+
+static void *robot_object(config_ctx *ctx, gw_config *cfg)
+{
+    (void)ctx;
+    return &cfg->robots[cfg->robot_count - 1];
+}
+
+#define KEYS(table) table, sizeof table / sizeof table[0]
+
 static const config_section config_sections[] = {
-    {"gateway", false, false, NULL, gateway_key, NULL},
-    {"robot", true, true, robot_begin, robot_key, robot_finish},
-    {"lcm", false, false, NULL, lcm_key, lcm_finish},
-    {"can", false, false, NULL, can_section_key, can_finish},
-    {"frame", true, true, NULL, can_section_key, NULL},
+    {"gateway", false, false, NULL, KEYS(gateway_keys), gateway_object, NULL, NULL},
+    {"robot", true, true, robot_begin, KEYS(robot_keys), robot_object, NULL, robot_finish},
+    {"lcm", false, false, NULL, KEYS(lcm_keys), lcm_object, NULL, lcm_finish},
+    {"can", false, false, can_begin, can_map_can_keys, CAN_MAP_CK_COUNT, NULL, can_set, can_finish},
+    {"frame", true, true, frame_begin, can_map_frame_keys, CAN_MAP_FK_COUNT, NULL, can_set, NULL},
 };
 #define CONFIG_SECTION_COUNT (sizeof config_sections / sizeof config_sections[0])
 
+static void unknown_section(config_ctx *ctx, const char *raw, const char *kind)
+{
+    const char *near = conf_suggest(kind, config_sections, CONFIG_SECTION_COUNT, sizeof config_sections[0]);
+    const config_section *like = NULL;
+    char known[256] = "";
+    size_t used = 0;
+    for (size_t i = 0; i < CONFIG_SECTION_COUNT && used < sizeof known; i++) {
+        used += (size_t)snprintf(known + used, sizeof known - used, "%s[%s%s]", i ? ", " : "",
+                                 config_sections[i].kind, config_sections[i].named ? " NAME" : "");
+        like = config_sections[i].kind == near ? &config_sections[i] : like;
+    }
+    if (like != NULL) {
+        config_error(ctx, ctx->line, "unknown section [%s]: did you mean [%s%s]? (sections: %s)", raw, like->kind,
+                     like->named ? " NAME" : "", known);
+    } else {
+        config_error(ctx, ctx->line, "unknown section [%s] (sections: %s)", raw, known);
+    }
+}
+
+/* "robot  arm1 " -> kind "robot", name "arm1" (trimmed). */
+static void split_header(const char *raw, char *kind, size_t kind_size, char *name, size_t name_size)
+{
+    size_t kind_len;
+    raw += strspn(raw, " \t\f\v");
+    kind_len = strcspn(raw, " \t");
+    snprintf(kind, kind_size, "%.*s", (int)(kind_len < kind_size ? kind_len : kind_size - 1), raw);
+    raw += kind_len;
+    while (isspace((unsigned char)*raw)) {
+        raw++;
+    }
+    snprintf(name, name_size, "%s", raw);
+    for (size_t n = strlen(name); n > 0 && isspace((unsigned char)name[n - 1]); n--) {
+        name[n - 1] = '\0';
+    }
+}
+
 static void begin_section(config_ctx *ctx, const char *raw)
 {
-    char kind[64];
-    const char *name;
-    size_t kind_len;
+    char kind[64], name[256];
     const config_section *sec = NULL;
-    size_t index = 0;
+    size_t index;
 
     snprintf(ctx->section_raw, sizeof ctx->section_raw, "%s", raw);
     ctx->section = NULL;
     ctx->section_ok = false;
     ctx->key_count = 0;
-
-    while (isspace((unsigned char)*raw)) {
-        raw++;
-    }
-    kind_len = strcspn(raw, " \t");
-    snprintf(kind, sizeof kind, "%.*s", (int)(kind_len < sizeof kind ? kind_len : sizeof kind - 1), raw);
-    name = raw + kind_len;
-    while (isspace((unsigned char)*name)) {
-        name++;
-    }
-    char name_buf[256];
-    snprintf(name_buf, sizeof name_buf, "%s", name);
-    for (size_t n = strlen(name_buf); n > 0 && isspace((unsigned char)name_buf[n - 1]); n--) {
-        name_buf[n - 1] = '\0';
-    }
-    for (index = 0; index < CONFIG_SECTION_COUNT; index++) {
-        if (strcmp(config_sections[index].kind, kind) == 0) {
-            sec = &config_sections[index];
-            break;
-        }
+    split_header(raw, kind, sizeof kind, name, sizeof name);
+    snprintf(ctx->section_label, sizeof ctx->section_label, "%s%s%s", kind, name[0] ? " " : "", name);
+    for (index = 0; index < CONFIG_SECTION_COUNT && sec == NULL; index++) {
+        sec = strcmp(config_sections[index].kind, kind) == 0 ? &config_sections[index] : NULL;
     }
     if (sec == NULL) {
-        char known[256] = "";
-        size_t used = 0;
-        for (index = 0; index < CONFIG_SECTION_COUNT && used < sizeof known; index++) {
-            used += (size_t)snprintf(known + used, sizeof known - used, "%s[%s%s]", index ? ", " : "",
-                                     config_sections[index].kind, config_sections[index].named ? " NAME" : "");
-        }
-        config_error(ctx, ctx->line, "unknown section [%s] (sections: %s)", raw, known);
+        unknown_section(ctx, ctx->section_label, kind);
         return;
     }
-    if (sec->named && name_buf[0] == '\0') {
+    index--;
+    if (sec->named && name[0] == '\0') {
         config_error(ctx, ctx->line, "section [%s] needs a name: [%s NAME]", kind, kind);
         return;
     }
-    if (!sec->named && name_buf[0] != '\0') {
-        config_error(ctx, ctx->line, "section [%s] takes no name, not \"%s\"", kind, name_buf);
+    if (!sec->named && name[0] != '\0') {
+        config_error(ctx, ctx->line, "section [%s] takes no name, not \"%s\"", kind, name);
         return;
     }
     if (!sec->repeatable && ctx->seen_line[index] != 0) {
@@ -721,7 +691,7 @@ static void begin_section(config_ctx *ctx, const char *raw)
         ctx->seen_line[index] = ctx->line;
     }
     ctx->section = sec;
-    ctx->section_ok = sec->begin == NULL || sec->begin(ctx, ctx->cfg, sec->named ? name_buf : NULL);
+    ctx->section_ok = sec->begin == NULL || sec->begin(ctx, ctx->cfg, sec->named ? name : NULL);
 }
 
 /* Reads one line for inih and counts it, because Debian's libinih is built
@@ -796,35 +766,58 @@ static char *read_line(char *str, int num, void *stream)
     return str;
 }
 
-static int on_key(void *user, const char *section, const char *key, const char *value)
+/* A key given twice in a section: reported once, at its second line. */
+static bool seen_again(config_ctx *ctx, const char *key)
 {
-    config_ctx *ctx = user;
-    if (section[0] == '\0') {
-        config_error(ctx, ctx->line, "\"%s\" is outside of any section: put it under [gateway], [lcm] or [robot NAME]", key);
-        return 0;
-    }
-    /* libinih keeps the first 49 characters of a section header only
-     * ("[robot NAME]" takes up to 70): its name is a prefix of ours. */
-    if (strncmp(section, ctx->section_raw, strlen(section)) != 0 || ctx->section == NULL || !ctx->section_ok) {
-        return 1; /* the header's error was reported */
-    }
-    /* A frame's "signal" key adds one signal per line. */
-    bool repeatable = strcmp(ctx->section->kind, "frame") == 0 && strcmp(key, "signal") == 0;
-    for (unsigned i = 0; i < ctx->key_count && !repeatable; i++) {
+    for (unsigned i = 0; i < ctx->key_count; i++) {
         if (strcmp(ctx->keys[i].name, key) == 0) {
             config_error(ctx, ctx->line, "%s is set again (first at line %d)", key, ctx->keys[i].line);
-            return 0;
+            return true;
         }
     }
     if (ctx->key_count < CONFIG_MAX_KEYS) {
         snprintf(ctx->keys[ctx->key_count].name, sizeof ctx->keys[0].name, "%s", key);
         ctx->keys[ctx->key_count++].line = ctx->line;
     }
+    return false;
+}
+
+static int on_key(void *user, const char *section, const char *key, const char *value)
+{
+    config_ctx *ctx = user;
+    const config_section *sec = ctx->section;
+    const struct conf_key *k;
+    char why[CONF_WHY_MAX];
+    bool ok;
+    if (section[0] == '\0') {
+        config_error(ctx, ctx->line, "\"%s\" is outside of any section: put it under [gateway], [lcm] or [robot NAME]", key);
+        return 0;
+    }
+    /* libinih keeps the first 49 characters of a section header only
+     * ("[robot NAME]" takes up to 70): its name is a prefix of ours. */
+    if (strncmp(section, ctx->section_raw, strlen(section)) != 0 || sec == NULL || !ctx->section_ok) {
+        return 1; /* the header's error was reported */
+    }
+    k = conf_key_find(sec->keys, sec->key_count, key);
+    if (k == NULL) {
+        conf_unknown_key(sec->keys, sec->key_count, key, ctx->section_label, why, sizeof why);
+        config_error(ctx, ctx->line, "%s", why);
+        return 0;
+    }
+    if (!k->many && seen_again(ctx, key)) {
+        return 0;
+    }
     if (value[0] == '\0') {
         config_error(ctx, ctx->line, "%s has no value", key);
         return 0;
     }
-    return ctx->section->key(ctx, ctx->cfg, key, value) ? 1 : 0;
+    ok = sec->set != NULL ? sec->set(ctx, ctx->cfg, k, value, why, sizeof why)
+                          : conf_key_set(k, sec->object(ctx, ctx->cfg), value, (struct conf_at){ctx->path, ctx->line},
+                                         why, sizeof why);
+    if (!ok) {
+        config_error(ctx, ctx->line, "%s", why);
+    }
+    return ok ? 1 : 0;
 }
 
 static void config_defaults(gw_config *cfg, const char *path)
@@ -866,6 +859,7 @@ static int config_parse(gw_config *cfg, FILE *in, FILE *err)
     } else if (r < 0 && ctx.errors == 0) {
         config_error(&ctx, 0, "cannot parse (inih error %d)", r);
     }
+    ctx.rank = RANK_FILE;
     for (size_t i = 0; i < CONFIG_SECTION_COUNT; i++) {
         if (config_sections[i].finish != NULL) {
             config_sections[i].finish(&ctx, cfg);

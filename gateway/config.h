@@ -3,11 +3,13 @@
  * config.h: the urrt-gateway configuration file.
  *
  * An INI file read with libinih. Sections are dispatched through a table of
- * section handlers (config.c: config_sections), so an output such as CAN adds
- * its sections ("[can]", "[frame NAME]") with one table entry and a member of
- * gw_config for its values. Every error is reported as "FILE:LINE: reason";
- * an unknown section or key is an error, because a typo must not be
- * silently ignored. Parsing allocates; nothing after startup does.
+ * sections, each with a table of keys (config.c: config_sections), so an
+ * output such as CAN adds its sections ("[can]", "[frame NAME]") with one
+ * entry and a member of gw_config for its values. Values are read by the
+ * parsers of conf.h, the same for every section and command line. Every
+ * error is reported as "FILE:LINE: reason"; an unknown section or key is an
+ * error, because a typo must not be silently ignored. Parsing allocates;
+ * nothing after startup does.
  */
 #ifndef URRT_GATEWAY_CONFIG_H
 #define URRT_GATEWAY_CONFIG_H
@@ -17,6 +19,7 @@
 #include <stdio.h>
 
 #include "can_map.h"
+#include "conf.h"
 #include "port.h"
 
 /* The LCM messages, one channel each per robot: "NAME.SUFFIX". */
@@ -95,8 +98,12 @@ void gw_config_usage(FILE *out);
 bool gw_parse_log_level(const char *text, urrt_log_level *level);
 
 /*
- * For section handlers. A handler reports a problem with config_error() and
- * returns false; the parser goes on, so that one run shows every error.
+ * The section table (config.c: config_sections). A section's keys are a
+ * table of conf.h keys: the front end finds the key (an unknown one is an
+ * error with a "did you mean" hint), refuses it twice, and parses the value
+ * into the section's object, or hands it to set. A handler reports a
+ * problem with config_error() and returns false; the parser goes on, so
+ * that one run shows every error.
  */
 typedef struct config_ctx config_ctx;
 
@@ -104,28 +111,22 @@ typedef struct config_section {
     const char *kind;   /* "robot" matches "[robot NAME]" */
     bool named;         /* the header carries a NAME */
     bool repeatable;    /* may appear more than once (with different names) */
-    /* A section header; name is NULL for unnamed sections. */
+    /* A section header; name is NULL for unnamed sections. May be NULL. */
     bool (*begin)(config_ctx *ctx, gw_config *cfg, const char *name);
-    bool (*key)(config_ctx *ctx, gw_config *cfg, const char *key, const char *value);
+    const struct conf_key *keys;
+    size_t key_count;
+    /* Where the keys write (the current robot, say); NULL when set is given. */
+    void *(*object)(config_ctx *ctx, gw_config *cfg);
+    /* Parses a key instead of conf_key_set: false with the reason in why. */
+    bool (*set)(config_ctx *ctx, gw_config *cfg, const struct conf_key *key, const char *value, char *why, size_t n);
     /* After the whole file: defaults and checks across sections. May be NULL. */
     void (*finish)(config_ctx *ctx, gw_config *cfg);
 } config_section;
 
 int config_line(const config_ctx *ctx);
+/* The one error channel: "FILE:LINE: reason", printed at the end, causes
+ * (what is wrong on a line) before consequences (what the file then lacks). */
 void config_error(config_ctx *ctx, int line, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
-
-/* Value parsers: false (after reporting the error at the current line) when
- * the value is not valid. what names the key in the message. */
-bool config_uint(config_ctx *ctx, const char *what, const char *value, unsigned long min,
-                 unsigned long max, unsigned long *out);
-/* "250 ms", "2 s", "1.5s": a unit is required. */
-bool config_duration_ms(config_ctx *ctx, const char *what, const char *value, uint32_t min_ms,
-                        uint32_t max_ms, uint32_t *out);
-/* "every", "off" or "N Hz". */
-bool config_rate(config_ctx *ctx, const char *what, const char *value, gw_rate *out);
-bool config_bool(config_ctx *ctx, const char *what, const char *value, bool *out);
-/* Letters, digits, '_' and '-' (and '.' when dots is true), 1..64 chars. */
-bool config_identifier(config_ctx *ctx, const char *what, const char *value, bool dots);
 
 #endif

@@ -39,10 +39,10 @@ $(LCMTYPES_JAR): $(LCMTYPES)
 
 # ---- urrt-gateway ------------------------------------------------------------------
 GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_out.o) \
-                $(BUILD)/gateway/cli.o $(LCMTYPES_OBJS)
+                $(BUILD)/gateway/cli.o $(BUILD)/gateway/conf.o $(LCMTYPES_OBJS)
 # Other fragments append their objects (the CAN output, say); read at link time.
 GATEWAY_EXTRA_OBJS ?=
-GATEWAY_HDRS := gateway/config.h gateway/gateway.h gateway/freshness.h gateway/lcm_out.h gateway/cli.h gateway/can_map.h gateway/can_out.h gateway/dbc.h port/port.h $(LIB_HDRS)
+GATEWAY_HDRS := gateway/config.h gateway/conf.h gateway/gateway.h gateway/freshness.h gateway/lcm_out.h gateway/cli.h gateway/can_map.h gateway/can_out.h gateway/dbc.h port/port.h $(LIB_HDRS)
 GATEWAY_LIBS := -llcm -linih -lm
 
 $(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_out.o): \
@@ -50,7 +50,7 @@ $(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_
 	@mkdir -p $(@D)
 	$(CC) $(PROG_WARN) $(OPT) $(CPPFLAGS) -Igateway -I$(LCMGEN) -c $< -o $@
 
-# $(BUILD)/gateway/cli.o (the programs' shared helpers) is built by tools.mk.
+# $(BUILD)/gateway/cli.o and conf.o (the programs' shared helpers) are built by tools.mk.
 
 .SECONDEXPANSION:
 $(BUILD)/bin/urrt-gateway: $(GATEWAY_OBJS) $$(GATEWAY_EXTRA_OBJS) $(LIBPORT) $(LIBURRT)

@@ -2,11 +2,13 @@
 # gateway/tools.mk: urrt-sim and urrt-dump, and the modules they share with
 # urrt-gateway. Other fragments link $(CLI_OBJ) (and $(SIM_MODEL_OBJ) to
 # recompute what the simulator sent) without redefining their rules.
-CLI_OBJ := $(BUILD)/gateway/cli.o
+# conf.o: the value parsers every program's options and configuration share.
+CONF_OBJ := $(BUILD)/gateway/conf.o
+CLI_OBJ := $(BUILD)/gateway/cli.o $(CONF_OBJ)
 SIM_MODEL_OBJ := $(BUILD)/gateway/sim_model.o
 TOOLS_OBJS := $(CLI_OBJ) $(SIM_MODEL_OBJ) $(BUILD)/gateway/urrt-sim.o $(BUILD)/gateway/urrt-dump.o
 
-$(TOOLS_OBJS): $(BUILD)/gateway/%.o: gateway/%.c gateway/cli.h gateway/sim_model.h port/port.h $(LIB_HDRS)
+$(TOOLS_OBJS): $(BUILD)/gateway/%.o: gateway/%.c gateway/cli.h gateway/conf.h gateway/sim_model.h port/port.h $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(PROG_WARN) $(OPT) $(CPPFLAGS) -Igateway -c $< -o $@
 

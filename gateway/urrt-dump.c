@@ -125,6 +125,9 @@ static void usage(FILE *out)
 "      --silence-timeout MS   treat this much silence as a lost link (default\n"
 "                             1000; 0: never)\n"
 "      --backoff-max MS       longest wait between connect attempts (default 5000)\n"
+"  Numbers are decimal or 0x hexadecimal (a leading zero is refused); SEC and\n"
+"  MS take a unit too: 250ms, 1.5s, 2min (us, ms, s, min), as in the gateway's\n"
+"  configuration file.\n"
 "\n"
 "Other:\n"
 "  -v, --verbose           more log lines (twice: debug)\n"
@@ -214,6 +217,7 @@ static void parse_options(int argc, char **argv, options *o)
         {"version", no_argument, NULL, 'V'},
         {NULL, 0, NULL, 0},
     };
+    char why[CONF_WHY_MAX];
     const char *err;
     int c;
 
@@ -242,36 +246,39 @@ static void parse_options(int argc, char **argv, options *o)
             break;
         case 'k': parse_fields(optarg, o); break;
         case 'n':
-            if ((err = cli_parse_u64(optarg, 1, UINT64_MAX, &o->count)) != NULL) {
-                usage_error("--count %s: %s", optarg, err);
+            if (!conf_uint(optarg, 1, UINT64_MAX, &o->count, why, sizeof why)) {
+                usage_error("--count %s: %s", optarg, why);
             }
             break;
         case 'e':
-            if ((err = cli_parse_u64(optarg, 1, UINT64_MAX, &o->every)) != NULL) {
-                usage_error("--every %s: %s", optarg, err);
+            if (!conf_uint(optarg, 1, UINT64_MAX, &o->every, why, sizeof why)) {
+                usage_error("--every %s: %s", optarg, why);
             }
             break;
         case 'w': o->record_path = optarg; break;
         case 'f': o->file_path = optarg; break;
         case OPT_ONCE: o->once = true; break;
-        case 't':
-            if ((err = cli_parse_double(optarg, 0.001, 1e6, &o->timeout_s)) != NULL) {
-                usage_error("--timeout %s: %s (seconds, e.g. 2.5)", optarg, err);
+        case 't': {
+            uint64_t us;
+            if (!conf_duration_us(optarg, "s", 1000, UINT64_C(1000000000000), &us, why, sizeof why)) {
+                usage_error("--timeout %s: %s (seconds, e.g. 2.5)", optarg, why);
             }
+            o->timeout_s = (double)us / 1e6;
             break;
+        }
         case OPT_CONNECT_TIMEOUT:
-            if ((err = cli_parse_u32(optarg, 1, 600000, &o->connect_timeout_ms)) != NULL) {
-                usage_error("--connect-timeout %s: %s (milliseconds)", optarg, err);
+            if (!conf_duration_ms(optarg, "ms", 1, 600000, &o->connect_timeout_ms, why, sizeof why)) {
+                usage_error("--connect-timeout %s: %s (milliseconds)", optarg, why);
             }
             break;
         case OPT_SILENCE_TIMEOUT:
-            if ((err = cli_parse_u32(optarg, 0, 600000, &o->silence_timeout_ms)) != NULL) {
-                usage_error("--silence-timeout %s: %s (milliseconds)", optarg, err);
+            if (!conf_duration_ms(optarg, "ms", 0, 600000, &o->silence_timeout_ms, why, sizeof why)) {
+                usage_error("--silence-timeout %s: %s (milliseconds)", optarg, why);
             }
             break;
         case OPT_BACKOFF_MAX:
-            if ((err = cli_parse_u32(optarg, 100, 600000, &o->backoff_max_ms)) != NULL) {
-                usage_error("--backoff-max %s: %s (milliseconds, at least 100)", optarg, err);
+            if (!conf_duration_ms(optarg, "ms", 100, 600000, &o->backoff_max_ms, why, sizeof why)) {
+                usage_error("--backoff-max %s: %s (milliseconds, at least 100)", optarg, why);
             }
             break;
         case OPT_NO_SUMMARY: o->summary = false; break;

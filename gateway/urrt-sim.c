@@ -442,6 +442,7 @@ static void parse_options(int argc, char **argv, options *o)
     const char *listen_arg = DEFAULT_LISTEN;
     const char *version_arg = NULL;
     bool length_given = false;
+    char reason[CONF_WHY_MAX];
     const char *err;
     int c;
 
@@ -481,8 +482,8 @@ static void parse_options(int argc, char **argv, options *o)
         case 'c': version_arg = optarg; break;
         case 'L': {
             uint32_t v;
-            if ((err = cli_parse_u32(optarg, URRT_PACKET_MIN, URRT_PACKET_MAX, &v)) != NULL) {
-                usage_error("--length %s: %s (from %u to %u)", optarg, err, URRT_PACKET_MIN, URRT_PACKET_MAX);
+            if (!conf_u32(optarg, URRT_PACKET_MIN, URRT_PACKET_MAX, &v, reason, sizeof reason)) {
+                usage_error("--length %s: %s", optarg, reason);
             }
             if ((v - URRT_HEADER_SIZE) % 8 != 0) {
                 usage_error("--length %s: a packet is 4 bytes of size and 8 per double: 4 + 8n (e.g. 1116)", optarg);
@@ -492,19 +493,19 @@ static void parse_options(int argc, char **argv, options *o)
             break;
         }
         case 'r':
-            if ((err = cli_parse_double(optarg, 0.1, 100000.0, &o->rate_hz)) != NULL) {
-                usage_error("--rate %s: %s (from 0.1 to 100000 Hz)", optarg, err);
+            if (!conf_number(optarg, 0.1, 100000.0, &o->rate_hz, reason, sizeof reason)) {
+                usage_error("--rate %s: %s (Hz)", optarg, reason);
             }
             o->rate_given = true;
             break;
         case 's':
-            if ((err = cli_parse_u64(optarg, 0, UINT64_MAX, &o->seed)) != NULL) {
-                usage_error("--seed %s: %s", optarg, err);
+            if (!conf_uint(optarg, 0, UINT64_MAX, &o->seed, reason, sizeof reason)) {
+                usage_error("--seed %s: %s", optarg, reason);
             }
             break;
         case 'n':
-            if ((err = cli_parse_u64(optarg, 1, UINT64_MAX, &o->count)) != NULL) {
-                usage_error("--count %s: %s", optarg, err);
+            if (!conf_uint(optarg, 1, UINT64_MAX, &o->count, reason, sizeof reason)) {
+                usage_error("--count %s: %s", optarg, reason);
             }
             break;
         case 'w': o->record_path = optarg; break;
@@ -512,18 +513,18 @@ static void parse_options(int argc, char **argv, options *o)
         case OPT_LOOP: o->loop = true; break;
         case OPT_START_ON_CONNECT: o->start_on_connect = true; break;
         case OPT_CLIENTS:
-            if ((err = cli_parse_u64(optarg, 1, UINT64_MAX, &o->clients_to_serve)) != NULL) {
-                usage_error("--clients %s: %s", optarg, err);
+            if (!conf_uint(optarg, 1, UINT64_MAX, &o->clients_to_serve, reason, sizeof reason)) {
+                usage_error("--clients %s: %s", optarg, reason);
             }
             break;
         case OPT_MAX_CLIENTS:
-            if ((err = cli_parse_u32(optarg, 1, MAX_CLIENTS_LIMIT, &o->max_clients)) != NULL) {
-                usage_error("--max-clients %s: %s (from 1 to %d)", optarg, err, MAX_CLIENTS_LIMIT);
+            if (!conf_u32(optarg, 1, MAX_CLIENTS_LIMIT, &o->max_clients, reason, sizeof reason)) {
+                usage_error("--max-clients %s: %s", optarg, reason);
             }
             break;
         case OPT_RT_PRIORITY:
-            if ((err = cli_parse_u32(optarg, 1, 99, &o->rt_priority)) != NULL) {
-                usage_error("--rt-priority %s: %s (from 1 to 99)", optarg, err);
+            if (!conf_u32(optarg, 1, 99, &o->rt_priority, reason, sizeof reason)) {
+                usage_error("--rt-priority %s: %s", optarg, reason);
             }
             break;
         case 'f': parse_fault(optarg, &o->fault); break;

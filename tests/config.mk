@@ -10,8 +10,8 @@ CFGT := $(BUILD)/tests/config
 CFG_SEEDS := $(CFGT)/seeds
 CFG_SEED_FILES := $(wildcard docs/examples/*.ini) gateway/urrt-gateway.example.ini tests/e2e/e2e-can.ini \
                   $(wildcard tests/config/seeds/*.ini)
-CFG_FUZZ_SRCS := gateway/config.c gateway/can_map.c gateway/can_run.c gateway/dbc.c
-CFG_FUZZ_HDRS := gateway/config.h gateway/can_map.h gateway/dbc.h port/port.h $(LIB_HDRS)
+CFG_FUZZ_SRCS := gateway/config.c gateway/conf.c gateway/can_map.c gateway/can_run.c gateway/dbc.c
+CFG_FUZZ_HDRS := gateway/config.h gateway/conf.h gateway/can_map.h gateway/dbc.h port/port.h $(LIB_HDRS)
 
 CHECKS += check-fuzz-config
 .PHONY: check-fuzz-config fuzz-config

@@ -2,7 +2,9 @@
 /*
  * test_config.c: regression tests for what the configuration fuzzer
  * (tests/config/fuzz_config.c) found in the loader, one per finding, with
- * the input it found in tests/config/regressions/ as well. Runs in
+ * the input it found in tests/config/regressions/ as well; then the rules
+ * of the one configuration front end (gateway/conf.h): one parser per kind
+ * of value, the same in every section, and messages causes first. Runs in
  * check-fuzz-config, under ASan + UBSan.
  */
 #define _GNU_SOURCE
@@ -12,6 +14,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "conf.h"
 #include "config.h"
 
 /* CHECK_EQ_INT evaluates its arguments again to print them: once only. */
@@ -95,7 +98,7 @@ static void test_control_characters_escaped(void)
     static const char *const want[] = {
         "\nt.ini:2: host \"h\\x1B[2J\" is not a host name, IPv4 or IPv6 address\n",
         "\nt.ini:3: port must be a whole number from 1 to 65535, not \"1\\x0D2\"\n",
-        "\nt.ini:5: unknown key 'hea\\x02rtbeat_id' in [can] (keys: ",
+        "\nt.ini:5: unknown key \"hea\\x02rtbeat_id\" in [can]: did you mean \"heartbeat_id\"? (keys: ",
         "\nt.ini:6: interface = 'a\\x09b': no control characters\n",
     };
     char *messages = NULL;
@@ -208,6 +211,241 @@ static void test_text_after_header(void)
     free(messages);
 }
 
+/* ---- the one front end (gateway/conf.h) -------------------------------------------- */
+
+/* Integers: decimal or 0x hexadecimal; a leading zero is C's octal and is
+ * refused with both readings spelled out. */
+static void test_integers(void)
+{
+    char why[CONF_WHY_MAX] = "";
+    uint64_t v = 0;
+    uint32_t v32 = 0;
+    int64_t i = 0;
+    CHECK(conf_uint("100", 0, 1000, &v, why, sizeof why) && v == 100, "100: %s", why);
+    CHECK(conf_uint("0x40", 0, 1000, &v, why, sizeof why) && v == 64, "0x40: %s", why);
+    CHECK(conf_uint("0X7ff", 0, 0x7ff, &v, why, sizeof why) && v == 0x7ff, "0X7ff: %s", why);
+    CHECK(conf_uint("0", 0, 10, &v, why, sizeof why) && v == 0, "0: %s", why);
+    CHECK(!conf_uint("0100", 0, 1000, &v, why, sizeof why), "0100 accepted");
+    CHECK_EQ_STR(why, "a leading zero is not allowed (write 0x40 for hexadecimal or 100 for decimal)");
+    CHECK(!conf_u32("010", 1, 100, &v32, why, sizeof why), "010 accepted");
+    CHECK_EQ_STR(why, "a leading zero is not allowed (write 0x8 for hexadecimal or 10 for decimal)");
+    CHECK(!conf_uint("09", 0, 100, &v, why, sizeof why), "09 accepted");
+    CHECK_EQ_STR(why, "a leading zero is not allowed (write 9)");
+    CHECK(!conf_uint("70000", 1, 65535, &v, why, sizeof why), "70000 accepted");
+    CHECK_EQ_STR(why, "out of range: from 1 to 65535");
+    CHECK(!conf_uint("99999999999999999999999", 0, UINT64_MAX, &v, why, sizeof why), "overflow accepted");
+    CHECK_EQ_STR(why, "out of range: from 0 to 18446744073709551615");
+    for (size_t k = 0; k < 6; k++) {
+        static const char *const words[] = {"-1", "+1", "12abc", "0x", " 1", "1.5"};
+        CHECK(!conf_uint(words[k], 0, 100, &v, why, sizeof why), "%s accepted", words[k]);
+        CHECK_EQ_STR(why, "not a whole number (decimal, or hexadecimal with 0x)");
+    }
+    CHECK(!conf_uint("", 0, 100, &v, why, sizeof why), "empty accepted");
+    CHECK_EQ_STR(why, "no value");
+    CHECK(conf_int("-128", INT64_MIN, INT64_MAX, &i, why, sizeof why) && i == -128, "-128: %s", why);
+    CHECK(conf_int("0x8000", INT64_MIN, INT64_MAX, &i, why, sizeof why) && i == 0x8000, "0x8000: %s", why);
+    CHECK(conf_int("-9223372036854775808", INT64_MIN, INT64_MAX, &i, why, sizeof why) && i == INT64_MIN,
+          "INT64_MIN: %s", why);
+    CHECK(!conf_int("-010", INT64_MIN, INT64_MAX, &i, why, sizeof why), "-010 accepted");
+    CHECK_EQ_STR(why, "a leading zero is not allowed (write 0x8 for hexadecimal or 10 for decimal)");
+    CHECK(!conf_int("-5", -4, 4, &i, why, sizeof why), "-5 accepted");
+    CHECK_EQ_STR(why, "out of range: from -4 to 4");
+}
+
+static void test_numbers_and_booleans(void)
+{
+    static const char *const yes[] = {"yes", "YES", "True", "on", "ON", "1"};
+    static const char *const no[] = {"no", "No", "FALSE", "off", "Off", "0"};
+    char why[CONF_WHY_MAX] = "";
+    double d = 0;
+    bool b;
+    CHECK(conf_number("2.5", 0, 10, &d, why, sizeof why) && d == 2.5, "2.5: %s", why);
+    CHECK(conf_number("1e-3", 0, 10, &d, why, sizeof why) && d == 1e-3, "1e-3: %s", why);
+    CHECK(conf_number("-.5", -1, 1, &d, why, sizeof why) && d == -0.5, "-.5: %s", why);
+    for (size_t k = 0; k < 4; k++) {
+        static const char *const words[] = {"nan", "inf", "0x1p3", "2.5x"};
+        CHECK(!conf_number(words[k], -1e300, 1e300, &d, why, sizeof why), "%s accepted", words[k]);
+        CHECK_EQ_STR(why, "not a number (write it in decimal, e.g. 2.5)");
+    }
+    CHECK(!conf_number("11", 0.1, 10, &d, why, sizeof why), "11 accepted");
+    CHECK_EQ_STR(why, "out of range: from 0.1 to 10");
+    for (size_t k = 0; k < 6; k++) {
+        b = false;
+        CHECK(conf_bool(yes[k], &b, why, sizeof why) && b, "%s", yes[k]);
+        b = true;
+        CHECK(conf_bool(no[k], &b, why, sizeof why) && !b, "%s", no[k]);
+    }
+    CHECK(!conf_bool("maybe", &b, why, sizeof why), "maybe accepted");
+    CHECK_EQ_STR(why, "use yes or no (or true/false, on/off, 1/0)");
+}
+
+/* One grammar for every duration key: a number and a unit; a bare number
+ * only where the key's name carries the unit. */
+static void test_durations(void)
+{
+    static const struct { const char *text; const char *bare; uint32_t ms; } good[] = {
+        {"100ms", NULL, 100}, {"250 ms", NULL, 250}, {"1.5s", NULL, 1500}, {"2 s", NULL, 2000},
+        {"2 min", NULL, 120000}, {"5000us", NULL, 5}, {"100", "ms", 100}, {"0.5 s", "ms", 500},
+    };
+    char why[CONF_WHY_MAX] = "";
+    uint32_t ms = 0;
+    uint64_t us = 0;
+    for (size_t k = 0; k < sizeof good / sizeof good[0]; k++) {
+        ms = 0;
+        CHECK(conf_duration_ms(good[k].text, good[k].bare, 1, 600000, &ms, why, sizeof why) && ms == good[k].ms,
+              "%s: %u, %s", good[k].text, (unsigned)ms, why);
+    }
+    CHECK(!conf_duration_ms("100", NULL, 1, 600000, &ms, why, sizeof why), "bare 100 accepted");
+    CHECK_EQ_STR(why, "a duration is written with a unit (us, ms, s or min), e.g. \"100 ms\" or \"100 s\"");
+    CHECK(!conf_duration_ms("5 ms", NULL, 20, 600000, &ms, why, sizeof why), "5 ms accepted");
+    CHECK_EQ_STR(why, "out of range: from 20 ms to 10 min");
+    CHECK(!conf_duration_ms("1.5 ms", NULL, 1, 600000, &ms, why, sizeof why), "1.5 ms accepted");
+    CHECK_EQ_STR(why, "not a whole number of milliseconds");
+    CHECK(!conf_duration_ms("3 h", NULL, 1, 600000, &ms, why, sizeof why), "3 h accepted");
+    CHECK_EQ_STR(why, "unknown unit \"h\": write us, ms, s or min");
+    CHECK(!conf_duration_ms("-1 s", NULL, 0, 600000, &ms, why, sizeof why), "-1 s accepted");
+    CHECK(conf_duration_us("2.5", "s", 0, 10000000, &us, why, sizeof why) && us == 2500000, "2.5 s: %s", why);
+    CHECK(conf_bare_unit("stale_after_ms") != NULL && strcmp(conf_bare_unit("stale_after_ms"), "ms") == 0, "_ms");
+    CHECK(conf_bare_unit("period_ms") != NULL && strcmp(conf_bare_unit("period_ms"), "ms") == 0, "period_ms");
+    CHECK(conf_bare_unit("silence_timeout") == NULL, "no unit in the name");
+    CHECK(conf_bare_unit("ms") == NULL, "a name that is only a unit");
+}
+
+static void test_names_and_text(void)
+{
+    char why[CONF_WHY_MAX] = "";
+    char text[8];
+    CHECK(conf_name("arm-1", CONF_NAME_DASH, 64, why, sizeof why), "arm-1: %s", why);
+    CHECK(!conf_name("arm.1", CONF_NAME_DASH, 64, why, sizeof why), "arm.1 accepted");
+    CHECK_EQ_STR(why, "must be 1 to 64 letters, digits, '_' or '-'");
+    CHECK(conf_name("A.B", CONF_NAME_DASH | CONF_NAME_DOTS, 64, why, sizeof why), "A.B: %s", why);
+    CHECK(!conf_name(".AB", CONF_NAME_DASH | CONF_NAME_DOTS, 64, why, sizeof why), ".AB accepted");
+    CHECK(conf_name("_q0", CONF_NAME_C, 32, why, sizeof why), "_q0: %s", why);
+    CHECK(!conf_name("9lives", CONF_NAME_C, 32, why, sizeof why), "9lives accepted");
+    CHECK_EQ_STR(why, "is not a C identifier of at most 32 characters");
+    CHECK(conf_text(text, sizeof text, "\"N m\"", why, sizeof why), "quoted: %s", why);
+    CHECK_EQ_STR(text, "N m");
+    CHECK(!conf_text(text, sizeof text, "a\x1b[2J", why, sizeof why), "escape accepted");
+    CHECK_EQ_STR(why, "at most 7 characters, no '\"', '\\' or control characters");
+    CHECK(!conf_printable("a\tb", why, sizeof why), "tab accepted");
+    CHECK_EQ_STR(why, "no control characters");
+}
+
+#define CAN_TEXT "[can]\ninterface = vcan0\nheartbeat_id = 0x701\n"
+#define FRAME_TEXT "[frame f]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n"
+
+/* A value means the same in every section: fd = YES and summary = YES,
+ * 0x ids, and durations with a unit wherever a duration is asked. */
+static void test_same_everywhere(void)
+{
+    static const char text[] = "[gateway]\nsummary = YES\n[robot a]\nhost = h\nport = 0x7533\n"
+                               "silence_timeout = 250ms\nconnect_timeout = 1.5s\n"
+                               "[can]\ninterface = vcan0\nheartbeat_id = 0x701\nfd = YES\nheartbeat_period_ms = 0.5 s\n"
+                               "stale_after_ms = 200\n"
+                               "[frame f]\nid = 0x40\nperiod_ms = 1s\nstale_after_ms = 50 ms\nextended = On\n"
+                               "signal = time @0|8 intel unsigned invalid=0xFF\n";
+    char *messages = NULL;
+    gw_config cfg;
+    CHECK_ERRORS(load(text, strlen(text), &messages, &cfg), 0);
+    CHECK_EQ_STR(messages, "");
+    CHECK(cfg.summary, "summary = YES");
+    CHECK(cfg.can.fd, "fd = YES");
+    CHECK_EQ_INT(cfg.robots[0].port, 30003);
+    CHECK_EQ_INT(cfg.robots[0].link.silence_timeout_ms, 250);
+    CHECK_EQ_INT(cfg.robots[0].link.connect_timeout_ms, 1500);
+    CHECK_EQ_INT(cfg.can.hb_period_ms, 500);
+    CHECK_EQ_INT(cfg.can.stale_after_ms, 200);
+    if (cfg.can.frame_count == 1) {
+        CHECK_EQ_INT(cfg.can.frames[0].id, 0x40);
+        CHECK_EQ_INT(cfg.can.frames[0].period_ms, 1000);
+        CHECK_EQ_INT(cfg.can.frames[0].stale_after_ms, 50);
+        CHECK(cfg.can.frames[0].extended, "extended = On");
+        CHECK_EQ_INT(cfg.can.frames[0].sigs[0].invalid_raw, 0xFF);
+    }
+    gw_config_free(&cfg);
+    free(messages);
+}
+
+/* Each refusal, with its message: the value as written, what to write. */
+static void test_refusals(void)
+{
+    static const struct { const char *text; const char *want; } cases[] = {
+        {"[robot a]\nhost = h\n" CAN_TEXT "[frame f]\nid = 0100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+         "t.ini:7: id = \"0100\": a leading zero is not allowed (write 0x40 for hexadecimal or 100 for decimal)\n"
+         "t.ini:6: [frame f] has no id\n"},
+        {"[robot a]\nhost = h\nport = 030003\n",
+         "t.ini:3: port = \"030003\": a leading zero is not allowed (write 0x3003 for hexadecimal or 30003 for "
+         "decimal)\n"},
+        {"[robot a]\nhost = h\nsilence_timeout = 100\n",
+         "t.ini:3: silence_timeout = \"100\": a duration is written with a unit (us, ms, s or min), e.g. \"100 ms\" "
+         "or \"100 s\"\n"},
+        {"[robot a]\nhost = h\nbackoff_max = 2 h\n",
+         "t.ini:3: backoff_max = \"2 h\": unknown unit \"h\": write us, ms, s or min\n"},
+        {"[robot a]\nhost = h\n" CAN_TEXT FRAME_TEXT "signal = robot_mode @8|8 intel signed invalid=0200\n",
+         "t.ini:10: signal: invalid = '0200' is not an integer raw value: a leading zero is not allowed (write 0x80 "
+         "for hexadecimal or 200 for decimal)\n"},
+        {"[robot a]\nhost = h\n" CAN_TEXT FRAME_TEXT "validity_bit = 063\n",
+         "t.ini:10: validity_bit = '063': give the bit number (0..511)\n"},
+        {"[gateway]\nsummary = maybe\n[robot a]\nhost = h\n",
+         "t.ini:2: summary must be yes or no (or true/false, on/off, 1/0), not \"maybe\"\n"},
+        {"[robot a]\nhost = 127.0.0.1:47010\nport = 1\n",
+         "t.ini:2: host \"127.0.0.1:47010\" is HOST:PORT: write host = 127.0.0.1 and port = 47010\n"
+         "t.ini:1: [robot a] has no host: add \"host = ADDRESS\"\n"},
+        {"[robot a]\nhost = [::1]:30003\n",
+         "t.ini:2: host \"[::1]:30003\": write the address without brackets (host = ::1) and the port apart "
+         "(port = 30003)\n"
+         "t.ini:1: [robot a] has no host: add \"host = ADDRESS\"\n"},
+        {"[robot a]\nhost = [fe80::1]\n",
+         "t.ini:2: host \"[fe80::1]\": write the address without brackets (host = fe80::1)\n"
+         "t.ini:1: [robot a] has no host: add \"host = ADDRESS\"\n"},
+        {"[robot a]\nhost = h\n" CAN_TEXT "[frame f]\nid = 0x100\n[frame f]\nperiod_ms = 10\n",
+         "t.ini:8: [frame f] is already defined at line 6: frame names must be unique\n"
+         "t.ini:6: [frame f] has no period_ms (milliseconds, or every)\n"
+         "t.ini:6: [frame f] has no signal (signal = FIELD[ELEM] @START|LENGTH ...)\n"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char *messages = NULL;
+        load_str(cases[k].text, &messages);
+        CHECK(strcmp(messages, cases[k].want) == 0, "case %zu:\n  got:  %s  want: %s", k, messages, cases[k].want);
+        free(messages);
+    }
+    /* Valid before, valid now: an IPv6 address, and a bare number where the key names the unit. */
+    {
+        char *messages = NULL;
+        CHECK_ERRORS(load_str("[robot a]\nhost = fe80::1%eth0\n[robot b]\nhost = ::1\n", &messages), 0);
+        CHECK_EQ_STR(messages, "");
+        free(messages);
+    }
+}
+
+/* Causes first: a typo'd key or section before what it then lacks. */
+static void test_causes_first(void)
+{
+    static const struct { const char *text; const char *want; } cases[] = {
+        {"[robot arm1]\nport = 30003\nhots = 127.0.0.1\n",
+         "t.ini:3: unknown key \"hots\" in [robot arm1]: did you mean \"host\"? (keys: host, port, version, "
+         "connect_timeout, silence_timeout, backoff_initial, backoff_max)\n"
+         "t.ini:1: [robot arm1] has no host: add \"host = ADDRESS\"\n"},
+        {"[lcm]\nstate_rate = 10 Hz\n[robto arm1]\nhost = h\n",
+         "t.ini:3: unknown section [robto arm1]: did you mean [robot NAME]? (sections: [gateway], [robot NAME], "
+         "[lcm], [can], [frame NAME])\n"
+         "t.ini: no robot: edit t.ini and add a section \"[robot NAME]\" with \"host = ADDRESS\" (the installed "
+         "file has one commented out)\n"},
+        {"[robot a]\nhost = h\n" CAN_TEXT "[frame f]\nid = 0x100\nperoid_ms = 10\nsignal = time @0|8 intel unsigned\n",
+         "t.ini:8: unknown key \"peroid_ms\" in [frame f]: did you mean \"period_ms\"? (keys: id, extended, fd, "
+         "length, period_ms, robot, alive_counter, validity_bit, stale_after_ms, stale_policy, comment, signal)\n"
+         "t.ini:6: [frame f] has no period_ms (milliseconds, or every)\n"},
+        {"[gateway]\nverbose = 1\n[robot a]\nhost = h\n",
+         "t.ini:2: unknown key \"verbose\" in [gateway] (keys: log_level, summary)\n"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char *messages = NULL;
+        load_str(cases[k].text, &messages);
+        CHECK(strcmp(messages, cases[k].want) == 0, "case %zu:\n  got:  %s  want: %s", k, messages, cases[k].want);
+        free(messages);
+    }
+}
+
 int main(void)
 {
     test_stream_and_file();
@@ -218,5 +456,12 @@ int main(void)
     test_long_robot_name();
     test_header_after_form_feed();
     test_text_after_header();
+    test_integers();
+    test_numbers_and_booleans();
+    test_durations();
+    test_names_and_text();
+    test_same_everywhere();
+    test_refusals();
+    test_causes_first();
     return check_report();
 }
