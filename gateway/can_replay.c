@@ -39,6 +39,8 @@ static void on_packet(struct replay *r, const uint8_t *pkt, size_t len)
         r->undated++;
         return;
     }
+    /* What a gateway waking at each deadline would have sent until now. */
+    urrt_cantx_catch_up(can_map_tx(r->map), (uint64_t)t_us, emit, r);
     urrt_cantx_on_packet(can_map_tx(r->map), 0, &r->state, (uint64_t)t_us);
     can_map_due(r->map, (uint64_t)t_us, urrt_canlink_get_stats(r->link), emit, r);
 }

@@ -334,6 +334,7 @@ void urrt_cantx_start(urrt_cantx *tx, uint64_t now_us)
     size_t i;
     tx->started = true;
     tx->start_us = now_us;
+    tx->run_us = now_us;
     for (i = 0; i < t->robot_count; i++) {
         urrt_cantx_robot *r = &tx->robots[i];
         r->has_data = false;
@@ -471,11 +472,27 @@ size_t urrt_cantx_run(urrt_cantx *tx, uint64_t now_us, urrt_cantx_emit_fn emit, 
     if (!tx->started) {
         urrt_cantx_start(tx, now_us);
     }
+    tx->run_us = now_us;
     for (i = 0; i < tx->tables->frame_count; i++) {
         const urrt_cantx_frame *f = &tx->tables->frames[i];
         bool fresh = urrt_cantx_fresh(tx, f->robot, now_us, f->stale_after_us);
         sent += f->period_us == URRT_CANTX_EVERY_PACKET ? run_every(tx, i, now_us, fresh, emit, ctx)
                                                          : run_periodic(tx, i, now_us, fresh, emit, ctx);
+    }
+    return sent;
+}
+
+size_t urrt_cantx_catch_up(urrt_cantx *tx, uint64_t until_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    size_t sent = 0;
+    uint64_t due;
+    if (tx == NULL || !tx->started) {
+        return 0;
+    }
+    /* Each run moves every frame it sends past `due`, and clears what is
+     * pending, so the loop ends. */
+    while ((due = urrt_cantx_deadline(tx)) < until_us) {
+        sent += urrt_cantx_run(tx, due > tx->run_us ? due : tx->run_us, emit, ctx);
     }
     return sent;
 }

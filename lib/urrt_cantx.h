@@ -175,6 +175,7 @@ typedef struct urrt_cantx {
     uint64_t clamped;          /* values packed with an outcome other than OK */
     uint64_t clamped_seen;     /* at the previous heartbeat */
     uint64_t start_us;
+    uint64_t run_us;           /* the time of the latest urrt_cantx_run */
     bool started;
 } urrt_cantx;
 
@@ -220,6 +221,13 @@ typedef void (*urrt_cantx_emit_fn)(void *ctx, const urrt_can_frame *frame, uint6
 /* Sends every frame due at now_us through emit, in table order. Returns the
  * number sent. */
 size_t urrt_cantx_run(urrt_cantx *tx, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx);
+
+/* Runs the schedule at each deadline before until_us, at that deadline's
+ * time: what a loop that woke at every deadline would have sent. For a
+ * replay clocked by its packets' time (urrt-gateway --replay) and for
+ * simulations; a loop on a real clock calls urrt_cantx_run. Returns the
+ * number sent. */
+size_t urrt_cantx_catch_up(urrt_cantx *tx, uint64_t until_us, urrt_cantx_emit_fn emit, void *ctx);
 
 /* When urrt_cantx_run must run next (URRT_CANTX_NEVER: not before the next
  * packet; a time at or before now means now). */

@@ -363,12 +363,34 @@ static void test_stall(void)
     CHECK_EQ(urrt_cantx_deadline(&tx), 45000, "then every 10 ms from the late one");
 }
 
+/* A replay's clock jumps from packet to packet: catch_up sends what a loop
+ * waking at every deadline would have, each at its own time. */
+static void test_catch_up(void)
+{
+    reset_tables();
+    CHECK_EQ(init(NULL, NULL), 0, "init");
+    CHECK_EQ(urrt_cantx_catch_up(&tx, 50000, capture, NULL), 0, "nothing before start");
+    packet(1000, 0, 7, 5.0);
+    run(1000);
+    out_count = 0;
+    CHECK_EQ(urrt_cantx_catch_up(&tx, 41000, capture, NULL), 3, "0x182 at 11, 21 and 31 ms: before 41");
+    CHECK_EQ(out_at[0], 11000, "the first at its due time");
+    CHECK_EQ(out_at[2], 31000, "the third at its due time");
+    CHECK_EQ(out[0].id == 0x182 && out[1].id == 0x182 && out[2].id == 0x182, 1, "all of them 0x182");
+    CHECK_EQ(urrt_cantx_deadline(&tx), 41000, "41 ms is left for the caller's run");
+    out_count = 0;
+    urrt_cantx_catch_up(&tx, 200000, capture, NULL);
+    CHECK_EQ(out[out_count - 1].id, 0x182, "0x182 goes on (invalid) to 191 ms");
+    CHECK_EQ(out_at[out_count - 1], 191000, "the last before 200 ms");
+}
+
 int main(void)
 {
     test_init();
     test_schedule();
     test_stop_policy_and_flags();
     test_stall();
+    test_catch_up();
     say_uint(passed);
     say(" passed, ");
     say_uint(failed);

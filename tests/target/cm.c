@@ -26,13 +26,41 @@ static uintptr_t semihost(uintptr_t op, const void *arg)
     return r0;
 }
 
+#define SYS_OPEN 0x01u
 #define SYS_WRITE0 0x04u
+#define SYS_READ 0x06u
+#define SYS_GET_CMDLINE 0x15u
 #define SYS_EXIT_EXTENDED 0x20u
 #define ADP_STOPPED_APPLICATION_EXIT 0x20026u
 
 void target_puts(const char *s)
 {
     semihost(SYS_WRITE0, s);
+}
+
+int target_open_cmdline_file(void)
+{
+    static char path[256];
+    uintptr_t block[3];
+    size_t len = 0;
+    block[0] = (uintptr_t)path;
+    block[1] = sizeof path;
+    if (semihost(SYS_GET_CMDLINE, block) != 0) {
+        return -1;
+    }
+    while (len < sizeof path && path[len] != '\0') {
+        len++;
+    }
+    block[0] = (uintptr_t)path;
+    block[1] = 1; /* "rb" */
+    block[2] = len;
+    return (int)semihost(SYS_OPEN, block);
+}
+
+size_t target_read(int handle, void *buf, size_t n)
+{
+    const uintptr_t block[3] = {(uintptr_t)handle, (uintptr_t)buf, n};
+    return n - semihost(SYS_READ, block); /* SYS_READ returns the bytes NOT read */
 }
 
 void target_exit(int status)

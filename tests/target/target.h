@@ -35,6 +35,10 @@ uintptr_t target_stack_limit(void);
  * call is its high-water mark. Uses no stack itself. */
 void target_stack_paint(uintptr_t sp);
 uintptr_t target_stack_lowest_used(uintptr_t sp);
+/* The host file qemu's `-semihosting-config ...,arg=PATH` names, opened for
+ * reading (a handle, or -1), and up to n bytes of it (0 at its end). */
+int target_open_cmdline_file(void);
+size_t target_read(int handle, void *buf, size_t n);
 /* SysTick, counting down from 0xFFFFFF at the core clock. */
 void target_systick_start(void);
 static inline uint32_t target_systick(void)
