@@ -174,33 +174,27 @@ static void put_field_comment(FILE *out, unsigned long id, const struct can_map 
     fprintf(out, "\";\n");
 }
 
-int dbc_write(FILE *out, const struct can_map *map, const char *source)
+/* Whether any frame is FD, and whether FD frames switch bit rate. */
+static bool any_fd(const struct can_map *map)
 {
-    size_t i;
-    size_t k;
-    bool any_fd = map->fd;
-    bool brs = map->fd && map->data_bitrate > map->bitrate;
-    unsigned long hb = dbc_id(map->hb_id, map->hb_extended);
-
-    if (out == NULL || map == NULL || !map->finished || !map->configured) {
-        errno = EINVAL;
-        return -1;
+    bool fd = map->fd;
+    for (size_t i = 0; i < map->frame_count; i++) {
+        fd |= map->frames[i].fd;
     }
-    for (i = 0; i < map->frame_count; i++) {
-        any_fd |= map->frames[i].fd;
-    }
+    return fd;
+}
 
+static void put_header(FILE *out, const struct can_map *map)
+{
+    static const char *const ns[] = {
+        "NS_DESC_", "CM_", "BA_DEF_", "BA_", "VAL_", "CAT_DEF_", "CAT_", "FILTER", "BA_DEF_DEF_", "EV_DATA_",
+        "ENVVAR_DATA_", "SGTYPE_", "SGTYPE_VAL_", "BA_DEF_SGTYPE_", "BA_SGTYPE_", "SIG_TYPE_REF_",
+        "VAL_TABLE_", "SIG_GROUP_", "SIG_VALTYPE_", "SIGTYPE_VALTYPE_", "BO_TX_BU_", "BA_DEF_REL_",
+        "BA_REL_", "BA_DEF_DEF_REL_", "BU_SG_REL_", "BU_EV_REL_", "BU_BO_REL_", "SG_MUL_VAL_"};
     fprintf(out, "VERSION \"\"\n\n\n");
     fprintf(out, "NS_ :\n");
-    {
-        static const char *const ns[] = {
-            "NS_DESC_", "CM_", "BA_DEF_", "BA_", "VAL_", "CAT_DEF_", "CAT_", "FILTER", "BA_DEF_DEF_", "EV_DATA_",
-            "ENVVAR_DATA_", "SGTYPE_", "SGTYPE_VAL_", "BA_DEF_SGTYPE_", "BA_SGTYPE_", "SIG_TYPE_REF_",
-            "VAL_TABLE_", "SIG_GROUP_", "SIG_VALTYPE_", "SIGTYPE_VALTYPE_", "BO_TX_BU_", "BA_DEF_REL_",
-            "BA_REL_", "BA_DEF_DEF_REL_", "BU_SG_REL_", "BU_EV_REL_", "BU_BO_REL_", "SG_MUL_VAL_"};
-        for (k = 0; k < sizeof ns / sizeof ns[0]; k++) {
-            fprintf(out, "\t%s\n", ns[k]);
-        }
+    for (size_t k = 0; k < sizeof ns / sizeof ns[0]; k++) {
+        fprintf(out, "\t%s\n", ns[k]);
     }
     fprintf(out, "\nBS_:\n\n");
     if (strcmp(map->receiver, "Vector__XXX") != 0 && strcmp(map->receiver, map->node) != 0) {
@@ -208,24 +202,67 @@ int dbc_write(FILE *out, const struct can_map *map, const char *source)
     } else {
         fprintf(out, "BU_: %s\n\n\n", map->node);
     }
+}
 
-    /* Frames, then the heartbeat. */
-    for (i = 0; i < map->frame_count; i++) {
+/* Frames, then the heartbeat. */
+static void put_frames(FILE *out, const struct can_map *map, unsigned long hb)
+{
+    for (size_t i = 0; i < map->frame_count; i++) {
         const struct can_map_frame *f = &map->frames[i];
         fprintf(out, "BO_ %lu %s: %u %s\n", dbc_id(f->id, f->extended), f->name, (unsigned)f->len, map->node);
-        for (k = 0; k < f->count; k++) {
+        for (size_t k = 0; k < f->count; k++) {
             put_signal(out, f->meta[k].name, &f->sigs[k], f->meta[k].unit, map->receiver);
         }
         fprintf(out, "\n");
     }
     fprintf(out, "BO_ %lu %s: %u %s\n", hb, CAN_MAP_HEARTBEAT_NAME, URRT_CANTX_HB_LEN, map->node);
-    for (k = 0; k < URRT_CANTX_HB_COUNT; k++) {
+    for (size_t k = 0; k < URRT_CANTX_HB_COUNT; k++) {
         const struct can_map_hb_signal *h = &can_map_heartbeat_layout[k];
         put_signal(out, h->name, &urrt_cantx_heartbeat_signals[k], h->unit, map->receiver);
     }
     fprintf(out, "\n\n");
+}
 
-    /* Comments. */
+static void put_frame_comment(FILE *out, const struct can_map *map, const struct can_map_frame *f)
+{
+    unsigned long id = dbc_id(f->id, f->extended);
+    const char *robot = f->robot_index < map->robot_count ? map->robots[f->robot_index].name : f->robot;
+    fprintf(out, "CM_ BO_ %lu \"", id);
+    if (f->comment[0] != '\0') {
+        put_text(out, f->comment);
+        fprintf(out, ". ");
+    }
+    fprintf(out, "Robot ");
+    put_text(out, robot);
+    if (f->every) {
+        fprintf(out, ", one frame per robot packet; stops when the packets stop.");
+    } else if (f->stale_policy == CAN_MAP_STALE_STOP) {
+        fprintf(out, ", every %u ms; stops when the data is older than %u ms.", (unsigned)f->period_ms,
+                (unsigned)f->stale_after_ms);
+    } else {
+        fprintf(out, ", every %u ms; sent with valid = 0 when the data is older than %u ms.",
+                (unsigned)f->period_ms, (unsigned)f->stale_after_ms);
+    }
+    fprintf(out, "\";\n");
+    for (size_t k = 0; k < f->count; k++) {
+        const struct can_map_signal *m = &f->meta[k];
+        switch (m->role) {
+        case CAN_MAP_ROLE_FIELD: put_field_comment(out, id, map, m); break;
+        case CAN_MAP_ROLE_ALIVE:
+            fprintf(out, "CM_ SG_ %lu %s \"Alive counter: +1 modulo 16 with every frame sent\";\n", id, m->name);
+            break;
+        case CAN_MAP_ROLE_VALID:
+            fprintf(out,
+                    "CM_ SG_ %lu %s \"1: every value in this frame is fresh and was sent as it is; 0: data "
+                    "older than %u ms, a value saturated or NaN, or no data yet\";\n",
+                    id, m->name, (unsigned)f->stale_after_ms);
+            break;
+        }
+    }
+}
+
+static void put_comments(FILE *out, const struct can_map *map, const char *source, unsigned long hb)
+{
     fprintf(out, "CM_ \"Generated by urrt-gateway %s: Universal Robots RealTime data on CAN. "
                  "Bit numbering and value scaling as in docs/can.md.\";\n",
             URRT_VERSION_STRING);
@@ -237,60 +274,25 @@ int dbc_write(FILE *out, const struct can_map *map, const char *source)
     } else {
         fprintf(out, "CM_ BU_ %s \"urrt-gateway\";\n", map->node);
     }
-    for (i = 0; i < map->frame_count; i++) {
-        const struct can_map_frame *f = &map->frames[i];
-        unsigned long id = dbc_id(f->id, f->extended);
-        const char *robot = f->robot_index < map->robot_count ? map->robots[f->robot_index].name : f->robot;
-        fprintf(out, "CM_ BO_ %lu \"", id);
-        if (f->comment[0] != '\0') {
-            put_text(out, f->comment);
-            fprintf(out, ". ");
-        }
-        fprintf(out, "Robot ");
-        put_text(out, robot);
-        if (f->every) {
-            fprintf(out, ", one frame per robot packet");
-        } else {
-            fprintf(out, ", every %u ms", (unsigned)f->period_ms);
-        }
-        if (f->every) {
-            fprintf(out, "; stops when the packets stop.");
-        } else if (f->stale_policy == CAN_MAP_STALE_STOP) {
-            fprintf(out, "; stops when the data is older than %u ms.", (unsigned)f->stale_after_ms);
-        } else {
-            fprintf(out, "; sent with valid = 0 when the data is older than %u ms.", (unsigned)f->stale_after_ms);
-        }
-        fprintf(out, "\";\n");
-        for (k = 0; k < f->count; k++) {
-            const struct can_map_signal *m = &f->meta[k];
-            switch (m->role) {
-            case CAN_MAP_ROLE_FIELD: put_field_comment(out, id, map, m); break;
-            case CAN_MAP_ROLE_ALIVE:
-                fprintf(out, "CM_ SG_ %lu %s \"Alive counter: +1 modulo 16 with every frame sent\";\n", id, m->name);
-                break;
-            case CAN_MAP_ROLE_VALID:
-                fprintf(out,
-                        "CM_ SG_ %lu %s \"1: every value in this frame is fresh and was sent as it is; 0: data "
-                        "older than %u ms, a value saturated or NaN, or no data yet\";\n",
-                        id, m->name, (unsigned)f->stale_after_ms);
-                break;
-            }
-        }
+    for (size_t i = 0; i < map->frame_count; i++) {
+        put_frame_comment(out, map, &map->frames[i]);
     }
     fprintf(out, "CM_ BO_ %lu \"Gateway heartbeat, every %u ms. Robot ", hb, (unsigned)map->hb_period_ms);
     put_text(out, map->hb_robot_index < map->robot_count ? map->robots[map->hb_robot_index].name : map->hb_robot);
     fprintf(out, "; data stale after %u ms.\";\n", (unsigned)map->stale_after_ms);
-    for (k = 0; k < URRT_CANTX_HB_COUNT; k++) {
+    for (size_t k = 0; k < URRT_CANTX_HB_COUNT; k++) {
         fprintf(out, "CM_ SG_ %lu %s \"", hb, can_map_heartbeat_layout[k].name);
         put_text(out, can_map_heartbeat_layout[k].comment);
         fprintf(out, "\";\n");
     }
+}
 
-    /* Attribute definitions and defaults. */
+static void put_attribute_definitions(FILE *out, bool fd, bool brs)
+{
     fprintf(out, "BA_DEF_ BO_ \"GenMsgCycleTime\" INT 0 65535;\n");
     fprintf(out, "BA_DEF_ BO_ \"GenMsgSendType\" ENUM %s;\n", send_types);
     fprintf(out, "BA_DEF_ BO_ \"VFrameFormat\" ENUM %s;\n", frame_formats);
-    if (any_fd) {
+    if (fd) {
         fprintf(out, "BA_DEF_ BO_ \"CANFD_BRS\" ENUM \"0\",\"1\";\n");
     }
     fprintf(out, "BA_DEF_ \"BusType\" STRING ;\n");
@@ -299,16 +301,23 @@ int dbc_write(FILE *out, const struct can_map *map, const char *source)
     fprintf(out, "BA_DEF_DEF_ \"GenMsgCycleTime\" 0;\n");
     fprintf(out, "BA_DEF_DEF_ \"GenMsgSendType\" \"Cyclic\";\n");
     fprintf(out, "BA_DEF_DEF_ \"VFrameFormat\" \"StandardCAN\";\n");
-    if (any_fd) {
+    if (fd) {
         fprintf(out, "BA_DEF_DEF_ \"CANFD_BRS\" \"%d\";\n", brs ? 1 : 0);
     }
     fprintf(out, "BA_DEF_DEF_ \"BusType\" \"CAN\";\n");
     fprintf(out, "BA_DEF_DEF_ \"Baudrate\" 500000;\n");
     fprintf(out, "BA_DEF_DEF_ \"DBName\" \"\";\n");
-    fprintf(out, "BA_ \"BusType\" \"%s\";\n", any_fd ? "CAN FD" : "CAN");
+}
+
+static void put_attributes(FILE *out, const struct can_map *map, unsigned long hb)
+{
+    bool fd_any = any_fd(map);
+    bool brs = map->fd && map->data_bitrate > map->bitrate;
+    put_attribute_definitions(out, fd_any, brs);
+    fprintf(out, "BA_ \"BusType\" \"%s\";\n", fd_any ? "CAN FD" : "CAN");
     fprintf(out, "BA_ \"Baudrate\" %u;\n", (unsigned)(map->bitrate > 1000000 ? 1000000 : map->bitrate));
     fprintf(out, "BA_ \"DBName\" \"urrt_gateway\";\n");
-    for (i = 0; i <= map->frame_count; i++) {
+    for (size_t i = 0; i <= map->frame_count; i++) {
         const struct can_map_frame *f = i < map->frame_count ? &map->frames[i] : NULL;
         bool ext = f ? f->extended : map->hb_extended;
         bool fd = f ? f->fd : false;
@@ -317,46 +326,32 @@ int dbc_write(FILE *out, const struct can_map *map, const char *source)
         fprintf(out, "BA_ \"GenMsgSendType\" BO_ %lu 0;\n", id);
         fprintf(out, "BA_ \"VFrameFormat\" BO_ %lu %d;\n", id,
                 fd ? (ext ? FORMAT_EXTENDED_FD : FORMAT_STANDARD_FD) : (ext ? FORMAT_EXTENDED : FORMAT_STANDARD));
-        if (any_fd && fd) {
+        if (fd_any && fd) {
             fprintf(out, "BA_ \"CANFD_BRS\" BO_ %lu %d;\n", id, brs ? 1 : 0);
         }
     }
+}
 
-    /* Value tables. */
-    for (i = 0; i < map->frame_count; i++) {
-        const struct can_map_frame *f = &map->frames[i];
-        unsigned long id = dbc_id(f->id, f->extended);
-        for (k = 0; k < f->count; k++) {
-            const struct can_map_signal *m = &f->meta[k];
-            urrt_enum_kind kind;
-            if (m->role != CAN_MAP_ROLE_FIELD) {
-                continue;
-            }
-            kind = urrt_field_enum((urrt_field_id)m->field, map->generation);
-            if (kind != URRT_ENUM_NONE) {
-                put_enum_values(out, id, m->name, &f->sigs[k], kind, 0, NULL);
-            }
-        }
-    }
-    for (k = 0; k < URRT_CANTX_HB_COUNT; k++) {
+static void put_heartbeat_values(FILE *out, const struct can_map *map, unsigned long hb)
+{
+    for (size_t k = 0; k < URRT_CANTX_HB_COUNT; k++) {
         const struct can_map_hb_signal *h = &can_map_heartbeat_layout[k];
+        const urrt_can_signal *sig = &urrt_cantx_heartbeat_signals[k];
         switch (h->values) {
-        case CAN_MAP_HB_VALUES_STATE: {
-            int s;
+        case CAN_MAP_HB_VALUES_STATE:
             fprintf(out, "VAL_ %lu %s", hb, h->name);
-            for (s = URRT_CANTX_STARTING; s <= URRT_CANTX_DISCONNECTED; s++) {
+            for (int s = URRT_CANTX_STARTING; s <= URRT_CANTX_DISCONNECTED; s++) {
                 fprintf(out, " %d \"%s\"", s, urrt_cantx_state_name((urrt_cantx_state)s));
             }
             fprintf(out, " ;\n");
             break;
-        }
         case CAN_MAP_HB_VALUES_ROBOT_MODE:
-            put_enum_values(out, hb, h->name, &urrt_cantx_heartbeat_signals[k],
+            put_enum_values(out, hb, h->name, sig,
                             map->generation == URRT_GEN_1X ? URRT_ENUM_ROBOT_MODE_1X : URRT_ENUM_ROBOT_MODE,
                             URRT_CANTX_HB_ROBOT_MODE_NA, "NOT_AVAILABLE");
             break;
         case CAN_MAP_HB_VALUES_SAFETY_MODE:
-            put_enum_values(out, hb, h->name, &urrt_cantx_heartbeat_signals[k], URRT_ENUM_SAFETY_MODE, URRT_CANTX_HB_SAFETY_MODE_NA,
+            put_enum_values(out, hb, h->name, sig, URRT_ENUM_SAFETY_MODE, URRT_CANTX_HB_SAFETY_MODE_NA,
                             "NOT_AVAILABLE");
             break;
         case CAN_MAP_HB_VALUES_GENERATION:
@@ -365,17 +360,48 @@ int dbc_write(FILE *out, const struct can_map *map, const char *source)
         default: break;
         }
     }
+}
 
-    /* Float signals. */
-    for (i = 0; i < map->frame_count; i++) {
+/* Value tables of coded fields, then the float signals' types. */
+static void put_values(FILE *out, const struct can_map *map, unsigned long hb)
+{
+    for (size_t i = 0; i < map->frame_count; i++) {
         const struct can_map_frame *f = &map->frames[i];
-        for (k = 0; k < f->count; k++) {
+        for (size_t k = 0; k < f->count; k++) {
+            const struct can_map_signal *m = &f->meta[k];
+            urrt_enum_kind kind = m->role == CAN_MAP_ROLE_FIELD
+                                      ? urrt_field_enum((urrt_field_id)m->field, map->generation)
+                                      : URRT_ENUM_NONE;
+            if (kind != URRT_ENUM_NONE) {
+                put_enum_values(out, dbc_id(f->id, f->extended), m->name, &f->sigs[k], kind, 0, NULL);
+            }
+        }
+    }
+    put_heartbeat_values(out, map, hb);
+    for (size_t i = 0; i < map->frame_count; i++) {
+        const struct can_map_frame *f = &map->frames[i];
+        for (size_t k = 0; k < f->count; k++) {
             if (f->sigs[k].type == URRT_CAN_FLOAT32 || f->sigs[k].type == URRT_CAN_FLOAT64) {
                 fprintf(out, "SIG_VALTYPE_ %lu %s : %d;\n", dbc_id(f->id, f->extended), f->meta[k].name,
                         f->sigs[k].type == URRT_CAN_FLOAT32 ? 1 : 2);
             }
         }
     }
+}
+
+int dbc_write(FILE *out, const struct can_map *map, const char *source)
+{
+    unsigned long hb;
+    if (out == NULL || map == NULL || !map->finished || !map->configured) {
+        errno = EINVAL;
+        return -1;
+    }
+    hb = dbc_id(map->hb_id, map->hb_extended);
+    put_header(out, map);
+    put_frames(out, map, hb);
+    put_comments(out, map, source, hb);
+    put_attributes(out, map, hb);
+    put_values(out, map, hb);
     fflush(out);
     return ferror(out) ? -1 : 0;
 }
