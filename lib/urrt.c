@@ -260,7 +260,8 @@ static bool plausible_length(uint32_t size)
     return size >= URRT_PACKET_MIN && size <= URRT_PACKET_MAX && (size - URRT_HEADER_SIZE) % 8u == 0;
 }
 
-/* The rates of protocol-facts.md: 125 Hz on CB2/CB3 (and so 1.5 on CB1), 500 Hz on e-series. */
+/* The rates of docs/protocol.md: 125 Hz on CB2/CB3, 500 Hz on e-series. No
+ * source gives CB1's (1.5): taken as 125 Hz, like the CB2 that followed it. */
 #define CB_US 8000u
 #define E_US 2000u
 

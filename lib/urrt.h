@@ -213,7 +213,8 @@ urrt_generation urrt_generation_of(uint32_t length);
 /*
  * Controller software versions, the one table of what each sends: one row
  * per message size, with the versions that send it as text and as numbers,
- * and the period each sends it at (125 Hz on CB1-CB3, 500 Hz on e-series).
+ * and the period each sends it at (125 Hz on CB2/CB3, and taken for CB1
+ * too, which no source gives; 500 Hz on e-series).
  * docs/protocol.md gives the sources.
  *
  * 1.6 controllers sent 756 or 764 bytes (the sources disagree), so 1.6 is
