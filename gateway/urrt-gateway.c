@@ -42,7 +42,13 @@ static void usage(FILE *out)
         "Options:\n"
         "  -c, --check-config     validate CONFIG, print what would run, exit\n"
         "  -d, --print-dbc        write the DBC of CONFIG's CAN frames, exit\n"
-        "  -o, --output FILE      with --print-dbc: write to FILE, not stdout\n"
+        "      --print-c-tables   write CONFIG's CAN frames as C tables of lib/urrt_cantx.h\n"
+        "                         for a firmware (docs/firmware.md), exit\n"
+        "  -o, --output FILE      with --print-dbc or --print-c-tables: write to FILE\n"
+        "      --replay CAPTURE   send a raw capture's packets through the CAN side,\n"
+        "                         clocked by their controller time, and exit: the\n"
+        "                         frames a PLC would have received (interface =\n"
+        "                         log:PATH); the capture is the first robot's\n"
         "  -s, --summary          one line per robot each second on stdout\n"
         "                         (state, data age, reconnects, messages/s per channel)\n"
         "  -u, --lcm-url URL      publish on URL instead of [lcm] url\n"
@@ -70,9 +76,11 @@ static void usage(FILE *out)
         "  urrt-gateway --summary /etc/urrt/gateway.ini\n"
         "  urrt-gateway -u 'udpm://239.255.76.67:7667?ttl=1' -l info gateway.ini\n"
         "  urrt-gateway --print-dbc -o robot.dbc gateway.ini\n"
+        "  urrt-gateway --print-c-tables -o can_tables.c gateway.ini\n"
+        "  urrt-gateway --replay capture.bin gateway.ini\n"
         "\n"
-        "Exit status: 0 stopped by a signal (or the configuration is valid, or the\n"
-        "DBC was written),\n"
+        "Exit status: 0 stopped by a signal (or the configuration is valid, the DBC or\n"
+        "C tables were written, the capture was replayed),\n"
         "1 runtime failure, 2 bad command line or configuration.\n",
         out);
 }
