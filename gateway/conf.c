@@ -47,10 +47,10 @@ static bool leading_zero(const char *text, char *why, size_t n)
         decimal = "0";
     }
     if (strspn(text, "01234567") == strlen(text) && strlen(text) <= 22) {
-        return say(why, n, "a leading zero is not allowed (write 0x%llX for hexadecimal or %s for decimal)",
+        return say(why, n, CONF_LEADING_ZERO " (write 0x%llX for hexadecimal or %s for decimal)",
                    strtoull(text, NULL, 8), decimal);
     }
-    return say(why, n, "a leading zero is not allowed (write %s)", decimal);
+    return say(why, n, CONF_LEADING_ZERO " (write %s)", decimal);
 }
 
 bool conf_uint(const char *text, uint64_t min, uint64_t max, uint64_t *out, char *why, size_t n)
@@ -93,12 +93,12 @@ bool conf_u32(const char *text, uint32_t min, uint32_t max, uint32_t *out, char 
 bool conf_int(const char *text, int64_t min, int64_t max, int64_t *out, char *why, size_t n)
 {
     bool negative = text != NULL && text[0] == '-';
+    char reason[CONF_WHY_MAX];
     uint64_t magnitude;
     int64_t v;
-    if (!conf_uint(negative ? text + 1 : text, 0, negative ? (uint64_t)INT64_MAX + 1 : UINT64_MAX, &magnitude,
-                   why, n)) {
-        if (strncmp(why, "out of range", 12) != 0) {
-            return false;
+    if (!conf_uint(negative ? text + 1 : text, 0, UINT64_MAX, &magnitude, reason, sizeof reason)) {
+        if (strncmp(reason, "out of range", 12) != 0) {
+            return say(why, n, "%s", reason);
         }
         magnitude = UINT64_MAX; /* reported below with this range */
     }
@@ -333,6 +333,10 @@ bool conf_key_set(const struct conf_key *key, void *obj, const char *value, stru
     void *field = (char *)obj + key->offset;
     uint64_t v = 0;
     bool ok;
+    if ((key->kind == CONF_BOOL && key->size != sizeof(bool)) || (key->kind == CONF_MS && key->size != 4) ||
+        (key->kind == CONF_UINT && key->size != 1 && key->size != 2 && key->size != 4 && key->size != 8)) {
+        return say(why, n, "%s: the table gives a field of %zu bytes (a bug)", key->name, key->size);
+    }
     switch (key->kind) {
     case CONF_UINT: ok = conf_uint(value, key->min, key->max, &v, reason, sizeof reason); break;
     case CONF_BOOL: ok = conf_bool(value, (bool *)field, reason, sizeof reason); break;
@@ -348,7 +352,7 @@ bool conf_key_set(const struct conf_key *key, void *obj, const char *value, stru
         }
         return true;
     }
-    if (key->hint != NULL && strncmp(reason, "a leading zero", 14) != 0) {
+    if (key->hint != NULL && !CONF_IS_LEADING_ZERO(reason)) {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wformat-nonliteral"
         snprintf(why, n, key->hint, key->name, value);

@@ -27,8 +27,13 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #define CONF_WHY_MAX 512 /* room for any reason these functions write */
+/* How the reason for a leading zero begins: a message that replaces the
+ * parser's reason with its own words keeps this one, which says what to write. */
+#define CONF_LEADING_ZERO "a leading zero is not allowed"
+#define CONF_IS_LEADING_ZERO(why) (strncmp((why), CONF_LEADING_ZERO, sizeof CONF_LEADING_ZERO - 1) == 0)
 
 bool conf_uint(const char *text, uint64_t min, uint64_t max, uint64_t *out, char *why, size_t n);
 bool conf_u32(const char *text, uint32_t min, uint32_t max, uint32_t *out, char *why, size_t n);

@@ -427,8 +427,7 @@ static bool set_version(void *obj, const struct conf_key *key, const char *value
             (length - URRT_HEADER_SIZE) % 8 != 0) {
             return bad(why, n, "version \"%s\": expected auto, a controller version such as 5.10, or a message "
                        "size in bytes (4 + 8n, %d to %d)%s%s", value, URRT_PACKET_MIN, URRT_PACKET_MAX,
-                       strncmp(reason, "a leading", 9) == 0 ? ": " : "",
-                       strncmp(reason, "a leading", 9) == 0 ? reason : "");
+                       CONF_IS_LEADING_ZERO(reason) ? ": " : "", CONF_IS_LEADING_ZERO(reason) ? reason : "");
         }
         rate = 1000000u / urrt_period_min_us(length);
     }

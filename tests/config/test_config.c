@@ -418,6 +418,48 @@ static void test_refusals(void)
     }
 }
 
+/* A table of keys: each kind parsed into its field, a hint replacing the
+ * parser's reason (but not the leading-zero one), a hint for the unknown. */
+struct table_test {
+    uint16_t port;
+    bool on;
+    uint32_t wait_ms;
+    uint32_t period_ms;
+};
+
+static void test_key_table(void)
+{
+    static const struct conf_key keys[] = {
+        {"port", CONF_UINT, CONF_FIELD(struct table_test, port), 1, 65535, NULL, "%1$s: 1 to 65535, not %2$s", false},
+        {"on", CONF_BOOL, CONF_FIELD(struct table_test, on), 0, 0, NULL, NULL, false},
+        {"wait", CONF_MS, CONF_FIELD(struct table_test, wait_ms), 1, 1000, NULL, NULL, false},
+        {"period_ms", CONF_MS, CONF_FIELD(struct table_test, period_ms), 1, 1000, NULL, NULL, false},
+        {"bad", CONF_MS, CONF_FIELD(struct table_test, port), 1, 1000, NULL, NULL, false},
+    };
+    struct table_test t = {0};
+    struct conf_at at = {"t.ini", 1};
+    char why[CONF_WHY_MAX] = "";
+    CHECK(conf_key_set(conf_key_find(keys, 5, "port"), &t, "0x7533", at, why, sizeof why) && t.port == 30003,
+          "port: %s", why);
+    CHECK(conf_key_set(&keys[1], &t, "TRUE", at, why, sizeof why) && t.on, "on: %s", why);
+    CHECK(conf_key_set(&keys[2], &t, "0.25 s", at, why, sizeof why) && t.wait_ms == 250, "wait: %s", why);
+    CHECK(conf_key_set(&keys[3], &t, "20", at, why, sizeof why) && t.period_ms == 20, "period_ms: %s", why);
+    CHECK(!conf_key_set(&keys[0], &t, "0", at, why, sizeof why), "port 0 accepted");
+    CHECK_EQ_STR(why, "port: 1 to 65535, not 0");
+    CHECK(!conf_key_set(&keys[0], &t, "080", at, why, sizeof why), "port 080 accepted");
+    CHECK_EQ_STR(why, "port = \"080\": a leading zero is not allowed (write 80)");
+    CHECK(!conf_key_set(&keys[2], &t, "20", at, why, sizeof why), "bare wait accepted");
+    CHECK_EQ_STR(why, "wait = \"20\": a duration is written with a unit (us, ms, s or min), e.g. \"20 ms\" or \"20 s\"");
+    CHECK(!conf_key_set(&keys[4], &t, "20 ms", at, why, sizeof why), "a 2-byte duration field accepted");
+    CHECK_EQ_STR(why, "bad: the table gives a field of 2 bytes (a bug)");
+    CHECK(conf_key_find(keys, 5, "Port") == NULL, "names are case-sensitive");
+    conf_unknown_key(keys, 4, "prot", "x", why, sizeof why);
+    CHECK_EQ_STR(why, "unknown key \"prot\" in [x]: did you mean \"port\"? (keys: port, on, wait, period_ms)");
+    conf_unknown_key(keys, 4, "colour", "x", why, sizeof why);
+    CHECK_EQ_STR(why, "unknown key \"colour\" in [x] (keys: port, on, wait, period_ms)");
+    CHECK(conf_suggest("o", keys, 4, sizeof keys[0]) == NULL, "no hint from one letter");
+}
+
 /* Causes first: a typo'd key or section before what it then lacks. */
 static void test_causes_first(void)
 {
@@ -462,6 +504,7 @@ int main(void)
     test_names_and_text();
     test_same_everywhere();
     test_refusals();
+    test_key_table();
     test_causes_first();
     return check_report();
 }
