@@ -56,11 +56,6 @@ const char *gw_kind_name(gw_kind kind)
 
 /* ---- the one error channel ------------------------------------------------------ */
 
-int config_line(const config_ctx *ctx)
-{
-    return ctx->line;
-}
-
 void config_error(config_ctx *ctx, int line, const char *fmt, ...)
 {
     va_list ap;

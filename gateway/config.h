@@ -123,7 +123,6 @@ typedef struct config_section {
     void (*finish)(config_ctx *ctx, gw_config *cfg);
 } config_section;
 
-int config_line(const config_ctx *ctx);
 /* The one error channel: "FILE:LINE: reason", printed at the end, causes
  * (what is wrong on a line) before consequences (what the file then lacks). */
 void config_error(config_ctx *ctx, int line, const char *fmt, ...)
