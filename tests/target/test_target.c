@@ -11,6 +11,7 @@
 #include "test_vectors.h"
 #include "urrt.h"
 #include "urrt_can.h"
+#include "urrt_cantx.h"
 
 /* ---- a harness without libc ----------------------------------------------- */
 
