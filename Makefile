@@ -41,7 +41,7 @@ all:
 
 include lib/lib.mk
 include port/port.mk
-include $(sort $(wildcard gateway/*.mk))
+include $(sort $(wildcard gateway/*/*.mk))
 include $(sort $(wildcard tests/*.mk))
 
 all: $(PROGRAMS)
@@ -98,7 +98,7 @@ check-suites: $(CHECKS)
 
 bench: deps $(BENCHES)
 
-# What goes where: gateway/install.mk (and the fragments that hook into install: and uninstall:).
+# What goes where: gateway/install/install.mk (and the fragments that hook into install: and uninstall:).
 install: all
 
 clean:

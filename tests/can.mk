@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 # tests/can.mk: the CAN mapping, packing and DBC.
-#   check-can      lib/urrt_can and gateway/can_map unit tests (hand vectors, saturation,
+#   check-can      lib/urrt_can and gateway/can/can_map unit tests (hand vectors, saturation,
 #                  config rejections with FILE:LINE, bus load, scheduling on a fake clock)
 #   check-can-san  the same under ASan + UBSan (float-cast-overflow included: no float to
 #                  integer conversion may be undefined), lib/ and gateway/ compiled with them
@@ -9,10 +9,10 @@
 #   bench-can      ns per packet for the CAN mapping beside urrt_decode of the same packet
 
 CANT := $(BUILD)/tests/can
-CAN_TEST_SRCS := gateway/can_map.c gateway/can_run.c gateway/dbc.c gateway/conf.c
-# can_map reads values with conf.o (built by gateway/tools.mk).
-CAN_TEST_OBJS := $(CAN_GATEWAY_OBJS) $(BUILD)/gateway/conf.o
-CAN_TEST_CFLAGS := $(PROG_WARN) $(CPPFLAGS) -Igateway -Itests
+CAN_TEST_SRCS := gateway/can/can_map.c gateway/can/can_run.c gateway/can/dbc.c gateway/common/conf.c
+# can_map reads values with conf.o (built by gateway/common/common.mk).
+CAN_TEST_OBJS := $(CAN_GATEWAY_OBJS) $(CONF_OBJ)
+CAN_TEST_CFLAGS := $(PROG_WARN) $(CPPFLAGS) $(GATEWAY_INC) -Itests
 
 CHECKS += check-can check-can-san check-can-dbc
 .PHONY: check-can check-can-san check-can-dbc
@@ -30,7 +30,7 @@ $(CANT)/test_can: tests/can/test_can.c tests/check.h $(CAN_TEST_OBJS) $(LIBURRT)
 	@mkdir -p $(@D)
 	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_TEST_OBJS) $(LIBURRT) -linih -lm -o $@
 
-$(CANT)/test_can_san: tests/can/test_can.c tests/check.h $(CAN_TEST_SRCS) $(CAN_GATEWAY_HDRS) gateway/conf.h $(LIB_SRCS)
+$(CANT)/test_can_san: tests/can/test_can.c tests/check.h $(CAN_TEST_SRCS) $(GATEWAY_HDRS) $(LIB_SRCS)
 	@mkdir -p $(@D)
 	$(CC) $(CAN_TEST_CFLAGS) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $< $(CAN_TEST_SRCS) $(LIB_SRCS) -linih -lm -o $@
 

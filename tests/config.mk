@@ -8,10 +8,10 @@
 
 CFGT := $(BUILD)/tests/config
 CFG_SEEDS := $(CFGT)/seeds
-CFG_SEED_FILES := $(wildcard docs/examples/*.ini) gateway/urrt-gateway.example.ini tests/e2e/e2e-can.ini \
+CFG_SEED_FILES := $(wildcard docs/examples/*.ini) gateway/install/urrt-gateway.example.ini tests/e2e/e2e-can.ini \
                   $(wildcard tests/config/seeds/*.ini)
-CFG_FUZZ_SRCS := gateway/config.c gateway/conf.c gateway/can_map.c gateway/can_run.c gateway/dbc.c
-CFG_FUZZ_HDRS := gateway/config.h gateway/conf.h gateway/can_map.h gateway/dbc.h port/port.h $(LIB_HDRS)
+CFG_FUZZ_SRCS := gateway/urrt-gateway/config.c gateway/common/conf.c gateway/can/can_map.c gateway/can/can_run.c gateway/can/dbc.c
+CFG_FUZZ_HDRS := $(GATEWAY_HDRS) port/port.h $(LIB_HDRS)
 
 CHECKS += check-fuzz-config
 .PHONY: check-fuzz-config fuzz-config
@@ -27,11 +27,11 @@ $(CFG_SEEDS)/.stamp: $(CFG_SEED_FILES)
 $(CFGT)/fuzz_config: tests/config/fuzz_config.c $(CFG_FUZZ_SRCS) $(CFG_FUZZ_HDRS) $(LIB_SRCS) $(LIBPORT)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) -std=gnu11 -Wall -Wextra -Wshadow -Werror -g -O1 -fsanitize=fuzzer,address,undefined \
-	  -fno-sanitize-recover=all $(CPPFLAGS) -Igateway $< $(CFG_FUZZ_SRCS) $(LIB_SRCS) $(LIBPORT) -linih -lm -o $@
+	  -fno-sanitize-recover=all $(CPPFLAGS) $(GATEWAY_INC) $< $(CFG_FUZZ_SRCS) $(LIB_SRCS) $(LIBPORT) -linih -lm -o $@
 
 $(CFGT)/test_config: tests/config/test_config.c tests/check.h $(CFG_FUZZ_SRCS) $(CFG_FUZZ_HDRS) $(LIB_SRCS) $(LIBPORT)
 	@mkdir -p $(@D)
-	$(CC) $(PROG_WARN) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $(CPPFLAGS) -Igateway -Itests \
+	$(CC) $(PROG_WARN) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $(CPPFLAGS) $(GATEWAY_INC) -Itests \
 	  $< $(CFG_FUZZ_SRCS) $(LIB_SRCS) $(LIBPORT) -linih -lm -o $@
 
 check-fuzz-config: $(CFGT)/fuzz_config $(CFGT)/test_config $(CFG_SEEDS)/.stamp

@@ -11,10 +11,10 @@ CHECKS += check-freshness check-gateway
 BENCHES += bench-gateway
 .PHONY: check-freshness check-gateway bench-gateway
 
-# The age estimator on a fake clock (gateway/freshness.h).
-$(GWT)/test_freshness: tests/gateway/test_freshness.c tests/check.h gateway/freshness.c gateway/freshness.h
+# The age estimator on a fake clock (gateway/urrt-gateway/freshness.h).
+$(GWT)/test_freshness: tests/gateway/test_freshness.c tests/check.h gateway/urrt-gateway/freshness.c gateway/urrt-gateway/freshness.h
 	@mkdir -p $(@D)
-	$(CC) $(PROG_WARN) $(OPT) -Igateway -Itests $< gateway/freshness.c -o $@
+	$(CC) $(PROG_WARN) $(OPT) $(GATEWAY_INC) -Itests $< gateway/urrt-gateway/freshness.c -o $@
 
 check-freshness: $(GWT)/test_freshness
 	@mkdir -p $(BUILD)/results

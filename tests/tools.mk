@@ -10,7 +10,7 @@ TOOLS_TEST_LINK := $(BUILD)/tests/test_link
 
 $(TOOLS_TEST_LINK): tests/tools/test_link.c tests/check.h $(CLI_OBJ) $(LIBPORT) $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(PROG_WARN) $(OPT) $(CPPFLAGS) -Igateway -Itests -o $@ $< $(CLI_OBJ) $(LIBPORT) $(LIBURRT) -lm
+	$(CC) $(PROG_WARN) $(OPT) $(CPPFLAGS) $(GATEWAY_INC) -Itests -o $@ $< $(CLI_OBJ) $(LIBPORT) $(LIBURRT) -lm
 
 .PHONY: check-tools-link check-tools check-tools-asan bench-tools
 check-tools-link: $(TOOLS_TEST_LINK)

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * can_tool: drives gateway/can_map, gateway/dbc and lib/urrt_can from the
+ * can_tool: drives gateway/can/can_map, gateway/can/dbc and lib/urrt_can from the
  * command line for the Python tests (tests/can/test_dbc.py), which hold
  * their output against python3-canmatrix and an independent reference.
  *

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * check-can: lib/urrt_can (bit placement by hand-worked vectors, rounding,
- * saturation, NaN, layout checks, frame bit lengths) and gateway/can_map
+ * saturation, NaN, layout checks, frame bit lengths) and gateway/can/can_map
  * (configuration and its rejections with FILE:LINE, bus load against
  * hand-computed figures, scheduling, staleness, alive counters and the
  * heartbeat on a fake clock). The DBC and bulk packing are checked against

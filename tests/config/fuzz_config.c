@@ -1,9 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * fuzz_config.c: libFuzzer harness for the urrt-gateway configuration, an
- * untrusted input like the robot's bytes: the loader (gateway/config.c and
- * libinih), the CAN mapping it feeds (gateway/can_map.c) and the DBC written
- * from it (gateway/dbc.c). Each input is one configuration file. It asserts:
+ * untrusted input like the robot's bytes: the loader (gateway/urrt-gateway/config.c and
+ * libinih), the CAN mapping it feeds (gateway/can/can_map.c) and the DBC written
+ * from it (gateway/can/dbc.c). Each input is one configuration file. It asserts:
  *
  *   - a rejected file gets exactly as many messages as errors counted, each
  *     one line "fuzz.ini:LINE: reason" with LINE within the file (or

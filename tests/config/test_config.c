@@ -3,7 +3,7 @@
  * test_config.c: regression tests for what the configuration fuzzer
  * (tests/config/fuzz_config.c) found in the loader, one per finding, with
  * the input it found in tests/config/regressions/ as well; then the rules
- * of the one configuration front end (gateway/conf.h): one parser per kind
+ * of the one configuration front end (gateway/common/conf.h): one parser per kind
  * of value, the same in every section, and messages causes first. Runs in
  * check-fuzz-config, under ASan + UBSan.
  */
@@ -211,7 +211,7 @@ static void test_text_after_header(void)
     free(messages);
 }
 
-/* ---- the one front end (gateway/conf.h) -------------------------------------------- */
+/* ---- the one front end (gateway/common/conf.h) -------------------------------------------- */
 
 /* Integers: decimal or 0x hexadecimal; a leading zero is C's octal and is
  * refused with both readings spelled out. */

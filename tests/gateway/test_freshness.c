@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * test_freshness: the age estimator of gateway/freshness.h on a fake clock.
+ * test_freshness: the age estimator of gateway/urrt-gateway/freshness.h on a fake clock.
  * Streams are simulated packet by packet: the controller stamps each packet
  * with its own clock, the host reads it some time later, and the socket was
  * last seen empty at a time the simulation knows. Each case asserts the lag

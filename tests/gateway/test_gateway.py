@@ -922,7 +922,7 @@ def t_install(args):
     usr = make("dist-files", where[0], "PREFIX=/usr")
     dist_unit = os.path.join(args.build, "dist", "urrt-gateway.service")
     check(usr.returncode == 0 and open(dist_unit).read() == open(os.path.join(repo, "gateway",
-          "urrt-gateway.service")).read(), "install: for PREFIX=/usr the unit is gateway/urrt-gateway.service as it is")
+          "urrt-gateway.service")).read(), "install: for PREFIX=/usr the unit is gateway/install/urrt-gateway.service as it is")
     make("dist-files")
     if subprocess.run(["which", "systemd-analyze"], capture_output=True).returncode == 0:
         v = subprocess.run(["systemd-analyze", "verify", os.path.join(unitdir, "urrt-gateway.service")],

@@ -76,9 +76,11 @@ def show(pairs):
 
 def main():
     build = sys.argv[1]
-    programs = {"urrt-gateway": "8", "urrt-dump": "1", "urrt-sim": "1"}
-    for prog, sec in programs.items():
-        table = normalise(table_options("gateway/%s.c" % prog))
+    # program: (man section, the source with its option table)
+    programs = {"urrt-gateway": ("8", "gateway/urrt-gateway/urrt-gateway.c"),
+                "urrt-dump": ("1", "gateway/tools/urrt-dump.c"), "urrt-sim": ("1", "gateway/tools/urrt-sim.c")}
+    for prog, (sec, source) in programs.items():
+        table = normalise(table_options(source))
         page = page_options("gateway/man/%s.%s.md" % (prog, sec))
         helped = help_options(os.path.join(build, "bin", prog))
         check(len(table) >= 8, "%s: the option table parses (%d options)" % (prog, len(table)))
@@ -92,7 +94,7 @@ def main():
     check(sorted(pages) == sorted(["urrt-gateway.8", "urrt-gateway.ini.5", "urrt-dump.1", "urrt-sim.1", "urrt-spy.1"]),
           "a page for each program and the configuration: %s" % pages)
     # urrt-spy is a script: its options are the ones it tests for itself.
-    spy = open("gateway/urrt-spy").read()
+    spy = open("gateway/install/urrt-spy").read()
     spy_opts = {(None, o) for o in re.findall(r'(?:"\$\{1:-\}" = |case \$a in )--([\w-]+)', spy)}
     spy_page = page_options("gateway/man/urrt-spy.1.md")
     check(spy_opts == spy_page and len(spy_opts) == 2, "urrt-spy(1) documents exactly the script's options (%s; page %s)"
@@ -107,7 +109,7 @@ def main():
                               env=dict(os.environ, MANWIDTH="80", MAN_KEEP_FORMATTING="")).stdout
         check("NAME" in text and "SEE ALSO" in text and "\\" not in text,
               "%s has NAME and SEE ALSO and no stray backslash" % p)
-    unit = open("gateway/urrt-gateway.service").read()
+    unit = open("gateway/install/urrt-gateway.service").read()
     check("Documentation=man:urrt-gateway(8)" in unit, "the unit's Documentation= is the man page")
     line = "%d passed, %d failed" % (PASSED, FAILED)
     print(line)

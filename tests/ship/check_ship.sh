@@ -63,14 +63,14 @@ check "demo on a taken port: exit non-zero, names DEMO_PORT, no gateway started"
   sh -c "[ $rc != 0 ] && grep -q 'make demo DEMO_PORT=N' '$T/busy.err' && ! grep -q 'urrt-gateway' '$T/busy.out'"
 
 # ---- urrt-spy -------------------------------------------------------------------------
-spy() { URRT_LCMTYPES_JAR="$BUILD/urrt_lcmtypes.jar" DISPLAY=:99 gateway/urrt-spy --check "$@"; }
+spy() { URRT_LCMTYPES_JAR="$BUILD/urrt_lcmtypes.jar" DISPLAY=:99 gateway/install/urrt-spy --check "$@"; }
 mkdir -p "$T/jre/bin"; printf '#!/bin/sh\nexit 0\n' > "$T/jre/bin/java"; chmod +x "$T/jre/bin/java"
 URRT_JAVA="$T/jre/bin/java" spy > "$T/spy1" 2>&1; rc=$?
 check "urrt-spy on a headless Java: exit 1, names default-jre, no stack trace" \
   sh -c "[ $rc = 1 ] && grep -q 'headless Java runtime' '$T/spy1' && grep -q 'apt-get install default-jre' '$T/spy1' && ! grep -q Exception '$T/spy1'"
 JCHART2D_JAR=$T/none.jar spy > "$T/spy2" 2>&1; rc=$?
 check "urrt-spy without jchart2d: names libjchart2d-java" sh -c "[ $rc = 1 ] && grep -q 'apt-get install libjchart2d-java' '$T/spy2'"
-URRT_LCMTYPES_JAR="$BUILD/urrt_lcmtypes.jar" DISPLAY= WAYLAND_DISPLAY= gateway/urrt-spy --check > "$T/spy3" 2>&1; rc=$?
+URRT_LCMTYPES_JAR="$BUILD/urrt_lcmtypes.jar" DISPLAY= WAYLAND_DISPLAY= gateway/install/urrt-spy --check > "$T/spy3" 2>&1; rc=$?
 check "urrt-spy without a display: says so" sh -c "[ $rc = 1 ] && grep -q 'no display' '$T/spy3'"
 if [ -f "$(dirname "$(dirname "$(readlink -f "$(command -v java)")")")/lib/libawt_xawt.so" ]; then
   spy > "$T/spy4" 2>&1; rc=$?

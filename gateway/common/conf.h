@@ -35,6 +35,9 @@
 #define CONF_LEADING_ZERO "a leading zero is not allowed"
 #define CONF_IS_LEADING_ZERO(why) (strncmp((why), CONF_LEADING_ZERO, sizeof CONF_LEADING_ZERO - 1) == 0)
 
+/* Writes a reason into why (n bytes); false, for "return conf_fail(...)". */
+bool conf_fail(char *why, size_t n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+
 bool conf_uint(const char *text, uint64_t min, uint64_t max, uint64_t *out, char *why, size_t n);
 bool conf_u32(const char *text, uint32_t min, uint32_t max, uint32_t *out, char *why, size_t n);
 /* An integer with an optional '-'. */

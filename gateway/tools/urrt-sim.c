@@ -4,7 +4,7 @@
  *
  * One packet per period on an absolute monotonic schedule, to every
  * connected client, from a deterministic model of a moving UR5e-like arm
- * (gateway/sim_model.c) or from a raw capture. Fault modes reproduce what
+ * (gateway/tools/sim_model.c) or from a raw capture. Fault modes reproduce what
  * real links do to the stream. See usage() and docs/tools.md.
  */
 #define _GNU_SOURCE

@@ -1,9 +1,8 @@
 # SPDX-License-Identifier: MIT
-# gateway/gateway.mk: urrt-gateway, its LCM types (C for the gateway, a jar
-# for lcm-spy), the urrt-spy launcher, the systemd unit and `make demo`.
+# gateway/urrt-gateway/urrt-gateway.mk: urrt-gateway itself (its loop, the
+# freshness estimator, the configuration file, the LCM output; the CAN side is
+# gateway/can/), `make spy` and `make demo`.
 
-LCM_JAR ?= /usr/share/java/lcm.jar
-JCHART2D_JAR ?= /usr/share/java/jchart2d.jar
 # The demo cannot be mistaken for production: its own robot name, its own LCM
 # group and port (the default is 239.255.76.67:7667), ttl=0 (this host only), and
 # the simulator on a free port unless DEMO_PORT says otherwise.
@@ -12,62 +11,35 @@ DEMO_PORT ?= 0
 DEMO_ROBOT ?= demo
 DEMO_LCM_URL ?= udpm://239.255.76.68:7668?ttl=0
 
-# ---- LCM types ------------------------------------------------------------------
-LCMTYPES := $(sort $(wildcard gateway/lcmtypes/*.lcm))
-LCMGEN := $(BUILD)/lcmgen
-LCMTYPES_C := $(LCMTYPES:gateway/lcmtypes/%.lcm=$(LCMGEN)/urrt_%.c)
-LCMTYPES_H := $(LCMTYPES_C:.c=.h)
-LCMTYPES_OBJS := $(LCMTYPES_C:$(LCMGEN)/%.c=$(BUILD)/gateway/lcmtypes/%.o)
-LCMTYPES_JAR := $(BUILD)/urrt_lcmtypes.jar
-
-# One lcm-gen run writes both files of a type.
-$(LCMGEN)/urrt_%.c $(LCMGEN)/urrt_%.h: gateway/lcmtypes/%.lcm
-	@mkdir -p $(LCMGEN)
-	lcm-gen -c --c-cpath $(LCMGEN) --c-hpath $(LCMGEN) $<
-
-# Generated code is not ours to clean up: its own warnings are not errors.
-$(LCMTYPES_OBJS): $(BUILD)/gateway/lcmtypes/%.o: $(LCMGEN)/%.c $(LCMTYPES_H)
-	@mkdir -p $(@D)
-	$(CC) -std=gnu11 $(OPT) -Wall -Wno-unused-parameter -I$(LCMGEN) -c $< -o $@
-
-$(LCMTYPES_JAR): $(LCMTYPES)
-	rm -rf $(BUILD)/lcmjava
-	mkdir -p $(BUILD)/lcmjava/src $(BUILD)/lcmjava/classes
-	lcm-gen -j --jpath $(BUILD)/lcmjava/src $(LCMTYPES)
-	javac -nowarn -encoding UTF-8 -cp $(LCM_JAR) -d $(BUILD)/lcmjava/classes $(BUILD)/lcmjava/src/urrt/*.java
-	jar cf $@ -C $(BUILD)/lcmjava/classes .
-
 # ---- urrt-gateway ------------------------------------------------------------------
-GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_out.o) \
-                $(BUILD)/gateway/cli.o $(BUILD)/gateway/conf.o $(LCMTYPES_OBJS)
-# Other fragments append their objects (the CAN output, say); read at link time.
+GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/urrt-gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_out.o)
+# Other folders append their objects (the CAN side); read at link time.
 GATEWAY_EXTRA_OBJS ?=
-GATEWAY_HDRS := gateway/config.h gateway/conf.h gateway/gateway.h gateway/freshness.h gateway/lcm_out.h gateway/cli.h gateway/can_map.h gateway/can_out.h gateway/dbc.h port/port.h $(LIB_HDRS)
 GATEWAY_LIBS := -llcm -linih -lm
 
-$(addprefix $(BUILD)/gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_out.o): \
-  $(BUILD)/gateway/%.o: gateway/%.c $(GATEWAY_HDRS) $(LCMTYPES_H)
+# The LCM types' headers are generated: they exist before anything includes them.
+$(BUILD)/gateway/urrt-gateway/%.o: gateway/urrt-gateway/%.c | $(LCMTYPES_H)
 	@mkdir -p $(@D)
-	$(CC) $(PROG_WARN) $(OPT) $(CPPFLAGS) -Igateway -I$(LCMGEN) -c $< -o $@
+	$(CC) $(GW_CFLAGS) -I$(LCMGEN) -c $< -o $@
 
-# $(BUILD)/gateway/cli.o and conf.o (the programs' shared helpers) are built by tools.mk.
+-include $(GATEWAY_OBJS:.o=.d)
 
 .SECONDEXPANSION:
-$(BUILD)/bin/urrt-gateway: $(GATEWAY_OBJS) $$(GATEWAY_EXTRA_OBJS) $(LIBPORT) $(LIBURRT)
+$(BUILD)/bin/urrt-gateway: $(GATEWAY_OBJS) $(CLI_OBJ) $(LCMTYPES_OBJS) $$(GATEWAY_EXTRA_OBJS) $(LIBPORT) $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(OPT) -o $@ $(GATEWAY_OBJS) $(GATEWAY_EXTRA_OBJS) $(LIBPORT) $(LIBURRT) $(GATEWAY_LIBS)
+	$(CC) $(OPT) -o $@ $(GATEWAY_OBJS) $(CLI_OBJ) $(LCMTYPES_OBJS) $(GATEWAY_EXTRA_OBJS) $(LIBPORT) $(LIBURRT) \
+	  $(GATEWAY_LIBS)
 
 PROGRAMS += $(BUILD)/bin/urrt-gateway
-all: $(LCMTYPES_JAR)
 
 # ---- lcm-spy ---------------------------------------------------------------------------
 # Runs lcm-spy with the urrt types on the demo's URL: `make spy` (DEMO_LCM_URL=...
 # as given to `make demo`, or LCM_URL=... to watch another URL).
 .PHONY: spy
 spy: deps-spy $(LCMTYPES_JAR)
-	URRT_LCMTYPES_JAR=$(LCMTYPES_JAR) gateway/urrt-spy --lcm-url='$(or $(LCM_URL),$(DEMO_LCM_URL))'
+	URRT_LCMTYPES_JAR=$(LCMTYPES_JAR) gateway/install/urrt-spy --lcm-url='$(or $(LCM_URL),$(DEMO_LCM_URL))'
 
-# ---- install: gateway/install.mk ------------------------------------------------------
+# ---- install: gateway/install/install.mk ----------------------------------------------
 
 # ---- make demo ---------------------------------------------------------------------------
 # urrt-sim (e-series 5.10 layout, 500 Hz) on 127.0.0.1, and once it listens urrt-gateway

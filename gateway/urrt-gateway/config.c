@@ -121,17 +121,6 @@ static void print_errors(config_ctx *ctx)
     ctx->messages = NULL;
 }
 
-static bool bad(char *why, size_t n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-
-/* Writes the reason of a bad value; false, for "return bad(...)". */
-static bool bad(char *why, size_t n, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(why, n, fmt, ap);
-    va_end(ap);
-    return false;
-}
 
 static char *xstrdup(const char *s)
 {
@@ -172,7 +161,7 @@ static bool set_log_level(void *obj, const struct conf_key *key, const char *val
     gw_config *cfg = obj;
     (void)key, (void)at;
     return gw_parse_log_level(value, &cfg->log_level) ||
-           bad(why, n, "log_level must be err, warning, notice, info or debug, not \"%s\"", value);
+           conf_fail(why, n, "log_level must be err, warning, notice, info or debug, not \"%s\"", value);
 }
 
 static const struct conf_key gateway_keys[] = {
@@ -192,19 +181,19 @@ static bool check_udpm_options(const char *url, const char *options, char *why, 
     for (char *save = NULL, *opt = strtok_r(opts, "&", &save); opt != NULL; opt = strtok_r(NULL, "&", &save)) {
         char *eq = strchr(opt, '=');
         if (eq == NULL) {
-            return bad(why, n, "url \"%s\": option \"%s\" has no value", url, opt);
+            return conf_fail(why, n, "url \"%s\": option \"%s\" has no value", url, opt);
         }
         *eq = '\0';
         if (strcmp(opt, "ttl") == 0) {
             if (!conf_uint(eq + 1, 0, 255, &v, NULL, 0)) {
-                return bad(why, n, "url \"%s\": ttl must be 0 to 255 (0: this host only, 1: the LAN)", url);
+                return conf_fail(why, n, "url \"%s\": ttl must be 0 to 255 (0: this host only, 1: the LAN)", url);
             }
         } else if (strcmp(opt, "recv_buf_size") == 0) {
             if (!conf_uint(eq + 1, 1, UINT32_MAX, &v, NULL, 0)) {
-                return bad(why, n, "url \"%s\": recv_buf_size must be a number of bytes", url);
+                return conf_fail(why, n, "url \"%s\": recv_buf_size must be a number of bytes", url);
             }
         } else if (strcmp(opt, "transmit_only") != 0) {
-            return bad(why, n, "url \"%s\": unknown udpm option \"%s\" (ttl, recv_buf_size, transmit_only)", url, opt);
+            return conf_fail(why, n, "url \"%s\": unknown udpm option \"%s\" (ttl, recv_buf_size, transmit_only)", url, opt);
         }
     }
     return true;
@@ -220,10 +209,10 @@ static bool check_udpm(const char *url, char *why, size_t n)
         if (sscanf(p, "%3u.%3u.%3u.%3u:%5u%n", &a, &b, &c, &d, &port, &used) != 5 ||
             (p[used] != '\0' && p[used] != '?') || a > 255 || b > 255 || c > 255 || d > 255 || port == 0 ||
             port > 65535) {
-            return bad(why, n, "url \"%s\": udpm needs GROUP:PORT, e.g. 239.255.76.67:7667", url);
+            return conf_fail(why, n, "url \"%s\": udpm needs GROUP:PORT, e.g. 239.255.76.67:7667", url);
         }
         if (a < 224 || a > 239) {
-            return bad(why, n, "url \"%s\": %u.%u.%u.%u is not a multicast group (224.0.0.0 to 239.255.255.255)",
+            return conf_fail(why, n, "url \"%s\": %u.%u.%u.%u is not a multicast group (224.0.0.0 to 239.255.255.255)",
                        url, a, b, c, d);
         }
         p += used;
@@ -243,17 +232,17 @@ static bool set_lcm_url(void *obj, const struct conf_key *key, const char *url, 
     (void)key;
     if (!conf_printable(url, NULL, 0)) {
         /* It is printed at start and by --check-config. */
-        return bad(why, n, "url \"%s\": no control characters", url);
+        return conf_fail(why, n, "url \"%s\": no control characters", url);
     }
     if (sep == NULL) {
-        return bad(why, n, "url \"%s\" is not an LCM URL (provider://address?options), e.g. %s", url,
+        return conf_fail(why, n, "url \"%s\" is not an LCM URL (provider://address?options), e.g. %s", url,
                    GW_DEFAULT_LCM_URL);
     }
     for (size_t i = 0; i < sizeof providers / sizeof providers[0]; i++) {
         known |= strlen(providers[i]) == (size_t)(sep - url) && strncmp(url, providers[i], (size_t)(sep - url)) == 0;
     }
     if (!known) {
-        return bad(why, n, "url \"%s\": unknown LCM provider \"%.*s\" (udpm, file, memq, tcpq, mpudpm)", url,
+        return conf_fail(why, n, "url \"%s\": unknown LCM provider \"%.*s\" (udpm, file, memq, tcpq, mpudpm)", url,
                    (int)(sep - url), url);
     }
     if (strncmp(url, "udpm://", 7) == 0 && !check_udpm(url, why, n)) {
@@ -276,10 +265,10 @@ static bool parse_rate(const char *key, const char *value, gw_rate *out, char *w
     }
     snprintf(number, sizeof number, "%.*s", (int)(len < sizeof number ? len : sizeof number - 1), value);
     if (!conf_number(number, -INFINITY, INFINITY, &out->hz, NULL, 0) || strcmp(unit, "Hz") != 0) {
-        return bad(why, n, "%s must be \"every\", \"off\" or a rate such as \"50 Hz\", not \"%s\"", key, value);
+        return conf_fail(why, n, "%s must be \"every\", \"off\" or a rate such as \"50 Hz\", not \"%s\"", key, value);
     }
     if (out->hz < 0.01 || out->hz > GW_ROBOT_MAX_RATE_HZ) {
-        return bad(why, n, "%s %s is out of range: from 0.01 Hz to %u Hz (the fastest robot)", key, value,
+        return conf_fail(why, n, "%s %s is out of range: from 0.01 Hz to %u Hz (the fastest robot)", key, value,
                    GW_ROBOT_MAX_RATE_HZ);
     }
     out->mode = GW_RATE_HZ;
@@ -303,7 +292,7 @@ static bool set_lcm_channel(void *obj, const struct conf_key *key, const char *v
     unsigned k = kind_of(key->name);
     char reason[CONF_WHY_MAX];
     if (!conf_name(value, CONF_NAME_DASH | CONF_NAME_DOTS, 64, reason, sizeof reason)) {
-        return bad(why, n, "%s \"%s\" %s", key->name, value, reason);
+        return conf_fail(why, n, "%s \"%s\" %s", key->name, value, reason);
     }
     replace_string(&lcm->channel[k], value);
     lcm->channel_line[k] = at.line;
@@ -320,10 +309,10 @@ static bool set_lcm_rate(void *obj, const struct conf_key *key, const char *valu
         return false;
     }
     if (k == GW_KIND_GATEWAY && rate.mode == GW_RATE_EVERY) {
-        return bad(why, n, "gateway_rate is a report rate: \"off\" or N Hz (default 1 Hz), not \"every\"");
+        return conf_fail(why, n, "gateway_rate is a report rate: \"off\" or N Hz (default 1 Hz), not \"every\"");
     }
     if (k == GW_KIND_GATEWAY && rate.mode == GW_RATE_HZ && rate.hz > 100) {
-        return bad(why, n, "gateway_rate %s is out of range: at most 100 Hz", value);
+        return conf_fail(why, n, "gateway_rate %s is out of range: at most 100 Hz", value);
     }
     lcm->rate[k] = rate;
     lcm->rate_line[k] = at.line;
@@ -393,15 +382,15 @@ static bool version_length(const char *text, uint32_t *length, unsigned *rate_hz
         return true;
     }
     if (count == 2) {
-        return bad(why, n, "version \"%s\": %s controllers sent %u or %u bytes: give the length instead "
+        return conf_fail(why, n, "version \"%s\": %s controllers sent %u or %u bytes: give the length instead "
                    "(version = %u or %u)", text, text, (unsigned)found[0]->length, (unsigned)found[1]->length,
                    (unsigned)found[0]->length, (unsigned)found[1]->length);
     }
     if (count == 0) {
-        return bad(why, n, "version \"%s\": no known controller version: give the message size in bytes instead "
+        return conf_fail(why, n, "version \"%s\": no known controller version: give the message size in bytes instead "
                    "(e.g. version = 1220)", text);
     }
-    return bad(why, n, "version \"%s\": expected auto, a controller version such as 5.10, or a message size in "
+    return conf_fail(why, n, "version \"%s\": expected auto, a controller version such as 5.10, or a message size in "
                "bytes", text);
 }
 
@@ -420,7 +409,7 @@ static bool set_version(void *obj, const struct conf_key *key, const char *value
     } else if (strcmp(value, "auto") != 0) {
         if (!conf_u32(value, URRT_PACKET_MIN, URRT_PACKET_MAX, &length, reason, sizeof reason) ||
             (length - URRT_HEADER_SIZE) % 8 != 0) {
-            return bad(why, n, "version \"%s\": expected auto, a controller version such as 5.10, or a message "
+            return conf_fail(why, n, "version \"%s\": expected auto, a controller version such as 5.10, or a message "
                        "size in bytes (4 + 8n, %d to %d)%s%s", value, URRT_PACKET_MIN, URRT_PACKET_MAX,
                        CONF_IS_LEADING_ZERO(reason) ? ": " : "", CONF_IS_LEADING_ZERO(reason) ? reason : "");
         }
@@ -444,12 +433,12 @@ static bool set_host(void *obj, const struct conf_key *key, const char *host, st
     bool ok = len >= 1 && len <= 253;
     (void)key;
     if (host[0] == '[' && close != NULL) {
-        return bad(why, n, "host \"%s\": write the address without brackets (host = %.*s)%s%s%s", host,
+        return conf_fail(why, n, "host \"%s\": write the address without brackets (host = %.*s)%s%s%s", host,
                    (int)(close - host - 1), host + 1, close[1] == ':' ? " and the port apart (port = " : "",
                    close[1] == ':' ? close + 2 : "", close[1] == ':' ? ")" : "");
     }
     if (colon != NULL && strchr(colon + 1, ':') == NULL) {
-        return bad(why, n, "host \"%s\" is HOST:PORT: write host = %.*s and port = %s", host, (int)(colon - host),
+        return conf_fail(why, n, "host \"%s\" is HOST:PORT: write host = %.*s and port = %s", host, (int)(colon - host),
                    host, colon + 1);
     }
     for (size_t i = 0; ok && i < len; i++) {
@@ -457,7 +446,7 @@ static bool set_host(void *obj, const struct conf_key *key, const char *host, st
         ok = colon != NULL ? (isalnum(c) || c == ':' || c == '.' || c == '%') : (isalnum(c) || c == '-' || c == '.');
     }
     if (!ok) {
-        return bad(why, n, "host \"%s\" is not a host name, IPv4 or IPv6 address", host);
+        return conf_fail(why, n, "host \"%s\" is not a host name, IPv4 or IPv6 address", host);
     }
     replace_string(&robot->host, host);
     robot->host_line = at.line;

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-# gateway/man.mk: the man pages, rendered from gateway/man/*.md by
+# gateway/man/man.mk: the man pages, rendered from gateway/man/*.md by
 # gateway/man/render.awk (awk only: no documentation toolchain to install).
 # tests/man.mk checks that each page documents exactly its program's options.
 MAN_SRCS := $(sort $(wildcard gateway/man/*.md))

@@ -1,11 +1,11 @@
 # SPDX-License-Identifier: MIT
-# gateway/install.mk: `make install` and `make uninstall` (PREFIX, DESTDIR and
+# gateway/install/install.mk: `make install` and `make uninstall` (PREFIX, DESTDIR and
 # the directory variables below; debian/rules sets them for the package).
 # INSTALL_ITEMS is the one list both rules read: uninstall removes exactly
 # what install put there. Each entry is SOURCE:DIRECTORY:MODE, the file keeping
 # its name; a file that needs another name or rewritten paths is made under
 # $(DIST) first. Other fragments hook their own install-X/uninstall-X rules
-# into install: and uninstall: (gateway/wireshark.mk does).
+# into install: and uninstall: (gateway/wireshark/wireshark.mk does).
 SYSCONFDIR ?= /etc
 UNITDIR ?= /lib/systemd/system
 DATADIR ?= $(PREFIX)/share
@@ -29,13 +29,13 @@ DIST_FILES := $(DIST)/urrt-spy $(DIST)/urrt-gateway.service $(DIST)/urrt.pc $(DI
 INSTALL_ITEMS = $(foreach f,$(PROGRAMS) $(DIST)/urrt-spy,$(f):$(BINDIR):0755) \
   $(DIST)/$(TYPES_JAR):$(JAVADIR):0644 \
   $(DIST)/urrt-gateway.service:$(UNITDIR):0644 \
-  gateway/urrt-gateway.example.ini:$(DATADIR)/urrt:0644 \
+  gateway/install/urrt-gateway.example.ini:$(DATADIR)/urrt:0644 \
   $(foreach f,$(LCMTYPES),$(f):$(DATADIR)/urrt/lcmtypes:0644) \
   $(foreach f,$(MAN_PAGES),$(f):$(MANDIR)/man$(subst .,,$(suffix $(f))):0644) \
   $(foreach f,$(DOCS) LICENSE,$(f):$(DOCDIR):0644) \
   $(foreach f,$(DOC_IMAGES),$(f):$(DOCDIR)/img:0644) \
   $(foreach f,$(EXAMPLES),$(f):$(DOCDIR)/examples:0644) \
-  lib/urrt.h:$(INCLUDEDIR):0644 lib/urrt_can.h:$(INCLUDEDIR):0644 \
+  lib/urrt.h:$(INCLUDEDIR):0644 lib/urrt_can.h:$(INCLUDEDIR):0644 lib/urrt_cantx.h:$(INCLUDEDIR):0644 \
   $(LIBURRT):$(LIBDIR):0644 \
   $(DIST)/urrt.pc:$(PKGCONFIGDIR):0644
 # Symbolic links: TARGET:LINK (TARGET relative to the link's directory).
@@ -46,11 +46,11 @@ INSTALL_OWN_DIRS = $(DATADIR)/urrt/lcmtypes $(DATADIR)/urrt $(DOCDIR)/img $(DOCD
 CONFIG_FILE = $(SYSCONFDIR)/urrt/gateway.ini
 
 # The checked-in unit is right for PREFIX=/usr; other prefixes rewrite its paths.
-$(DIST)/urrt-gateway.service: gateway/urrt-gateway.service
+$(DIST)/urrt-gateway.service: gateway/install/urrt-gateway.service
 	@mkdir -p $(@D)
 	sed -e 's|/usr/bin/urrt-gateway|$(BINDIR)/urrt-gateway|g; s|/etc/urrt/|$(SYSCONFDIR)/urrt/|g' $< > $@
 
-$(DIST)/urrt-spy: gateway/urrt-spy
+$(DIST)/urrt-spy: gateway/install/urrt-spy
 	@mkdir -p $(@D)
 	sed -e 's|^URRT_JAR_DEFAULT=.*|URRT_JAR_DEFAULT=$(JAVADIR)/urrt-lcmtypes.jar|' $< > $@
 
@@ -60,7 +60,7 @@ $(DIST)/$(TYPES_JAR): $(LCMTYPES_JAR)
 
 # The example with its robot commented out: an unedited install refuses to
 # start and says which file to edit.
-$(DIST)/gateway.ini: gateway/urrt-gateway.example.ini
+$(DIST)/gateway.ini: gateway/install/urrt-gateway.example.ini
 	@mkdir -p $(@D)
 	awk '/^\[/ { robot = /^\[robot / } \
 	     robot && /^\[robot / { print "# Uncomment this section and set the robot'\''s address, then run"; \
@@ -100,3 +100,22 @@ uninstall-files: dist-files
 	@if cmp -s $(DIST)/gateway.ini $(DESTDIR)$(CONFIG_FILE); then rm -f $(DESTDIR)$(CONFIG_FILE); \
 	elif [ -e $(DESTDIR)$(CONFIG_FILE) ]; then echo "uninstall: $(DESTDIR)$(CONFIG_FILE) was edited: kept"; fi
 	@for d in $(INSTALL_OWN_DIRS); do [ ! -d $(DESTDIR)$$d ] || rmdir --ignore-fail-on-non-empty $(DESTDIR)$$d; done
+
+# ---- the Debian package ------------------------------------------------------------
+# `make deb` builds the Debian package (debian/) from this
+# tree into $(BUILD)/deb/. dpkg-buildpackage works on a copy, because it
+# writes into debian/ and the parent directory; build directories stay out.
+DEB_DIR := $(BUILD)/deb
+DEB_WORK := $(BUILD)/deb-work
+DEB_JOBS ?= $(shell nproc 2>/dev/null || echo 1)
+
+.PHONY: deb
+deb:
+	rm -rf $(DEB_WORK) $(DEB_DIR)
+	mkdir -p $(DEB_WORK)/urrt $(DEB_DIR)
+	tar -c --exclude-vcs --exclude='./build' --exclude='./build-*' --exclude='./$(BUILD)' . | tar -x -C $(DEB_WORK)/urrt
+	cd $(DEB_WORK)/urrt && DEB_BUILD_OPTIONS="parallel=$(DEB_JOBS) noddebs $(DEB_BUILD_OPTIONS)" \
+	  dpkg-buildpackage -b -us -uc > ../build.log 2>&1 || { tail -n 30 ../build.log; exit 1; }
+	mv $(DEB_WORK)/*.deb $(DEB_WORK)/*.changes $(DEB_WORK)/*.buildinfo $(DEB_WORK)/build.log $(DEB_DIR)/
+	rm -rf $(DEB_WORK)
+	@ls $(DEB_DIR)/*.deb

@@ -12,10 +12,7 @@
 #include <string.h>
 #include <strings.h>
 
-static bool say(char *why, size_t n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-
-/* Writes a reason; false, for "return say(...)". */
-static bool say(char *why, size_t n, const char *fmt, ...)
+bool conf_fail(char *why, size_t n, const char *fmt, ...)
 {
     va_list ap;
     if (why != NULL && n > 0) {
@@ -47,10 +44,10 @@ static bool leading_zero(const char *text, char *why, size_t n)
         decimal = "0";
     }
     if (strspn(text, "01234567") == strlen(text) && strlen(text) <= 22) {
-        return say(why, n, CONF_LEADING_ZERO " (write 0x%llX for hexadecimal or %s for decimal)",
+        return conf_fail(why, n, CONF_LEADING_ZERO " (write 0x%llX for hexadecimal or %s for decimal)",
                    strtoull(text, NULL, 8), decimal);
     }
-    return say(why, n, CONF_LEADING_ZERO " (write %s)", decimal);
+    return conf_fail(why, n, CONF_LEADING_ZERO " (write %s)", decimal);
 }
 
 bool conf_uint(const char *text, uint64_t min, uint64_t max, uint64_t *out, char *why, size_t n)
@@ -59,14 +56,14 @@ bool conf_uint(const char *text, uint64_t min, uint64_t max, uint64_t *out, char
     int base = 10;
     unsigned long long v;
     if (text == NULL || text[0] == '\0') {
-        return say(why, n, "no value");
+        return conf_fail(why, n, "no value");
     }
     if (text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
         base = 16;
         digits = text + 2;
     }
     if (!all_digits(digits, base)) {
-        return say(why, n, "not a whole number (decimal, or hexadecimal with 0x)");
+        return conf_fail(why, n, "not a whole number (decimal, or hexadecimal with 0x)");
     }
     if (base == 10 && text[0] == '0' && text[1] != '\0') {
         return leading_zero(text, why, n);
@@ -74,7 +71,7 @@ bool conf_uint(const char *text, uint64_t min, uint64_t max, uint64_t *out, char
     errno = 0;
     v = strtoull(digits, NULL, base);
     if (errno == ERANGE || v < min || v > max) {
-        return say(why, n, "out of range: from %llu to %llu", (unsigned long long)min, (unsigned long long)max);
+        return conf_fail(why, n, "out of range: from %llu to %llu", (unsigned long long)min, (unsigned long long)max);
     }
     *out = v;
     return true;
@@ -98,7 +95,7 @@ bool conf_int(const char *text, int64_t min, int64_t max, int64_t *out, char *wh
     int64_t v;
     if (!conf_uint(negative ? text + 1 : text, 0, UINT64_MAX, &magnitude, reason, sizeof reason)) {
         if (strncmp(reason, "out of range", 12) != 0) {
-            return say(why, n, "%s", reason);
+            return conf_fail(why, n, "%s", reason);
         }
         magnitude = UINT64_MAX; /* reported below with this range */
     }
@@ -109,7 +106,7 @@ bool conf_int(const char *text, int64_t min, int64_t max, int64_t *out, char *wh
     }
     if ((negative && magnitude > (uint64_t)INT64_MAX + 1) || (!negative && magnitude > (uint64_t)INT64_MAX) ||
         v < min || v > max) {
-        return say(why, n, "out of range: from %lld to %lld", (long long)min, (long long)max);
+        return conf_fail(why, n, "out of range: from %lld to %lld", (long long)min, (long long)max);
     }
     *out = v;
     return true;
@@ -143,13 +140,13 @@ bool conf_number(const char *text, double min, double max, double *out, char *wh
 {
     double v;
     if (text == NULL || text[0] == '\0') {
-        return say(why, n, "no value");
+        return conf_fail(why, n, "no value");
     }
     if (!parse_decimal(text, &v, NULL)) {
-        return say(why, n, "not a number (write it in decimal, e.g. 2.5)");
+        return conf_fail(why, n, "not a number (write it in decimal, e.g. 2.5)");
     }
     if (v < min || v > max) {
-        return say(why, n, "out of range: from %g to %g", min, max);
+        return conf_fail(why, n, "out of range: from %g to %g", min, max);
     }
     *out = v;
     return true;
@@ -166,7 +163,7 @@ bool conf_bool(const char *text, bool *out, char *why, size_t n)
             }
         }
     }
-    return say(why, n, "use yes or no (or true/false, on/off, 1/0)");
+    return conf_fail(why, n, "use yes or no (or true/false, on/off, 1/0)");
 }
 
 /* ---- durations ----------------------------------------------------------------- */
@@ -203,26 +200,26 @@ bool conf_duration_us(const char *text, const char *bare_unit, uint64_t min_us, 
     const char *unit;
     char lo[32], hi[32];
     if (text == NULL || text[0] == '\0') {
-        return say(why, n, "no value");
+        return conf_fail(why, n, "no value");
     }
     if (text[0] == '-' || text[0] == '+' || !parse_decimal(text, &v, &unit)) {
-        return say(why, n, "not a duration: a number with a unit (us, ms, s or min), e.g. \"250 ms\" or \"1.5 s\"");
+        return conf_fail(why, n, "not a duration: a number with a unit (us, ms, s or min), e.g. \"250 ms\" or \"1.5 s\"");
     }
     unit += strspn(unit, " \t");
     if (unit[0] == '\0' && bare_unit == NULL) {
-        return say(why, n, "a duration is written with a unit (us, ms, s or min), e.g. \"%s ms\" or \"%s s\"", text,
+        return conf_fail(why, n, "a duration is written with a unit (us, ms, s or min), e.g. \"%s ms\" or \"%s s\"", text,
                    text);
     }
     if (!unit_scale(unit[0] == '\0' ? bare_unit : unit, &scale)) {
-        return say(why, n, "unknown unit \"%s\": write us, ms, s or min", unit);
+        return conf_fail(why, n, "unknown unit \"%s\": write us, ms, s or min", unit);
     }
     us = v * scale;
     if (us < (double)min_us - 1e-6 || us > (double)max_us + 1e-6) {
-        return say(why, n, "out of range: from %s to %s", format_duration(min_us, lo, sizeof lo),
+        return conf_fail(why, n, "out of range: from %s to %s", format_duration(min_us, lo, sizeof lo),
                    format_duration(max_us, hi, sizeof hi));
     }
     if (fabs(us - nearbyint(us)) > 1e-6 * (us > 1 ? us : 1)) {
-        return say(why, n, "finer than a microsecond");
+        return conf_fail(why, n, "finer than a microsecond");
     }
     *out = (uint64_t)nearbyint(us);
     return true;
@@ -236,7 +233,7 @@ bool conf_duration_ms(const char *text, const char *bare_unit, uint32_t min_ms, 
         return false;
     }
     if (us % 1000u != 0) {
-        return say(why, n, "not a whole number of milliseconds");
+        return conf_fail(why, n, "not a whole number of milliseconds");
     }
     *out = (uint32_t)(us / 1000u);
     return true;
@@ -273,9 +270,9 @@ bool conf_name(const char *text, unsigned flags, size_t max, char *why, size_t n
         return true;
     }
     if (flags & CONF_NAME_C) {
-        return say(why, n, "is not a C identifier of at most %zu characters", max);
+        return conf_fail(why, n, "is not a C identifier of at most %zu characters", max);
     }
-    return say(why, n, "must be 1 to %zu letters, digits, '_'%s%s", max, (flags & CONF_NAME_DASH) ? " or '-'" : "",
+    return conf_fail(why, n, "must be 1 to %zu letters, digits, '_'%s%s", max, (flags & CONF_NAME_DASH) ? " or '-'" : "",
                (flags & CONF_NAME_DOTS) ? " (or '.' inside)" : "");
 }
 
@@ -283,7 +280,7 @@ bool conf_printable(const char *text, char *why, size_t n)
 {
     for (const char *c = text; *c != '\0'; c++) {
         if ((unsigned char)*c < 0x20 || *c == 0x7f) {
-            return say(why, n, "no control characters");
+            return conf_fail(why, n, "no control characters");
         }
     }
     return true;
@@ -298,7 +295,7 @@ bool conf_text(char *dst, size_t size, const char *text, char *why, size_t n)
     }
     if (len >= size || memchr(text, '"', len) != NULL || memchr(text, '\\', len) != NULL ||
         !conf_printable(text, NULL, 0)) {
-        return say(why, n, "at most %zu characters, no '\"', '\\' or control characters", size - 1);
+        return conf_fail(why, n, "at most %zu characters, no '\"', '\\' or control characters", size - 1);
     }
     memcpy(dst, text, len);
     dst[len] = '\0';
@@ -335,7 +332,7 @@ bool conf_key_set(const struct conf_key *key, void *obj, const char *value, stru
     bool ok;
     if ((key->kind == CONF_BOOL && key->size != sizeof(bool)) || (key->kind == CONF_MS && key->size != 4) ||
         (key->kind == CONF_UINT && key->size != 1 && key->size != 2 && key->size != 4 && key->size != 8)) {
-        return say(why, n, "%s: the table gives a field of %zu bytes (a bug)", key->name, key->size);
+        return conf_fail(why, n, "%s: the table gives a field of %zu bytes (a bug)", key->name, key->size);
     }
     switch (key->kind) {
     case CONF_UINT: ok = conf_uint(value, key->min, key->max, &v, reason, sizeof reason); break;
@@ -359,7 +356,7 @@ bool conf_key_set(const struct conf_key *key, void *obj, const char *value, stru
 #pragma GCC diagnostic pop
         return false;
     }
-    return say(why, n, "%s = \"%s\": %s", key->name, value, reason);
+    return conf_fail(why, n, "%s = \"%s\": %s", key->name, value, reason);
 }
 
 /* Levenshtein distance, for names of up to 63 characters. */

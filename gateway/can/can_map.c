@@ -152,17 +152,6 @@ int can_map_describe(const struct can_map *map, char *buf, size_t size)
 
 /* ---- [can] ----------------------------------------------------------------------- */
 
-static bool bad(char *why, size_t n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-
-/* Writes the reason of a bad value; false, for "return bad(...)". */
-static bool bad(char *why, size_t n, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(why, n, fmt, ap);
-    va_end(ap);
-    return false;
-}
 
 static bool can_interface(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
                           size_t n)
@@ -170,17 +159,17 @@ static bool can_interface(void *obj, const struct conf_key *key, const char *val
     struct can_map *map = obj;
     (void)key, (void)at;
     if (value[0] == '\0' || strlen(value) > 255 || (strncmp(value, "log:", 4) == 0 && value[4] == '\0')) {
-        return bad(why, n, "interface = '%s': give a CAN interface (can0) or log:PATH (log:- for stdout)", value);
+        return conf_fail(why, n, "interface = '%s': give a CAN interface (can0) or log:PATH (log:- for stdout)", value);
     }
     if (!conf_printable(value, NULL, 0)) {
-        return bad(why, n, "interface = '%s': no control characters", value);
+        return conf_fail(why, n, "interface = '%s': no control characters", value);
     }
     if (strncmp(value, "log:", 4) != 0 && (strlen(value) >= 16 || strpbrk(value, " /\t") != NULL)) {
-        return bad(why, n, "interface = '%s' is not an interface name (at most 15 characters, no '/')", value);
+        return conf_fail(why, n, "interface = '%s' is not an interface name (at most 15 characters, no '/')", value);
     }
     free(map->interface);
     map->interface = strdup(value);
-    return map->interface != NULL || bad(why, n, "out of memory");
+    return map->interface != NULL || conf_fail(why, n, "out of memory");
 }
 
 /* heartbeat_robot, and a frame's robot: a name checked against the robots at the end. */
@@ -190,7 +179,7 @@ static bool robot_name(void *obj, const struct conf_key *key, const char *value,
     char *dst = (char *)obj + key->offset;
     (void)at;
     if (!conf_text(dst, key->size, value, NULL, 0) || dst[0] == '\0') {
-        return bad(why, n, "%s = '%s': give a robot name", key->name, value);
+        return conf_fail(why, n, "%s = '%s': give a robot name", key->name, value);
     }
     return true;
 }
@@ -206,7 +195,7 @@ static bool can_generation(void *obj, const struct conf_key *key, const char *va
     } else if (strcmp(value, "1") == 0 || strcasecmp(value, "1.x") == 0) {
         map->generation = URRT_GEN_1X;
     } else {
-        return bad(why, n, "robot_generation = '%s': use 3 (CB3 and e-series, 3.x/5.x) or 1 (CB1/CB2, 1.x)", value);
+        return conf_fail(why, n, "robot_generation = '%s': use 3 (CB3 and e-series, 3.x/5.x) or 1 (CB1/CB2, 1.x)", value);
     }
     return true;
 }
@@ -216,7 +205,7 @@ static bool dbc_name(void *obj, const struct conf_key *key, const char *value, s
 {
     (void)at;
     if (!conf_name(value, CONF_NAME_C, CAN_MAP_NAME_MAX, NULL, 0)) {
-        return bad(why, n, "%s = '%s': a DBC node name is a C identifier of at most %d characters", key->name, value,
+        return conf_fail(why, n, "%s = '%s': a DBC node name is a C identifier of at most %d characters", key->name, value,
                    CAN_MAP_NAME_MAX);
     }
     snprintf((char *)obj + key->offset, key->size, "%s", value);
@@ -278,23 +267,23 @@ struct can_map_frame *can_map_frame_begin(struct can_map *map, const char *name,
     struct can_map_frame *f = frame_named(map, name);
     map->configured = true;
     if (!conf_name(name, CONF_NAME_C, CAN_MAP_NAME_MAX, NULL, 0)) {
-        bad(why, n, "[frame %s]: the frame name is its DBC name, a C identifier of at most %d characters", name,
+        conf_fail(why, n, "[frame %s]: the frame name is its DBC name, a C identifier of at most %d characters", name,
             CAN_MAP_NAME_MAX);
         return NULL;
     }
     if (strcmp(name, CAN_MAP_HEARTBEAT_NAME) == 0) {
-        bad(why, n, "[frame %s]: that name is the heartbeat's", CAN_MAP_HEARTBEAT_NAME);
+        conf_fail(why, n, "[frame %s]: that name is the heartbeat's", CAN_MAP_HEARTBEAT_NAME);
         return NULL;
     }
     if (f != NULL) {
-        bad(why, n, "[frame %s] is already defined at line %d: frame names must be unique", name, f->loc.line);
+        conf_fail(why, n, "[frame %s] is already defined at line %d: frame names must be unique", name, f->loc.line);
         return NULL;
     }
     if (map->frame_count == map->frame_capacity) {
         size_t cap = map->frame_capacity ? 2 * map->frame_capacity : 8;
         struct can_map_frame *grown = realloc(map->frames, cap * sizeof *grown);
         if (grown == NULL) {
-            bad(why, n, "out of memory");
+            conf_fail(why, n, "out of memory");
             return NULL;
         }
         map->frames = grown;
@@ -420,7 +409,7 @@ static bool signal_field(struct signal_parse *s, const char *word, char *why, si
     int fid = urrt_field_find(word, name_len);
     char reason[CONF_WHY_MAX];
     if (fid < 0) {
-        return bad(why, n, "signal: no field '%.*s' (field names as in docs/protocol.md: q_actual, tcp_force, "
+        return conf_fail(why, n, "signal: no field '%.*s' (field names as in docs/protocol.md: q_actual, tcp_force, "
                    "robot_mode, ...)", (int)name_len, word);
     }
     s->info = urrt_field((urrt_field_id)fid);
@@ -431,20 +420,20 @@ static bool signal_field(struct signal_parse *s, const char *word, char *why, si
         char num[16];
         uint32_t e;
         if (blen < 3 || bracket[blen - 1] != ']' || blen - 2 >= sizeof num) {
-            return bad(why, n, "signal: '%s': write FIELD[ELEM], e.g. q_actual[0]", word);
+            return conf_fail(why, n, "signal: '%s': write FIELD[ELEM], e.g. q_actual[0]", word);
         }
         snprintf(num, sizeof num, "%.*s", (int)(blen - 2), bracket + 1);
         if (!conf_u32(num, 0, UINT32_MAX, &e, reason, sizeof reason)) {
-            return bad(why, n, "signal: '%s': the element is a number: %s", word, reason);
+            return conf_fail(why, n, "signal: '%s': the element is a number: %s", word, reason);
         }
         if (e >= s->info->count) {
-            return bad(why, n, "signal: %s has %u element%s: %s[%u] is out of range (0..%u)", s->info->name,
+            return conf_fail(why, n, "signal: %s has %u element%s: %s[%u] is out of range (0..%u)", s->info->name,
                        (unsigned)s->info->count, s->info->count == 1 ? "" : "s", s->info->name, (unsigned)e,
                        (unsigned)s->info->count - 1);
         }
         s->meta.elem = e;
     } else if (s->info->count > 1) {
-        return bad(why, n, "signal: %s has %u elements: write %s[0] .. %s[%u]", s->info->name,
+        return conf_fail(why, n, "signal: %s has %u elements: write %s[0] .. %s[%u]", s->info->name,
                    (unsigned)s->info->count, s->info->name, s->info->name, (unsigned)s->info->count - 1);
     }
     return true;
@@ -457,22 +446,22 @@ static bool signal_place(struct signal_parse *s, const char *word, char *why, si
     char *bar;
     uint32_t start, length;
     if (word[0] != '@' || strlen(word) >= sizeof buf) {
-        return bad(why, n, "signal: '%s': expected @START|LENGTH, e.g. @0|16", word);
+        return conf_fail(why, n, "signal: '%s': expected @START|LENGTH, e.g. @0|16", word);
     }
     snprintf(buf, sizeof buf, "%s", word + 1);
     bar = strchr(buf, '|');
     if (bar == NULL) {
-        return bad(why, n, "signal: '%s': expected @START|LENGTH, e.g. @0|16", word);
+        return conf_fail(why, n, "signal: '%s': expected @START|LENGTH, e.g. @0|16", word);
     }
     *bar = '\0';
     if (!conf_u32(buf, 0, UINT32_MAX, &start, NULL, 0) || !conf_u32(bar + 1, 0, UINT32_MAX, &length, NULL, 0)) {
-        return bad(why, n, "signal: '%s': expected @START|LENGTH, e.g. @0|16 (decimal bit numbers)", word);
+        return conf_fail(why, n, "signal: '%s': expected @START|LENGTH, e.g. @0|16 (decimal bit numbers)", word);
     }
     if (length < 1 || length > 64) {
-        return bad(why, n, "signal: length %u: give 1..64 bits", (unsigned)length);
+        return conf_fail(why, n, "signal: length %u: give 1..64 bits", (unsigned)length);
     }
     if (start >= 8 * URRT_CAN_MAX_LEN) {
-        return bad(why, n, "signal: start bit %u: give 0..511", (unsigned)start);
+        return conf_fail(why, n, "signal: start bit %u: give 0..511", (unsigned)start);
     }
     s->sig.start = (uint16_t)start;
     s->sig.length = (uint8_t)length;
@@ -491,13 +480,13 @@ static bool signal_word(struct signal_parse *s, const char *w, char *why, size_t
         if (strcmp(w, words[i].word) == 0) {
             int *slot = words[i].is_order ? &s->order : &s->type;
             if (*slot >= 0) {
-                return bad(why, n, "signal: '%s': %s given twice", w, words[i].is_order ? "byte order" : "type");
+                return conf_fail(why, n, "signal: '%s': %s given twice", w, words[i].is_order ? "byte order" : "type");
             }
             *slot = words[i].value;
             return true;
         }
     }
-    return bad(why, n, "signal: unknown word '%s': expected intel|motorola, unsigned|signed|float32|float64 "
+    return conf_fail(why, n, "signal: unknown word '%s': expected intel|motorola, unsigned|signed|float32|float64 "
                "or factor=, offset=, min=, max=, unit=, name=, invalid=", w);
 }
 
@@ -506,11 +495,11 @@ static bool signal_number(struct signal_parse *s, const char *k, const char *v, 
 {
     double d;
     if (!conf_number(v, -DBL_MAX, DBL_MAX, &d, NULL, 0)) {
-        return bad(why, n, "signal: %s = '%s' is not a finite number", k, v);
+        return conf_fail(why, n, "signal: %s = '%s' is not a finite number", k, v);
     }
     if (strcmp(k, "factor") == 0) {
         if (d == 0.0) {
-            return bad(why, n, "signal: factor must not be 0");
+            return conf_fail(why, n, "signal: factor must not be 0");
         }
         s->sig.factor = d;
     } else if (strcmp(k, "offset") == 0) {
@@ -537,12 +526,12 @@ static bool signal_option(struct signal_parse *s, char *w, char *eq, char *why, 
     if (strcmp(k, "unit") == 0) {
         s->have_unit = true;
         return conf_text(s->meta.unit, sizeof s->meta.unit, v, NULL, 0) ||
-               bad(why, n, "signal: unit '%s': at most %d characters, no '\"', '\\' or control characters", v,
+               conf_fail(why, n, "signal: unit '%s': at most %d characters, no '\"', '\\' or control characters", v,
                    CAN_MAP_UNIT_MAX);
     }
     if (strcmp(k, "name") == 0) {
         if (!conf_name(v, CONF_NAME_C, CAN_MAP_NAME_MAX, NULL, 0)) {
-            return bad(why, n, "signal: name '%s': a DBC signal name is a C identifier of at most %d characters", v,
+            return conf_fail(why, n, "signal: name '%s': a DBC signal name is a C identifier of at most %d characters", v,
                        CAN_MAP_NAME_MAX);
         }
         snprintf(s->meta.name, sizeof s->meta.name, "%s", v);
@@ -552,11 +541,11 @@ static bool signal_option(struct signal_parse *s, char *w, char *eq, char *why, 
     if (strcmp(k, "invalid") == 0) {
         s->have_invalid = true;
         if (!conf_int(v, INT64_MIN, INT64_MAX, &s->invalid, reason, sizeof reason)) {
-            return bad(why, n, "signal: invalid = '%s' is not an integer raw value: %s", v, reason);
+            return conf_fail(why, n, "signal: invalid = '%s' is not an integer raw value: %s", v, reason);
         }
         return true;
     }
-    return bad(why, n, "signal: unknown option '%s=': expected factor=, offset=, min=, max=, unit=, name=, invalid=",
+    return conf_fail(why, n, "signal: unknown option '%s=': expected factor=, offset=, min=, max=, unit=, name=, invalid=",
                k);
 }
 
@@ -571,18 +560,18 @@ static bool signal_limits(struct signal_parse *s, char *why, size_t n)
     double lo, hi;
     bare.min = bare.max = 0;
     if (urrt_can_signal_range(&bare, &lo, &hi) < 0) {
-        return bad(why, n, "signal: invalid scaling");
+        return conf_fail(why, n, "signal: invalid scaling");
     }
     if (s->have_min && s->sig.min < lo - slack) {
-        return bad(why, n, "signal: min=%.17g is below what the signal can carry (%.17g)", s->sig.min, lo);
+        return conf_fail(why, n, "signal: min=%.17g is below what the signal can carry (%.17g)", s->sig.min, lo);
     }
     if (s->have_max && s->sig.max > hi + slack) {
-        return bad(why, n, "signal: max=%.17g is above what the signal can carry (%.17g)", s->sig.max, hi);
+        return conf_fail(why, n, "signal: max=%.17g is above what the signal can carry (%.17g)", s->sig.max, hi);
     }
     s->sig.min = s->have_min ? s->sig.min : lo;
     s->sig.max = s->have_max ? s->sig.max : hi;
     if (s->sig.min > s->sig.max) {
-        return bad(why, n, "signal: min=%.17g is above max=%.17g", s->sig.min, s->sig.max);
+        return conf_fail(why, n, "signal: min=%.17g is above max=%.17g", s->sig.min, s->sig.max);
     }
     return true;
 }
@@ -597,16 +586,16 @@ static bool signal_invalid(struct signal_parse *s, char *why, size_t n)
         return true;
     }
     if (s->type == URRT_CAN_FLOAT32 || s->type == URRT_CAN_FLOAT64) {
-        return bad(why, n, "signal: invalid= applies to integer signals (float signals send NaN)");
+        return conf_fail(why, n, "signal: invalid= applies to integer signals (float signals send NaN)");
     }
     if (s->invalid < 0) {
         int64_t lowest = length >= 64 ? INT64_MIN : -((int64_t)1 << (length - 1));
         if (s->type != URRT_CAN_SIGNED || s->invalid < lowest) {
-            return bad(why, n, "signal: invalid=%lld does not fit %u %s bits", (long long)s->invalid, length,
+            return conf_fail(why, n, "signal: invalid=%lld does not fit %u %s bits", (long long)s->invalid, length,
                        s->type == URRT_CAN_SIGNED ? "signed" : "unsigned");
         }
     } else if (((uint64_t)s->invalid & ~mask) != 0) {
-        return bad(why, n, "signal: invalid=%lld does not fit %u bits", (long long)s->invalid, length);
+        return conf_fail(why, n, "signal: invalid=%lld does not fit %u bits", (long long)s->invalid, length);
     }
     s->sig.invalid_raw = (uint64_t)s->invalid & mask;
     s->sig.flags = URRT_CAN_SIG_INVALID_RAW;
@@ -623,15 +612,15 @@ static bool signal_rest(struct signal_parse *s, char **words, int nwords, char *
         }
     }
     if (s->order < 0) {
-        return bad(why, n, "signal: byte order missing: add intel (little-endian) or motorola (big-endian)");
+        return conf_fail(why, n, "signal: byte order missing: add intel (little-endian) or motorola (big-endian)");
     }
     if (s->type < 0) {
-        return bad(why, n, "signal: type missing: add unsigned, signed, float32 or float64");
+        return conf_fail(why, n, "signal: type missing: add unsigned, signed, float32 or float64");
     }
     s->sig.byte_order = (uint8_t)s->order;
     s->sig.type = (uint8_t)s->type;
     if ((s->type == URRT_CAN_FLOAT32 && s->sig.length != 32) || (s->type == URRT_CAN_FLOAT64 && s->sig.length != 64)) {
-        return bad(why, n, "signal: %s needs length %d, not %u", s->type == URRT_CAN_FLOAT32 ? "float32" : "float64",
+        return conf_fail(why, n, "signal: %s needs length %d, not %u", s->type == URRT_CAN_FLOAT32 ? "float32" : "float64",
                    s->type == URRT_CAN_FLOAT32 ? 32 : 64, (unsigned)s->sig.length);
     }
     return signal_limits(s, why, n) && signal_invalid(s, why, n);
@@ -647,15 +636,15 @@ static bool frame_signal(void *obj, const struct conf_key *key, const char *valu
     struct signal_parse s;
     (void)key;
     if (strlen(value) >= sizeof line) {
-        return bad(why, n, "signal line too long");
+        return conf_fail(why, n, "signal line too long");
     }
     snprintf(line, sizeof line, "%s", value);
     nwords = split_words(line, words);
     if (nwords < 0) {
-        return bad(why, n, "signal: unbalanced quotes or more than %d words", SIGNAL_MAX_WORDS);
+        return conf_fail(why, n, "signal: unbalanced quotes or more than %d words", SIGNAL_MAX_WORDS);
     }
     if (nwords < 4) {
-        return bad(why, n, "signal = '%s': expected %s", value, SIGNAL_GRAMMAR);
+        return conf_fail(why, n, "signal = '%s': expected %s", value, SIGNAL_GRAMMAR);
     }
     memset(&s, 0, sizeof s);
     s.order = s.type = -1;
@@ -679,13 +668,13 @@ static bool frame_signal(void *obj, const struct conf_key *key, const char *valu
     }
     other = signal_named(f, s.meta.name);
     if (other >= 0) {
-        return bad(why, n, "signal name '%s' already used in [frame %s] (line %d): add name=OTHER", s.meta.name,
+        return conf_fail(why, n, "signal name '%s' already used in [frame %s] (line %d): add name=OTHER", s.meta.name,
                    f->name, f->meta[other].loc.line);
     }
     if (urrt_can_signal_check(&s.sig, URRT_CAN_MAX_LEN) < 0) {
-        return bad(why, n, "signal: does not fit even a 64-byte frame");
+        return conf_fail(why, n, "signal: does not fit even a 64-byte frame");
     }
-    return add_signal(f, &s.sig, &s.meta) >= 0 || bad(why, n, "out of memory");
+    return add_signal(f, &s.sig, &s.meta) >= 0 || conf_fail(why, n, "out of memory");
 }
 
 /* alive_counter = START [intel|motorola], validity_bit = BIT */
@@ -706,31 +695,31 @@ static bool frame_marker(void *obj, const struct conf_key *key, const char *valu
     nwords = split_words(buf, words);
     if (nwords < 1 || nwords > 2 || !conf_u32(words[0], 0, UINT32_MAX, &start, NULL, 0) ||
         (nwords == 2 && role == CAN_MAP_ROLE_VALID)) {
-        return bad(why, n, role == CAN_MAP_ROLE_ALIVE ? "alive_counter = '%s': give the start bit of the 4-bit "
+        return conf_fail(why, n, role == CAN_MAP_ROLE_ALIVE ? "alive_counter = '%s': give the start bit of the 4-bit "
                    "counter and optionally its byte order (56, or 59 motorola)"
                    : "validity_bit = '%s': give the bit number (0..511)", value);
     }
     if (nwords == 2 && strcmp(words[1], "motorola") == 0) {
         sig.byte_order = URRT_CAN_MOTOROLA;
     } else if (nwords == 2 && strcmp(words[1], "intel") != 0) {
-        return bad(why, n, "alive_counter: byte order '%s': use intel or motorola", words[1]);
+        return conf_fail(why, n, "alive_counter: byte order '%s': use intel or motorola", words[1]);
     }
     if (start >= 8 * URRT_CAN_MAX_LEN) {
-        return bad(why, n, "%s = %u: give a bit number 0..511", key->name, (unsigned)start);
+        return conf_fail(why, n, "%s = %u: give a bit number 0..511", key->name, (unsigned)start);
     }
     sig.start = (uint16_t)start;
     sig.length = role == CAN_MAP_ROLE_ALIVE ? CAN_MAP_ALIVE_BITS : 1;
     sig.max = (double)((1u << sig.length) - 1);
     snprintf(meta.name, sizeof meta.name, "%s", name);
     if (signal_named(f, name) >= 0) {
-        return bad(why, n, "[frame %s] already has a signal named '%s'", f->name, name);
+        return conf_fail(why, n, "[frame %s] already has a signal named '%s'", f->name, name);
     }
     if (urrt_can_signal_check(&sig, URRT_CAN_MAX_LEN) < 0) {
-        return bad(why, n, "%s does not fit even a 64-byte frame", key->name);
+        return conf_fail(why, n, "%s does not fit even a 64-byte frame", key->name);
     }
     index = add_signal(f, &sig, &meta);
     if (index < 0) {
-        return bad(why, n, "out of memory");
+        return conf_fail(why, n, "out of memory");
     }
     *(role == CAN_MAP_ROLE_ALIVE ? &f->alive_index : &f->valid_index) = index;
     return true;
@@ -747,7 +736,7 @@ static bool frame_period(void *obj, const struct conf_key *key, const char *valu
         return true;
     }
     if (!conf_duration_ms(value, conf_bare_unit(key->name), 1, 60000, &f->period_ms, reason, sizeof reason)) {
-        return bad(why, n, "period_ms = '%s': give 1..60000 milliseconds, or every (each packet): %s", value, reason);
+        return conf_fail(why, n, "period_ms = '%s': give 1..60000 milliseconds, or every (each packet): %s", value, reason);
     }
     return true;
 }
@@ -762,7 +751,7 @@ static bool frame_policy(void *obj, const struct conf_key *key, const char *valu
     } else if (strcmp(value, "invalid") == 0) {
         f->stale_policy = CAN_MAP_STALE_INVALID;
     } else {
-        return bad(why, n, "stale_policy = '%s': use stop or invalid", value);
+        return conf_fail(why, n, "stale_policy = '%s': use stop or invalid", value);
     }
     return true;
 }
@@ -773,7 +762,7 @@ static bool frame_comment(void *obj, const struct conf_key *key, const char *val
     struct can_map_frame *f = obj;
     (void)key, (void)at;
     return conf_text(f->comment, sizeof f->comment, value, NULL, 0) ||
-           bad(why, n, "comment: at most %zu characters, no '\"', '\\' or control characters", sizeof f->comment - 1);
+           conf_fail(why, n, "comment: at most %zu characters, no '\"', '\\' or control characters", sizeof f->comment - 1);
 }
 
 const struct conf_key can_map_frame_keys[CAN_MAP_FK_COUNT] = {

@@ -1,0 +1,20 @@
+# SPDX-License-Identifier: MIT
+# gateway/common/common.mk: what the three programs share: the value parsers of
+# the configuration front end (conf) and the command-line helpers (cli).
+#
+# Every gateway/ folder compiles its .c files with GW_CFLAGS: -MMD -MP let the
+# compiler tell make which headers an object depends on, so no .mk lists them.
+
+GATEWAY_INC := -Igateway/common -Igateway/urrt-gateway -Igateway/can -Igateway/tools
+GW_CFLAGS = $(PROG_WARN) $(OPT) $(CPPFLAGS) $(GATEWAY_INC) -MMD -MP
+# For tests that compile gateway/ sources in one command (sanitizer builds).
+GATEWAY_HDRS := $(wildcard gateway/*/*.h)
+
+CONF_OBJ := $(BUILD)/gateway/common/conf.o
+CLI_OBJ := $(BUILD)/gateway/common/cli.o $(CONF_OBJ)
+
+$(BUILD)/gateway/common/%.o: gateway/common/%.c
+	@mkdir -p $(@D)
+	$(CC) $(GW_CFLAGS) -c $< -o $@
+
+-include $(CLI_OBJ:.o=.d)
