@@ -855,8 +855,6 @@ int can_map_ini(struct can_map *map, const char *section, const char *key, const
     if (k == NULL) {
         conf_unknown_key(f ? can_map_frame_keys : can_map_can_keys, f ? CAN_MAP_FK_COUNT : CAN_MAP_CK_COUNT, key,
                          f ? section : "can", why, sizeof why);
-        /* tests/can pin the single quotes this path always wrote. */
-        why[12] = why[13 + strlen(key)] = '\'';
         return fail(map, err, errlen, loc, "%s", why);
     }
     first = f ? &f->key_loc[k - can_map_frame_keys] : &map->key_loc[k - can_map_can_keys];

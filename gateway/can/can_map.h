@@ -48,7 +48,8 @@
 #define CAN_MAP_DEFAULT_STALE_MS 100u
 #define CAN_MAP_DEFAULT_HEARTBEAT_MS 100u
 #define CAN_MAP_DEFAULT_MAX_LOAD 50u  /* percent */
-#define CAN_MAP_FASTEST_ROBOT_US 2000u /* e-series, 500 Hz: used where a robot's rate is unknown */
+/* Where a robot's rate is unknown: the fastest any controller sends (lib's table). */
+#define CAN_MAP_FASTEST_ROBOT_US urrt_period_min_us(0)
 
 /* Where a key came from, for "FILE:LINE: reason". line 0: not given. */
 struct can_map_loc {

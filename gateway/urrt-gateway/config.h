@@ -70,8 +70,8 @@ typedef struct gw_robot_config {
 
 #define GW_DEFAULT_LCM_URL "udpm://239.255.76.67:7667?ttl=0"
 #define GW_MAX_ROBOTS 64
-/* The fastest controllers send 500 packets per second (e-series). */
-#define GW_ROBOT_MAX_RATE_HZ 500u
+/* The fastest any controller sends (e-series, 500 Hz): lib's controller table. */
+#define GW_ROBOT_MAX_RATE_HZ (1000000u / urrt_period_min_us(0))
 
 typedef struct gw_config {
     const char *path;

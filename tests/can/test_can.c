@@ -643,14 +643,14 @@ struct rejection {
 
 static const struct rejection rejections[] = {
     /* Syntax of keys and values (can_map_ini). */
-    {CAN_HEAD "bogus = 1\n", "t.ini:4: unknown key 'bogus' in [can]"},
+    {CAN_HEAD "bogus = 1\n", "t.ini:4: unknown key \"bogus\" in [can]"},
     {CAN_HEAD "interface = can1\n", "t.ini:4: [can] interface given twice (first at line 2)"},
     {CAN_HEAD "heartbeat_period_ms = 1001\n", "t.ini:4: heartbeat_period_ms = '1001': give 10..1000"},
     {CAN_HEAD "bitrate = fast\n", "t.ini:4: bitrate = 'fast': give bits per second"},
     {CAN_HEAD "[frame 9lives]\nid = 1\n", "t.ini:5: [frame 9lives]: the frame name is its DBC name"},
     {CAN_HEAD "[frame urrt_heartbeat]\nid = 1\n", "t.ini:5: [frame urrt_heartbeat]: that name is the heartbeat's"},
     {CAN_HEAD "[frame a]\nid = 0x100\nid = 0x101\n", "t.ini:6: [frame a] id given twice (first at line 5)"},
-    {CAN_HEAD "[frame a]\ncolour = red\n", "t.ini:5: unknown key 'colour' in [frame a]"},
+    {CAN_HEAD "[frame a]\ncolour = red\n", "t.ini:5: unknown key \"colour\" in [frame a]"},
     {CAN_HEAD "[frame a]\nperiod_ms = sometimes\n", "t.ini:5: period_ms = 'sometimes'"},
     {CAN_HEAD "[frame a]\nstale_policy = ignore\n", "t.ini:5: stale_policy = 'ignore': use stop or invalid"},
     {CAN_HEAD "[frame a]\nsignal = q_actual[0] @0|16 intel\n", "t.ini:5: signal = 'q_actual[0] @0|16 intel': expected"},

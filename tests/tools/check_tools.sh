@@ -103,6 +103,12 @@ check "dump -o (once --fields, --output in urrt-gateway): usage error naming -k"
   sh -c "[ $rc = 2 ] && grep -q -- '-k A,B (--fields A,B)' '$T/e9'"
 "$DUMP" robot:99999 2> "$T/e6"; rc=$?
 check "port out of range: usage error" sh -c "[ $rc = 2 ] && grep -q '1 to 65535' '$T/e6'"
+# One integer grammar (gateway/common/conf.c): a leading zero is refused, never read as octal.
+"$DUMP" -n 010 --file /dev/null 2> "$T/e10"; rc=$?
+check "dump -n 010: usage error, both readings named" \
+  sh -c "[ $rc = 2 ] && grep -q 'leading zero is not allowed (write 0x8 for hexadecimal or 10 for decimal)' '$T/e10'"
+"$SIM" --rt-priority 010 -n 1 2> "$T/e11"; rc=$?
+check "sim --rt-priority 010: usage error" sh -c "[ $rc = 2 ] && grep -q 'leading zero is not allowed' '$T/e11'"
 
 # ---- every length, gnuplot columns bit-exact ----------------------------------------
 # Every length a controller sends, lengths none sends (between the generations,
