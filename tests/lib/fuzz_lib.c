@@ -10,6 +10,7 @@
  * and the stream itself is handed to the whole-packet functions.
  */
 #include "urrt.h"
+#include "state_slot.h"
 
 #include <stdint.h>
 #include <stdio.h>
@@ -31,16 +32,6 @@ static uint64_t bits_of(double d)
     return u;
 }
 
-static double *slot(urrt_state *st, int id)
-{
-    switch (id) {
-#define X(ID, name, count, c1, c3, unit, since, desc) \
-    case URRT_F_##ID: return st->name;
-        URRT_FIELDS(X)
-#undef X
-    default: return NULL;
-    }
-}
 
 static int is_error(int r)
 {
@@ -87,7 +78,7 @@ static void check_cleared(const urrt_state *st)
 {
     REQUIRE(st->present == 0);
     for (int id = 0; id < URRT_FIELD_COUNT; id++) {
-        const double *v = slot((urrt_state *)st, id);
+        const double *v = state_slot((urrt_state *)st, id);
         for (unsigned i = 0; i < urrt_field((urrt_field_id)id)->count; i++) {
             REQUIRE(v[i] != v[i]);
         }
@@ -116,7 +107,7 @@ static void check_packet(const uint8_t *pkt, size_t len)
         unsigned col = urrt_field_column((urrt_field_id)id, gen);
         int whole = col != 0 && col + f->count - 1u <= doubles &&
                     !(gen == URRT_GEN_1X && id == URRT_F_TOOL_ACCELEROMETER && doubles < 95);
-        double *v = slot(&st, id);
+        double *v = state_slot(&st, id);
         REQUIRE((int)urrt_has(&st, id) == whole);
         for (unsigned i = 0; i < f->count; i++) {
             double d;
@@ -141,7 +132,7 @@ static void check_packet(const uint8_t *pkt, size_t len)
     REQUIRE(urrt_decode(out, len, &back) == (int)len && back.present == st.present);
     for (int id = 0; id < URRT_FIELD_COUNT; id++) {
         if (urrt_has(&st, id)) {
-            REQUIRE(memcmp(slot(&st, id), slot(&back, id), 8u * urrt_field((urrt_field_id)id)->count) == 0);
+            REQUIRE(memcmp(state_slot(&st, id), state_slot(&back, id), 8u * urrt_field((urrt_field_id)id)->count) == 0);
         }
     }
 }

@@ -10,6 +10,7 @@
  * test and then checked against itself.
  */
 #include "urrt.h"
+#include "state_slot.h"
 #include "check.h"
 
 #include <inttypes.h>
@@ -67,18 +68,6 @@ static uint64_t rng_next(void)
     return rng_state;
 }
 
-/* The member of a state that holds a field (the struct is the library's;
- * this maps ids to members, it does not state any expectation). */
-static double *slot(urrt_state *st, int id)
-{
-    switch (id) {
-#define X(ID, name, count, c1, c3, unit, since, desc) \
-    case URRT_F_##ID: return st->name;
-        URRT_FIELDS(X)
-#undef X
-    default: return NULL;
-    }
-}
 
 /* ---- reference vectors ---------------------------------------------------- */
 
@@ -158,7 +147,7 @@ static void check_vector(const vector *v, expected_field *e)
 
     for (int id = 0; id < URRT_FIELD_COUNT; id++) {
         const urrt_field_info *f = urrt_field((urrt_field_id)id);
-        double *val = slot(&st, id);
+        double *val = state_slot(&st, id);
         CHECK(e[id].seen, "%s: the reference does not know field %s", v->name, f->name);
         if (!e[id].seen) {
             continue;
@@ -279,7 +268,7 @@ static void check_vector(const vector *v, expected_field *e)
           "%s: decode(encode(st)) differs in presence", v->name);
     for (int id = 0; id < URRT_FIELD_COUNT; id++) {
         if (urrt_has(&st, id)) {
-            CHECK(memcmp(slot(&st, id), slot(&st2, id), 8u * urrt_field((urrt_field_id)id)->count) == 0,
+            CHECK(memcmp(state_slot(&st, id), state_slot(&st2, id), 8u * urrt_field((urrt_field_id)id)->count) == 0,
                   "%s: %s changed in a round trip", v->name, urrt_field((urrt_field_id)id)->name);
         }
     }
@@ -1153,13 +1142,13 @@ static void test_state_clear_and_encoder(void)
     CHECK(st.present == 0 && st.length == 0 && st.generation == URRT_GEN_UNKNOWN, "cleared state");
     for (int id = 0; id < URRT_FIELD_COUNT; id++) {
         for (unsigned i = 0; i < urrt_field((urrt_field_id)id)->count; i++) {
-            CHECK(isnan(slot(&st, id)[i]), "cleared %s[%u]", urrt_field((urrt_field_id)id)->name, i);
+            CHECK(isnan(state_slot(&st, id)[i]), "cleared %s[%u]", urrt_field((urrt_field_id)id)->name, i);
         }
     }
     /* A state set by hand, encoded at every length the library accepts. */
     for (int id = 0; id < URRT_FIELD_COUNT; id++) {
         for (unsigned i = 0; i < urrt_field((urrt_field_id)id)->count; i++) {
-            slot(&st, id)[i] = double_of(rng_next());
+            state_slot(&st, id)[i] = double_of(rng_next());
         }
     }
     for (uint32_t len = URRT_PACKET_MIN; len <= URRT_PACKET_MAX; len += 8) {
@@ -1170,7 +1159,7 @@ static void test_state_clear_and_encoder(void)
         }
         for (int id = 0; id < URRT_FIELD_COUNT; id++) {
             const urrt_field_info *f = urrt_field((urrt_field_id)id);
-            if (urrt_has(&back, id) && memcmp(slot(&st, id), slot(&back, id), 8u * f->count) != 0) {
+            if (urrt_has(&back, id) && memcmp(state_slot(&st, id), state_slot(&back, id), 8u * f->count) != 0) {
                 bad++;
             }
             /* A field this generation has and the packet holds whole is present. */

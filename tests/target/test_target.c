@@ -10,6 +10,7 @@
 #include "target.h"
 #include "test_vectors.h"
 #include "urrt.h"
+#include "../lib/state_slot.h"
 #include "urrt_can.h"
 #include "urrt_cantx.h"
 
@@ -96,16 +97,6 @@ static uint64_t bits_of(double d)
     return b.u;
 }
 
-static const double *slot(const urrt_state *st, unsigned id)
-{
-    switch (id) {
-#define X(ID, name, count, c1, c3, unit, since, desc) \
-    case URRT_F_##ID: return st->name;
-        URRT_FIELDS(X)
-#undef X
-    default: return NULL;
-    }
-}
 
 /* Large objects are static: the Cortex-M0 board has 16 KiB of RAM. */
 static urrt_state st;
@@ -119,7 +110,7 @@ static void check_fields(const tv_vector *v, const uint8_t *pkt, const urrt_stat
     unsigned k, i;
     for (k = 0; k < v->expect_count; k++) {
         const tv_expect *e = &v->expect[k];
-        const double *val = slot(s, e->id);
+        const double *val = state_slot((urrt_state *)(uintptr_t)s, e->id);
         const urrt_field_info *f = urrt_field((urrt_field_id)e->id);
         double d = 0;
         uint64_t raw = 0;
