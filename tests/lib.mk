@@ -40,7 +40,7 @@ $(LIB_VECTORS): tests/ref/urrt_ref.py
 
 # ---- unit tests --------------------------------------------------------------
 
-$(LIBT)/test_lib: tests/lib/test_lib.c tests/check.h $(LIBURRT) $(LIB_HDRS)
+$(LIBT)/test_lib: tests/lib/test_lib.c tests/check.h tests/lib/state_slot.h $(LIBURRT) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_TEST_CFLAGS) $(OPT) $< $(LIBURRT) -lm -o $@
 
@@ -48,7 +48,7 @@ $(LIBT)/test_lib: tests/lib/test_lib.c tests/check.h $(LIBURRT) $(LIB_HDRS)
 # machine's CPU, so that the widest vector path of the decoder it has
 # (AVX-512, AVX2, SSSE3 or NEON) runs under the sanitizers; check-lib covers
 # the portable path and the other widths.
-$(LIBT)/test_lib_san: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+$(LIBT)/test_lib_san: tests/lib/test_lib.c tests/check.h tests/lib/state_slot.h $(LIB_SRCS) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_TEST_CFLAGS) -O1 -g -march=native $(SAN_FLAGS) $< $(LIB_SRCS) -lm -o $@
 
@@ -57,7 +57,7 @@ $(LIBT)/test_lib_san: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
 LIB_CPU_FLAGS := $(shell grep -m 1 '^flags' /proc/cpuinfo 2>/dev/null)
 LIB_TEST_ISAS := $(if $(filter x86_64,$(shell uname -m)),$(filter ssse3 avx2 avx512bw,$(LIB_CPU_FLAGS)))
 LIB_TEST_VARIANTS := $(LIB_TEST_ISAS:%=$(LIBT)/test_lib_%)
-$(LIBT)/test_lib_%: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+$(LIBT)/test_lib_%: tests/lib/test_lib.c tests/check.h tests/lib/state_slot.h $(LIB_SRCS) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_TEST_CFLAGS) $(OPT) -m$* $< $(LIB_SRCS) -lm -o $@
 
@@ -69,14 +69,14 @@ LIB_ISA_BYTES_avx2 := 32
 LIB_ISA_BYTES_avx512bw := 64
 LIB_DISPATCH_WIDTHS := $(if $(filter x86_64,$(shell uname -m)),0 $(foreach i,$(LIB_TEST_ISAS),$(LIB_ISA_BYTES_$(i))))
 LIB_TEST_VARIANTS += $(LIB_DISPATCH_WIDTHS:%=$(LIBT)/test_lib_dispatch%)
-$(LIBT)/test_lib_dispatch%: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+$(LIBT)/test_lib_dispatch%: tests/lib/test_lib.c tests/check.h tests/lib/state_slot.h $(LIB_SRCS) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_TEST_CFLAGS) $(OPT) -mno-ssse3 -DURRT_X86_MAX_VECTOR_BYTES=$* -DURRT_TEST_VECTOR_BYTES=$* \
 	  $< $(LIB_SRCS) -lm -o $@
 
 # And the smallest packet bound a firmware may choose (URRT_MAX_DOUBLES=152):
 # longer reference packets must then be refused, not misread.
-$(LIBT)/test_lib_max152: tests/lib/test_lib.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+$(LIBT)/test_lib_max152: tests/lib/test_lib.c tests/check.h tests/lib/state_slot.h $(LIB_SRCS) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_TEST_CFLAGS) $(OPT) -DURRT_MAX_DOUBLES=152 $< $(LIB_SRCS) -lm -o $@
 
@@ -88,7 +88,7 @@ $(LIBT)/nognu/%.o: lib/%.c $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_WARN) $(OPT) -U__GNUC__ -U__BYTE_ORDER__ -c $< -o $@
 
-$(LIBT)/test_lib_nognu: tests/lib/test_lib.c tests/check.h $(LIBT_NOGNU) $(LIB_HDRS)
+$(LIBT)/test_lib_nognu: tests/lib/test_lib.c tests/check.h tests/lib/state_slot.h $(LIBT_NOGNU) $(LIB_HDRS)
 	$(CC) $(LIB_TEST_CFLAGS) $(OPT) $< $(LIBT_NOGNU) -lm -o $@
 
 check-lib: $(LIBT)/test_lib $(LIBT)/test_lib_max152 $(LIBT)/test_lib_nognu $(LIB_TEST_VARIANTS) $(LIB_VECTORS)
@@ -124,7 +124,7 @@ FUZZ_SECONDS ?= 300
 # Seconds of fuzzing inside make check.
 FUZZ_CHECK_SECONDS ?= 15
 
-$(LIBT)/fuzz_lib: tests/lib/fuzz_lib.c $(LIB_SRCS) $(LIB_HDRS)
+$(LIBT)/fuzz_lib: tests/lib/fuzz_lib.c tests/lib/state_slot.h $(LIB_SRCS) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) -std=c99 -Wall -Wextra -Werror -g -O1 -march=native -fsanitize=fuzzer,address,undefined \
 	  -fno-sanitize-recover=all $(CPPFLAGS) $< $(LIB_SRCS) -o $@

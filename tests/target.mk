@@ -43,7 +43,7 @@ $(TGT)/vectors_%.c: $(LIB_VECTORS) tests/target/vectors_c.py
 	@mkdir -p $(@D)
 	$(PYTHON) tests/target/vectors_c.py $(LIB_VECTORS) $@ $*
 
-TGT_DRIVER := tests/target/test_target.c tests/target/stack_target.h tests/target/target.h \
+TGT_DRIVER := tests/target/test_target.c tests/target/stack_target.h tests/target/target.h tests/lib/state_slot.h \
               tests/target/test_vectors.h tests/target/cm.c tests/target/sections.ld
 
 # $(call tgt_image,NAME,CPU FLAGS,OPT,LINKER SCRIPT,VECTORS): lib/ objects and a test image.
@@ -98,7 +98,7 @@ define tgt_linux
 $(TGT)/$(1)/lib/%.o: lib/%.c $(LIB_HDRS)
 	@mkdir -p $$(@D)
 	$(2) $(LIB_WARN) -O2 -c $$< -o $$@
-$(TGT)/$(1)/test_lib: tests/lib/test_lib.c tests/check.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
+$(TGT)/$(1)/test_lib: tests/lib/test_lib.c tests/check.h tests/lib/state_slot.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
 	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
 $(TGT)/$(1)/test_can: $(TGT_CAN_LIB) tests/check.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
 	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
