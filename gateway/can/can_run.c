@@ -242,30 +242,33 @@ urrt_cantx_state can_map_state(const struct can_map *map, uint64_t now_us)
     return urrt_cantx_gateway_state(&map->run->tx, can_map_heartbeat_index(map), now_us);
 }
 
-void can_map_due(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats, urrt_cantx_emit_fn emit,
-                 void *ctx)
+/* The core, started at now_us if it was not, with the link's counters
+ * (stats NULL: unchanged); NULL when the tables cannot be built. */
+static urrt_cantx *core_at(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats)
 {
     if (map->run == NULL) {
         can_map_start(map, now_us);
     }
-    if (map->run != NULL) {
-        if (stats != NULL) {
-            can_map_link_stats(map, stats);
-        }
-        urrt_cantx_run(&map->run->tx, now_us, emit, ctx);
+    if (map->run != NULL && stats != NULL) {
+        can_map_link_stats(map, stats);
+    }
+    return map->run != NULL ? &map->run->tx : NULL;
+}
+
+void can_map_due(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats, urrt_cantx_emit_fn emit,
+                 void *ctx)
+{
+    urrt_cantx *tx = core_at(map, now_us, stats);
+    if (tx != NULL) {
+        urrt_cantx_run(tx, now_us, emit, ctx);
     }
 }
 
 void can_map_heartbeat_frame(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats,
                              urrt_can_frame *frame)
 {
-    if (map->run == NULL) {
-        can_map_start(map, now_us);
-    }
-    if (map->run != NULL) {
-        if (stats != NULL) {
-            can_map_link_stats(map, stats);
-        }
-        urrt_cantx_peek(&map->run->tx, can_map_heartbeat_index(map), now_us, frame);
+    urrt_cantx *tx = core_at(map, now_us, stats);
+    if (tx != NULL) {
+        urrt_cantx_peek(tx, can_map_heartbeat_index(map), now_us, frame);
     }
 }
