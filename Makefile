@@ -41,7 +41,11 @@ all:
 
 include lib/lib.mk
 include port/port.mk
-include $(sort $(wildcard gateway/*/*.mk))
+# gateway/: the definitions other folders use at parse time first (the flags every
+# folder compiles with, the LCM types), then each folder's .mk.
+GATEWAY_MK_FIRST := gateway/common/common.mk gateway/lcmtypes/lcmtypes.mk
+include $(GATEWAY_MK_FIRST)
+include $(filter-out $(GATEWAY_MK_FIRST),$(sort $(wildcard gateway/*/*.mk)))
 include $(sort $(wildcard tests/*.mk))
 
 all: $(PROGRAMS)

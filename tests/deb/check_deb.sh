@@ -43,7 +43,7 @@ for f in /usr/bin/urrt-gateway /usr/bin/urrt-dump /usr/bin/urrt-sim /usr/bin/urr
          /usr/share/man/man1/urrt-dump.1.gz /usr/share/man/man1/urrt-sim.1.gz /usr/share/man/man1/urrt-spy.1.gz \
          /usr/share/doc/urrt/copyright /usr/share/doc/urrt/gateway.md.gz /usr/share/doc/urrt/examples/canopen.ini \
          /usr/share/urrt/urrt-gateway.example.ini /usr/share/urrt/lcmtypes/state_t.lcm \
-         /usr/share/java/urrt-lcmtypes.jar /usr/include/urrt.h /usr/include/urrt_can.h; do
+         /usr/share/java/urrt-lcmtypes.jar /usr/include/urrt.h /usr/include/urrt_can.h /usr/include/urrt_cantx.h; do
   check "contents: $f" grep -qx "$f" "$T/contents"
 done
 check "contents: liburrt.a and urrt.pc under /usr/lib/<multiarch>" \

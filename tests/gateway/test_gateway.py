@@ -824,7 +824,7 @@ def t_configs(args):
     p = subprocess.run([args.gateway, "--check-config", os.path.join(d, "missing.ini")], capture_output=True,
                        text=True, timeout=10)
     check(p.returncode == 2 and "missing.ini: cannot open" in p.stderr, "config: a missing file is named")
-    example = os.path.join(HERE, "..", "..", "gateway", "urrt-gateway.example.ini")
+    example = os.path.join(HERE, "..", "..", "gateway", "install", "urrt-gateway.example.ini")
     p = subprocess.run([args.gateway, "--check-config", example], capture_output=True, text=True, timeout=10)
     check(p.returncode == 0 and "arm1.STATE: every packet" in p.stdout and "arm1.STATUS: 10 Hz" in p.stdout,
           "config: the example configuration is valid and its plan printed")
@@ -882,7 +882,8 @@ def t_install(args):
              "usr/share/doc/urrt/LICENSE", "usr/share/doc/urrt/examples/canopen.ini",
              "usr/share/doc/urrt/examples/fd.ini", "usr/share/doc/urrt/examples/j1939.ini",
              "usr/share/urrt/lcmtypes/state_t.lcm", "usr/share/urrt/lcmtypes/gateway_t.lcm",
-             "usr/include/urrt.h", "usr/include/urrt_can.h", "usr/lib/liburrt.a", "usr/lib/pkgconfig/urrt.pc"]
+             "usr/include/urrt.h", "usr/include/urrt_can.h", "usr/include/urrt_cantx.h", "usr/lib/liburrt.a",
+             "usr/lib/pkgconfig/urrt.pc", "usr/share/doc/urrt/firmware.md", "usr/share/doc/urrt/architecture.md"]
     missing = [f for f in files if not os.path.exists(os.path.join(root, f))]
     check(p.returncode == 0 and not missing, "install: %d files in place (missing: %s; %s)" %
           (len(files), missing, p.stderr.strip()[-200:]))
@@ -921,7 +922,7 @@ def t_install(args):
     # The checked-in unit is the one for PREFIX=/usr, so that it can be copied as it is.
     usr = make("dist-files", where[0], "PREFIX=/usr")
     dist_unit = os.path.join(args.build, "dist", "urrt-gateway.service")
-    check(usr.returncode == 0 and open(dist_unit).read() == open(os.path.join(repo, "gateway",
+    check(usr.returncode == 0 and open(dist_unit).read() == open(os.path.join(repo, "gateway", "install",
           "urrt-gateway.service")).read(), "install: for PREFIX=/usr the unit is gateway/install/urrt-gateway.service as it is")
     make("dist-files")
     if subprocess.run(["which", "systemd-analyze"], capture_output=True).returncode == 0:
