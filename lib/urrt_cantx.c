@@ -175,10 +175,9 @@ int urrt_cantx_init(urrt_cantx *tx, const urrt_cantx_tables *tables, urrt_cantx_
         frame = i;
     }
     if (rc == 0) {
-        frame = NONE;
         size_t needed = urrt_cantx_value_count(tables);
-        if (needed > value_count || needed > UINT16_MAX ||
-            (value_count > 0u && values == NULL)) {
+        frame = NONE;
+        if (needed > value_count || needed > UINT16_MAX || (value_count > 0u && values == NULL)) {
             rc = URRT_CANTX_E_STORAGE;
         }
     }
@@ -203,6 +202,11 @@ int urrt_cantx_init(urrt_cantx *tx, const urrt_cantx_tables *tables, urrt_cantx_
     for (i = 0; i < tables->frame_count; i++) {
         frame_states[i].first_value = (uint16_t)first;
         first += tables->frames[i].signal_count;
+    }
+    /* Before the first start, no robot has data and no link is up. */
+    for (i = 0; i < tables->robot_count; i++) {
+        robots[i].has_data = false;
+        robots[i].up = false;
     }
     tx->started = false;
     return 0;

@@ -116,7 +116,7 @@ typedef struct urrt_cantx_frame {
     uint8_t flags;             /* URRT_CANTX_EXTENDED, URRT_CANTX_FD */
     uint32_t id;
     uint32_t period_us;        /* URRT_CANTX_EVERY_PACKET or the period */
-    uint32_t stale_after_us;   /* data older than this is stale (0: always stale) */
+    uint32_t stale_after_us;   /* data older than this is stale */
     uint8_t stale;             /* urrt_cantx_stale */
     uint8_t robot;             /* the robot whose fields it carries and whose age counts */
     urrt_cantx_fill_fn fill;   /* NULL unless the frame has URRT_CANTX_FILLED signals */
@@ -136,7 +136,7 @@ typedef struct urrt_cantx_frame_state {
     uint64_t sent_invalid;     /* sent with the validity bit cleared */
     uint64_t stale_stops;      /* times it stopped (or dropped a packet's frame) for stale data */
     uint16_t first_value;      /* its signals' slots in values[] */
-    uint8_t payload[URRT_CAN_MAX_LEN]; /* field values, packed once per packet taken */
+    uint8_t payload[URRT_CAN_MAX_LEN]; /* the field values last taken, packed when first needed */
     int8_t outcome;            /* worst URRT_CAN_PACK_* of that packing */
     uint8_t alive;
     bool unpacked;             /* values taken since the payload was packed */
@@ -169,7 +169,7 @@ typedef struct urrt_cantx {
     urrt_cantx_frame_state *frames;
     urrt_cantx_robot *robots;
     double *values;
-    void *user;                /* for the caller's fill functions */
+    void *user;                /* for the caller's fill functions: set it after urrt_cantx_init */
     urrt_cantx_link link;      /* as last set */
     urrt_cantx_link link_seen; /* at the previous heartbeat */
     uint64_t clamped;          /* values packed with an outcome other than OK */

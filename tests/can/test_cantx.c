@@ -155,6 +155,11 @@ static void test_init(void)
     CHECK_EQ(init(&bad_frame, &bad_signal), 0, "valid tables");
     CHECK_EQ(bad_frame, SIZE_MAX, "no bad frame");
     CHECK_EQ(states[1].first_value, 3, "frame 1's values follow frame 0's");
+    robots[0].has_data = true; /* what a reused or uninitialised array might hold */
+    robots[0].up = true;
+    CHECK_EQ(init(NULL, NULL), 0, "init again");
+    CHECK_EQ(urrt_cantx_gateway_state(&tx, 2, 0), URRT_CANTX_DISCONNECTED, "before start: no data, no link");
+    CHECK_EQ(urrt_cantx_fresh(&tx, 0, 0, STALE_US), 0, "before start: nothing is fresh");
 
     frames[1].id = 0x800;
     expect_refused(URRT_CAN_E_ID, 1, SIZE_MAX, "11-bit id above 0x7FF");
