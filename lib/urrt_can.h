@@ -230,11 +230,14 @@ int urrt_can_pack(const urrt_can_signal *sig, double value, uint8_t *data, unsig
 /*
  * For a descriptor already checked against this payload's length
  * (urrt_can_signal_check, urrt_can_layout_check or urrt_cantx_init returned
- * 0): what urrt_can_pack and urrt_can_put_raw do, without checking it again.
+ * 0): what urrt_can_pack and urrt_can_put_raw do, without checking it again,
+ * into a whole frame buffer (URRT_CAN_MAX_LEN bytes, a urrt_can_frame's
+ * data, whatever the frame's length), so that a signal can be written a
+ * 64-bit word at a time; bits outside the signal keep their value.
  * Passing a descriptor that was not checked is undefined behaviour.
  */
-int urrt_can_pack_checked(const urrt_can_signal *sig, double value, uint8_t *data);
-void urrt_can_put_raw_checked(const urrt_can_signal *sig, uint64_t raw, uint8_t *data);
+int urrt_can_pack_checked(const urrt_can_signal *sig, double value, uint8_t data[URRT_CAN_MAX_LEN]);
+void urrt_can_put_raw_checked(const urrt_can_signal *sig, uint64_t raw, uint8_t data[URRT_CAN_MAX_LEN]);
 
 /* urrt_can_get_raw then urrt_can_from_raw. */
 int urrt_can_unpack(const urrt_can_signal *sig, const uint8_t *data, unsigned frame_len, double *value);

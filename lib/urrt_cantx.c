@@ -36,6 +36,11 @@ static double nan_value(void)
     return b.d;
 }
 
+static bool takes_field(uint8_t kind)
+{
+    return kind == (uint8_t)URRT_CANTX_FIELD || kind == (uint8_t)URRT_CANTX_FIELD_MASK;
+}
+
 const char *urrt_cantx_strerror(int result)
 {
     switch (result) {
@@ -156,6 +161,24 @@ size_t urrt_cantx_value_count(const urrt_cantx_tables *tables)
     return n;
 }
 
+/* The frame's fixed parts, and zeros where no signal is. */
+static void frame_init(urrt_cantx_frame_state *fs, const urrt_cantx_frame *f, size_t first_value)
+{
+    size_t i;
+    fs->first_value = (uint16_t)first_value;
+    fs->fields_end = 0;
+    for (i = 0; i < f->signal_count; i++) {
+        fs->fields_end = takes_field(f->sources[i].kind) ? (uint16_t)(i + 1u) : fs->fields_end;
+    }
+    fs->frame.id = f->id;
+    fs->frame.extended = (f->flags & URRT_CANTX_EXTENDED) != 0u;
+    fs->frame.fd = (f->flags & URRT_CANTX_FD) != 0u;
+    fs->frame.len = f->len;
+    for (i = 0; i < URRT_CAN_MAX_LEN; i++) {
+        fs->frame.data[i] = 0;
+    }
+}
+
 int urrt_cantx_init(urrt_cantx *tx, const urrt_cantx_tables *tables, urrt_cantx_frame_state *frame_states,
                     urrt_cantx_robot *robots, double *values, size_t value_count, size_t *bad_frame,
                     size_t *bad_signal)
@@ -200,9 +223,10 @@ int urrt_cantx_init(urrt_cantx *tx, const urrt_cantx_tables *tables, urrt_cantx_
     tx->clamped = 0;
     tx->clamped_seen = 0;
     for (i = 0; i < tables->frame_count; i++) {
-        frame_states[i].first_value = (uint16_t)first;
+        frame_init(&frame_states[i], &tables->frames[i], first);
         first += tables->frames[i].signal_count;
     }
+    tx->wake_us = 0;
     /* Before the first start, no robot has data and no link is up. */
     for (i = 0; i < tables->robot_count; i++) {
         robots[i].has_data = false;
@@ -214,37 +238,44 @@ int urrt_cantx_init(urrt_cantx *tx, const urrt_cantx_tables *tables, urrt_cantx_
 
 /* ---- values in, payloads out -------------------------------------------------- */
 
-static double field_value(const urrt_state *st, const urrt_cantx_source *src)
-{
-    double v;
-    uint64_t mask;
-    if (st == NULL || !urrt_has(st, src->field)) {
-        return nan_value();
-    }
-    v = urrt_field_values(st, (urrt_field_id)src->field)[src->elem];
-    if (src->kind != (uint8_t)URRT_CANTX_FIELD_MASK) {
-        return v;
-    }
-    return urrt_bitmask(v, &mask) < 0 ? nan_value() : (double)mask;
-}
+/* Where each field's values start in urrt_state, in doubles: what
+ * urrt_field_values gives, without a call for every value of every packet. */
+static const uint16_t field_slots[URRT_FIELD_COUNT] = {
+#define URRT_X_SLOT(ID, name, count, c1, c3, unit, since, desc) \
+    (uint16_t)(offsetof(urrt_state, name) / sizeof(double)),
+    URRT_FIELDS(URRT_X_SLOT)
+#undef URRT_X_SLOT
+};
 
 /* A packet costs these loads only: the values are packed once, when the
- * frame next goes out (or a heartbeat reports clamping). */
+ * frame next goes out (or a heartbeat reports clamping); a bit mask is
+ * read as one then too. No state: every field NaN. */
 static void take_fields(urrt_cantx *tx, size_t index, const urrt_state *st)
 {
-    const urrt_cantx_frame *f = &tx->tables->frames[index];
+    const urrt_cantx_source *sources = tx->tables->frames[index].sources;
     urrt_cantx_frame_state *fs = &tx->frames[index];
     double *values = tx->values + fs->first_value;
+    const double *slots = (const double *)(const void *)st;
+    uint64_t present = st != NULL ? st->present : 0u;
+    size_t end = fs->fields_end;
     size_t i;
-    for (i = 0; i < f->signal_count; i++) {
-        uint8_t kind = f->sources[i].kind;
-        if (kind == (uint8_t)URRT_CANTX_FIELD || kind == (uint8_t)URRT_CANTX_FIELD_MASK) {
-            values[i] = field_value(st, &f->sources[i]);
+    for (i = 0; i < end; i++) {
+        const urrt_cantx_source src = sources[i];
+        if (takes_field(src.kind)) {
+            values[i] = ((present >> src.field) & 1u) != 0u ? slots[field_slots[src.field] + src.elem] : nan_value();
         }
     }
     fs->unpacked = true;
 }
 
+static double mask_value(double v)
+{
+    uint64_t mask;
+    return urrt_bitmask(v, &mask) < 0 ? nan_value() : (double)mask;
+}
+
+/* The fields' bits of the frame; each write replaces the signal's own bits
+ * (urrt_cantx_init saw that signals do not overlap). */
 static void pack_fields(urrt_cantx *tx, size_t index)
 {
     const urrt_cantx_frame *f = &tx->tables->frames[index];
@@ -256,16 +287,15 @@ static void pack_fields(urrt_cantx *tx, size_t index)
         return;
     }
     fs->unpacked = false;
-    for (i = 0; i < f->len; i++) {
-        fs->payload[i] = 0;
-    }
-    for (i = 0; i < f->signal_count; i++) {
+    for (i = 0; i < fs->fields_end; i++) {
         uint8_t kind = f->sources[i].kind;
         int outcome;
-        if (kind != (uint8_t)URRT_CANTX_FIELD && kind != (uint8_t)URRT_CANTX_FIELD_MASK) {
+        if (!takes_field(kind)) {
             continue;
         }
-        outcome = urrt_can_pack_checked(&f->signals[i], values[i], fs->payload);
+        outcome = urrt_can_pack_checked(&f->signals[i], kind == (uint8_t)URRT_CANTX_FIELD_MASK ? mask_value(values[i])
+                                                                                              : values[i],
+                                        fs->frame.data);
         if (outcome != URRT_CAN_PACK_OK) {
             tx->clamped++;
             worst = outcome > worst ? outcome : worst;
@@ -274,9 +304,9 @@ static void pack_fields(urrt_cantx *tx, size_t index)
     fs->outcome = (int8_t)worst;
 }
 
-/* The frame as it goes out at now_us: the packed fields, then the filled
- * values, the alive counter and the validity bit. */
-static void build(urrt_cantx *tx, size_t index, uint64_t now_us, bool fresh, bool sending, urrt_can_frame *out)
+/* The frame as it goes out at now_us, in fs->frame: the packed fields,
+ * then the filled values, the alive counter and the validity bit. */
+static const urrt_can_frame *build(urrt_cantx *tx, size_t index, uint64_t now_us, bool fresh, bool sending)
 {
     const urrt_cantx_frame *f = &tx->tables->frames[index];
     urrt_cantx_frame_state *fs = &tx->frames[index];
@@ -285,37 +315,43 @@ static void build(urrt_cantx *tx, size_t index, uint64_t now_us, bool fresh, boo
     size_t i;
     pack_fields(tx, index);
     valid = fresh && fs->outcome == URRT_CAN_PACK_OK;
-    out->id = f->id;
-    out->extended = (f->flags & URRT_CANTX_EXTENDED) != 0u;
-    out->fd = (f->flags & URRT_CANTX_FD) != 0u;
-    out->len = f->len;
-    for (i = 0; i < URRT_CAN_MAX_LEN; i++) {
-        out->data[i] = i < f->len ? fs->payload[i] : 0u;
-    }
     if (f->fill != NULL) {
         f->fill(tx, index, now_us, sending, values);
     }
     for (i = 0; i < f->signal_count; i++) {
         const urrt_can_signal *sig = &f->signals[i];
         switch ((urrt_cantx_kind)f->sources[i].kind) {
-        case URRT_CANTX_ALIVE: urrt_can_put_raw_checked(sig, fs->alive, out->data); break;
-        case URRT_CANTX_VALID: urrt_can_put_raw_checked(sig, valid ? 1u : 0u, out->data); break;
-        case URRT_CANTX_FILLED: (void)urrt_can_pack_checked(sig, values[i], out->data); break;
+        case URRT_CANTX_ALIVE: urrt_can_put_raw_checked(sig, fs->alive, fs->frame.data); break;
+        case URRT_CANTX_VALID: urrt_can_put_raw_checked(sig, valid ? 1u : 0u, fs->frame.data); break;
+        case URRT_CANTX_FILLED: (void)urrt_can_pack_checked(sig, values[i], fs->frame.data); break;
         default: break;
         }
     }
+    return &fs->frame;
 }
 
 static void send_frame(urrt_cantx *tx, size_t index, uint64_t now_us, bool fresh, urrt_cantx_emit_fn emit, void *ctx)
 {
     urrt_cantx_frame_state *fs = &tx->frames[index];
-    urrt_can_frame out;
-    build(tx, index, now_us, fresh, true, &out);
+    const urrt_can_frame *out = build(tx, index, now_us, fresh, true);
     fs->alive++;
     fs->sent++;
     fs->sent_invalid += !(fresh && fs->outcome == URRT_CAN_PACK_OK);
     if (emit != NULL) {
-        emit(ctx, &out, now_us);
+        emit(ctx, out, now_us);
+    }
+}
+
+/* Field by field, as link_copy. */
+static void frame_copy(urrt_can_frame *to, const urrt_can_frame *from)
+{
+    size_t i;
+    to->id = from->id;
+    to->extended = from->extended;
+    to->fd = from->fd;
+    to->len = from->len;
+    for (i = 0; i < URRT_CAN_MAX_LEN; i++) {
+        to->data[i] = from->data[i];
     }
 }
 
@@ -326,11 +362,33 @@ void urrt_cantx_peek(urrt_cantx *tx, size_t frame, uint64_t now_us, urrt_can_fra
         return;
     }
     f = &tx->tables->frames[frame];
-    build(tx, frame, now_us, urrt_cantx_fresh(tx, f->robot, now_us, f->stale_after_us), false, out);
+    /* What build writes beyond the packed fields, the next send writes again. */
+    frame_copy(out, build(tx, frame, now_us, urrt_cantx_fresh(tx, f->robot, now_us, f->stale_after_us), false));
 }
 
 /* ---- the schedule ------------------------------------------------------------- */
 
+uint64_t urrt_cantx_deadline(const urrt_cantx *tx)
+{
+    return tx == NULL || !tx->started ? URRT_CANTX_NEVER : tx->wake_us;
+}
+
+/* The deadline from the frames: kept in wake_us by whatever moves it
+ * (start, a packet, a run), so that a run or a deadline between frames
+ * costs a comparison. */
+static uint64_t next_wake(const urrt_cantx *tx)
+{
+    uint64_t next = URRT_CANTX_NEVER;
+    size_t i;
+    for (i = 0; i < tx->tables->frame_count; i++) {
+        const urrt_cantx_frame_state *fs = &tx->frames[i];
+        if (fs->pending) {
+            return 0; /* now */
+        }
+        next = fs->next_due_us < next ? fs->next_due_us : next;
+    }
+    return next;
+}
 
 void urrt_cantx_start(urrt_cantx *tx, uint64_t now_us)
 {
@@ -361,6 +419,7 @@ void urrt_cantx_start(urrt_cantx *tx, uint64_t now_us)
         fs->stopped = f->stale == (uint8_t)URRT_CANTX_STALE_STOP;
         fs->next_due_us = f->period_us == URRT_CANTX_EVERY_PACKET || fs->stopped ? URRT_CANTX_NEVER : now_us;
     }
+    tx->wake_us = next_wake(tx);
     tx->clamped = 0; /* the NaNs above are no packet's values */
     tx->clamped_seen = 0;
     link_zero(&tx->link_seen); /* the first heartbeat reports what came before */
@@ -407,10 +466,12 @@ void urrt_cantx_on_packet(urrt_cantx *tx, size_t robot, const urrt_state *st, ui
         take_fields(tx, i, st);
         if (t->frames[i].period_us == URRT_CANTX_EVERY_PACKET) {
             fs->pending = true;
+            tx->wake_us = 0;
         } else if (fs->stopped) {
             /* Fresh data again: resume now, then keep the period. */
             fs->stopped = false;
             fs->next_due_us = data_us;
+            tx->wake_us = data_us < tx->wake_us ? data_us : tx->wake_us;
         }
     }
 }
@@ -477,12 +538,16 @@ size_t urrt_cantx_run(urrt_cantx *tx, uint64_t now_us, urrt_cantx_emit_fn emit, 
         urrt_cantx_start(tx, now_us);
     }
     tx->run_us = now_us;
+    if (now_us < tx->wake_us) {
+        return 0; /* most packets: no frame is due */
+    }
     for (i = 0; i < tx->tables->frame_count; i++) {
         const urrt_cantx_frame *f = &tx->tables->frames[i];
         bool fresh = urrt_cantx_fresh(tx, f->robot, now_us, f->stale_after_us);
         sent += f->period_us == URRT_CANTX_EVERY_PACKET ? run_every(tx, i, now_us, fresh, emit, ctx)
                                                          : run_periodic(tx, i, now_us, fresh, emit, ctx);
     }
+    tx->wake_us = next_wake(tx);
     return sent;
 }
 
@@ -499,23 +564,6 @@ size_t urrt_cantx_catch_up(urrt_cantx *tx, uint64_t until_us, urrt_cantx_emit_fn
         sent += urrt_cantx_run(tx, due > tx->run_us ? due : tx->run_us, emit, ctx);
     }
     return sent;
-}
-
-uint64_t urrt_cantx_deadline(const urrt_cantx *tx)
-{
-    uint64_t next = URRT_CANTX_NEVER;
-    size_t i;
-    if (tx == NULL || !tx->started) {
-        return URRT_CANTX_NEVER;
-    }
-    for (i = 0; i < tx->tables->frame_count; i++) {
-        const urrt_cantx_frame_state *fs = &tx->frames[i];
-        if (fs->pending) {
-            return 0; /* now */
-        }
-        next = fs->next_due_us < next ? fs->next_due_us : next;
-    }
-    return next;
 }
 
 /* ---- the heartbeat ------------------------------------------------------------ */

@@ -136,8 +136,11 @@ typedef struct urrt_cantx_frame_state {
     uint64_t sent_invalid;     /* sent with the validity bit cleared */
     uint64_t stale_stops;      /* times it stopped (or dropped a packet's frame) for stale data */
     uint16_t first_value;      /* its signals' slots in values[] */
-    uint8_t payload[URRT_CAN_MAX_LEN]; /* the field values last taken, packed when first needed */
-    int8_t outcome;            /* worst URRT_CAN_PACK_* of that packing */
+    uint16_t fields_end;       /* no signal from this index on carries a robot field */
+    urrt_can_frame frame;      /* as last built: the field values last taken (packed when
+                                  first needed), then the alive counter, validity bit and
+                                  filled values of its latest send; emit receives it */
+    int8_t outcome;            /* worst URRT_CAN_PACK_* of the fields' packing */
     uint8_t alive;
     bool unpacked;             /* values taken since the payload was packed */
     bool pending;              /* every packet: a packet came since the last send */
@@ -176,6 +179,7 @@ typedef struct urrt_cantx {
     uint64_t clamped_seen;     /* at the previous heartbeat */
     uint64_t start_us;
     uint64_t run_us;           /* the time of the latest urrt_cantx_run */
+    uint64_t wake_us;          /* urrt_cantx_deadline: nothing is due before it */
     bool started;
 } urrt_cantx;
 

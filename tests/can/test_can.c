@@ -352,17 +352,23 @@ static void test_values(void)
     }
 }
 
-/* Random descriptors: pack, unpack, compare within half a raw step; and
- * every bit outside the signal is kept. */
+/* Random descriptors: pack, unpack, compare within half a raw step; every
+ * bit outside the signal is kept; and the word-wide urrt_can_pack_checked
+ * and urrt_can_put_raw_checked write the same bytes as the checked calls,
+ * whose bytes the placement tests above pin down. */
 static void test_round_trip(void)
 {
     int n;
     int bad_value = 0;
     int bad_bits = 0;
+    int bad_checked = 0;
     for (n = 0; n < 20000; n++) {
         urrt_can_signal s;
         uint8_t data[64];
         uint8_t before[64];
+        uint8_t word[64];
+        uint8_t raw_bytes[64];
+        uint64_t raw = rnd();
         uint8_t mask[64] = {0};
         unsigned len = (unsigned)(rnd() % 64) + 1;
         unsigned type = (unsigned)(rnd() % 4);
@@ -395,7 +401,13 @@ static void test_round_trip(void)
         if (type >= URRT_CAN_FLOAT32) {
             v = (double)((int64_t)(rnd() % 2000001) - 1000000) / 64.0;
         }
+        memcpy(word, before, sizeof word);
         outcome = urrt_can_pack(&s, v, data, frame_len);
+        bad_checked += urrt_can_pack_checked(&s, v, word) != outcome || memcmp(word, data, sizeof word) != 0;
+        memcpy(raw_bytes, data, sizeof raw_bytes);
+        urrt_can_put_raw_checked(&s, raw, word);
+        urrt_can_put_raw(&s, raw, raw_bytes, frame_len);
+        bad_checked += memcmp(word, raw_bytes, sizeof word) != 0;
         urrt_can_unpack(&s, data, frame_len, &back);
         if (outcome != URRT_CAN_PACK_OK || !(fabs(back - v) <= fabs(factor) * 0.5000001 + fabs(v) * 1e-15)) {
             if (bad_value++ < 5) {
@@ -412,6 +424,7 @@ static void test_round_trip(void)
     }
     CHECK(bad_value == 0, "%d of 20000 random values did not round-trip", bad_value);
     CHECK(bad_bits == 0, "%d of 20000 packs changed bits outside the signal", bad_bits);
+    CHECK(bad_checked == 0, "%d of 40000 word-wide writes differ from urrt_can_pack / urrt_can_put_raw", bad_checked);
 }
 
 /* ---- lib: layout, lengths, ids, bits on the wire --------------------------------- */

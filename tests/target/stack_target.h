@@ -115,6 +115,7 @@ static void stack_cantx(urrt_can_signal *sigs)
     STACK(urrt_cantx_set_link, (&tx, &link));
     STACK(urrt_cantx_on_packet, (&tx, 0, &st, 2000));
     STACK(urrt_cantx_run, (&tx, 2000, stack_emit, NULL));
+    urrt_cantx_on_packet(&tx, 0, &st, 3000); /* catch-up's first frame packs new values */
     STACK(urrt_cantx_catch_up, (&tx, 250000, stack_emit, NULL));
     STACK(urrt_cantx_on_packet, (&tx, 0, &st, 255000));
     STACK(urrt_cantx_gateway_state, (&tx, 1, 260000));
