@@ -31,7 +31,7 @@ $(GWT)/alloc_shim.so: tests/gateway/alloc_shim.c
 
 $(GWT)/bench_gateway: tests/gateway/bench_gateway.c $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(GWT_CFLAGS) -o $@ $< $(LIBURRT) -llcm -lm -lpthread
+	$(CC) $(GWT_CFLAGS) -o $@ $< $(LIBURRT) -lm -lpthread
 
 $(GWT)/bench_relay: tests/gateway/bench_relay.c $(LIBURRT)
 	@mkdir -p $(@D)
