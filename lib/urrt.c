@@ -820,19 +820,21 @@ unsigned urrt_x86_vector_bytes(void)
 #endif
 
 #ifndef URRT_VECTOR
-/* n big-endian doubles from src into dst. */
+/* n big-endian doubles from src into dst. Counted by the destination
+ * pointer: an index beside it cost GCC for Cortex-M4 (-O2) one more
+ * instruction per double. */
 static void load_doubles(double *dst, const uint8_t *src, unsigned n)
 {
-    unsigned i = 0;
+    double *end = dst + n;
 #ifdef URRT_LOAD_WORDS
     if (((uintptr_t)(const void *)src & 3u) == 0) {
-        for (; i < n; i++) {
-            dst[i] = double_from_bits(load_be64_aligned4(src + 8u * i));
+        for (; dst < end; dst++, src += 8) {
+            *dst = double_from_bits(load_be64_aligned4(src));
         }
     }
 #endif
-    for (; i < n; i++) {
-        dst[i] = double_from_bits(load_be64(src + 8u * i));
+    for (; dst < end; dst++, src += 8) {
+        *dst = double_from_bits(load_be64(src));
     }
 }
 

@@ -220,6 +220,8 @@ void urrt_cantx_robot_link(urrt_cantx *tx, size_t robot, bool up);
 /* The CAN link's counters now, for the heartbeat. */
 void urrt_cantx_set_link(urrt_cantx *tx, const urrt_cantx_link *link);
 
+/* Sends a frame; *frame is the core's own and changes with the next
+ * frame built: copy it to keep it past the call (a transmit queue). */
 typedef void (*urrt_cantx_emit_fn)(void *ctx, const urrt_can_frame *frame, uint64_t now_us);
 
 /* Sends every frame due at now_us through emit, in table order. Returns the
