@@ -347,9 +347,8 @@ static void store_be64(uint8_t *p, uint64_t w)
 }
 
 /* move_bits' write into a whole frame buffer: the signal in one 64-bit
- * word of it where it fits in one (any signal shorter than 57 bits, and
- * every one of a classic frame but a full 64-bit one), else chunk by
- * chunk. An Intel signal counts up from bit `shift` of a little-endian
+ * word of it where it fits in one (any signal of up to 57 bits, and every
+ * signal of a classic frame), else chunk by chunk. An Intel signal counts up from bit `shift` of a little-endian
  * word; a Motorola one from bit `shift` of a big-endian word, which holds
  * its contiguous run of big-endian linear bits. */
 static void put_bits_in_frame(const urrt_can_signal *sig, uint8_t *data, uint64_t raw)
