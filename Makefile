@@ -7,7 +7,7 @@ DESTDIR ?=
 BUILD ?= build
 
 CC ?= cc
-# What the README recommends for an edge box.
+# Default build flags; docs/performance.md measures them beside -march=native.
 OPT ?= -O2 -g
 # lib/ is held to the strictest warnings; programs and tests to a little less.
 LIB_WARN := -std=c99 -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion \
@@ -20,8 +20,8 @@ PYTHON := /usr/bin/python3
 
 # Debian packages (Debian 12 names) in three tiers, each package named once
 # (check-ship lists the union and finds no duplicate):
-# 1. `make` and `make demo`: compiler, LCM (C, lcm-gen, Java), inih, a JDK for the types jar.
-DEPS_BUILD := gcc libc6-dev make pkg-config liblcm-dev liblcm-bin liblcm-java default-jdk-headless libinih-dev
+# 1. `make` and `make demo`: compiler, LCM (C, lcm-gen, Java), a JDK for the types jar.
+DEPS_BUILD := gcc libc6-dev make pkg-config liblcm-dev liblcm-bin liblcm-java default-jdk-headless
 # 2. `make spy`: a Java runtime with GUI libraries, and jchart2d for lcm-spy's charts.
 DEPS_SPY := default-jre libjchart2d-java
 # 3. `make check`: everything else. Fragments add theirs with DEB_DEPS += ...

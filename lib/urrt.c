@@ -39,7 +39,7 @@ URRT_FIELDS(URRT_X_COUNT_CHECK)
 #define URRT_NAN_BITS UINT64_C(0x7FF8000000000000)
 #define URRT_1X_MAX_DOUBLES 101u
 #define URRT_3X_MIN_DOUBLES 130u
-/* 1.5 sent columns 50-52 without the accelerometer (protocol-facts.md). */
+/* 1.5 sent columns 50-52 without the accelerometer (docs/sources.md, "1.x differences"). */
 #define URRT_1X_ACCELEROMETER_MIN_DOUBLES 95u
 
 /* The shortest 3.x grid ends with a whole field: a 3.x decode copies at
@@ -563,63 +563,14 @@ static unsigned bit_count(uint32_t x)
  * fields after them (URRT_GRID_DOUBLES doubles, asserted contiguous
  * above), then present, length, doubles, extra_columns and generation. It
  * is bound by stores (about one per cycle, whatever its width up to a
- * cache line), so the vector paths below make as few as they can.
+ * cache line; lib/vector/urrt_vector.c has the vector paths).
  */
 #define URRT_GRID_DOUBLES (URRT_WIRE_COLUMNS + URRT_1X_ONLY_DOUBLES)
-/* The vector paths write the struct's last 48 bytes as {NaN, NaN, NaN,
- * present} and, where the counts are laid out so (not where enums are
- * short, as arm-none-eabi has them), {length | doubles << 32 |
- * extra_columns << 48, generation} (little-endian hosts only, as below). */
-#define URRT_FILL_END (URRT_GRID_DOUBLES - 3u)
-URRT_STATIC_ASSERT(present_follows_the_grid, offsetof(urrt_state, present) == URRT_GRID_DOUBLES * sizeof(double));
-#define URRT_COUNTS_PACKED                                                                          \
-    (offsetof(urrt_state, length) == offsetof(urrt_state, present) + 8 &&                           \
-     offsetof(urrt_state, doubles) == offsetof(urrt_state, length) + 4 &&                           \
-     offsetof(urrt_state, extra_columns) == offsetof(urrt_state, length) + 6 &&                     \
-     offsetof(urrt_state, generation) == offsetof(urrt_state, length) + 8 &&                        \
-     sizeof(urrt_generation) == 4 && sizeof(urrt_state) >= offsetof(urrt_state, generation) + 8)
-/* The fill before the tail holds at least one 64-byte vector. */
-URRT_STATIC_ASSERT(fill_holds_a_vector, URRT_FILL_END >= URRT_WIRE_COLUMNS + 8u);
 
 static inline uint64_t present_mask(unsigned fields)
 {
     return fields >= 64u ? ~UINT64_C(0) : (UINT64_C(1) << fields) - 1u;
 }
-
-/*
- * Vector byte swap for the grid copy, where the compiler offers portable
- * vector extensions (GCC, clang) and the target has a byte shuffle: x86
- * SSSE3 (-march=x86-64-v2), AVX2 (-march=x86-64-v3), AVX-512BW
- * (-march=x86-64-v4), ARM NEON; -march=native picks the widest. The decode
- * is bound by stores, so the widest vector wins. Elsewhere the copy is one
- * 8-byte load and swap per double. Little-endian hosts only: on a
- * big-endian one (armeb, aarch64_be also have NEON) the swap would reverse
- * bytes that are already in the host's order.
- *
- * x86-64 built without SSSE3 (a distribution's baseline -O2 build) carries
- * all three widths as functions compiled for their instruction sets and
- * picks the widest the CPU has at each decode (URRT_CPU_DISPATCH), from
- * libgcc's CPU model (__builtin_cpu_supports: a load and a bit test; libgcc
- * fills it in a constructor that runs before any other). Define
- * URRT_NO_CPU_DISPATCH to keep such a build to one double at a time, or
- * URRT_X86_MAX_VECTOR_BYTES (0, 16, 32, 64) to cap the choice (the tests
- * run every width that way).
- */
-#if defined(URRT_LOAD_UNALIGNED) && (defined(__SSSE3__) || defined(__ARM_NEON))
-#define URRT_VECTOR 1
-#if defined(__AVX512BW__)
-#define URRT_VECTOR_BYTES 64
-#elif defined(__AVX2__)
-#define URRT_VECTOR_BYTES 32
-#else
-#define URRT_VECTOR_BYTES 16
-#endif
-#elif defined(URRT_LOAD_UNALIGNED) && defined(__x86_64__) && !defined(URRT_NO_CPU_DISPATCH)
-#define URRT_CPU_DISPATCH 1
-#ifndef URRT_X86_MAX_VECTOR_BYTES
-#define URRT_X86_MAX_VECTOR_BYTES 64
-#endif
-#endif
 
 /* What a 3.x/5.x packet of `doubles` doubles fills in. */
 typedef struct grid_shape {
@@ -627,6 +578,12 @@ typedef struct grid_shape {
     unsigned fields;  /* the grid fields present (a prefix of the table) */
     unsigned known;   /* the packet's columns that the grid has */
 } grid_shape;
+
+/* The grid_tail_ends of the tail fields that end by column `known`. */
+static inline uint32_t grid_tail_ends_by(unsigned known)
+{
+    return grid_tail_ends & ((UINT32_C(2) << (known - URRT_3X_MIN_DOUBLES)) - 1u);
+}
 
 static inline grid_shape grid_shape_of(unsigned doubles)
 {
@@ -637,189 +594,13 @@ static inline grid_shape grid_shape_of(unsigned doubles)
      * ending by column `known` (a bit count, no branches: walking back
      * from the last field until one fitted cost the 1060-byte packet,
      * seven steps, a sixth of its decode). */
-    g.fields = grid_fields - grid_tail_fields +
-               bit_count(grid_tail_ends & ((UINT32_C(2) << (g.known - URRT_3X_MIN_DOUBLES)) - 1u));
-    /* The columns before the first absent field: the vector paths take the
-     * last end by column `known` (columns are dense and one field ends at
-     * URRT_3X_MIN_DOUBLES, asserted above), a CLZ instead of a load that
-     * waits for the bit count; the others take the first absent field's
-     * column (no CLZ instruction on Cortex-M0). */
-#if defined(URRT_VECTOR) || defined(URRT_CPU_DISPATCH)
-    g.copied = URRT_3X_MIN_DOUBLES + 31u -
-               (unsigned)__builtin_clz((grid_tail_ends & ((UINT32_C(2) << (g.known - URRT_3X_MIN_DOUBLES)) - 1u)) | 1u);
-#else
+    g.fields = grid_fields - grid_tail_fields + bit_count(grid_tail_ends_by(g.known));
+    /* The columns before the first absent field, the one after the prefix
+     * (lib/vector/urrt_vector.c counts them by a CLZ instead). */
     g.copied = g.fields < grid_fields ? layout_table[g.fields].col_3x - 1u : URRT_WIRE_COLUMNS;
-#endif
     return g;
 }
 
-#if defined(URRT_VECTOR) || defined(URRT_CPU_DISPATCH)
-#define URRT_SWAP_INDEX_16 7, 6, 5, 4, 3, 2, 1, 0, 15, 14, 13, 12, 11, 10, 9, 8
-#define URRT_SWAP_INDEX_32 URRT_SWAP_INDEX_16, 23, 22, 21, 20, 19, 18, 17, 16, 31, 30, 29, 28, 27, 26, 25, 24
-#define URRT_SWAP_INDEX_64 URRT_SWAP_INDEX_32, 39, 38, 37, 36, 35, 34, 33, 32, 47, 46, 45, 44, 43, 42, 41, 40, \
-                           55, 54, 53, 52, 51, 50, 49, 48, 63, 62, 61, 60, 59, 58, 57, 56
-#define URRT_NAN_16 URRT_NAN_BITS, URRT_NAN_BITS
-#define URRT_NAN_32 URRT_NAN_16, URRT_NAN_16
-#define URRT_NAN_64 URRT_NAN_32, URRT_NAN_32
-#define URRT_LANES_16 0, 1
-#define URRT_LANES_32 0, 1, 2, 3
-#define URRT_LANES_64 0, 1, 2, 3, 4, 5, 6, 7
-#if defined(__clang__)
-#define URRT_SHUFFLE(v, type, ...) __builtin_shufflevector((v), (v), __VA_ARGS__)
-#else
-#define URRT_SHUFFLE(v, type, ...) __builtin_shuffle((v), (type){__VA_ARGS__})
-#endif
-#define URRT_PASTE2(a, b) a##b
-#define URRT_PASTE(a, b) URRT_PASTE2(a, b)
-
-/*
- * decode_3x at one width. The stores are aligned to the vector size except
- * the first and, where the caller's struct is not aligned, the last of the
- * fill: misaligned stores cost two (and where the struct crossed a 4 KiB
- * boundary, all-unaligned stores made the decode half again as slow). The
- * vector where the copy meets the NaN is one store (BOUNDARY, where the
- * compiler has a two-vector shuffle by a variable index) or two overlapping
- * ones. Loads come two vectors at a time ahead of their stores (one at a
- * time cost 1060 bytes a tenth more). NaN is a constant vector (built lane
- * by lane it went through the stack, and realigning the stack for it cost
- * a prologue). No stack, no call: a push is a store too.
- */
-#define URRT_DECODE_3X_FUNC(NAME, BYTES, ATTR, BOUNDARY)                                           \
-    static ATTR int NAME(const uint8_t *buf, unsigned size, urrt_state *st)                        \
-    {                                                                                              \
-        typedef unsigned char bytes_v __attribute__((vector_size(BYTES)));                         \
-        typedef uint64_t u64_v __attribute__((vector_size(BYTES)));                                \
-        typedef uint64_t u64x4 __attribute__((vector_size(32)));                                   \
-        typedef uint64_t u64x2 __attribute__((vector_size(16)));                                   \
-        const unsigned per = BYTES / 8u;                                                           \
-        const u64_v nan = {URRT_NAN_##BYTES};                                                      \
-        const uint8_t *src = buf + URRT_HEADER_SIZE;                                               \
-        double *dst = grid_slot(st, 1);                                                            \
-        unsigned doubles = (size - URRT_HEADER_SIZE) / 8u;                                         \
-        grid_shape g = grid_shape_of(doubles);                                                     \
-        unsigned n = g.copied;                                                                     \
-        unsigned i = (unsigned)(BYTES - ((uintptr_t)(void *)dst & (BYTES - 1u))) / 8u;             \
-        /* the struct's last 48 bytes, worked out first: fewer live registers */                   \
-        const u64x4 last = {URRT_NAN_BITS, URRT_NAN_BITS, URRT_NAN_BITS, present_mask(g.fields)};  \
-        const u64x2 counts = {size | (uint64_t)doubles << 32 | (uint64_t)(doubles - g.known) << 48, \
-                              (uint64_t)URRT_GEN_3X};                                              \
-        bytes_v a, b;                                                                              \
-        __builtin_memcpy(&a, src, sizeof a);                                                       \
-        a = URRT_SHUFFLE(a, bytes_v, URRT_SWAP_INDEX_##BYTES);                                     \
-        __builtin_memcpy(dst, &a, sizeof a);                                                       \
-        for (; i + 2u * per <= n; i += 2u * per) {                                                 \
-            __builtin_memcpy(&a, src + 8u * i, sizeof a);                                          \
-            __builtin_memcpy(&b, src + 8u * i + BYTES, sizeof b);                                  \
-            a = URRT_SHUFFLE(a, bytes_v, URRT_SWAP_INDEX_##BYTES);                                 \
-            b = URRT_SHUFFLE(b, bytes_v, URRT_SWAP_INDEX_##BYTES);                                 \
-            __builtin_memcpy(&dst[i], &a, sizeof a);                                               \
-            __builtin_memcpy(&dst[i + per], &b, sizeof b);                                         \
-        }                                                                                          \
-        if (i + per <= n) {                                                                        \
-            __builtin_memcpy(&a, src + 8u * i, sizeof a);                                          \
-            a = URRT_SHUFFLE(a, bytes_v, URRT_SWAP_INDEX_##BYTES);                                 \
-            __builtin_memcpy(&dst[i], &a, sizeof a);                                               \
-            i += per;                                                                              \
-        }                                                                                          \
-        if (i < n) {                                                                               \
-            /* the last `per` doubles, the first n - i of them wanted at dst[i] */                 \
-            __builtin_memcpy(&a, src + 8u * (n - per), sizeof a);                                  \
-            a = URRT_SHUFFLE(a, bytes_v, URRT_SWAP_INDEX_##BYTES);                                 \
-            BOUNDARY                                                                               \
-            i += per;                                                                              \
-        }                                                                                          \
-        for (; i + per <= URRT_FILL_END; i += per) {                                               \
-            __builtin_memcpy(&dst[i], &nan, sizeof nan);                                           \
-        }                                                                                          \
-        if (i < URRT_FILL_END) {                                                                   \
-            __builtin_memcpy(&dst[URRT_FILL_END - per], &nan, sizeof nan);                         \
-        }                                                                                          \
-        __builtin_memcpy(&dst[URRT_FILL_END], &last, sizeof last);                                 \
-        if (URRT_COUNTS_PACKED) {                                                                  \
-            __builtin_memcpy(&dst[URRT_GRID_DOUBLES + 1u], &counts, sizeof counts);                \
-        } else {                                                                                   \
-            st->length = size;                                                                     \
-            st->doubles = (uint16_t)doubles;                                                       \
-            st->extra_columns = (uint16_t)(doubles - g.known);                                     \
-            st->generation = URRT_GEN_3X;                                                          \
-        }                                                                                          \
-        return (int)size;                                                                          \
-    }
-
-/* BOUNDARY as two overlapping stores, and as one: lane j of the store at
- * dst[i] takes lane j + per - (n - i) of `a`, which for j >= n - i is past
- * `a`'s last and so picks lane j - (n - i) of `nan` (GCC: VPERMT2Q). */
-#define URRT_BOUNDARY_OVERLAP                                                                      \
-    __builtin_memcpy(&dst[n - per], &a, sizeof a);                                                 \
-    __builtin_memcpy(&dst[n], &nan, sizeof nan);
-#define URRT_BOUNDARY_BLEND(BYTES)                                                                 \
-    {                                                                                              \
-        const u64_v lanes = {URRT_LANES_##BYTES};                                                  \
-        u64_v q = __builtin_shuffle((u64_v)a, nan, lanes + (uint64_t)(per - (n - i)));             \
-        __builtin_memcpy(&dst[i], &q, sizeof q);                                                   \
-    }
-#if defined(__clang__)
-#define URRT_BOUNDARY_64 URRT_BOUNDARY_OVERLAP
-#else
-#define URRT_BOUNDARY_64 URRT_BOUNDARY_BLEND(64)
-#endif
-#define URRT_BOUNDARY_32 URRT_BOUNDARY_OVERLAP
-#define URRT_BOUNDARY_16 URRT_BOUNDARY_OVERLAP
-#endif
-
-#ifdef URRT_VECTOR
-/* Not inlined either: inside urrt_decode it cost four pushes. */
-#define URRT_DECODE_3X_AT(BYTES) \
-    URRT_DECODE_3X_FUNC(decode_3x_vector, BYTES, __attribute__((noinline)), URRT_PASTE(URRT_BOUNDARY_, BYTES))
-URRT_DECODE_3X_AT(URRT_VECTOR_BYTES)
-#endif
-
-#ifdef URRT_CPU_DISPATCH
-#if URRT_X86_MAX_VECTOR_BYTES >= 16
-URRT_DECODE_3X_FUNC(decode_3x_16, 16, __attribute__((target("ssse3"))), URRT_BOUNDARY_16)
-#endif
-#if URRT_X86_MAX_VECTOR_BYTES >= 32
-URRT_DECODE_3X_FUNC(decode_3x_32, 32, __attribute__((target("avx2"))), URRT_BOUNDARY_32)
-#endif
-#if URRT_X86_MAX_VECTOR_BYTES >= 64
-URRT_DECODE_3X_FUNC(decode_3x_64, 64, __attribute__((target("avx512bw"))), URRT_BOUNDARY_64)
-#endif
-
-static unsigned cpu_vector_bytes(void)
-{
-#if URRT_X86_MAX_VECTOR_BYTES >= 64
-    if (__builtin_cpu_supports("avx512bw")) {
-        return 64;
-    }
-#endif
-#if URRT_X86_MAX_VECTOR_BYTES >= 32
-    if (__builtin_cpu_supports("avx2")) {
-        return 32;
-    }
-#endif
-#if URRT_X86_MAX_VECTOR_BYTES >= 16
-    if (__builtin_cpu_supports("ssse3")) {
-        return 16;
-    }
-#endif
-    return 0;
-}
-#endif
-
-#if defined(__x86_64__)
-unsigned urrt_x86_vector_bytes(void)
-{
-#if defined(URRT_CPU_DISPATCH)
-    return cpu_vector_bytes();
-#elif defined(URRT_VECTOR)
-    return URRT_VECTOR_BYTES;
-#else
-    return 0;
-#endif
-}
-#endif
-
-#ifndef URRT_VECTOR
 /* n big-endian doubles from src into dst. Counted by the destination
  * pointer: an index beside it cost GCC for Cortex-M4 (-O2) one more
  * instruction per double. */
@@ -854,33 +635,25 @@ static int decode_3x_scalar(const uint8_t *buf, unsigned size, urrt_state *st)
     return (int)size;
 }
 
-#endif
-
-/* The hot path (e-series at 500 Hz): one pass over the grid, by the widest
- * vectors this build or CPU has. */
+/* The hot path (e-series at 500 Hz): one pass over the grid. Where
+ * lib/vector/urrt_vector.c includes this file, it defines decode_3x after
+ * it: by the widest vectors the build or the CPU has, else as here. */
+#ifdef URRT_VECTOR_PATHS
+static int decode_3x(const uint8_t *buf, unsigned size, urrt_state *st);
+#else
 static int decode_3x(const uint8_t *buf, unsigned size, urrt_state *st)
 {
-#if defined(URRT_VECTOR)
-    return decode_3x_vector(buf, size, st);
-#else
-#if defined(URRT_CPU_DISPATCH) && URRT_X86_MAX_VECTOR_BYTES >= 64
-    if (__builtin_cpu_supports("avx512bw")) {
-        return decode_3x_64(buf, size, st);
-    }
-#endif
-#if defined(URRT_CPU_DISPATCH) && URRT_X86_MAX_VECTOR_BYTES >= 32
-    if (__builtin_cpu_supports("avx2")) {
-        return decode_3x_32(buf, size, st);
-    }
-#endif
-#if defined(URRT_CPU_DISPATCH) && URRT_X86_MAX_VECTOR_BYTES >= 16
-    if (__builtin_cpu_supports("ssse3")) {
-        return decode_3x_16(buf, size, st);
-    }
-#endif
     return decode_3x_scalar(buf, size, st);
-#endif
 }
+
+#if defined(__x86_64__)
+/* Declared by urrt.h on x86-64: this file alone copies one double at a time. */
+unsigned urrt_x86_vector_bytes(void)
+{
+    return 0;
+}
+#endif
+#endif
 
 /* 1.x and the ambiguous lengths: field by field from the table. */
 static void decode_by_table(const uint8_t *body, unsigned doubles, urrt_generation gen, urrt_state *st)
@@ -903,10 +676,10 @@ static void decode_by_table(const uint8_t *body, unsigned doubles, urrt_generati
 }
 
 /* Everything but a 3.x/5.x packet: errors, 1.x, the ambiguous lengths. Not
- * inlined beside a vector path, so that urrt_decode saves no registers
- * before it jumps there (a push is a store). A firmware keeps one frame
+ * inlined beside the vector paths, so that urrt_decode saves no registers
+ * before it jumps to them (a push is a store). A firmware keeps one frame
  * (the stack checker adds the frames of a tail call). */
-#if defined(URRT_VECTOR) || defined(URRT_CPU_DISPATCH)
+#if defined(URRT_VECTOR_PATHS) && defined(__GNUC__)
 __attribute__((noinline))
 #endif
 static int decode_other(const uint8_t *buf, int size, urrt_state *st)

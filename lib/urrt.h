@@ -290,7 +290,8 @@ int urrt_decode(const uint8_t *buf, size_t len, urrt_state *st);
 #if defined(__x86_64__)
 /* x86-64: the vector width in bytes urrt_decode uses on this CPU, 64
  * (AVX-512BW), 32 (AVX2), 16 (SSSE3) or 0 (one double at a time). A build
- * without -m flags chooses it at run time; a -march build has it fixed. */
+ * without -m flags chooses it at run time; a -march build has it fixed; 0
+ * where lib/urrt.c is built without lib/vector/urrt_vector.c. */
 unsigned urrt_x86_vector_bytes(void);
 #endif
 

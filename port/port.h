@@ -66,7 +66,6 @@ void urrt_log(urrt_log_level level, const char *fmt, ...)
 
 /* Change the threshold after init (a --verbose option, say). */
 void urrt_log_set_level(urrt_log_level max_level);
-urrt_log_level urrt_log_get_level(void);
 /* "error", "warning", "notice", "info", "debug". */
 const char *urrt_log_level_name(urrt_log_level level);
 
@@ -99,7 +98,11 @@ typedef struct urrt_link_config {
 #define URRT_LINK_PORT_RW 30003
 #define URRT_LINK_PORT_RO 30013
 
-/* Defaults: port 30003, connect 2 s, silence 100 ms (12 periods at 125 Hz),
+/* The silence that drops a link by default: 12 periods at 125 Hz. A
+ * literal: urrt-gateway's key table shows it as text. */
+#define URRT_LINK_SILENCE_TIMEOUT_MS 100
+
+/* Defaults: port 30003, connect 2 s, silence URRT_LINK_SILENCE_TIMEOUT_MS,
  * backoff 100 ms doubling to 5 s. */
 void urrt_link_config_defaults(urrt_link_config *cfg);
 
@@ -233,8 +236,6 @@ typedef enum urrt_canlink_state {
     URRT_CANLINK_DOWN = 0,         /* not open, or the interface is down; reopening */
     URRT_CANLINK_UP
 } urrt_canlink_state;
-
-const char *urrt_canlink_state_name(urrt_canlink_state state);
 
 typedef struct urrt_canlink_stats {
     uint64_t sent;             /* frames the driver (or the log file) took */

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 # tests/can.mk: the CAN mapping, packing and DBC.
-#   check-can      lib/urrt_can and gateway/can/can_map unit tests (hand vectors, saturation,
-#                  config rejections with FILE:LINE, bus load, scheduling on a fake clock)
+#   check-can      lib/urrt_can and gateway/can/can_map, can_run unit tests (hand vectors,
+#                  saturation, configurations loaded by the gateway's loader and their
+#                  rejections with FILE:LINE, bus load, scheduling on a fake clock)
 #   check-can-san  the same under ASan + UBSan (float-cast-overflow included: no float to
 #                  integer conversion may be undefined), lib/ and gateway/ compiled with them
 #   check-can-dbc  DBCs and payloads against python3-canmatrix and an independent
@@ -9,9 +10,11 @@
 #   bench-can      ns per packet for the CAN mapping beside urrt_decode of the same packet
 
 CANT := $(BUILD)/tests/can
-CAN_TEST_SRCS := gateway/can/can_map.c gateway/can/can_run.c gateway/can/dbc.c gateway/common/conf.c
-# can_map reads values with conf.o (built by gateway/common/common.mk).
-CAN_TEST_OBJS := $(CAN_GATEWAY_OBJS) $(CONF_OBJ)
+CAN_TEST_SRCS := gateway/can/can_map.c gateway/can/can_run.c gateway/can/dbc.c gateway/common/conf.c \
+                 gateway/urrt-gateway/config.c
+# The tests load configurations as the gateway does: its loader (config.o, which
+# needs no LCM), conf.o (gateway/common/common.mk) and the port's link defaults.
+CAN_TEST_OBJS := $(CAN_GATEWAY_OBJS) $(BUILD)/gateway/urrt-gateway/config.o $(CONF_OBJ)
 CAN_TEST_CFLAGS := $(PROG_WARN) $(CPPFLAGS) $(GATEWAY_INC) -Itests
 
 CHECKS += check-can check-can-san check-can-dbc
@@ -28,15 +31,16 @@ endef
 
 $(CANT)/test_can: tests/can/test_can.c tests/check.h $(CAN_TEST_OBJS) $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_TEST_OBJS) $(LIBURRT) -linih -lm -o $@
+	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_TEST_OBJS) $(LIBPORT) $(LIBURRT) -lm -o $@
 
-$(CANT)/test_can_san: tests/can/test_can.c tests/check.h $(CAN_TEST_SRCS) $(GATEWAY_HDRS) $(LIB_SRCS)
+$(CANT)/test_can_san: tests/can/test_can.c tests/check.h $(CAN_TEST_SRCS) $(GATEWAY_HDRS) $(LIB_SRCS) $(LIBPORT)
 	@mkdir -p $(@D)
-	$(CC) $(CAN_TEST_CFLAGS) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $< $(CAN_TEST_SRCS) $(LIB_SRCS) -linih -lm -o $@
+	$(CC) $(CAN_TEST_CFLAGS) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $< $(CAN_TEST_SRCS) $(LIB_SRCS) \
+	  $(LIBPORT) -lm -o $@
 
-$(CANT)/can_tool: tests/can/can_tool.c $(CAN_TEST_OBJS) $(LIBURRT)
+$(CANT)/can_tool: tests/can/can_tool.c $(CAN_TEST_OBJS) $(LIBPORT) $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_TEST_OBJS) $(LIBURRT) -linih -lm -o $@
+	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_TEST_OBJS) $(LIBPORT) $(LIBURRT) -lm -o $@
 
 check-can: $(CANT)/test_can
 	$(call can_suite,check-can,$(CANT)/test_can)
@@ -51,9 +55,9 @@ check-can-dbc: $(CANT)/can_tool
 BENCHES += bench-can
 .PHONY: bench-can
 
-$(CANT)/bench_can: tests/can/bench_can.c $(CAN_TEST_OBJS) $(LIBURRT)
+$(CANT)/bench_can: tests/can/bench_can.c $(CAN_TEST_OBJS) $(LIBPORT) $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_TEST_OBJS) $(LIBURRT) -linih -lm -o $@
+	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_TEST_OBJS) $(LIBPORT) $(LIBURRT) -lm -o $@
 
 bench-can: $(CANT)/bench_can
 	@$(CANT)/bench_can docs/examples/canopen.ini

@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: MIT
 # tests/config.mk: the gateway configuration as untrusted input.
 #   check-fuzz-config  the regression tests of what the fuzzer found (test_config), then the
-#                      libFuzzer harness (ASan + UBSan) over the loader, the CAN mapping and
-#                      the DBC writer: every seed and regression input, then briefly
+#                      libFuzzer harness (ASan + UBSan) over the loader, the CAN mapping, its
+#                      tables and the DBC writer: every seed and regression input, then briefly
 #   fuzz-config        the same harness for FUZZ_SECONDS (part of `make fuzz`)
 # Seeds: docs/examples, the example configuration, the e2e one, tests/config/seeds.
 
@@ -27,12 +27,12 @@ $(CFG_SEEDS)/.stamp: $(CFG_SEED_FILES)
 $(CFGT)/fuzz_config: tests/config/fuzz_config.c $(CFG_FUZZ_SRCS) $(CFG_FUZZ_HDRS) $(LIB_SRCS) $(LIBPORT)
 	@mkdir -p $(@D)
 	$(FUZZ_CC) -std=gnu11 -Wall -Wextra -Wshadow -Werror -g -O1 -fsanitize=fuzzer,address,undefined \
-	  -fno-sanitize-recover=all $(CPPFLAGS) $(GATEWAY_INC) $< $(CFG_FUZZ_SRCS) $(LIB_SRCS) $(LIBPORT) -linih -lm -o $@
+	  -fno-sanitize-recover=all $(CPPFLAGS) $(GATEWAY_INC) $< $(CFG_FUZZ_SRCS) $(LIB_SRCS) $(LIBPORT) -lm -o $@
 
 $(CFGT)/test_config: tests/config/test_config.c tests/check.h $(CFG_FUZZ_SRCS) $(CFG_FUZZ_HDRS) $(LIB_SRCS) $(LIBPORT)
 	@mkdir -p $(@D)
 	$(CC) $(PROG_WARN) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $(CPPFLAGS) $(GATEWAY_INC) -Itests \
-	  $< $(CFG_FUZZ_SRCS) $(LIB_SRCS) $(LIBPORT) -linih -lm -o $@
+	  $< $(CFG_FUZZ_SRCS) $(LIB_SRCS) $(LIBPORT) -lm -o $@
 
 check-fuzz-config: $(CFGT)/fuzz_config $(CFGT)/test_config $(CFG_SEEDS)/.stamp
 	@mkdir -p $(BUILD)/results

@@ -7,15 +7,17 @@
 #                  and hard-float -O2), netduinoplus2
 #                  (STM32F405) and microbit (Cortex-M0, -Os and -O2); no C library in the
 #                  images, results through semihosting and qemu's exit status; and the painted
-#                  stack of every public lib/ function against -fstack-usage and README.md;
+#                  stack of every public lib/ function against -fstack-usage and docs/footprint.md;
 #                  the CAN core's tests (tests/can/test_cantx.c) on the M4 (soft and hard float)
 #                  and the M0
 #   check-lib-be   tests/lib/test_lib.c on big-endian s390x, powerpc and mips (with the lib/urrt_can
-#                  tests of tests/can/test_can.c) and on little-endian NEON (aarch64, armhf)
+#                  tests of tests/can/test_can.c), lib/*.c alone, and on little-endian NEON
+#                  (aarch64, armhf; lib/vector/urrt_vector.c, and aarch64 also lib/*.c alone)
 #                  under qemu-user; on big-endian NEON (aarch64_be, armeb; freestanding)
-#                  lib/ passes and lib/ with the old vector condition (commit d7588d7) fails
+#                  lib/vector/urrt_vector.c passes and the same with the old vector condition
+#                  (commit d7588d7) fails
 #   bench-lib-m4   instructions per operation on the emulated Cortex-M4 (qemu -icount),
-#                  a cycle estimate at 168 MHz, checked against README.md
+#                  a cycle estimate at 168 MHz, checked against docs/performance.md
 
 TGT := $(BUILD)/tests/target
 TGT_QEMU_M := qemu-system-arm -nographic -monitor none -serial none -semihosting-config enable=on,target=native
@@ -83,12 +85,13 @@ check-lib-m4: $(foreach b,$(TGT_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/te
 	    -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/test.elf") \
 	  $(foreach b,$(TGT_CANTX),cantx-$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M) -M $(lastword $(subst :, ,$(b))) \
 	    -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/cantx.elf") \
-	  stack-m4-os="$(PYTHON) tests/target/stack.py $(TGT)/logs/m4-os.log README.md $(TGT)/m4-os/lib/*.ci")
+	  stack-m4-os="$(PYTHON) tests/target/stack.py $(TGT)/logs/m4-os.log docs/footprint.md $(TGT)/m4-os/lib/*.ci")
 
 # ---- big-endian and NEON under qemu-user ---------------------------------------------
 
-# $(call tgt_linux,NAME,CC AND FLAGS,QEMU[,can]): test_lib (and with "can" the urrt_can
-# tests, which have no vector path: on the big-endian targets only), static.
+# $(call tgt_linux,NAME,CC AND FLAGS,QEMU,SOURCES[,can]): test_lib of lib/ as SOURCES
+# (LIB_SRCS or LIB_HOST_SRCS, lib/lib.mk) and with "can" the urrt_can tests, which have no
+# vector path: on the big-endian targets only; static.
 TGT_CAN_LIB := $(TGT)/can_lib_tests.c
 $(TGT_CAN_LIB): tests/can/test_can.c tests/target/can_lib_tests.sh
 	@mkdir -p $(@D)
@@ -98,47 +101,55 @@ define tgt_linux
 $(TGT)/$(1)/lib/%.o: lib/%.c $(LIB_HDRS)
 	@mkdir -p $$(@D)
 	$(2) $(LIB_WARN) -O2 -c $$< -o $$@
-$(TGT)/$(1)/test_lib: tests/lib/test_lib.c tests/check.h tests/lib/state_slot.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
-	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
-$(TGT)/$(1)/test_can: $(TGT_CAN_LIB) tests/check.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
-	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
-TGT_BE_BINS += $(TGT)/$(1)/test_lib $(if $(4),$(TGT)/$(1)/test_can)
-TGT_BE_RUNS += $(1)="$(3) $(TGT)/$(1)/test_lib $(LIB_VECTORS)" $(if $(4),$(1)-can="$(3) $(TGT)/$(1)/test_can")
+$(TGT)/$(1)/lib/vector/urrt_vector.o: lib/urrt.c
+$(TGT)/$(1)/test_lib: tests/lib/test_lib.c tests/check.h tests/lib/state_slot.h $(4:lib/%.c=$(TGT)/$(1)/lib/%.o)
+	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(4:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
+$(TGT)/$(1)/test_can: $(TGT_CAN_LIB) tests/check.h $(4:lib/%.c=$(TGT)/$(1)/lib/%.o)
+	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(4:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
+TGT_BE_BINS += $(TGT)/$(1)/test_lib $(if $(5),$(TGT)/$(1)/test_can)
+TGT_BE_RUNS += $(1)="$(3) $(TGT)/$(1)/test_lib $(LIB_VECTORS)" $(if $(5),$(1)-can="$(3) $(TGT)/$(1)/test_can")
 endef
 TGT_NEON := -mfpu=neon-vfpv4
-$(eval $(call tgt_linux,s390x,s390x-linux-gnu-gcc,qemu-s390x,can))
-$(eval $(call tgt_linux,powerpc,powerpc-linux-gnu-gcc,qemu-ppc,can))
-$(eval $(call tgt_linux,mips,mips-linux-gnu-gcc,qemu-mips,can))
-$(eval $(call tgt_linux,aarch64,aarch64-linux-gnu-gcc,qemu-aarch64))
-$(eval $(call tgt_linux,armhf,arm-linux-gnueabihf-gcc $(TGT_NEON),qemu-arm))
+$(eval $(call tgt_linux,s390x,s390x-linux-gnu-gcc,qemu-s390x,$(LIB_SRCS),can))
+$(eval $(call tgt_linux,powerpc,powerpc-linux-gnu-gcc,qemu-ppc,$(LIB_SRCS),can))
+$(eval $(call tgt_linux,mips,mips-linux-gnu-gcc,qemu-mips,$(LIB_SRCS),can))
+$(eval $(call tgt_linux,aarch64,aarch64-linux-gnu-gcc,qemu-aarch64,$(LIB_HOST_SRCS)))
+$(eval $(call tgt_linux,aarch64-alone,aarch64-linux-gnu-gcc,qemu-aarch64,$(LIB_SRCS)))
+$(eval $(call tgt_linux,armhf,arm-linux-gnueabihf-gcc $(TGT_NEON),qemu-arm,$(LIB_HOST_SRCS)))
 
-# Which grid copy each build takes: the byte-swapping vector path on little-endian
-# NEON, never on big-endian NEON (where the wire's order is the host's).
+# Which grid copy each build of lib/vector/urrt_vector.c takes: the byte-swapping vector
+# path on little-endian NEON, never on big-endian NEON (where the wire's order is the host's).
 TGT_ARMEB := arm-none-eabi-gcc -mbig-endian -mcpu=cortex-a7 $(TGT_NEON) -mfloat-abi=hard -Wl,--be8
 TGT_A64BE := aarch64-linux-gnu-gcc -mbig-endian
-tgt_vector = $(1) -ffreestanding -O2 -Ilib -E -dM lib/urrt.c | grep -q '^\#define URRT_VECTOR ' && echo '1 passed, 0 failed'
-tgt_no_vector = ! $(1) -ffreestanding -O2 -Ilib -E -dM lib/urrt.c | grep -q '^\#define URRT_VECTOR ' && echo '1 passed, 0 failed'
+tgt_vector = $(1) -ffreestanding -O2 -Ilib -E -dM $(LIB_VECTOR_SRC) | grep -q '^\#define URRT_VECTOR ' && \
+  echo '1 passed, 0 failed'
+tgt_no_vector = ! $(1) -ffreestanding -O2 -Ilib -E -dM $(LIB_VECTOR_SRC) | grep -q '^\#define URRT_VECTOR ' && \
+  echo '1 passed, 0 failed'
 
 # Big-endian NEON has no C library in Debian: freestanding images of
-# test_target.c with tests/target/linux_start.c. The regression build is
-# lib/urrt.c with the vector condition as it was before commit d7588d7
-# (any GNU compiler, not little-endian only), generated here; it must fail.
-TGT_OLD_NEON := $(TGT)/old_neon/urrt.c
-$(TGT_OLD_NEON): lib/urrt.c
+# test_target.c with tests/target/linux_start.c, on lib/vector/urrt_vector.c
+# (the vector paths; lib/urrt.c alone has none). The regression build is that
+# file with the vector condition as it was before commit d7588d7 (any GNU
+# compiler, not little-endian only), generated here; it must fail. The copy
+# finds its #include "../urrt.c" through -Ilib/vector.
+TGT_OLD_NEON := $(TGT)/old_neon/urrt_vector.c
+$(TGT_OLD_NEON): $(LIB_VECTOR_SRC)
 	@mkdir -p $(@D)
 	sed 's/^#if defined(URRT_LOAD_UNALIGNED) && (defined(__SSSE3__) || defined(__ARM_NEON))$$/#if defined(__GNUC__) \&\& (defined(__SSSE3__) || defined(__ARM_NEON))/' $< > $@.tmp
 	@grep -q '^#if defined(__GNUC__) && (defined(__SSSE3__) || defined(__ARM_NEON))$$' $@.tmp || \
-	  { echo "$@: lib/urrt.c's vector condition changed: update the regression's sed"; exit 1; }
+	  { echo "$@: $<'s vector condition changed: update the regression's sed"; exit 1; }
 	mv $@.tmp $@
 
 TGT_BE_FREE := $(TGT_FLAGS) -O2 -nostdlib -static tests/target/linux_start.c tests/target/test_target.c \
                $(TGT)/vectors_named.c
-$(TGT)/%/neon_be: $(TGT_DRIVER) tests/target/linux_start.c $(TGT)/vectors_named.c lib/urrt.c $(LIB_HDRS)
+$(TGT)/%/neon_be: $(TGT_DRIVER) tests/target/linux_start.c $(TGT)/vectors_named.c $(LIB_VECTOR_SRC) lib/urrt.c \
+  $(LIB_HDRS)
 	@mkdir -p $(@D)
-	$(if $(filter armeb,$*),$(TGT_ARMEB),$(TGT_A64BE)) $(TGT_BE_FREE) lib/urrt.c -o $@
-$(TGT)/%/neon_be_old: $(TGT_DRIVER) tests/target/linux_start.c $(TGT)/vectors_named.c $(TGT_OLD_NEON) $(LIB_HDRS)
+	$(if $(filter armeb,$*),$(TGT_ARMEB),$(TGT_A64BE)) $(TGT_BE_FREE) $(LIB_VECTOR_SRC) -o $@
+$(TGT)/%/neon_be_old: $(TGT_DRIVER) tests/target/linux_start.c $(TGT)/vectors_named.c $(TGT_OLD_NEON) lib/urrt.c \
+  $(LIB_HDRS)
 	@mkdir -p $(@D)
-	$(if $(filter armeb,$*),$(TGT_ARMEB),$(TGT_A64BE)) $(TGT_BE_FREE) -Ilib $(TGT_OLD_NEON) -o $@
+	$(if $(filter armeb,$*),$(TGT_ARMEB),$(TGT_A64BE)) $(TGT_BE_FREE) -Ilib/vector $(TGT_OLD_NEON) -o $@
 TGT_BE_BINS += $(foreach a,armeb aarch64_be,$(TGT)/$(a)/neon_be $(TGT)/$(a)/neon_be_old)
 
 check-lib-be: $(TGT_BE_BINS) $(LIB_VECTORS) $(TGT_OLD_NEON)
@@ -170,7 +181,7 @@ $(eval $(call tgt_bench,m0-os-portable,$(TGT_M0),-Os,microbit.ld,-U__BYTE_ORDER_
 
 bench-lib-m4: $(foreach b,m4-os m4-o2 m0-os m0-os-portable,$(TGT)/bench-$(b).elf) tests/target/bench.py
 	$(call lib_suite,bench-lib-m4,sh tests/target/run.sh $(TGT)/logs-bench \
-	  m4="$(PYTHON) tests/target/bench.py README.md '$(TGT_QEMU_M) -M mps2-an386' \
+	  m4="$(PYTHON) tests/target/bench.py docs/performance.md '$(TGT_QEMU_M) -M mps2-an386' \
 	    -Os=$(TGT)/bench-m4-os.elf -O2=$(TGT)/bench-m4-o2.elf" \
 	  m0="$(PYTHON) tests/target/bench.py --not-slower '$(TGT_QEMU_M) -M microbit' \
 	    words=$(TGT)/bench-m0-os.elf portable=$(TGT)/bench-m0-os-portable.elf")

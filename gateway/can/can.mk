@@ -1,12 +1,13 @@
 # SPDX-License-Identifier: MIT
-# gateway/can/can.mk: urrt-gateway's CAN side. The mapping configuration
-# (can_map), its run-time tables over lib/urrt_cantx (can_run), the DBC writer
-# (dbc) and the C tables writer (can_ctables), which tests link too; and the
-# parts that use the port's CAN link (can_out, the gateway output; can_replay,
-# --replay), which only the gateway links. tests/can.mk tests them.
+# gateway/can/can.mk: what urrt-gateway's CAN side is without the gateway's
+# loop. The mapping language (can_map), its run-time tables over
+# lib/urrt_cantx (can_run), the DBC writer (dbc) and the C tables writer
+# (can_ctables), which tests link too; and --replay (can_replay), which uses
+# the port's CAN link and only the gateway links. The CAN output, beside the
+# loop that drives it, is gateway/urrt-gateway/can_out.c. tests/can.mk tests them.
 
 CAN_GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/can/,can_map.o can_run.o dbc.o can_ctables.o)
-CAN_PORT_OBJS := $(addprefix $(BUILD)/gateway/can/,can_out.o can_replay.o)
+CAN_PORT_OBJS := $(addprefix $(BUILD)/gateway/can/,can_replay.o)
 GATEWAY_EXTRA_OBJS += $(CAN_GATEWAY_OBJS) $(CAN_PORT_OBJS)
 
 $(BUILD)/gateway/can/%.o: gateway/can/%.c

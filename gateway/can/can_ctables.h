@@ -2,7 +2,7 @@
 /*
  * can_ctables: `urrt-gateway --print-c-tables`. The CAN frames of a
  * configuration as C source of lib/urrt_cantx.h tables (the very tables
- * urrt-gateway runs on, can_map_tx), with their storage and an init
+ * urrt-gateway runs on, can_run.h), with their storage and an init
  * function, so that a firmware sends the same frames without a mapping
  * written by hand. docs/firmware.md shows one in use.
  */
@@ -12,10 +12,11 @@
 #include <stdio.h>
 
 #include "can_map.h"
+#include "can_run.h"
 
-/* Writes the C source for a finished map (source: the configuration's
- * path, for the header comment). 0, or -1 when the tables cannot be built
- * or the stream failed. */
-int can_ctables_write(FILE *out, struct can_map *map, const char *source);
+/* Writes the C source of run, the tables of map (source: the
+ * configuration's path, for the header comment). 0, or -1 when the stream
+ * failed. */
+int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run, const char *source);
 
 #endif

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* can_map: mapping configuration, checks and frame scheduling for the CAN
- * side of urrt-gateway. See can_map.h and docs/can.md. */
+/* can_map: the CAN mapping's keys, signal grammar and whole-file checks.
+ * See can_map.h and docs/can.md. */
 #include "can_map.h"
 
 #include <ctype.h>
@@ -15,10 +15,9 @@
 /* ---- reporting ------------------------------------------------------------------- */
 
 /* Reports a problem: to the map's reporter if one is set, and as
- * "FILE:LINE: reason" into err. add_error appends ('\n'-separated, as far as
- * it fits); fail replaces and returns -1. */
-static void report(const struct can_map *map, char *err, size_t errlen, bool append, struct can_map_loc loc,
-                   const char *fmt, va_list ap)
+ * "FILE:LINE: reason" appended to err ('\n'-separated, as far as it fits). */
+static void report(const struct can_map *map, char *err, size_t errlen, struct can_map_loc loc, const char *fmt,
+                   va_list ap)
 {
     char reason[512];
     size_t used = 0;
@@ -29,14 +28,12 @@ static void report(const struct can_map *map, char *err, size_t errlen, bool app
     if (err == NULL || errlen == 0) {
         return;
     }
-    if (append) {
-        used = strnlen(err, errlen);
-        if (used + 1 >= errlen) {
-            return;
-        }
-        if (used > 0) {
-            err[used++] = '\n';
-        }
+    used = strnlen(err, errlen);
+    if (used + 1 >= errlen) {
+        return;
+    }
+    if (used > 0) {
+        err[used++] = '\n';
     }
     snprintf(err + used, errlen - used, "%s:%d: %s", loc.file ? loc.file : "?", loc.line, reason);
 }
@@ -49,20 +46,8 @@ static void add_error(const struct can_map *map, char *err, size_t errlen, struc
 {
     va_list ap;
     va_start(ap, fmt);
-    report(map, err, errlen, true, loc, fmt, ap);
+    report(map, err, errlen, loc, fmt, ap);
     va_end(ap);
-}
-
-static int fail(const struct can_map *map, char *err, size_t errlen, struct can_map_loc loc, const char *fmt, ...)
-    __attribute__((format(printf, 5, 6)));
-
-static int fail(const struct can_map *map, char *err, size_t errlen, struct can_map_loc loc, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    report(map, err, errlen, false, loc, fmt, ap);
-    va_end(ap);
-    return -1;
 }
 
 static const char *intern_file(struct can_map *map, const char *file)
@@ -94,19 +79,13 @@ static const char *intern_file(struct can_map *map, const char *file)
 void can_map_init(struct can_map *map)
 {
     memset(map, 0, sizeof *map);
-    map->bitrate = CAN_MAP_DEFAULT_BITRATE;
-    map->max_load_percent = CAN_MAP_DEFAULT_MAX_LOAD;
-    map->hb_period_ms = CAN_MAP_DEFAULT_HEARTBEAT_MS;
-    map->stale_after_ms = CAN_MAP_DEFAULT_STALE_MS;
-    map->generation = URRT_GEN_3X;
-    snprintf(map->node, sizeof map->node, "URRT_GATEWAY");
-    snprintf(map->receiver, sizeof map->receiver, "Vector__XXX");
+    /* The table's defaults parse: test_config checks every table's. */
+    (void)conf_key_defaults(can_map_can_keys, CAN_MAP_CK_COUNT, map, NULL, 0);
 }
 
 void can_map_free(struct can_map *map)
 {
     size_t i;
-    can_map_run_free(map);
     for (i = 0; i < map->frame_count; i++) {
         free(map->frames[i].sigs);
         free(map->frames[i].meta);
@@ -149,6 +128,43 @@ int can_map_describe(const struct can_map *map, char *buf, size_t size)
                     map->interface ? map->interface : "?", map->load * 100.0, (unsigned)map->bitrate,
                     map->data_bitrate > map->bitrate ? " with an FD data phase" : "", map->max_load_percent);
 }
+
+/* What the DBC says of each heartbeat signal (dbc.c). */
+const struct can_map_hb_signal can_map_heartbeat_layout[URRT_CANTX_HB_COUNT] = {
+    [URRT_CANTX_HB_STATE] = {"state", "", CAN_MAP_HB_VALUES_STATE,
+                          "Gateway state: 0 starting, 1 ok, 2 data stale, 3 robot disconnected"},
+    [URRT_CANTX_HB_ALIVE] = {"alive_counter", "", CAN_MAP_HB_VALUES_NONE,
+                          "Incremented (modulo 16) with every heartbeat"},
+    [URRT_CANTX_HB_ROBOT_MODE] = {"robot_mode", "",
+                               CAN_MAP_HB_VALUES_ROBOT_MODE,
+                               "Robot mode of the heartbeat robot as it sends it (numbering per generation); "
+                               "-128: not available (no data, or older than stale_after_ms)"},
+    [URRT_CANTX_HB_SAFETY_MODE] = {"safety_mode", "",
+                                CAN_MAP_HB_VALUES_SAFETY_MODE,
+                                "Safety mode of the heartbeat robot; 0: not available (1.x, no data, or older "
+                                "than stale_after_ms)"},
+    [URRT_CANTX_HB_GENERATION] = {"generation", "",
+                               CAN_MAP_HB_VALUES_GENERATION,
+                               "Controller generation of the heartbeat robot: 0 unknown, 1 CB1/CB2 (1.x), "
+                               "3 CB3/e-series (3.x/5.x)"},
+    [URRT_CANTX_HB_BUS_OFF] = {"bus_off", "", CAN_MAP_HB_VALUES_FLAG,
+                            "The CAN controller went bus-off since the previous heartbeat"},
+    [URRT_CANTX_HB_CAN_ERRORS] = {"can_errors", "", CAN_MAP_HB_VALUES_FLAG,
+                               "CAN error frames since the previous heartbeat"},
+    [URRT_CANTX_HB_CAN_DOWN] = {"can_down", "", CAN_MAP_HB_VALUES_FLAG,
+                             "The CAN interface went down since the previous heartbeat"},
+    [URRT_CANTX_HB_SEND_ERRORS] = {"send_errors", "",
+                                CAN_MAP_HB_VALUES_FLAG, "Frames refused by the CAN link since the previous heartbeat"},
+    [URRT_CANTX_HB_TX_DROPPED] = {"tx_dropped", "", CAN_MAP_HB_VALUES_FLAG,
+                               "Frames dropped on a full transmit queue since the previous heartbeat"},
+    [URRT_CANTX_HB_CLAMPED] = {"clamped", "", CAN_MAP_HB_VALUES_FLAG,
+                            "A mapped value saturated or was NaN since the previous heartbeat"},
+    [URRT_CANTX_HB_DATA_AGE] = {"data_age", "ms",
+                             CAN_MAP_HB_VALUES_NONE,
+                             "Age of the heartbeat robot's latest packet, saturated at 65534; 65535: no data yet"},
+    [URRT_CANTX_HB_DROPS] = {"drops", "", CAN_MAP_HB_VALUES_NONE,
+                          "Frames dropped by the CAN link since start, modulo 65536"},
+};
 
 /* ---- [can] ----------------------------------------------------------------------- */
 
@@ -215,29 +231,40 @@ static bool dbc_name(void *obj, const struct conf_key *key, const char *value, s
 #define YES_NO "%1$s = '%2$s': use yes or no"
 
 const struct conf_key can_map_can_keys[CAN_MAP_CK_COUNT] = {
-    [CAN_MAP_CK_INTERFACE] = {"interface", CONF_FN, 0, 0, 0, 0, can_interface, NULL, false},
-    [CAN_MAP_CK_FD] = {"fd", CONF_BOOL, CONF_FIELD(struct can_map, fd), 0, 0, NULL, YES_NO, false},
+    [CAN_MAP_CK_INTERFACE] = {"interface", CONF_FN, 0, 0, 0, 0, can_interface, NULL, false, "can0|log:PATH", NULL,
+                              "required", "the SocketCAN interface, or log:PATH for candump's log format"},
+    [CAN_MAP_CK_FD] = {"fd", CONF_BOOL, CONF_FIELD(struct can_map, fd), 0, 0, NULL, YES_NO, false, NULL, "no", NULL,
+                       "CAN FD frames may be configured"},
     [CAN_MAP_CK_BITRATE] = {"bitrate", CONF_UINT, CONF_FIELD(struct can_map, bitrate), 10000, 12000000, NULL,
-                            "%1$s = '%2$s': give bits per second between 10000 and 12000000 (500000)", false},
+                            "%1$s = '%2$s': give bits per second between 10000 and 12000000 (500000)", false, NULL,
+                            "500000", NULL, "arbitration bit rate, bit/s, for the bus load check and the DBC"},
     [CAN_MAP_CK_DATA_BITRATE] = {"data_bitrate", CONF_UINT, CONF_FIELD(struct can_map, data_bitrate), 10000,
                                  12000000, NULL,
-                                 "%1$s = '%2$s': give bits per second between 10000 and 12000000 (2000000)", false},
+                                 "%1$s = '%2$s': give bits per second between 10000 and 12000000 (2000000)", false,
+                                 NULL, NULL, "= bitrate", "CAN FD data-phase bit rate"},
     [CAN_MAP_CK_MAX_LOAD] = {"max_bus_load", CONF_UINT, CONF_FIELD(struct can_map, max_load_percent), 1, 100, NULL,
-                             "%1$s = '%2$s': give a percentage 1..100", false},
+                             "%1$s = '%2$s': give a percentage 1..100", false, NULL, "50", NULL,
+                             "worst-case bus load allowed, percent"},
     [CAN_MAP_CK_HB_ID] = {"heartbeat_id", CONF_UINT, CONF_FIELD(struct can_map, hb_id), 0, UINT32_MAX, NULL,
-                          "%1$s = '%2$s' is not a number (0x701 or 1793)", false},
+                          "%1$s = '%2$s' is not a number (0x701 or 1793)", false, NULL, NULL, "required",
+                          "id of the heartbeat frame (gateway state, modes, data age, drops)"},
     [CAN_MAP_CK_HB_EXTENDED] = {"heartbeat_extended", CONF_BOOL, CONF_FIELD(struct can_map, hb_extended), 0, 0, NULL,
-                                YES_NO, false},
+                                YES_NO, false, NULL, "no", NULL, "the heartbeat id is 29-bit"},
     [CAN_MAP_CK_HB_PERIOD] = {"heartbeat_period_ms", CONF_MS, CONF_FIELD(struct can_map, hb_period_ms), 10, 1000,
                               NULL, "%1$s = '%2$s': give 10..1000 ms (the heartbeat goes at least once a second)",
-                              false},
+                              false, NULL, "100", NULL, "the heartbeat's period"},
     [CAN_MAP_CK_HB_ROBOT] = {"heartbeat_robot", CONF_FN, CONF_FIELD(struct can_map, hb_robot), 0, 0, robot_name,
-                             NULL, false},
+                             NULL, false, "NAME", NULL, "the only robot",
+                             "robot whose mode, safety mode and data age the heartbeat carries"},
     [CAN_MAP_CK_STALE_AFTER] = {"stale_after_ms", CONF_MS, CONF_FIELD(struct can_map, stale_after_ms), 1, 60000,
-                                NULL, "%1$s = '%2$s': give 1..60000 milliseconds", false},
-    [CAN_MAP_CK_GENERATION] = {"robot_generation", CONF_FN, 0, 0, 0, 0, can_generation, NULL, false},
-    [CAN_MAP_CK_NODE] = {"node", CONF_FN, CONF_FIELD(struct can_map, node), 0, 0, dbc_name, NULL, false},
-    [CAN_MAP_CK_RECEIVER] = {"receiver", CONF_FN, CONF_FIELD(struct can_map, receiver), 0, 0, dbc_name, NULL, false},
+                                NULL, "%1$s = '%2$s': give 1..60000 milliseconds", false, NULL, "100", NULL,
+                                "data older than this is stale (the frames' default, the heartbeat's state)"},
+    [CAN_MAP_CK_GENERATION] = {"robot_generation", CONF_FN, 0, 0, 0, 0, can_generation, NULL, false, "3|1", "3",
+                               NULL, "robot-mode numbering of the DBC's value tables (3: CB3, e-series; 1: CB2)"},
+    [CAN_MAP_CK_NODE] = {"node", CONF_FN, CONF_FIELD(struct can_map, node), 0, 0, dbc_name, NULL, false, "NAME",
+                         "URRT_GATEWAY", NULL, "DBC node name of the gateway"},
+    [CAN_MAP_CK_RECEIVER] = {"receiver", CONF_FN, CONF_FIELD(struct can_map, receiver), 0, 0, dbc_name, NULL, false,
+                             "NAME", "Vector__XXX", NULL, "DBC receiver of every signal (Vector__XXX: none)"},
 };
 
 void can_map_can_begin(struct can_map *map, struct conf_at at)
@@ -294,7 +321,7 @@ struct can_map_frame *can_map_frame_begin(struct can_map *map, const char *name,
     snprintf(f->name, sizeof f->name, "%s", name);
     f->loc.file = intern_file(map, at.file);
     f->loc.line = at.line;
-    f->len = 8;
+    (void)conf_key_defaults(can_map_frame_keys, CAN_MAP_FK_COUNT, f, NULL, 0);
     f->alive_index = -1;
     f->valid_index = -1;
     return f;
@@ -735,8 +762,10 @@ static bool frame_period(void *obj, const struct conf_key *key, const char *valu
         f->every = true;
         return true;
     }
-    if (!conf_duration_ms(value, conf_bare_unit(key->name), 1, 60000, &f->period_ms, reason, sizeof reason)) {
-        return conf_fail(why, n, "period_ms = '%s': give 1..60000 milliseconds, or every (each packet): %s", value, reason);
+    if (!conf_duration_ms(value, conf_bare_unit(key->name), (uint32_t)key->min, (uint32_t)key->max, &f->period_ms,
+                          reason, sizeof reason)) {
+        return conf_fail(why, n, "period_ms = '%s': give %u..%u milliseconds, or every (each packet): %s", value,
+                         (unsigned)key->min, (unsigned)key->max, reason);
     }
     return true;
 }
@@ -767,22 +796,34 @@ static bool frame_comment(void *obj, const struct conf_key *key, const char *val
 
 const struct conf_key can_map_frame_keys[CAN_MAP_FK_COUNT] = {
     [CAN_MAP_FK_ID] = {"id", CONF_UINT, CONF_FIELD(struct can_map_frame, id), 0, UINT32_MAX, NULL,
-                       "%1$s = '%2$s' is not a number (0x181 or 385)", false},
+                       "%1$s = '%2$s' is not a number (0x181 or 385)", false, NULL, NULL, "required",
+                       "the frame's CAN id"},
     [CAN_MAP_FK_EXTENDED] = {"extended", CONF_BOOL, CONF_FIELD(struct can_map_frame, extended), 0, 0, NULL,
-                             "%1$s = '%2$s': use yes (29-bit id) or no (11-bit id)", false},
+                             "%1$s = '%2$s': use yes (29-bit id) or no (11-bit id)", false, NULL, "no", NULL,
+                             "a 29-bit id"},
     [CAN_MAP_FK_FD] = {"fd", CONF_BOOL, CONF_FIELD(struct can_map_frame, fd), 0, 0, NULL,
-                       "%1$s = '%2$s': use yes (CAN FD frame) or no (classic CAN)", false},
+                       "%1$s = '%2$s': use yes (CAN FD frame) or no (classic CAN)", false, NULL, "no", NULL,
+                       "a CAN FD frame"},
     [CAN_MAP_FK_LENGTH] = {"length", CONF_UINT, CONF_FIELD(struct can_map_frame, len), 0, URRT_CAN_MAX_LEN, NULL,
-                           "%1$s = '%2$s': give the payload length in bytes, 0..8 (FD: up to 64)", false},
-    [CAN_MAP_FK_PERIOD] = {"period_ms", CONF_FN, 0, 0, 0, 0, frame_period, NULL, false},
-    [CAN_MAP_FK_ROBOT] = {"robot", CONF_FN, CONF_FIELD(struct can_map_frame, robot), 0, 0, robot_name, NULL, false},
-    [CAN_MAP_FK_ALIVE] = {"alive_counter", CONF_FN, 0, 0, 0, 0, frame_marker, NULL, false},
-    [CAN_MAP_FK_VALID] = {"validity_bit", CONF_FN, 0, 0, 0, 0, frame_marker, NULL, false},
+                           "%1$s = '%2$s': give the payload length in bytes, 0..8 (FD: up to 64)", false, NULL, "8",
+                           NULL, "payload bytes (a CAN FD length above 8)"},
+    [CAN_MAP_FK_PERIOD] = {"period_ms", CONF_FN, 0, 0, 1, 60000, frame_period, NULL, false, "N|every", NULL,
+                           "required", "the frame's period, or every: one frame per robot packet"},
+    [CAN_MAP_FK_ROBOT] = {"robot", CONF_FN, CONF_FIELD(struct can_map_frame, robot), 0, 0, robot_name, NULL, false,
+                          "NAME", NULL, "the only robot", "robot the values come from"},
+    [CAN_MAP_FK_ALIVE] = {"alive_counter", CONF_FN, 0, 0, 0, 0, frame_marker, NULL, false, "START [intel|motorola]",
+                          NULL, "none", "a 4-bit counter at that start bit, +1 per frame sent"},
+    [CAN_MAP_FK_VALID] = {"validity_bit", CONF_FN, 0, 0, 0, 0, frame_marker, NULL, false, "BIT", NULL, "none",
+                          "1 while every value of the frame is fresh and sent as it is"},
     [CAN_MAP_FK_STALE_AFTER] = {"stale_after_ms", CONF_MS, CONF_FIELD(struct can_map_frame, stale_after_ms), 1, 60000,
-                                NULL, "%1$s = '%2$s': give 1..60000 milliseconds", false},
-    [CAN_MAP_FK_STALE_POLICY] = {"stale_policy", CONF_FN, 0, 0, 0, 0, frame_policy, NULL, false},
-    [CAN_MAP_FK_COMMENT] = {"comment", CONF_FN, 0, 0, 0, 0, frame_comment, NULL, false},
-    [CAN_MAP_FK_SIGNAL] = {"signal", CONF_FN, 0, 0, 0, 0, frame_signal, NULL, true},
+                                NULL, "%1$s = '%2$s': give 1..60000 milliseconds", false, NULL, NULL,
+                                "[can] stale_after_ms", "data older than this is stale"},
+    [CAN_MAP_FK_STALE_POLICY] = {"stale_policy", CONF_FN, 0, 0, 0, 0, frame_policy, NULL, false, "stop|invalid",
+                                 "stop", NULL, "what a frame does when its data is stale"},
+    [CAN_MAP_FK_COMMENT] = {"comment", CONF_FN, 0, 0, 0, 0, frame_comment, NULL, false, "TEXT", NULL, "none",
+                            "text for the DBC"},
+    [CAN_MAP_FK_SIGNAL] = {"signal", CONF_FN, 0, 0, 0, 0, frame_signal, NULL, true, "FIELD[ELEM] @START|LENGTH ...",
+                           NULL, "at least one", "one field element; the key again for each signal"},
 };
 
 bool can_map_set(struct can_map *map, struct can_map_frame *frame, const struct conf_key *key, const char *value,
@@ -797,75 +838,6 @@ bool can_map_set(struct can_map *map, struct can_map_frame *frame, const struct 
     loc->file = at.file;
     loc->line = at.line;
     return true;
-}
-
-/* ---- without the front end: can_map_ini ---------------------------------------- */
-
-/* "can", "frame NAME": the table, and for a frame the frame (made on its
- * first key). 0: not a CAN section; -1: a bad frame name (in why). */
-static int ini_section(struct can_map *map, const char *section, struct conf_at at, struct can_map_frame **frame,
-                       char *why, size_t n)
-{
-    char name[256];
-    size_t len;
-    *frame = NULL;
-    if (strcmp(section, "can") == 0) {
-        can_map_can_begin(map, at);
-        return 1;
-    }
-    if (strncmp(section, "frame", 5) != 0 || !isspace((unsigned char)section[5])) {
-        return 0; /* [frames], [frame_x], [frame]: not ours */
-    }
-    section += 5 + strspn(section + 5, " \t");
-    snprintf(name, sizeof name, "%s", section);
-    for (len = strlen(name); len > 0 && isspace((unsigned char)name[len - 1]); len--) {
-        name[len - 1] = '\0';
-    }
-    *frame = frame_named(map, name);
-    if (*frame == NULL) {
-        *frame = can_map_frame_begin(map, name, at, why, n);
-    }
-    return *frame != NULL ? 1 : -1;
-}
-
-int can_map_ini(struct can_map *map, const char *section, const char *key, const char *value, const char *file,
-                int line, char *err, size_t errlen)
-{
-    char why[CONF_WHY_MAX];
-    struct can_map_frame *f = NULL;
-    struct conf_at at = {intern_file(map, file), line};
-    struct can_map_loc loc = {at.file, line};
-    const struct conf_key *k;
-    const struct can_map_loc *first;
-    int rc;
-    if (err != NULL && errlen > 0) {
-        err[0] = '\0';
-    }
-    if (section == NULL || key == NULL || value == NULL) {
-        return 0;
-    }
-    if (map->finished) {
-        return fail(map, err, errlen, loc, "CAN configuration already finished");
-    }
-    rc = ini_section(map, section, at, &f, why, sizeof why);
-    if (rc <= 0) {
-        return rc < 0 ? fail(map, err, errlen, loc, "%s", why) : 0;
-    }
-    k = conf_key_find(f ? can_map_frame_keys : can_map_can_keys, f ? CAN_MAP_FK_COUNT : CAN_MAP_CK_COUNT, key);
-    if (k == NULL) {
-        conf_unknown_key(f ? can_map_frame_keys : can_map_can_keys, f ? CAN_MAP_FK_COUNT : CAN_MAP_CK_COUNT, key,
-                         f ? section : "can", why, sizeof why);
-        return fail(map, err, errlen, loc, "%s", why);
-    }
-    first = f ? &f->key_loc[k - can_map_frame_keys] : &map->key_loc[k - can_map_can_keys];
-    if (!k->many && first->line != 0) {
-        return fail(map, err, errlen, loc, "[%s] %s given twice (first at line %d)", f ? section : "can", key,
-                    first->line);
-    }
-    if (!can_map_set(map, f, k, value, at, why, sizeof why)) {
-        return fail(map, err, errlen, loc, "%s", why);
-    }
-    return 1;
 }
 
 /* ---- whole-file checks ------------------------------------------------------------- */
@@ -954,7 +926,7 @@ static void problem(struct finish *fin, struct can_map_loc loc, const char *fmt,
 {
     va_list ap;
     va_start(ap, fmt);
-    report(fin->map, fin->err, fin->errlen, true, loc, fmt, ap);
+    report(fin->map, fin->err, fin->errlen, loc, fmt, ap);
     va_end(ap);
     fin->errors++;
 }

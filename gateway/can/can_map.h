@@ -1,27 +1,23 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * can_map: the CAN side of urrt-gateway. Which robot fields go into which
- * CAN frames (the mapping configuration, its checks), and when each frame is
- * sent (periods, every packet, staleness, alive counters, the heartbeat).
+ * can_map: the CAN mapping, urrt-gateway's configuration language for CAN.
+ * Which robot fields go into which CAN frames, at which periods, with which
+ * staleness rules (the keys of [can] and [frame NAME], the signal grammar),
+ * and the checks a whole configuration must pass (ids, layouts, robots, bus
+ * load). It describes frames; it sends nothing: can_run.h turns a finished
+ * map into the tables of lib/urrt_cantx.h, and dbc.h describes it for the
+ * PLC side. The bit packing is lib/urrt_can.h. docs/can.md is the user's
+ * reference.
  *
- * It produces urrt_can_frame values and hands them to a callback; it never
- * touches a CAN link, a clock or a socket itself: the gateway loop passes
- * the time and the link's statistics in and sends what comes out. The bit
- * packing is lib/urrt_can.h. docs/can.md is the user's reference.
- *
- * Life cycle:
- *   struct can_map map;  can_map_init(&map);
- *   the configuration front end (config.c) reads [can] with can_map_can_keys
- *   and [frame NAME] with can_map_frame_keys, through can_map_can_begin,
- *   can_map_frame_begin and can_map_set; a caller without it (tests,
- *   tools) feeds keys to can_map_ini
- *   can_map_finish(&map, robots, robot_count, err, sizeof err)
- *   can_map_start(&map, now)
- *   loop:
- *       on a robot packet:    can_map_on_packet(&map, robot, &state, rx_us)
- *       on a robot link change: can_map_robot_link(&map, robot, up)
- *       can_map_due(&map, now, urrt_canlink_get_stats(can), send_fn, can)
- *       poll until min(can_map_deadline(&map), ...)
+ * Life cycle (the configuration loader, gateway/urrt-gateway/config.c,
+ * drives the parsing part):
+ *   struct can_map map;  can_map_init(&map);    the keys' defaults set
+ *   a [can] section:     can_map_can_begin, then can_map_set per key
+ *   a [frame NAME]:      can_map_frame_begin, then can_map_set per key
+ *                        (keys looked up in can_map_can_keys and
+ *                        can_map_frame_keys by the loader)
+ *   can_map_finish(&map, robots, robot_count, ...)   the whole-file checks
+ *   ... can_run_build(&map, ...) ...
  *   can_map_free(&map)
  */
 #ifndef URRT_GATEWAY_CAN_MAP_H
@@ -43,11 +39,6 @@
 #define CAN_MAP_ALIVE_NAME "alive_counter"
 #define CAN_MAP_VALID_NAME "valid"
 #define CAN_MAP_ALIVE_BITS 4u
-#define CAN_MAP_STARTUP_MS 5000u      /* "starting" lasts at most this long without data */
-#define CAN_MAP_DEFAULT_BITRATE 500000u
-#define CAN_MAP_DEFAULT_STALE_MS 100u
-#define CAN_MAP_DEFAULT_HEARTBEAT_MS 100u
-#define CAN_MAP_DEFAULT_MAX_LOAD 50u  /* percent */
 /* Where a robot's rate is unknown: the fastest any controller sends (lib's table). */
 #define CAN_MAP_FASTEST_ROBOT_US urrt_period_min_us(0)
 
@@ -89,7 +80,7 @@ enum can_map_frame_key {
 struct can_map_frame {
     char name[CAN_MAP_NAME_MAX + 1];
     char comment[128];
-    struct can_map_loc loc;                 /* first key of the section */
+    struct can_map_loc loc;                 /* the section's header */
     struct can_map_loc key_loc[CAN_MAP_FK_COUNT];
     uint32_t id;
     bool extended;
@@ -155,8 +146,8 @@ struct can_map_robot_rt {
 extern const struct conf_key can_map_can_keys[CAN_MAP_CK_COUNT];
 extern const struct conf_key can_map_frame_keys[CAN_MAP_FK_COUNT];
 
-/* Receives each problem can_map_ini and can_map_finish find, as file, line
- * and reason (without "FILE:LINE: "), for a caller with its own error list. */
+/* Receives each problem can_map_finish finds, as file, line and reason
+ * (without "FILE:LINE: "), for a caller with its own error list. */
 typedef void (*can_map_report_fn)(void *ctx, const char *file, int line, const char *reason);
 
 struct can_map {
@@ -165,7 +156,7 @@ struct can_map {
     bool configured;                        /* a [can] key or a [frame] section was seen */
     bool finished;
     /* [can] */
-    struct can_map_loc can_loc;             /* first key of [can] */
+    struct can_map_loc can_loc;             /* the [can] header */
     struct can_map_loc key_loc[CAN_MAP_CK_COUNT];
     char *interface;                        /* "can0" or "log:PATH": for urrt_canlink_config */
     bool fd;                                /* FD frames allowed: urrt_canlink_config.fd */
@@ -193,10 +184,9 @@ struct can_map {
     /* File names seen, each stored once (struct can_map_loc points here). */
     char **files;
     size_t file_count;
-    /* Run time: lib/urrt_cantx.h over tables built from the above (can_run.c). */
-    struct can_map_run *run;
 };
 
+/* An empty map with the keys' defaults (can_map_can_keys' def). */
 void can_map_init(struct can_map *map);
 void can_map_free(struct can_map *map);
 
@@ -214,17 +204,6 @@ struct can_map_frame *can_map_frame_begin(struct can_map *map, const char *name,
                                           size_t n);
 bool can_map_set(struct can_map *map, struct can_map_frame *frame, const struct conf_key *key, const char *value,
                  struct conf_at at, char *why, size_t n);
-
-/*
- * One key of the configuration file, for a caller without the front end
- * (tests, tools): the same tables. Handles the sections "can" and "frame
- * NAME" (a second [frame NAME] continues the first). Returns 1 when the key
- * was handled, 0 when the section is not the CAN map's (the caller's own),
- * -1 on an error, with "FILE:LINE: reason" in err. Repeated keys are errors
- * except "signal", which adds one signal per line.
- */
-int can_map_ini(struct can_map *map, const char *section, const char *key, const char *value, const char *file,
-                int line, char *err, size_t errlen);
 
 /*
  * Checks that need the whole file and the gateway's robots: overlaps and
@@ -251,44 +230,6 @@ void can_map_link_config(const struct can_map *map, urrt_canlink_config *cfg);
 /* One line for the log at start: "4 frames + heartbeat 0x705 on can0,
  * worst-case bus load 7.6% of 500000 bit/s (max 40%)". Returns snprintf's. */
 int can_map_describe(const struct can_map *map, char *buf, size_t size);
-
-/* ---- run time ------------------------------------------------------------------ */
-
-/*
- * The map as lib/urrt_cantx.h tables: its frames in configuration order, then
- * the heartbeat. Built once, after can_map_finish; 0, or -1 with the reason
- * in err (a table lib/ refuses: a check missing above). can_map_start builds
- * them if the caller did not. can_map_free frees them.
- */
-int can_map_build(struct can_map *map, char *err, size_t errlen);
-void can_map_run_free(struct can_map *map);
-
-/* The CAN core over the built tables (NULL before can_map_build), and the
- * heartbeat's index in them. */
-urrt_cantx *can_map_tx(struct can_map *map);
-size_t can_map_heartbeat_index(const struct can_map *map);
-
-/* Restarts the schedule at now_us (urrt_cantx_start). */
-void can_map_start(struct can_map *map, uint64_t now_us);
-
-/* The CAN link's counters, as the heartbeat's flags need them. */
-void can_map_link_stats(struct can_map *map, const urrt_canlink_stats *stats);
-
-/* Values packed with an outcome other than OK, since start. */
-uint64_t can_map_clamped(const struct can_map *map);
-
-/* The CAN link's counters (NULL: unchanged), then every frame due at now_us
- * through emit (urrt_cantx_run). Starts the schedule on its first call. */
-void can_map_due(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats, urrt_cantx_emit_fn emit,
-                 void *ctx);
-
-/* The heartbeat as it would go out at now_us with these link counters,
- * without sending it (urrt_cantx_peek): for status displays and tests. */
-void can_map_heartbeat_frame(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats,
-                             urrt_can_frame *frame);
-
-/* The heartbeat's gateway state at now_us. */
-urrt_cantx_state can_map_state(const struct can_map *map, uint64_t now_us);
 
 /* Worst-case bus time of one frame in microseconds at the map's bit rates. */
 double can_map_frame_time_us(const struct can_map *map, unsigned len, bool extended, bool fd);

@@ -10,7 +10,7 @@
 #include "port.h"
 
 struct replay {
-    struct can_map *map;
+    struct can_run *run;
     urrt_canlink *link;
     urrt_state state;
     uint64_t packets;
@@ -40,9 +40,9 @@ static void on_packet(struct replay *r, const uint8_t *pkt, size_t len)
         return;
     }
     /* What a gateway waking at each deadline would have sent until now. */
-    urrt_cantx_catch_up(can_map_tx(r->map), (uint64_t)t_us, emit, r);
-    urrt_cantx_on_packet(can_map_tx(r->map), 0, &r->state, (uint64_t)t_us);
-    can_map_due(r->map, (uint64_t)t_us, urrt_canlink_get_stats(r->link), emit, r);
+    urrt_cantx_catch_up(can_run_tx(r->run), (uint64_t)t_us, emit, r);
+    urrt_cantx_on_packet(can_run_tx(r->run), 0, &r->state, (uint64_t)t_us);
+    can_run_due(r->run, (uint64_t)t_us, urrt_canlink_get_stats(r->link), emit, r);
 }
 
 static int pump(struct replay *r, FILE *in, const char *path)
@@ -74,15 +74,15 @@ static int pump(struct replay *r, FILE *in, const char *path)
     return CLI_EXIT_OK;
 }
 
-int can_replay(struct can_map *map, const char *capture_path)
+int can_replay(const struct can_map *map, struct can_run *run, const char *capture_path)
 {
     struct replay r;
     urrt_canlink_config cfg;
     FILE *in;
     int rc;
     memset(&r, 0, sizeof r);
-    r.map = map;
-    if (can_map_tx(map) == NULL) {
+    r.run = run;
+    if (run == NULL) {
         urrt_log(URRT_LOG_ERR, "--replay needs a [can] section and [frame NAME]s in the configuration");
         return CLI_EXIT_USAGE;
     }

@@ -12,9 +12,11 @@
 #define URRT_GATEWAY_CAN_REPLAY_H
 
 #include "can_map.h"
+#include "can_run.h"
 
-/* Sends the capture's frames on [can] interface (log:PATH is the usual
+/* Sends the capture's frames, run's (the tables of map; NULL: no CAN
+ * output configured), on map's [can] interface (log:PATH is the usual
  * choice). Returns a CLI_EXIT_* status; reasons go to the log. */
-int can_replay(struct can_map *map, const char *capture_path);
+int can_replay(const struct can_map *map, struct can_run *run, const char *capture_path);
 
 #endif

@@ -1,68 +1,28 @@
 /* SPDX-License-Identifier: MIT */
-/*
- * can_run.c: the run-time side of can_map.h. The map's frames become
- * lib/urrt_cantx.h tables (the same tables --print-c-tables writes for a
- * firmware), and the CAN core does the rest.
- */
-#include "can_map.h"
+/* can_run.c: see can_run.h. */
+#include "can_run.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-const struct can_map_hb_signal can_map_heartbeat_layout[URRT_CANTX_HB_COUNT] = {
-    [URRT_CANTX_HB_STATE] = {"state", "", CAN_MAP_HB_VALUES_STATE,
-                          "Gateway state: 0 starting, 1 ok, 2 data stale, 3 robot disconnected"},
-    [URRT_CANTX_HB_ALIVE] = {"alive_counter", "", CAN_MAP_HB_VALUES_NONE,
-                          "Incremented (modulo 16) with every heartbeat"},
-    [URRT_CANTX_HB_ROBOT_MODE] = {"robot_mode", "",
-                               CAN_MAP_HB_VALUES_ROBOT_MODE,
-                               "Robot mode of the heartbeat robot as it sends it (numbering per generation); "
-                               "-128: not available (no data, or older than stale_after_ms)"},
-    [URRT_CANTX_HB_SAFETY_MODE] = {"safety_mode", "",
-                                CAN_MAP_HB_VALUES_SAFETY_MODE,
-                                "Safety mode of the heartbeat robot; 0: not available (1.x, no data, or older "
-                                "than stale_after_ms)"},
-    [URRT_CANTX_HB_GENERATION] = {"generation", "",
-                               CAN_MAP_HB_VALUES_GENERATION,
-                               "Controller generation of the heartbeat robot: 0 unknown, 1 CB1/CB2 (1.x), "
-                               "3 CB3/e-series (3.x/5.x)"},
-    [URRT_CANTX_HB_BUS_OFF] = {"bus_off", "", CAN_MAP_HB_VALUES_FLAG,
-                            "The CAN controller went bus-off since the previous heartbeat"},
-    [URRT_CANTX_HB_CAN_ERRORS] = {"can_errors", "", CAN_MAP_HB_VALUES_FLAG,
-                               "CAN error frames since the previous heartbeat"},
-    [URRT_CANTX_HB_CAN_DOWN] = {"can_down", "", CAN_MAP_HB_VALUES_FLAG,
-                             "The CAN interface went down since the previous heartbeat"},
-    [URRT_CANTX_HB_SEND_ERRORS] = {"send_errors", "",
-                                CAN_MAP_HB_VALUES_FLAG, "Frames refused by the CAN link since the previous heartbeat"},
-    [URRT_CANTX_HB_TX_DROPPED] = {"tx_dropped", "", CAN_MAP_HB_VALUES_FLAG,
-                               "Frames dropped on a full transmit queue since the previous heartbeat"},
-    [URRT_CANTX_HB_CLAMPED] = {"clamped", "", CAN_MAP_HB_VALUES_FLAG,
-                            "A mapped value saturated or was NaN since the previous heartbeat"},
-    [URRT_CANTX_HB_DATA_AGE] = {"data_age", "ms",
-                             CAN_MAP_HB_VALUES_NONE,
-                             "Age of the heartbeat robot's latest packet, saturated at 65534; 65535: no data yet"},
-    [URRT_CANTX_HB_DROPS] = {"drops", "", CAN_MAP_HB_VALUES_NONE,
-                          "Frames dropped by the CAN link since start, modulo 65536"},
-};
-
-struct can_map_run {
+struct can_run {
     urrt_cantx tx;
     urrt_cantx_tables tables;
     urrt_cantx_frame *frames;        /* the map's, then the heartbeat */
     urrt_cantx_source **sources;     /* per map frame */
+    size_t frame_count;              /* of the map: sources has as many */
     urrt_cantx_frame_state *states;
     urrt_cantx_robot *robots;
     double *values;
 };
 
-void can_map_run_free(struct can_map *map)
+void can_run_free(struct can_run *run)
 {
-    struct can_map_run *run = map->run;
     if (run == NULL) {
         return;
     }
-    for (size_t i = 0; i < map->frame_count && run->sources != NULL; i++) {
+    for (size_t i = 0; i < run->frame_count && run->sources != NULL; i++) {
         free(run->sources[i]);
     }
     free(run->sources);
@@ -71,7 +31,6 @@ void can_map_run_free(struct can_map *map)
     free(run->robots);
     free(run->values);
     free(run);
-    map->run = NULL;
 }
 
 static urrt_cantx_source source_of(const struct can_map_signal *m)
@@ -125,7 +84,7 @@ static urrt_cantx_frame heartbeat_of(const struct can_map *map)
     return hb;
 }
 
-static bool alloc_run(struct can_map_run *run, size_t frames, size_t robots)
+static bool alloc_run(struct can_run *run, size_t frames, size_t robots)
 {
     run->frames = calloc(frames, sizeof *run->frames);
     run->sources = calloc(frames, sizeof *run->sources);
@@ -134,9 +93,8 @@ static bool alloc_run(struct can_map_run *run, size_t frames, size_t robots)
     return run->frames != NULL && run->sources != NULL && run->states != NULL && run->robots != NULL;
 }
 
-static int init_core(struct can_map *map, char *err, size_t errlen)
+static int init_core(struct can_run *run, const struct can_map *map, char *err, size_t errlen)
 {
-    struct can_map_run *run = map->run;
     size_t count = urrt_cantx_value_count(&run->tables);
     size_t bad_frame;
     size_t bad_signal;
@@ -161,114 +119,90 @@ static int init_core(struct can_map *map, char *err, size_t errlen)
     return 0;
 }
 
-int can_map_build(struct can_map *map, char *err, size_t errlen)
+/* The frames' tables; false when out of memory. */
+static bool fill_frames(struct can_run *run, const struct can_map *map)
 {
-    size_t robots = map->robot_count ? map->robot_count : 1;
-    size_t i;
-    if (map->run != NULL) {
-        return 0;
-    }
-    map->run = calloc(1, sizeof *map->run);
-    if (map->run == NULL || !alloc_run(map->run, map->frame_count + 1, robots)) {
-        can_map_run_free(map);
-        snprintf(err, errlen, "CAN tables: out of memory");
-        return -1;
-    }
-    for (i = 0; i < map->frame_count; i++) {
+    for (size_t i = 0; i < map->frame_count; i++) {
         const struct can_map_frame *f = &map->frames[i];
-        map->run->sources[i] = calloc(f->count ? f->count : 1, sizeof *map->run->sources[i]);
-        if (map->run->sources[i] == NULL) {
-            can_map_run_free(map);
-            snprintf(err, errlen, "CAN tables: out of memory");
-            return -1;
+        run->sources[i] = calloc(f->count ? f->count : 1, sizeof *run->sources[i]);
+        if (run->sources[i] == NULL) {
+            return false;
         }
         for (size_t k = 0; k < f->count; k++) {
-            map->run->sources[i][k] = source_of(&f->meta[k]);
+            run->sources[i][k] = source_of(&f->meta[k]);
         }
-        map->run->frames[i] = frame_of(f, map->run->sources[i]);
+        run->frames[i] = frame_of(f, run->sources[i]);
     }
-    map->run->frames[map->frame_count] = heartbeat_of(map);
-    map->run->tables = (urrt_cantx_tables){map->run->frames, map->frame_count + 1, robots,
-                                           CAN_MAP_STARTUP_MS * 1000u};
-    if (init_core(map, err, errlen) < 0) {
-        can_map_run_free(map);
-        return -1;
-    }
-    return 0;
+    run->frames[map->frame_count] = heartbeat_of(map);
+    return true;
 }
 
-urrt_cantx *can_map_tx(struct can_map *map)
+struct can_run *can_run_build(const struct can_map *map, char *err, size_t errlen)
 {
-    char err[256];
-    if (map->run == NULL && (!can_map_enabled(map) || can_map_build(map, err, sizeof err) < 0)) {
+    size_t robots = map->robot_count ? map->robot_count : 1;
+    struct can_run *run = calloc(1, sizeof *run);
+    if (run != NULL) {
+        run->frame_count = map->frame_count;
+    }
+    if (run == NULL || !alloc_run(run, map->frame_count + 1, robots) || !fill_frames(run, map)) {
+        can_run_free(run);
+        snprintf(err, errlen, "CAN tables: out of memory");
         return NULL;
     }
-    return &map->run->tx;
-}
-
-size_t can_map_heartbeat_index(const struct can_map *map)
-{
-    return map->frame_count;
-}
-
-void can_map_start(struct can_map *map, uint64_t now_us)
-{
-    char err[256];
-    if (map->run == NULL && can_map_build(map, err, sizeof err) < 0) {
-        return;
+    run->tables = (urrt_cantx_tables){run->frames, map->frame_count + 1, robots, CAN_RUN_STARTUP_MS * 1000u};
+    if (init_core(run, map, err, errlen) < 0) {
+        can_run_free(run);
+        return NULL;
     }
-    urrt_cantx_start(&map->run->tx, now_us);
+    return run;
 }
 
-void can_map_link_stats(struct can_map *map, const urrt_canlink_stats *stats)
+urrt_cantx *can_run_tx(struct can_run *run)
+{
+    return &run->tx;
+}
+
+size_t can_run_heartbeat_index(const struct can_run *run)
+{
+    return run->frame_count;
+}
+
+void can_run_start(struct can_run *run, uint64_t now_us)
+{
+    urrt_cantx_start(&run->tx, now_us);
+}
+
+static void set_link(struct can_run *run, const urrt_canlink_stats *stats)
 {
     urrt_cantx_link link = {stats->bus_off, stats->error_frames, stats->down_events, stats->send_errors,
                             stats->dropped};
-    if (map->run != NULL) {
-        urrt_cantx_set_link(&map->run->tx, &link);
-    }
+    urrt_cantx_set_link(&run->tx, &link);
 }
 
-uint64_t can_map_clamped(const struct can_map *map)
+uint64_t can_run_clamped(const struct can_run *run)
 {
-    return map->run != NULL ? map->run->tx.clamped : 0;
+    return run->tx.clamped;
 }
 
-urrt_cantx_state can_map_state(const struct can_map *map, uint64_t now_us)
+urrt_cantx_state can_run_state(const struct can_run *run, uint64_t now_us)
 {
-    if (map->run == NULL) {
-        return URRT_CANTX_STARTING;
-    }
-    return urrt_cantx_gateway_state(&map->run->tx, can_map_heartbeat_index(map), now_us);
+    return urrt_cantx_gateway_state(&run->tx, can_run_heartbeat_index(run), now_us);
 }
 
-/* The core, started at now_us if it was not, with the link's counters
- * (stats NULL: unchanged); NULL when the tables cannot be built. */
-static urrt_cantx *core_at(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats)
-{
-    if (map->run == NULL) {
-        can_map_start(map, now_us);
-    }
-    if (map->run != NULL && stats != NULL) {
-        can_map_link_stats(map, stats);
-    }
-    return map->run != NULL ? &map->run->tx : NULL;
-}
-
-void can_map_due(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats, urrt_cantx_emit_fn emit,
+void can_run_due(struct can_run *run, uint64_t now_us, const urrt_canlink_stats *stats, urrt_cantx_emit_fn emit,
                  void *ctx)
 {
-    urrt_cantx *tx = core_at(map, now_us, stats);
-    if (tx != NULL) {
-        urrt_cantx_run(tx, now_us, emit, ctx);
+    if (stats != NULL) {
+        set_link(run, stats);
     }
+    urrt_cantx_run(&run->tx, now_us, emit, ctx);
 }
 
-void can_map_heartbeat_frame(struct can_map *map, uint64_t now_us, const urrt_canlink_stats *stats,
+void can_run_heartbeat_frame(struct can_run *run, uint64_t now_us, const urrt_canlink_stats *stats,
                              urrt_can_frame *frame)
 {
-    urrt_cantx *tx = core_at(map, now_us, stats);
-    if (tx != NULL) {
-        urrt_cantx_peek(tx, can_map_heartbeat_index(map), now_us, frame);
+    if (stats != NULL) {
+        set_link(run, stats);
     }
+    urrt_cantx_peek(&run->tx, can_run_heartbeat_index(run), now_us, frame);
 }

@@ -2,7 +2,9 @@
 /* cli.c: see cli.h. */
 #define _GNU_SOURCE
 #include "cli.h"
+#include "urrt.h"
 
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -90,9 +92,162 @@ const char *cli_parse_u32(const char *text, uint32_t min, uint32_t max, uint32_t
     return conf_u32(text, min, max, out, cli_why, sizeof cli_why) ? NULL : cli_why;
 }
 
-const char *cli_parse_double(const char *text, double min, double max, double *out)
+void cli_usage_error(const char *program, const char *fmt, ...)
 {
-    return conf_number(text, min, max, out, cli_why, sizeof cli_why) ? NULL : cli_why;
+    va_list ap;
+    fprintf(stderr, "%s: ", program);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\nTry '%s --help'.\n", program);
+    exit(CLI_EXIT_USAGE);
+}
+
+/* ---- options read by a table ------------------------------------------------------ */
+
+/* getopt_long's value for a long name without a letter: past any char. */
+#define CLI_LONG_ONLY 256
+/* Options of one program at most: its getopt tables live on the stack. */
+#define CLI_OPTIONS_MAX 40
+
+void cli_bad_value(const char *program, const cli_option *row, const char *arg, const char *why)
+{
+    cli_usage_error(program, "--%s %s: %s%s", row->name, arg, why, row->hint != NULL ? row->hint : "");
+}
+
+void cli_print_version(const char *program)
+{
+    printf("%s %s\n", program, URRT_VERSION_STRING);
+    exit(CLI_EXIT_OK);
+}
+
+/* "--clock sundial: use start, monotonic or realtime". */
+static void bad_word(const char *program, const cli_option *row, const char *arg)
+{
+    char list[CONF_WHY_MAX] = "";
+    size_t used = 0;
+    for (size_t i = 0; row->words[i] != NULL && used < sizeof list; i++) {
+        const char *sep = i == 0 ? "" : row->words[i + 1] == NULL ? " or " : ", ";
+        used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", sep, row->words[i]);
+    }
+    cli_usage_error(program, "--%s %s: use %s", row->name, arg, list);
+}
+
+static int word_index(const char *const *words, const char *arg)
+{
+    for (int i = 0; words[i] != NULL; i++) {
+        if (strcmp(words[i], arg) == 0) {
+            return i;
+        }
+    }
+    return -1;
+}
+
+/* Parses arg by row->kind into field; false with the reason in why. */
+static bool read_value(const cli_option *row, const char *arg, void *field, char *why, size_t n)
+{
+    uint64_t us;
+    switch (row->kind) {
+    case CLI_TEXT: *(const char **)field = arg; return true;
+    case CLI_UINT: return conf_uint(arg, row->min, row->max, field, why, n);
+    case CLI_U32: return conf_u32(arg, (uint32_t)row->min, (uint32_t)row->max, field, why, n);
+    case CLI_MS: return conf_duration_ms(arg, "ms", (uint32_t)row->min, (uint32_t)row->max, field, why, n);
+    case CLI_SECONDS:
+        if (!conf_duration_us(arg, "s", row->min, row->max, &us, why, n)) {
+            return false;
+        }
+        *(double *)field = (double)us / 1e6;
+        return true;
+    default: return conf_fail(why, n, "option kind %d takes no value (a bug in the table)", (int)row->kind);
+    }
+}
+
+static void apply(const cli_options *set, const cli_option *row, const char *arg, void *obj)
+{
+    char why[CONF_WHY_MAX];
+    void *field = (char *)obj + row->offset;
+    urrt_log_level *level = field;
+    int word;
+
+    switch (row->kind) {
+    case CLI_FN: row->fn(row, arg, obj); return;
+    case CLI_TRUE: *(bool *)field = true; break;
+    case CLI_FALSE: *(bool *)field = false; break;
+    case CLI_VERBOSE: *level = *level == URRT_LOG_NOTICE ? URRT_LOG_INFO : URRT_LOG_DEBUG; break;
+    case CLI_QUIET: *level = URRT_LOG_ERR; break;
+    case CLI_HELP: set->usage(stdout); exit(CLI_EXIT_OK);
+    case CLI_VERSION: cli_print_version(set->program);
+    case CLI_WORD:
+        if ((word = word_index(row->words, arg)) < 0) {
+            bad_word(set->program, row, arg);
+        }
+        memcpy(field, &word, sizeof word); /* an enum: int's size (the tables' users assert it) */
+        break;
+    default:
+        if (!read_value(row, arg, field, why, sizeof why)) {
+            cli_bad_value(set->program, row, arg, why);
+        }
+    }
+    if (row->fn != NULL) {
+        row->fn(row, arg, obj);
+    }
+}
+
+/* getopt_long's option string and table from the rows. */
+static void getopt_tables(const cli_options *set, char *letters, struct option *longs)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < set->count; i++) {
+        const cli_option *row = &set->rows[i];
+        int val = row->letter != 0 ? row->letter : CLI_LONG_ONLY + (int)i;
+        longs[i] = (struct option){row->name, row->arg, NULL, val};
+        if (row->letter != 0) {
+            letters[k++] = row->letter;
+            if (row->arg == required_argument) {
+                letters[k++] = ':';
+            }
+        }
+    }
+    letters[k] = '\0';
+    longs[set->count] = (struct option){NULL, 0, NULL, 0};
+}
+
+static const cli_option *row_of(const cli_options *set, int c)
+{
+    if (c >= CLI_LONG_ONLY) {
+        return &set->rows[c - CLI_LONG_ONLY];
+    }
+    for (size_t i = 0; i < set->count; i++) {
+        if (set->rows[i].letter == c) {
+            return &set->rows[i];
+        }
+    }
+    return NULL;
+}
+
+int cli_parse_options(const cli_options *set, int argc, char **argv, void *obj)
+{
+    char letters[2 * CLI_OPTIONS_MAX + 1];
+    struct option longs[CLI_OPTIONS_MAX + 1];
+    int c;
+
+    if (set->count > CLI_OPTIONS_MAX) {
+        cli_usage_error(set->program, "%zu options: more than cli.c's CLI_OPTIONS_MAX (a bug)", set->count);
+    }
+    getopt_tables(set, letters, longs);
+    while ((c = getopt_long(argc, argv, letters, longs, NULL)) != -1) {
+        const cli_option *row = row_of(set, c);
+        if (row == NULL) {
+            /* getopt said what was wrong. */
+            if (set->on_unknown != NULL) {
+                set->on_unknown(optopt);
+            }
+            fprintf(stderr, "Try '%s --help'.\n", set->program);
+            exit(CLI_EXIT_USAGE);
+        }
+        apply(set, row, optarg, obj);
+    }
+    return optind;
 }
 
 static volatile sig_atomic_t *running_flag;

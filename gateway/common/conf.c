@@ -415,3 +415,72 @@ void conf_unknown_key(const struct conf_key *keys, size_t count, const char *key
         snprintf(why + used, n - used, "%s%s", i == 0 ? "" : i < count ? ", " : ")", i < count ? keys[i].name : "");
     }
 }
+
+/* ---- what a table says about its keys -------------------------------------------- */
+
+bool conf_key_defaults(const struct conf_key *keys, size_t count, void *obj, char *why, size_t n)
+{
+    char reason[CONF_WHY_MAX];
+    for (size_t i = 0; i < count; i++) {
+        if (keys[i].def != NULL && !conf_key_set(&keys[i], obj, keys[i].def, (struct conf_at){NULL, 0}, reason,
+                                                 sizeof reason)) {
+            return conf_fail(why, n, "the default of %s does not parse (a bug): %s", keys[i].name, reason);
+        }
+    }
+    return true;
+}
+
+const char *conf_key_bounds(const struct conf_key *key, char *buf, size_t size)
+{
+    char lo[32], hi[32];
+    buf[0] = '\0';
+    /* 0 to the field's own limit is no bound worth saying (a CAN id's 32 bits). */
+    if (key->kind == CONF_BOOL || key->max == 0 || (key->min == 0 && key->max >= UINT32_MAX)) {
+        return buf;
+    }
+    if (key->kind == CONF_MS && conf_bare_unit(key->name) == NULL) {
+        snprintf(buf, size, "%s..%s", format_duration(key->min * 1000u, lo, sizeof lo),
+                 format_duration(key->max * 1000u, hi, sizeof hi));
+    } else {
+        snprintf(buf, size, "%llu..%llu", (unsigned long long)key->min, (unsigned long long)key->max);
+    }
+    return buf;
+}
+
+static const char *key_form(const struct conf_key *key)
+{
+    if (key->form != NULL) {
+        return key->form;
+    }
+    switch (key->kind) {
+    case CONF_UINT: return "N";
+    case CONF_BOOL: return "yes|no";
+    case CONF_MS: return "DURATION";
+    default: return "VALUE";
+    }
+}
+
+void conf_key_print(FILE *out, const char *section, const struct conf_key *keys, size_t count)
+{
+    char bounds[80];
+    for (size_t i = 0; i < count; i++) {
+        const struct conf_key *k = &keys[i];
+        conf_key_bounds(k, bounds, sizeof bounds);
+        fprintf(out, "%s\t%s\t%s\t%s%s%s\t%s\t%s\n", section, k->name, key_form(k), k->def ? k->def : "(",
+                k->def ? "" : k->absent ? k->absent : "none", k->def ? "" : ")", bounds[0] ? bounds : "-",
+                k->help ? k->help : "-");
+    }
+}
+
+void conf_key_usage(FILE *out, const struct conf_key *keys, size_t count)
+{
+    char bounds[80], left[64];
+    for (size_t i = 0; i < count; i++) {
+        const struct conf_key *k = &keys[i];
+        conf_key_bounds(k, bounds, sizeof bounds);
+        snprintf(left, sizeof left, "%s = %s", k->name, key_form(k));
+        fprintf(out, "  %-30s (%s%s%s%s)\n      %s\n", left, k->def ? "default " : "",
+                k->def ? k->def : k->absent ? k->absent : "none", bounds[0] ? "; " : "", bounds,
+                k->help ? k->help : "");
+    }
+}

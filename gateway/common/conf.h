@@ -27,6 +27,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
 #define CONF_WHY_MAX 512 /* room for any reason these functions write */
@@ -88,22 +89,48 @@ struct conf_key;
 typedef bool (*conf_set_fn)(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
                             size_t n);
 
+/*
+ * One key: how its value is parsed and everything said about it. The table
+ * is the one source of a key's default, bounds and help: the loader applies
+ * def, and --help, --print-keys (and through it check-man, against the man
+ * page, docs/ and the example configuration) show them.
+ */
 struct conf_key {
     const char *name;
     enum conf_kind kind;
     size_t offset;     /* of the field in the section's object (not CONF_FN) */
     size_t size;
-    uint64_t min, max; /* CONF_UINT; CONF_MS in milliseconds */
+    /* CONF_UINT; CONF_MS in milliseconds; a CONF_FN key that parses a number
+     * may use them too. min == max == 0: no bounds to show. */
+    uint64_t min, max;
     conf_set_fn set;   /* CONF_FN */
     /* The message for a bad value other than a leading zero, a printf
      * format taking the key (%1$s) and the value (%2$s); NULL: the parser's
      * reason, as KEY = "VALUE": reason. */
     const char *hint;
     bool many;         /* may appear more than once in a section (a frame's signal lines) */
+    const char *form;  /* what a value looks like ("DURATION", "yes|no", "every|N Hz|off") */
+    const char *def;   /* the default in the file's grammar, set before the section's keys; NULL: none */
+    const char *absent; /* without def: what holds when the key is not given ("required", "the only robot") */
+    const char *help;  /* one line: what the key does */
 };
 
 /* CONF_FIELD(type, member): the offset and size of a destination. */
 #define CONF_FIELD(type, member) offsetof(type, member), sizeof(((type *)0)->member)
+
+/* Sets every key of the table that has a default (def) in obj, as if the
+ * file said so: false with the reason (a bug in the table) in why. */
+bool conf_key_defaults(const struct conf_key *keys, size_t count, void *obj, char *why, size_t n);
+/* The key's bounds as a value of its grammar ("1..65535", "20 ms..10 min",
+ * "10..1000" for a key named _ms); "" when it has none. */
+const char *conf_key_bounds(const struct conf_key *key, char *buf, size_t size);
+/* What --print-keys writes for a table: one line per key, tab-separated:
+ * SECTION KEY FORM DEFAULT BOUNDS HELP ("-" for an empty column; DEFAULT is
+ * def, or "(absent)" when the key has none). */
+void conf_key_print(FILE *out, const char *section, const struct conf_key *keys, size_t count);
+/* What --help writes for a table: per key "  KEY = FORM   (default DEF;
+ * BOUNDS)" and its help on a line of its own. */
+void conf_key_usage(FILE *out, const struct conf_key *keys, size_t count);
 
 const struct conf_key *conf_key_find(const struct conf_key *keys, size_t count, const char *name);
 /* Parses value for key into obj: false with the whole reason in why. */

@@ -71,12 +71,6 @@ double sim_model_time(const sim_model *m, uint64_t index)
     return m->start_time + (double)index / m->rate_hz;
 }
 
-uint64_t sim_model_index_of_time(const sim_model *m, double time)
-{
-    double k = (time - m->start_time) * m->rate_hz;
-    return k <= 0.0 ? 0 : (uint64_t)llround(k);
-}
-
 void sim_model_joints(const sim_model *m, double t, double q[6], double qd[6], double qdd[6])
 {
     for (int j = 0; j < 6; j++) {

@@ -5,8 +5,8 @@
  * A UR5e-like arm following smooth joint trajectories (sums of sines, so
  * that velocity and acceleration are their exact derivatives). Every value
  * of packet k is a function of (seed, k) alone: a test, or another program,
- * can recompute what the simulator sent from the seed and the packet's time
- * column (see sim_model_index_of_time).
+ * can recompute what the simulator sent from the seed and the packet's index
+ * (which its time column gives: SIM_MODEL_START_TIME + index / rate).
  *
  * Consistency the model keeps: targets lead actuals by SIM_MODEL_LAG_S;
  * torques are inertia * acceleration + friction + gravity of the arm in its
@@ -43,8 +43,6 @@ void sim_model_init(sim_model *m, uint64_t seed, double rate_hz);
 
 /* Controller time (the time column) of packet index. */
 double sim_model_time(const sim_model *m, uint64_t index);
-/* The packet index whose time column is time (nearest). */
-uint64_t sim_model_index_of_time(const sim_model *m, double time);
 
 /* Every field of packet index, for a packet of the given generation (robot
  * mode numbering and the 1.x-only fields depend on it). */

@@ -10,10 +10,10 @@
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
-#include <getopt.h>
 #include <inttypes.h>
 #include <math.h>
 #include <poll.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -153,21 +153,12 @@ static void usage(FILE *out)
 "  nc robot 30013 | " PROGRAM " --file - -F gnuplot > live.dat\n");
 }
 
-static void usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
-static void usage_error(const char *fmt, ...)
+/* --fields A,B,...: the fields to print, in this order. */
+static void parse_fields(const cli_option *row, const char *list, void *obj)
 {
-    va_list ap;
-    fprintf(stderr, PROGRAM ": ");
-    va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fprintf(stderr, "\nTry '" PROGRAM " --help'.\n");
-    exit(CLI_EXIT_USAGE);
-}
-
-static void parse_fields(const char *list, options *o)
-{
+    options *o = obj;
     const char *p = list;
+    (void)row;
     while (*p != '\0') {
         const char *comma = strchr(p, ',');
         size_t n = comma != NULL ? (size_t)(comma - p) : strlen(p);
@@ -191,35 +182,78 @@ static void parse_fields(const char *list, options *o)
         }
     }
     if (!o->fields_given) {
-        usage_error("--fields: empty list");
+        cli_usage_error(PROGRAM, "--fields: empty list");
+    }
+}
+
+static void on_unknown_option(int letter)
+{
+    if (letter == 'o') {
+        /* -o was --fields before it meant --output in urrt-gateway. */
+        cli_usage_error(PROGRAM, "-o is gone: fields are -k A,B (--fields A,B)");
+    }
+}
+
+static const char *const format_words[] = {"table", "csv", "json", "gnuplot", NULL}; /* format's order */
+_Static_assert(sizeof(format) == sizeof(int), "CLI_WORD stores an int");
+
+/* One row per option: names, argument, the parser that reads it (cli.h's
+ * kinds), where it goes, its range, what the message adds. The order is
+ * getopt_long's when it lists the options an abbreviation could mean. */
+#define AT(member) offsetof(options, member)
+static const cli_option option_table[] = {
+    {"format", 'F', required_argument, CLI_WORD, AT(fmt), 0, 0, NULL, format_words, NULL},
+    {"fields", 'k', required_argument, CLI_FN, 0, 0, 0, NULL, NULL, parse_fields},
+    {"count", 'n', required_argument, CLI_UINT, AT(count), 1, UINT64_MAX, NULL, NULL, NULL},
+    {"every", 'e', required_argument, CLI_UINT, AT(every), 1, UINT64_MAX, NULL, NULL, NULL},
+    {"record", 'w', required_argument, CLI_TEXT, AT(record_path), 0, 0, NULL, NULL, NULL},
+    {"file", 'f', required_argument, CLI_TEXT, AT(file_path), 0, 0, NULL, NULL, NULL},
+    {"once", 0, no_argument, CLI_TRUE, AT(once), 0, 0, NULL, NULL, NULL},
+    {"timeout", 't', required_argument, CLI_SECONDS, AT(timeout_s), 1000, UINT64_C(1000000000000),
+     " (seconds, e.g. 2.5)", NULL, NULL},
+    {"connect-timeout", 0, required_argument, CLI_MS, AT(connect_timeout_ms), 1, 600000, " (milliseconds)", NULL,
+     NULL},
+    {"silence-timeout", 0, required_argument, CLI_MS, AT(silence_timeout_ms), 0, 600000, " (milliseconds)", NULL,
+     NULL},
+    {"backoff-max", 0, required_argument, CLI_MS, AT(backoff_max_ms), 100, 600000, " (milliseconds, at least 100)",
+     NULL, NULL},
+    {"no-summary", 0, no_argument, CLI_FALSE, AT(summary), 0, 0, NULL, NULL, NULL},
+    {"verbose", 'v', no_argument, CLI_VERBOSE, AT(log_level), 0, 0, NULL, NULL, NULL},
+    {"quiet", 'q', no_argument, CLI_QUIET, AT(log_level), 0, 0, NULL, NULL, NULL},
+    {"help", 'h', no_argument, CLI_HELP, 0, 0, 0, NULL, NULL, NULL},
+    {"version", 'V', no_argument, CLI_VERSION, 0, 0, 0, NULL, NULL, NULL},
+};
+#undef AT
+
+/* The source: a file, or one robot. */
+static void check_source(int argc, char **argv, int operand, options *o)
+{
+    const char *err;
+    if (o->file_path != NULL) {
+        if (operand < argc) {
+            cli_usage_error(PROGRAM, "give --file or HOST[:PORT], not both");
+        }
+        if (o->once || o->timeout_s > 0) {
+            cli_usage_error(PROGRAM, "--once and --timeout are for a robot, not --file");
+        }
+        return;
+    }
+    if (operand >= argc) {
+        cli_usage_error(PROGRAM, "no robot to read from: give HOST[:PORT] or --file PATH");
+    }
+    if (operand + 1 < argc) {
+        cli_usage_error(PROGRAM, "unexpected argument \"%s\" (one robot at a time)", argv[operand + 1]);
+    }
+    if ((err = cli_parse_host_port(argv[operand], URRT_LINK_PORT_RW, o->host, sizeof o->host, &o->port)) != NULL) {
+        cli_usage_error(PROGRAM, "%s: %s", argv[operand], err);
     }
 }
 
 static void parse_options(int argc, char **argv, options *o)
 {
-    enum { OPT_ONCE = 256, OPT_CONNECT_TIMEOUT, OPT_SILENCE_TIMEOUT, OPT_BACKOFF_MAX, OPT_NO_SUMMARY };
-    static const struct option longopts[] = {
-        {"format", required_argument, NULL, 'F'},
-        {"fields", required_argument, NULL, 'k'},
-        {"count", required_argument, NULL, 'n'},
-        {"every", required_argument, NULL, 'e'},
-        {"record", required_argument, NULL, 'w'},
-        {"file", required_argument, NULL, 'f'},
-        {"once", no_argument, NULL, OPT_ONCE},
-        {"timeout", required_argument, NULL, 't'},
-        {"connect-timeout", required_argument, NULL, OPT_CONNECT_TIMEOUT},
-        {"silence-timeout", required_argument, NULL, OPT_SILENCE_TIMEOUT},
-        {"backoff-max", required_argument, NULL, OPT_BACKOFF_MAX},
-        {"no-summary", no_argument, NULL, OPT_NO_SUMMARY},
-        {"verbose", no_argument, NULL, 'v'},
-        {"quiet", no_argument, NULL, 'q'},
-        {"help", no_argument, NULL, 'h'},
-        {"version", no_argument, NULL, 'V'},
-        {NULL, 0, NULL, 0},
-    };
-    char why[CONF_WHY_MAX];
-    const char *err;
-    int c;
+    static const cli_options set = {PROGRAM, option_table, sizeof option_table / sizeof option_table[0], usage,
+                                    on_unknown_option};
+    int operand;
 
     memset(o, 0, sizeof *o);
     o->fmt = FORMAT_TABLE;
@@ -229,92 +263,11 @@ static void parse_options(int argc, char **argv, options *o)
     o->backoff_max_ms = 5000;
     o->summary = true;
     o->log_level = URRT_LOG_NOTICE;
-    while ((c = getopt_long(argc, argv, "F:k:n:e:w:f:t:vqhV", longopts, NULL)) != -1) {
-        switch (c) {
-        case 'F':
-            if (strcmp(optarg, "table") == 0) {
-                o->fmt = FORMAT_TABLE;
-            } else if (strcmp(optarg, "csv") == 0) {
-                o->fmt = FORMAT_CSV;
-            } else if (strcmp(optarg, "json") == 0) {
-                o->fmt = FORMAT_JSON;
-            } else if (strcmp(optarg, "gnuplot") == 0) {
-                o->fmt = FORMAT_GNUPLOT;
-            } else {
-                usage_error("--format %s: use table, csv, json or gnuplot", optarg);
-            }
-            break;
-        case 'k': parse_fields(optarg, o); break;
-        case 'n':
-            if (!conf_uint(optarg, 1, UINT64_MAX, &o->count, why, sizeof why)) {
-                usage_error("--count %s: %s", optarg, why);
-            }
-            break;
-        case 'e':
-            if (!conf_uint(optarg, 1, UINT64_MAX, &o->every, why, sizeof why)) {
-                usage_error("--every %s: %s", optarg, why);
-            }
-            break;
-        case 'w': o->record_path = optarg; break;
-        case 'f': o->file_path = optarg; break;
-        case OPT_ONCE: o->once = true; break;
-        case 't': {
-            uint64_t us;
-            if (!conf_duration_us(optarg, "s", 1000, UINT64_C(1000000000000), &us, why, sizeof why)) {
-                usage_error("--timeout %s: %s (seconds, e.g. 2.5)", optarg, why);
-            }
-            o->timeout_s = (double)us / 1e6;
-            break;
-        }
-        case OPT_CONNECT_TIMEOUT:
-            if (!conf_duration_ms(optarg, "ms", 1, 600000, &o->connect_timeout_ms, why, sizeof why)) {
-                usage_error("--connect-timeout %s: %s (milliseconds)", optarg, why);
-            }
-            break;
-        case OPT_SILENCE_TIMEOUT:
-            if (!conf_duration_ms(optarg, "ms", 0, 600000, &o->silence_timeout_ms, why, sizeof why)) {
-                usage_error("--silence-timeout %s: %s (milliseconds)", optarg, why);
-            }
-            break;
-        case OPT_BACKOFF_MAX:
-            if (!conf_duration_ms(optarg, "ms", 100, 600000, &o->backoff_max_ms, why, sizeof why)) {
-                usage_error("--backoff-max %s: %s (milliseconds, at least 100)", optarg, why);
-            }
-            break;
-        case OPT_NO_SUMMARY: o->summary = false; break;
-        case 'v': o->log_level = o->log_level == URRT_LOG_NOTICE ? URRT_LOG_INFO : URRT_LOG_DEBUG; break;
-        case 'q': o->log_level = URRT_LOG_ERR; break;
-        case 'h': usage(stdout); exit(CLI_EXIT_OK);
-        case 'V': printf(PROGRAM " " URRT_VERSION_STRING "\n"); exit(CLI_EXIT_OK);
-        default:
-            if (optopt == 'o') {
-                /* -o was --fields before it meant --output in urrt-gateway. */
-                usage_error("-o is gone: fields are -k A,B (--fields A,B)");
-            }
-            fprintf(stderr, "Try '" PROGRAM " --help'.\n");
-            exit(CLI_EXIT_USAGE);
-        }
-    }
-    if (o->file_path != NULL) {
-        if (optind < argc) {
-            usage_error("give --file or HOST[:PORT], not both");
-        }
-        if (o->once || o->timeout_s > 0) {
-            usage_error("--once and --timeout are for a robot, not --file");
-        }
-    } else {
-        if (optind >= argc) {
-            usage_error("no robot to read from: give HOST[:PORT] or --file PATH");
-        }
-        if (optind + 1 < argc) {
-            usage_error("unexpected argument \"%s\" (one robot at a time)", argv[optind + 1]);
-        }
-        if ((err = cli_parse_host_port(argv[optind], URRT_LINK_PORT_RW, o->host, sizeof o->host, &o->port)) != NULL) {
-            usage_error("%s: %s", argv[optind], err);
-        }
-    }
+    operand = cli_parse_options(&set, argc, argv, o);
+    check_source(argc, argv, operand, o);
     if (o->fmt == FORMAT_GNUPLOT && o->fields_given) {
-        usage_error("gnuplot output holds every column (column N is UR's col. N): use csv or json for --fields");
+        cli_usage_error(PROGRAM, "gnuplot output holds every column (column N is UR's col. N): use csv or json "
+                                 "for --fields");
     }
 }
 

@@ -10,13 +10,13 @@
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
-#include <getopt.h>
 #include <inttypes.h>
 #include <math.h>
 #include <netdb.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -98,6 +98,17 @@ typedef struct options {
     fault_config fault;
     urrt_log_level log_level;
 } options;
+
+/* What the command line says, as it is read: options, and what is resolved
+ * once every option is in. */
+typedef struct command_line {
+    options opt;
+    const char *listen_arg;
+    const char *version_arg;   /* --controller V, or --version V */
+    bool length_given;
+    int argc;                  /* for --version, which may take the next word */
+    char **argv;
+} command_line;
 
 /* ---- the packet source: the model or a capture ------------------------------ */
 
@@ -269,18 +280,6 @@ static void usage(FILE *out)
             URRT_PACKET_MAX, DEFAULT_LENGTH);
 }
 
-static void usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
-static void usage_error(const char *fmt, ...)
-{
-    va_list ap;
-    fprintf(stderr, PROGRAM ": ");
-    va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fprintf(stderr, "\nTry '" PROGRAM " --help'.\n");
-    exit(CLI_EXIT_USAGE);
-}
-
 /* Controller software version -> packet length and default rate, from
  * lib's controller table. NULL, or why the version is refused (why_buf
  * holds it). */
@@ -312,11 +311,11 @@ static uint64_t fault_value(const char *name, const char *value, uint64_t min, u
     uint64_t v;
     const char *err;
     if (value == NULL) {
-        usage_error("fault %s needs a value: %s=N", name, name);
+        cli_usage_error(PROGRAM, "fault %s needs a value: %s=N", name, name);
     }
     if ((err = cli_parse_u64(value, min, max, &v)) != NULL) {
-        usage_error("fault %s=%s: %s (from %llu to %llu)", name, value, err, (unsigned long long)min,
-                    (unsigned long long)max);
+        cli_usage_error(PROGRAM, "fault %s=%s: %s (from %llu to %llu)", name, value, err,
+                        (unsigned long long)min, (unsigned long long)max);
     }
     return v;
 }
@@ -347,9 +346,9 @@ static void parse_fault_kind(const char *kind, const char *value, fault_config *
     } else if (strcmp(kind, "freeze-every") == 0) {
         f->freeze_every = fault_value(kind, value, 1, UINT64_MAX);
     } else {
-        usage_error("unknown fault \"%s\": use close-after, reset-after, truncate-after, garbage-every, "
-                    "tiny-writes, coalesce, stall-after, odd-length, freeze-after or freeze-every",
-                    kind);
+        cli_usage_error(PROGRAM, "unknown fault \"%s\": use close-after, reset-after, truncate-after, "
+                        "garbage-every, tiny-writes, coalesce, stall-after, odd-length, freeze-after or freeze-every",
+                        kind);
     }
 }
 
@@ -367,10 +366,10 @@ static void parse_fault_param(const char *spec, const char *kind, const char *ke
     } else if (strcmp(kind, "odd-length") == 0 && strcmp(key, "length") == 0) {
         f->odd_length = (uint32_t)fault_value(key, value, URRT_PACKET_MIN, URRT_PACKET_MAX);
         if ((f->odd_length - URRT_HEADER_SIZE) % 8 != 0) {
-            usage_error("odd-length length=%s: must be 4 + 8n", value);
+            cli_usage_error(PROGRAM, "odd-length length=%s: must be 4 + 8n", value);
         }
     } else {
-        usage_error("fault \"%s\": unknown parameter \"%s\"", spec, key);
+        cli_usage_error(PROGRAM, "fault \"%s\": unknown parameter \"%s\"", spec, key);
     }
 }
 
@@ -384,19 +383,22 @@ static char *split_value(char *tok)
     return value;
 }
 
-static void parse_fault(const char *spec, fault_config *f)
+/* --fault KIND[=N][,KEY=VALUE]: into the options' fault_config. */
+static void parse_fault(const cli_option *row, const char *spec, void *obj)
 {
+    fault_config *f = &((command_line *)obj)->opt.fault;
     char buf[128];
     char *save = NULL;
     char *kind, *tok;
 
+    (void)row;
     if (strlen(spec) >= sizeof buf) {
-        usage_error("fault \"%s\" is too long", spec);
+        cli_usage_error(PROGRAM, "fault \"%s\" is too long", spec);
     }
     strcpy(buf, spec);
     kind = strtok_r(buf, ",", &save);
     if (kind == NULL) {
-        usage_error("empty --fault");
+        cli_usage_error(PROGRAM, "empty --fault");
     }
     parse_fault_kind(kind, split_value(kind), f);
     /* A kind takes one parameter at most. */
@@ -405,168 +407,146 @@ static void parse_fault(const char *spec, fault_config *f)
         parse_fault_param(spec, params == 0 ? kind : "", tok, value, f);
     }
     if (f->freeze_after != 0 && f->freeze_every != 0) {
-        usage_error("give freeze-after or freeze-every, not both");
+        cli_usage_error(PROGRAM, "give freeze-after or freeze-every, not both");
     }
     if (f->freeze_every != 0 && f->freeze_ms == 0) {
-        usage_error("fault freeze-every needs its length: freeze-every=N,for=MS");
+        cli_usage_error(PROGRAM, "fault freeze-every needs its length: freeze-every=N,for=MS");
+    }
+}
+
+/* --version [V]: a word after it is a controller version, not an option. */
+static void version_or_controller(const cli_option *row, const char *arg, void *obj)
+{
+    command_line *cl = obj;
+    (void)row;
+    /* urrt-sim takes no operands, so a word after --version can only be
+     * a controller version (the older spelling of --controller): it is
+     * never taken for "print the version", whatever it says. */
+    if (arg == NULL && optind < cl->argc && cl->argv[optind][0] != '-') {
+        arg = cl->argv[optind++];
+    }
+    if (arg == NULL) {
+        cli_print_version(PROGRAM);
+    }
+    cl->version_arg = arg;
+}
+
+static void check_length(const cli_option *row, const char *arg, void *obj)
+{
+    command_line *cl = obj;
+    (void)row;
+    if ((cl->opt.length - URRT_HEADER_SIZE) % 8 != 0) {
+        cli_usage_error(PROGRAM, "--length %s: a packet is 4 bytes of size and 8 per double: 4 + 8n (e.g. 1116)",
+                        arg);
+    }
+    cl->length_given = true;
+}
+
+static void parse_rate(const cli_option *row, const char *arg, void *obj)
+{
+    command_line *cl = obj;
+    char why[CONF_WHY_MAX];
+    if (!conf_number(arg, 0.1, 100000.0, &cl->opt.rate_hz, why, sizeof why)) {
+        cli_bad_value(PROGRAM, row, arg, why);
+    }
+    cl->opt.rate_given = true;
+}
+
+static const char *const clock_words[] = {"start", "monotonic", "realtime", NULL}; /* sim_clock's order */
+_Static_assert(sizeof(sim_clock) == sizeof(int), "CLI_WORD stores an int");
+
+/* One row per option: names, argument, the parser that reads it (cli.h's
+ * kinds), where it goes, its range, what the message adds. The order is
+ * getopt_long's when it lists the options an abbreviation could mean. */
+#define AT(member) offsetof(command_line, member)
+static const cli_option option_table[] = {
+    {"listen", 'l', required_argument, CLI_TEXT, AT(listen_arg), 0, 0, NULL, NULL, NULL},
+    {"port-file", 0, required_argument, CLI_TEXT, AT(opt.port_file), 0, 0, NULL, NULL, NULL},
+    {"clock", 0, required_argument, CLI_WORD, AT(opt.clock), 0, 0, NULL, clock_words, NULL},
+    {"version", 'V', optional_argument, CLI_FN, 0, 0, 0, NULL, NULL, version_or_controller},
+    {"controller", 'c', required_argument, CLI_TEXT, AT(version_arg), 0, 0, NULL, NULL, NULL},
+    {"length", 'L', required_argument, CLI_U32, AT(opt.length), URRT_PACKET_MIN, URRT_PACKET_MAX, NULL, NULL,
+     check_length},
+    {"rate", 'r', required_argument, CLI_FN, 0, 0, 0, " (Hz)", NULL, parse_rate},
+    {"seed", 's', required_argument, CLI_UINT, AT(opt.seed), 0, UINT64_MAX, NULL, NULL, NULL},
+    {"count", 'n', required_argument, CLI_UINT, AT(opt.count), 1, UINT64_MAX, NULL, NULL, NULL},
+    {"record", 'w', required_argument, CLI_TEXT, AT(opt.record_path), 0, 0, NULL, NULL, NULL},
+    {"replay", 0, required_argument, CLI_TEXT, AT(opt.replay_path), 0, 0, NULL, NULL, NULL},
+    {"loop", 0, no_argument, CLI_TRUE, AT(opt.loop), 0, 0, NULL, NULL, NULL},
+    {"start-on-connect", 0, no_argument, CLI_TRUE, AT(opt.start_on_connect), 0, 0, NULL, NULL, NULL},
+    {"clients", 0, required_argument, CLI_UINT, AT(opt.clients_to_serve), 1, UINT64_MAX, NULL, NULL, NULL},
+    {"max-clients", 0, required_argument, CLI_U32, AT(opt.max_clients), 1, MAX_CLIENTS_LIMIT, NULL, NULL, NULL},
+    {"rt-priority", 0, required_argument, CLI_U32, AT(opt.rt_priority), 1, 99, NULL, NULL, NULL},
+    {"fault", 'f', required_argument, CLI_FN, 0, 0, 0, NULL, NULL, parse_fault},
+    {"verbose", 'v', no_argument, CLI_VERBOSE, AT(opt.log_level), 0, 0, NULL, NULL, NULL},
+    {"quiet", 'q', no_argument, CLI_QUIET, AT(opt.log_level), 0, 0, NULL, NULL, NULL},
+    {"help", 'h', no_argument, CLI_HELP, 0, 0, 0, NULL, NULL, NULL},
+};
+#undef AT
+
+/* --controller V: the length and, unless --rate says, the rate of V. */
+static void resolve_controller(command_line *cl)
+{
+    options *o = &cl->opt;
+    double rate;
+    char why_buf[128];
+    const char *why;
+    if (cl->length_given) {
+        cli_usage_error(PROGRAM, "give --controller or --length, not both");
+    }
+    if ((why = length_of_version(cl->version_arg, &o->length, &rate, why_buf, sizeof why_buf)) != NULL) {
+        cli_usage_error(PROGRAM, "--controller %s: %s", cl->version_arg, why);
+    }
+    if (!o->rate_given) {
+        o->rate_hz = rate;
+    }
+}
+
+/* Options that go together, or do not, once every one is in. */
+static void check_combinations(command_line *cl)
+{
+    options *o = &cl->opt;
+    const char *err;
+    if (o->replay_path != NULL && (cl->version_arg != NULL || cl->length_given || o->rate_given)) {
+        cli_usage_error(PROGRAM, "--replay sends the capture's own packets at its own pace: drop --controller, "
+                                 "--length, --rate");
+    }
+    if (o->replay_path != NULL && o->clock != SIM_CLOCK_START) {
+        cli_usage_error(PROGRAM, "--replay sends the capture's own time column: drop --clock");
+    }
+    if (o->loop && o->replay_path == NULL) {
+        cli_usage_error(PROGRAM, "--loop goes with --replay");
+    }
+    if (o->fault.odd_every != 0 && o->fault.odd_length == 0) {
+        o->fault.odd_length = o->length + 8;
+    }
+    if ((err = cli_parse_listen_address(cl->listen_arg, URRT_LINK_PORT_RW, o->listen_host, sizeof o->listen_host,
+                                        &o->listen_port)) != NULL) {
+        cli_usage_error(PROGRAM, "--listen %s: %s", cl->listen_arg, err);
     }
 }
 
 static void parse_options(int argc, char **argv, options *o)
 {
-    enum { OPT_REPLAY = 256, OPT_LOOP, OPT_START_ON_CONNECT, OPT_CLIENTS, OPT_MAX_CLIENTS,
-           OPT_RT_PRIORITY, OPT_PORT_FILE, OPT_CLOCK };
-    static const struct option longopts[] = {
-        {"listen", required_argument, NULL, 'l'},
-        {"port-file", required_argument, NULL, OPT_PORT_FILE},
-        {"clock", required_argument, NULL, OPT_CLOCK},
-        {"version", optional_argument, NULL, 'V'},
-        {"controller", required_argument, NULL, 'c'},
-        {"length", required_argument, NULL, 'L'},
-        {"rate", required_argument, NULL, 'r'},
-        {"seed", required_argument, NULL, 's'},
-        {"count", required_argument, NULL, 'n'},
-        {"record", required_argument, NULL, 'w'},
-        {"replay", required_argument, NULL, OPT_REPLAY},
-        {"loop", no_argument, NULL, OPT_LOOP},
-        {"start-on-connect", no_argument, NULL, OPT_START_ON_CONNECT},
-        {"clients", required_argument, NULL, OPT_CLIENTS},
-        {"max-clients", required_argument, NULL, OPT_MAX_CLIENTS},
-        {"rt-priority", required_argument, NULL, OPT_RT_PRIORITY},
-        {"fault", required_argument, NULL, 'f'},
-        {"verbose", no_argument, NULL, 'v'},
-        {"quiet", no_argument, NULL, 'q'},
-        {"help", no_argument, NULL, 'h'},
-        {NULL, 0, NULL, 0},
-    };
-    const char *listen_arg = DEFAULT_LISTEN;
-    const char *version_arg = NULL;
-    bool length_given = false;
-    char reason[CONF_WHY_MAX];
-    const char *err;
-    int c;
+    static const cli_options set = {PROGRAM, option_table, sizeof option_table / sizeof option_table[0], usage,
+                                    NULL};
+    command_line cl = {.listen_arg = DEFAULT_LISTEN, .argc = argc, .argv = argv};
+    int operand;
 
-    memset(o, 0, sizeof *o);
-    o->length = DEFAULT_LENGTH;
-    o->rate_hz = 125.0;
-    o->seed = 1;
-    o->max_clients = 16;
-    o->log_level = URRT_LOG_NOTICE;
-    while ((c = getopt_long(argc, argv, "c:l:L:r:s:n:w:f:vqhV", longopts, NULL)) != -1) {
-        switch (c) {
-        case 'l': listen_arg = optarg; break;
-        case OPT_PORT_FILE: o->port_file = optarg; break;
-        case OPT_CLOCK:
-            if (strcmp(optarg, "start") == 0) {
-                o->clock = SIM_CLOCK_START;
-            } else if (strcmp(optarg, "monotonic") == 0) {
-                o->clock = SIM_CLOCK_MONOTONIC;
-            } else if (strcmp(optarg, "realtime") == 0) {
-                o->clock = SIM_CLOCK_REALTIME;
-            } else {
-                usage_error("--clock %s: use start, monotonic or realtime", optarg);
-            }
-            break;
-        case 'V':
-            /* urrt-sim takes no operands, so a word after --version can only be
-             * a controller version (the older spelling of --controller): it is
-             * never taken for "print the version", whatever it says. */
-            if (optarg == NULL && optind < argc && argv[optind][0] != '-') {
-                optarg = argv[optind++];
-            }
-            if (optarg == NULL) {
-                printf(PROGRAM " " URRT_VERSION_STRING "\n");
-                exit(CLI_EXIT_OK);
-            }
-            /* fall through */
-        case 'c': version_arg = optarg; break;
-        case 'L': {
-            uint32_t v;
-            if (!conf_u32(optarg, URRT_PACKET_MIN, URRT_PACKET_MAX, &v, reason, sizeof reason)) {
-                usage_error("--length %s: %s", optarg, reason);
-            }
-            if ((v - URRT_HEADER_SIZE) % 8 != 0) {
-                usage_error("--length %s: a packet is 4 bytes of size and 8 per double: 4 + 8n (e.g. 1116)", optarg);
-            }
-            o->length = v;
-            length_given = true;
-            break;
-        }
-        case 'r':
-            if (!conf_number(optarg, 0.1, 100000.0, &o->rate_hz, reason, sizeof reason)) {
-                usage_error("--rate %s: %s (Hz)", optarg, reason);
-            }
-            o->rate_given = true;
-            break;
-        case 's':
-            if (!conf_uint(optarg, 0, UINT64_MAX, &o->seed, reason, sizeof reason)) {
-                usage_error("--seed %s: %s", optarg, reason);
-            }
-            break;
-        case 'n':
-            if (!conf_uint(optarg, 1, UINT64_MAX, &o->count, reason, sizeof reason)) {
-                usage_error("--count %s: %s", optarg, reason);
-            }
-            break;
-        case 'w': o->record_path = optarg; break;
-        case OPT_REPLAY: o->replay_path = optarg; break;
-        case OPT_LOOP: o->loop = true; break;
-        case OPT_START_ON_CONNECT: o->start_on_connect = true; break;
-        case OPT_CLIENTS:
-            if (!conf_uint(optarg, 1, UINT64_MAX, &o->clients_to_serve, reason, sizeof reason)) {
-                usage_error("--clients %s: %s", optarg, reason);
-            }
-            break;
-        case OPT_MAX_CLIENTS:
-            if (!conf_u32(optarg, 1, MAX_CLIENTS_LIMIT, &o->max_clients, reason, sizeof reason)) {
-                usage_error("--max-clients %s: %s", optarg, reason);
-            }
-            break;
-        case OPT_RT_PRIORITY:
-            if (!conf_u32(optarg, 1, 99, &o->rt_priority, reason, sizeof reason)) {
-                usage_error("--rt-priority %s: %s", optarg, reason);
-            }
-            break;
-        case 'f': parse_fault(optarg, &o->fault); break;
-        case 'v': o->log_level = o->log_level == URRT_LOG_NOTICE ? URRT_LOG_INFO : URRT_LOG_DEBUG; break;
-        case 'q': o->log_level = URRT_LOG_ERR; break;
-        case 'h': usage(stdout); exit(CLI_EXIT_OK);
-        default: fprintf(stderr, "Try '" PROGRAM " --help'.\n"); exit(CLI_EXIT_USAGE);
-        }
+    cl.opt.length = DEFAULT_LENGTH;
+    cl.opt.rate_hz = 125.0;
+    cl.opt.seed = 1;
+    cl.opt.max_clients = 16;
+    cl.opt.log_level = URRT_LOG_NOTICE;
+    operand = cli_parse_options(&set, argc, argv, &cl);
+    if (operand < argc) {
+        cli_usage_error(PROGRAM, "unexpected argument \"%s\" (options only)", argv[operand]);
     }
-    if (optind < argc) {
-        usage_error("unexpected argument \"%s\" (options only)", argv[optind]);
+    if (cl.version_arg != NULL) {
+        resolve_controller(&cl);
     }
-    if (version_arg != NULL) {
-        double rate;
-        char why_buf[128];
-        const char *why;
-        if (length_given) {
-            usage_error("give --controller or --length, not both");
-        }
-        if ((why = length_of_version(version_arg, &o->length, &rate, why_buf, sizeof why_buf)) != NULL) {
-            usage_error("--controller %s: %s", version_arg, why);
-        }
-        if (!o->rate_given) {
-            o->rate_hz = rate;
-        }
-    }
-    if (o->replay_path != NULL && (version_arg != NULL || length_given || o->rate_given)) {
-        usage_error("--replay sends the capture's own packets at its own pace: drop --controller, --length, --rate");
-    }
-    if (o->replay_path != NULL && o->clock != SIM_CLOCK_START) {
-        usage_error("--replay sends the capture's own time column: drop --clock");
-    }
-    if (o->loop && o->replay_path == NULL) {
-        usage_error("--loop goes with --replay");
-    }
-    if (o->fault.odd_every != 0 && o->fault.odd_length == 0) {
-        o->fault.odd_length = o->length + 8;
-    }
-    if ((err = cli_parse_listen_address(listen_arg, URRT_LINK_PORT_RW, o->listen_host, sizeof o->listen_host,
-                                   &o->listen_port)) != NULL) {
-        usage_error("--listen %s: %s", listen_arg, err);
-    }
+    check_combinations(&cl);
+    *o = cl.opt;
 }
 
 /* ---- capture loading ---------------------------------------------------------- */

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <ini.h>
+#include "can_run.h"
 
 #define CONFIG_MAX_KEYS 64
 
@@ -33,12 +33,12 @@ struct config_ctx {
     int errors;
     config_message *messages;   /* printed by rank and line at the end */
     int rank;                 /* RANK_FILE once the whole-file checks run */
-    int line;                 /* line the reader handed to inih last */
+    int line;                 /* of the line being read */
     FILE *file;
     gw_config *cfg;
+    bool in_section;          /* a section header was seen: keys are not outside of any */
     const config_section *section; /* NULL before the first header or after a bad one */
     bool section_ok;          /* keys of a bad section are skipped: one error is enough */
-    char section_raw[256];    /* the text between the brackets, as inih sees it */
     char section_label[64 + 1 + 256]; /* "robot arm1": kind and name, blanks trimmed */
     struct can_map_frame *frame; /* of the current [frame NAME] */
     struct { char name[64]; int line; } keys[CONFIG_MAX_KEYS];
@@ -47,7 +47,6 @@ struct config_ctx {
 };
 
 static const char *const kind_names[GW_KIND_COUNT] = {"state", "joints", "tool", "status", "gateway"};
-static const char *const kind_channels[GW_KIND_COUNT] = {"STATE", "JOINTS", "TOOL", "STATUS", "GATEWAY"};
 
 const char *gw_kind_name(gw_kind kind)
 {
@@ -138,6 +137,16 @@ static void replace_string(char **slot, const char *value)
     *slot = xstrdup(value);
 }
 
+/* The table's defaults into obj, as if the file said them first. One that
+ * does not parse is a bug of the table: said, not hidden. */
+static void set_defaults(config_ctx *ctx, const struct conf_key *keys, size_t count, void *obj)
+{
+    char why[CONF_WHY_MAX];
+    if (!conf_key_defaults(keys, count, obj, why, sizeof why)) {
+        config_error(ctx, 0, "%s", why);
+    }
+}
+
 /* ---- [gateway] ------------------------------------------------------------------ */
 
 bool gw_parse_log_level(const char *text, urrt_log_level *level)
@@ -165,9 +174,11 @@ static bool set_log_level(void *obj, const struct conf_key *key, const char *val
 }
 
 static const struct conf_key gateway_keys[] = {
-    {"log_level", CONF_FN, 0, 0, 0, 0, set_log_level, NULL, false},
+    {"log_level", CONF_FN, 0, 0, 0, 0, set_log_level, NULL, false, "err|warning|notice|info|debug", "notice", NULL,
+     "the least severe message logged"},
     {"summary", CONF_BOOL, CONF_FIELD(gw_config, summary), 0, 0, NULL,
-     "%1$s must be yes or no (or true/false, on/off, 1/0), not \"%2$s\"", false},
+     "%1$s must be yes or no (or true/false, on/off, 1/0), not \"%2$s\"", false, NULL, "no", NULL,
+     "one status line per robot each second on stdout"},
 };
 
 /* ---- [lcm] ------------------------------------------------------------------------ */
@@ -319,26 +330,27 @@ static bool set_lcm_rate(void *obj, const struct conf_key *key, const char *valu
     return true;
 }
 
-#define LCM_KIND_KEYS(kind)                                                    \
-    {kind "_channel", CONF_FN, 0, 0, 0, 0, set_lcm_channel, NULL, false},      \
-    {kind "_rate", CONF_FN, 0, 0, 0, 0, set_lcm_rate, NULL, false}
+/* A kind of message: its channel suffix and its rate (kind_names' order). */
+#define LCM_KIND_KEYS(kind, channel, rate, rate_form)                                                           \
+    {kind "_channel", CONF_FN, 0, 0, 0, 0, set_lcm_channel, NULL, false, "SUFFIX", channel, NULL,                 \
+     "the channel NAME.SUFFIX of " kind " messages"},                                                          \
+    {kind "_rate", CONF_FN, 0, 0, 0, 0, set_lcm_rate, NULL, false, rate_form, rate, NULL,                         \
+     "how often " kind " messages go out (N Hz on the controller's clock)"}
 
 static const struct conf_key lcm_keys[] = {
-    {"url", CONF_FN, 0, 0, 0, 0, set_lcm_url, NULL, false},
-    LCM_KIND_KEYS("state"), LCM_KIND_KEYS("joints"), LCM_KIND_KEYS("tool"), LCM_KIND_KEYS("status"),
-    LCM_KIND_KEYS("gateway"),
+    {"url", CONF_FN, 0, 0, 0, 0, set_lcm_url, NULL, false, "PROVIDER://...", GW_DEFAULT_LCM_URL, NULL,
+     "the LCM URL to publish on"},
+    LCM_KIND_KEYS("state", "STATE", "every", "every|N Hz|off"),
+    LCM_KIND_KEYS("joints", "JOINTS", "every", "every|N Hz|off"),
+    LCM_KIND_KEYS("tool", "TOOL", "every", "every|N Hz|off"),
+    LCM_KIND_KEYS("status", "STATUS", "10 Hz", "every|N Hz|off"),
+    LCM_KIND_KEYS("gateway", "GATEWAY", "1 Hz", "N Hz|off"),
 };
 
 static void lcm_finish(config_ctx *ctx, gw_config *cfg)
 {
     gw_lcm_config *lcm = &cfg->lcm;
-    if (lcm->url == NULL) {
-        lcm->url = xstrdup(GW_DEFAULT_LCM_URL);
-    }
     for (unsigned k = 0; k < GW_KIND_COUNT; k++) {
-        if (lcm->channel[k] == NULL) {
-            lcm->channel[k] = xstrdup(kind_channels[k]);
-        }
         for (unsigned j = 0; j < k; j++) {
             if (strcmp(lcm->channel[j], lcm->channel[k]) == 0) {
                 /* Blame the line that set it; of two, the later one. */
@@ -454,18 +466,29 @@ static bool set_host(void *obj, const struct conf_key *key, const char *host, st
 }
 
 #define LINK_FIELD(member) CONF_FIELD(gw_robot_config, link.member)
+/* A number as the text of the file: the port's constants are literals. */
+#define TEXT_OF(x) TEXT_OF_(x)
+#define TEXT_OF_(x) #x
 
 static const struct conf_key robot_keys[] = {
-    {"host", CONF_FN, 0, 0, 0, 0, set_host, NULL, false},
+    {"host", CONF_FN, 0, 0, 0, 0, set_host, NULL, false, "ADDRESS", NULL, "required",
+     "the robot's IPv4 or IPv6 address (no brackets, no :PORT), or host name"},
     {"port", CONF_UINT, CONF_FIELD(gw_robot_config, port), 1, 65535, NULL,
-     "%1$s must be a whole number from 1 to 65535, not \"%2$s\"", false},
-    {"version", CONF_FN, 0, 0, 0, 0, set_version, NULL, false},
-    {"connect_timeout", CONF_MS, LINK_FIELD(connect_timeout_ms), 10, 600000, NULL, NULL, false},
+     "%1$s must be a whole number from 1 to 65535, not \"%2$s\"", false, NULL, TEXT_OF(URRT_LINK_PORT_RW), NULL,
+     "the RealTime port; " TEXT_OF(URRT_LINK_PORT_RO) " is the read-only one"},
+    {"version", CONF_FN, 0, 0, 0, 0, set_version, NULL, false, "auto|X.Y|BYTES", "auto", NULL,
+     "the expected controller version or message size: others are mismatches"},
+    {"connect_timeout", CONF_MS, LINK_FIELD(connect_timeout_ms), 10, 600000, NULL, NULL, false, NULL, "2 s", NULL,
+     "how long a connection attempt may take"},
     /* A 125 Hz controller sends every 8 ms: less than 20 ms would drop a
-     * healthy link on ordinary jitter. */
-    {"silence_timeout", CONF_MS, LINK_FIELD(silence_timeout_ms), 20, 600000, NULL, NULL, false},
-    {"backoff_initial", CONF_MS, LINK_FIELD(backoff_initial_ms), 10, 600000, NULL, NULL, false},
-    {"backoff_max", CONF_MS, LINK_FIELD(backoff_max_ms), 10, 600000, NULL, NULL, false},
+     * healthy link on ordinary jitter. The default is the port's. */
+    {"silence_timeout", CONF_MS, LINK_FIELD(silence_timeout_ms), 20, 600000, NULL, NULL, false, NULL,
+     TEXT_OF(URRT_LINK_SILENCE_TIMEOUT_MS) " ms", NULL,
+     "no packet for this long: reconnect; nothing is published meanwhile"},
+    {"backoff_initial", CONF_MS, LINK_FIELD(backoff_initial_ms), 10, 600000, NULL, NULL, false, NULL, "100 ms", NULL,
+     "the first wait before reconnecting after a failure"},
+    {"backoff_max", CONF_MS, LINK_FIELD(backoff_max_ms), 10, 600000, NULL, NULL, false, NULL, "5 s", NULL,
+     "the wait doubles up to this"},
 };
 
 static bool robot_begin(config_ctx *ctx, gw_config *cfg, const char *name)
@@ -497,10 +520,8 @@ static bool robot_begin(config_ctx *ctx, gw_config *cfg, const char *name)
     memset(robot, 0, sizeof *robot);
     robot->name = xstrdup(name);
     robot->line = ctx->line;
-    robot->port = URRT_LINK_PORT_RW;
-    robot->expected = xstrdup("auto");
-    robot->max_rate_hz = GW_ROBOT_MAX_RATE_HZ;
     urrt_link_config_defaults(&robot->link);
+    set_defaults(ctx, robot_keys, sizeof robot_keys / sizeof robot_keys[0], robot);
     return true;
 }
 
@@ -559,15 +580,24 @@ static bool can_set(config_ctx *ctx, gw_config *cfg, const struct conf_key *key,
     return can_map_set(&cfg->can, ctx->frame, key, value, (struct conf_at){ctx->path, ctx->line}, why, n);
 }
 
+/* The whole-file checks, then the run-time tables: built here, once, so that
+ * --check-config proves they build. */
 static void can_finish(config_ctx *ctx, gw_config *cfg)
 {
     struct can_map_robot robots[GW_MAX_ROBOTS];
-    (void)ctx;
+    char why[CONF_WHY_MAX];
     for (unsigned i = 0; i < cfg->robot_count; i++) {
         robots[i].name = cfg->robots[i].name;
         robots[i].period_us = 1000000u / cfg->robots[i].max_rate_hz;
     }
-    can_map_finish(&cfg->can, robots, cfg->robot_count, NULL, 0);
+    if (can_map_finish(&cfg->can, robots, cfg->robot_count, NULL, 0) != 0 || !can_map_enabled(&cfg->can) ||
+        ctx->errors > 0) {
+        return;
+    }
+    cfg->can_run = can_run_build(&cfg->can, why, sizeof why);
+    if (cfg->can_run == NULL) {
+        config_error(ctx, 0, "%s", why);
+    }
 }
 
 /* ---- the section table ---------------------------------------------------------- */
@@ -593,11 +623,14 @@ static void *robot_object(config_ctx *ctx, gw_config *cfg)
 #define KEYS(table) table, sizeof table / sizeof table[0]
 
 static const config_section config_sections[] = {
-    {"gateway", false, false, NULL, KEYS(gateway_keys), gateway_object, NULL, NULL},
-    {"robot", true, true, robot_begin, KEYS(robot_keys), robot_object, NULL, robot_finish},
-    {"lcm", false, false, NULL, KEYS(lcm_keys), lcm_object, NULL, lcm_finish},
-    {"can", false, false, can_begin, can_map_can_keys, CAN_MAP_CK_COUNT, NULL, can_set, can_finish},
-    {"frame", true, true, frame_begin, can_map_frame_keys, CAN_MAP_FK_COUNT, NULL, can_set, NULL},
+    {"gateway", false, false, NULL, KEYS(gateway_keys), gateway_object, NULL, NULL, "optional, once"},
+    {"robot", true, true, robot_begin, KEYS(robot_keys), robot_object, NULL, robot_finish,
+     "one per robot; NAME prefixes its channels"},
+    {"lcm", false, false, NULL, KEYS(lcm_keys), lcm_object, NULL, lcm_finish, "optional, once"},
+    {"can", false, false, can_begin, can_map_can_keys, CAN_MAP_CK_COUNT, NULL, can_set, can_finish,
+     "the CAN output (optional; docs/can.md)"},
+    {"frame", true, true, frame_begin, can_map_frame_keys, CAN_MAP_FK_COUNT, NULL, can_set, NULL,
+     "one per CAN frame; NAME is its DBC name"},
 };
 #define CONFIG_SECTION_COUNT (sizeof config_sections / sizeof config_sections[0])
 
@@ -643,7 +676,7 @@ static void begin_section(config_ctx *ctx, const char *raw)
     const config_section *sec = NULL;
     size_t index;
 
-    snprintf(ctx->section_raw, sizeof ctx->section_raw, "%s", raw);
+    ctx->in_section = true;
     ctx->section = NULL;
     ctx->section_ok = false;
     ctx->key_count = 0;
@@ -677,76 +710,129 @@ static void begin_section(config_ctx *ctx, const char *raw)
     ctx->section_ok = sec->begin == NULL || sec->begin(ctx, ctx->cfg, sec->named ? name : NULL);
 }
 
-/* Reads one line for inih and counts it, because Debian's libinih is built
- * without line numbers in the handler. It also sees each section header
- * first, so that empty and repeated sections are noticed too. */
-static char *read_line(char *str, int num, void *stream)
-{
-    config_ctx *ctx = stream;
-    const char *p;
-    size_t n = 0;
-    int c = 0;
+/* ---- the reader: each line read once, here ------------------------------------- */
 
-    /* Byte by byte, not fgets: after a NUL byte strlen() would miss the
-     * end of a long line, and its rest would count as a line of its own. */
-    while (n + 1 < (size_t)num && c != '\n' && (c = getc(ctx->file)) != EOF) {
-        str[n++] = (char)c;
+/* Characters of a line before its end ("\n" or "\r\n"): room for any
+ * configuration a person writes, and a bound for a file that is not one. */
+#define CONFIG_LINE_MAX 198
+
+/* The next line into buf (CONFIG_LINE_MAX + 2 bytes), without its "\n":
+ * false at the end of the file. A line too long or holding a NUL byte is
+ * reported and comes back empty. Byte by byte, not fgets: after a NUL byte
+ * strlen() would miss the end of the line, and its rest would count as a
+ * line of its own. */
+static bool next_line(config_ctx *ctx, char *buf)
+{
+    size_t n = 0, len = 0;
+    int c, last = 0;
+    bool nul = false;
+    while ((c = getc(ctx->file)) != EOF && c != '\n') {
+        if (n < CONFIG_LINE_MAX + 1) {
+            buf[n++] = (char)c;
+        }
+        nul |= c == '\0';
+        last = c;
+        len++;
     }
-    if (n == 0) {
-        return NULL;
+    buf[n] = '\0';
+    if (c == EOF && len == 0) {
+        return false;
     }
-    str[n] = '\0';
     ctx->line++;
-    if (n == (size_t)num - 1 && str[n - 1] != '\n' && (c = getc(ctx->file)) != EOF) {
-        while (c != EOF && c != '\n') {
-            c = getc(ctx->file);
-        }
-        config_error(ctx, ctx->line, "line longer than %d characters", num - 3);
-        str[0] = '\n';
-        str[1] = '\0';
-        return str;
-    }
-    if (memchr(str, '\0', n) != NULL) {
+    if (len - (last == '\r') > CONFIG_LINE_MAX) {
+        config_error(ctx, ctx->line, "line longer than %d characters", CONFIG_LINE_MAX);
+        buf[0] = '\0';
+    } else if (nul) {
         config_error(ctx, ctx->line, "a NUL byte: the configuration must be a text file");
-        str[0] = '\n';
-        str[1] = '\0';
-        return str;
+        buf[0] = '\0';
     }
-    p = str;
-    if (ctx->line == 1 && (unsigned char)p[0] == 0xEF && (unsigned char)p[1] == 0xBB && (unsigned char)p[2] == 0xBF) {
-        p += 3;
+    return true;
+}
+
+/* Blanks (isspace: a form feed too) off both ends. */
+static char *trim(char *s)
+{
+    size_t n;
+    while (isspace((unsigned char)*s)) {
+        s++;
     }
-    /* Blanks as libinih skips them (isspace: a form feed too), so that a
-     * line is a header for both or for neither. */
-    while (isspace((unsigned char)*p)) {
-        p++;
+    for (n = strlen(s); n > 0 && isspace((unsigned char)s[n - 1]); n--) {
+        s[n - 1] = '\0';
     }
-    if (*p == '[') {
-        const char *end = strchr(p, ']');
-        if (end != NULL) {
-            char raw[256];
-            const char *rest = end + 1;
-            while (isspace((unsigned char)*rest)) {
-                rest++;
-            }
-            if (*rest != '\0' && *rest != ';' && *rest != '#') {
-                /* libinih ignores it: "[lcm] url = ..." would be lost. */
-                config_error(ctx, ctx->line, "text after the section header: \"%.*s\" (keys go on lines of their own)",
-                             (int)strcspn(rest, "\r\n"), rest);
-            }
-            snprintf(raw, sizeof raw, "%.*s", (int)(end - p - 1), p + 1);
-            begin_section(ctx, raw);
-        } else {
-            config_error(ctx, ctx->line, "section header without ']'");
-            ctx->section = NULL;
-            ctx->section_ok = false;
+    return s;
+}
+
+/* The first of chars in s, or where a comment starts: ';' or '#' after a
+ * blank. Returns the end of s when there is neither. */
+static char *find_or_comment(char *s, const char *chars)
+{
+    bool after_blank = false;
+    for (; *s != '\0'; s++) {
+        if ((chars != NULL && strchr(chars, *s) != NULL) || (after_blank && (*s == ';' || *s == '#'))) {
+            break;
         }
-    } else if (*p != '\0' && *p != '\n' && *p != '\r' && *p != ';' && *p != '#' &&
-               strpbrk(p, "=:") == NULL) {
-        config_error(ctx, ctx->line, "expected \"[section]\" or \"key = value\", not \"%.*s\"",
-                     (int)strcspn(p, "\r\n"), p);
+        after_blank = isspace((unsigned char)*s) != 0;
     }
-    return str;
+    return s;
+}
+
+/* "[KIND NAME]", with nothing after it but a comment. */
+static void header_line(config_ctx *ctx, char *line)
+{
+    char *end = strchr(line, ']');
+    char *rest;
+    if (end == NULL) {
+        config_error(ctx, ctx->line, "section header without ']'");
+        ctx->section = NULL;
+        ctx->section_ok = false;
+        return;
+    }
+    rest = end + 1 + strspn(end + 1, " \t\f\v\r\n");
+    if (*rest != '\0' && *rest != ';' && *rest != '#') {
+        /* "[lcm] url = ..." would lose the key. */
+        config_error(ctx, ctx->line, "text after the section header: \"%.*s\" (keys go on lines of their own)",
+                     (int)strcspn(rest, "\r\n"), rest);
+    }
+    *end = '\0';
+    begin_section(ctx, line + 1);
+}
+
+static void on_key(config_ctx *ctx, const char *key, const char *value);
+
+/* "KEY = VALUE" (or "KEY: VALUE"); a comment after a blank is not part of
+ * the value. */
+static void key_line(config_ctx *ctx, char *line)
+{
+    char *sep = find_or_comment(line, "=:");
+    char *value;
+    if (*sep != '=' && *sep != ':') {
+        config_error(ctx, ctx->line, "expected \"[section]\" or \"key = value\", not \"%s\"", line);
+        return;
+    }
+    *sep = '\0';
+    value = sep + 1;
+    *find_or_comment(value, NULL) = '\0';
+    on_key(ctx, trim(line), trim(value));
+}
+
+static void read_file(config_ctx *ctx)
+{
+    char buf[CONFIG_LINE_MAX + 2];
+    while (next_line(ctx, buf)) {
+        char *line = buf;
+        if (ctx->line == 1 && strncmp(line, "\xEF\xBB\xBF", 3) == 0) {
+            line += 3; /* a byte order mark */
+        }
+        line = trim(line);
+        if (*line == '[') {
+            header_line(ctx, line);
+        } else if (*line != '\0' && *line != ';' && *line != '#') {
+            key_line(ctx, line);
+        }
+    }
+    if (ferror(ctx->file)) {
+        config_error(ctx, 0, "read error: %s", strerror(errno));
+    }
 }
 
 /* A key given twice in a section: reported once, at its second line. */
@@ -765,55 +851,43 @@ static bool seen_again(config_ctx *ctx, const char *key)
     return false;
 }
 
-static int on_key(void *user, const char *section, const char *key, const char *value)
+static void on_key(config_ctx *ctx, const char *key, const char *value)
 {
-    config_ctx *ctx = user;
     const config_section *sec = ctx->section;
     const struct conf_key *k;
     char why[CONF_WHY_MAX];
-    bool ok;
-    if (section[0] == '\0') {
-        config_error(ctx, ctx->line, "\"%s\" is outside of any section: put it under [gateway], [lcm] or [robot NAME]", key);
-        return 0;
+    if (!ctx->in_section) {
+        config_error(ctx, ctx->line, "\"%s\" is outside of any section: put it under [gateway], [lcm] or [robot NAME]",
+                     key);
+        return;
     }
-    /* libinih keeps the first 49 characters of a section header only
-     * ("[robot NAME]" takes up to 70): its name is a prefix of ours. */
-    if (strncmp(section, ctx->section_raw, strlen(section)) != 0 || sec == NULL || !ctx->section_ok) {
-        return 1; /* the header's error was reported */
+    if (sec == NULL || !ctx->section_ok) {
+        return; /* the header's error was reported */
     }
     k = conf_key_find(sec->keys, sec->key_count, key);
     if (k == NULL) {
         conf_unknown_key(sec->keys, sec->key_count, key, ctx->section_label, why, sizeof why);
         config_error(ctx, ctx->line, "%s", why);
-        return 0;
+        return;
     }
     if (!k->many && seen_again(ctx, key)) {
-        return 0;
+        return;
     }
     if (value[0] == '\0') {
         config_error(ctx, ctx->line, "%s has no value", key);
-        return 0;
+        return;
     }
-    ok = sec->set != NULL ? sec->set(ctx, ctx->cfg, k, value, why, sizeof why)
-                          : conf_key_set(k, sec->object(ctx, ctx->cfg), value, (struct conf_at){ctx->path, ctx->line},
-                                         why, sizeof why);
-    if (!ok) {
+    if (!(sec->set != NULL ? sec->set(ctx, ctx->cfg, k, value, why, sizeof why)
+                           : conf_key_set(k, sec->object(ctx, ctx->cfg), value, (struct conf_at){ctx->path, ctx->line},
+                                          why, sizeof why))) {
         config_error(ctx, ctx->line, "%s", why);
     }
-    return ok ? 1 : 0;
 }
 
 static void config_defaults(gw_config *cfg, const char *path)
 {
     memset(cfg, 0, sizeof *cfg);
     cfg->path = path;
-    cfg->log_level = URRT_LOG_NOTICE;
-    cfg->lcm.rate[GW_KIND_STATE].mode = GW_RATE_EVERY;
-    cfg->lcm.rate[GW_KIND_JOINTS].mode = GW_RATE_EVERY;
-    cfg->lcm.rate[GW_KIND_TOOL].mode = GW_RATE_EVERY;
-    cfg->lcm.rate[GW_KIND_STATUS] = (gw_rate){GW_RATE_HZ, 10};
-    cfg->lcm.rate[GW_KIND_GATEWAY] = (gw_rate){GW_RATE_HZ, 1};
-
     can_map_init(&cfg->can);
 }
 
@@ -821,7 +895,6 @@ static int config_parse(gw_config *cfg, FILE *in, FILE *err)
 {
     config_ctx ctx;
     int seen[CONFIG_SECTION_COUNT] = {0};
-    int r;
 
     memset(&ctx, 0, sizeof ctx);
     can_map_set_reporter(&cfg->can, report_can_problem, &ctx);
@@ -830,18 +903,9 @@ static int config_parse(gw_config *cfg, FILE *in, FILE *err)
     ctx.cfg = cfg;
     ctx.seen_line = seen;
     ctx.file = in;
-    /* A value is one line; ';' or '#' after a blank starts a comment. */
-    ini_allow_multiline = false;
-    ini_inline_comment_prefixes = ";#";
-    r = ini_parse_stream(read_line, &ctx, on_key, &ctx);
-    if (ferror(ctx.file)) {
-        config_error(&ctx, 0, "read error: %s", strerror(errno));
-    }
-    if (r > 0 && ctx.errors == 0) {
-        config_error(&ctx, r, "syntax error");
-    } else if (r < 0 && ctx.errors == 0) {
-        config_error(&ctx, 0, "cannot parse (inih error %d)", r);
-    }
+    set_defaults(&ctx, KEYS(gateway_keys), cfg);
+    set_defaults(&ctx, KEYS(lcm_keys), &cfg->lcm);
+    read_file(&ctx);
     ctx.rank = RANK_FILE;
     for (size_t i = 0; i < CONFIG_SECTION_COUNT; i++) {
         if (config_sections[i].finish != NULL) {
@@ -889,50 +953,30 @@ void gw_config_free(gw_config *cfg)
         free(cfg->robots[i].expected);
     }
     free(cfg->robots);
+    can_run_free(cfg->can_run); /* before the map: its tables are the map's */
     can_map_free(&cfg->can);
     memset(cfg, 0, sizeof *cfg);
 }
 
 void gw_config_usage(FILE *out)
 {
-    fputs(
-        "Configuration file (INI; '#' or ';' starts a comment; every key is optional\n"
-        "unless marked required; an unknown section or key is an error). Values:\n"
-        "integers decimal or 0x hex (no leading zero); yes/no (true/false, on/off,\n"
-        "1/0); DURATION a number and a unit: 250ms, 1.5 s, 2 min (us, ms, s, min),\n"
-        "a bare number only for keys named _ms (milliseconds).\n"
-        "\n"
-        "  [gateway]\n"
-        "  log_level = err | warning | notice | info | debug    (notice)\n"
-        "  summary = yes | no           one status line per second on stdout (no)\n"
-        "\n"
-        "  [lcm]\n"
-        "  url = PROVIDER://...         (" GW_DEFAULT_LCM_URL ")\n"
-        "  KIND_channel = SUFFIX        channel NAME.SUFFIX (STATE, JOINTS, TOOL, STATUS, GATEWAY)\n"
-        "  KIND_rate = every | N Hz | off\n"
-        "      KIND: state (every), joints (every), tool (every), status (10 Hz),\n"
-        "            gateway (1 Hz; N Hz or off only). N Hz decimates on the\n"
-        "            controller's clock and may not exceed the robot's rate.\n"
-        "\n"
-        "  [robot NAME]                 one per robot; NAME prefixes its channels\n"
-        "  host = ADDRESS               required: host name, IPv4 or IPv6 address (no :PORT)\n"
-        "  port = N                     (30003; 30013 is the read-only port)\n"
-        "  version = auto | X.Y | BYTES expected controller version or message size;\n"
-        "                               other packets are counted as mismatches (auto)\n"
-        "  connect_timeout = DURATION   (2 s)\n"
-        "  silence_timeout = DURATION   (100 ms)   no packet for this long: reconnect,\n"
-        "                                          and no state is published meanwhile\n"
-        "  backoff_initial = DURATION   (100 ms)   first wait before reconnecting\n"
-        "  backoff_max = DURATION       (5 s)      doubling up to this\n"
-        "\n"
-        "  [can]                        CAN output (optional; docs/can.md has every key)\n"
-        "  interface = can0 | log:PATH  SocketCAN interface, or candump log format\n"
-        "  bitrate = 500000             for the bus load check and the DBC\n"
-        "  heartbeat_id = 0x701         gateway state, modes, data age, drops (<= 1 s)\n"
-        "\n"
-        "  [frame NAME]                 one per CAN frame; NAME is its DBC name\n"
-        "  id = 0x181                   (extended = yes for 29-bit)\n"
-        "  period_ms = 10 | every       (fd = yes and length = 64 for CAN FD)\n"
-        "  signal = FIELD[ELEM] ...     one line per signal: see docs/can.md\n",
-        out);
+    fputs("Configuration file (INI; '#' or ';' starts a comment; every key is optional\n"
+          "unless marked required; an unknown section or key is an error). Values:\n"
+          "integers decimal or 0x hex (no leading zero); yes/no (true/false, on/off,\n"
+          "1/0); DURATION a number and a unit: 250ms, 1.5 s, 2 min (us, ms, s, min),\n"
+          "a bare number only for keys named _ms (milliseconds). docs/can.md has the\n"
+          "signal grammar.\n",
+          out);
+    for (size_t i = 0; i < CONFIG_SECTION_COUNT; i++) {
+        const config_section *sec = &config_sections[i];
+        fprintf(out, "\n  [%s%s]  %s\n", sec->kind, sec->named ? " NAME" : "", sec->usage);
+        conf_key_usage(out, sec->keys, sec->key_count);
+    }
+}
+
+void gw_config_print_keys(FILE *out)
+{
+    for (size_t i = 0; i < CONFIG_SECTION_COUNT; i++) {
+        conf_key_print(out, config_sections[i].kind, config_sections[i].keys, config_sections[i].key_count);
+    }
 }

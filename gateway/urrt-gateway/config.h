@@ -2,14 +2,16 @@
 /*
  * config.h: the urrt-gateway configuration file.
  *
- * An INI file read with libinih. Sections are dispatched through a table of
- * sections, each with a table of keys (config.c: config_sections), so an
- * output such as CAN adds its sections ("[can]", "[frame NAME]") with one
- * entry and a member of gw_config for its values. Values are read by the
- * parsers of conf.h, the same for every section and command line. Every
- * error is reported as "FILE:LINE: reason"; an unknown section or key is an
- * error, because a typo must not be silently ignored. Parsing allocates;
- * nothing after startup does.
+ * An INI file, each line read once by config.c's own reader (a byte order
+ * mark, blank lines, ';' and '#' comments, "[KIND NAME]" headers, "key =
+ * value"). Sections are dispatched through a table of sections, each with a
+ * table of keys (config.c: config_sections), so an output such as CAN adds
+ * its sections ("[can]", "[frame NAME]") with one entry and a member of
+ * gw_config for its values. A key's default, bounds and help are its table
+ * entry's (conf.h). Values are read by the parsers of conf.h, the same for
+ * every section and command line. Every error is reported as "FILE:LINE:
+ * reason"; an unknown section or key is an error, because a typo must not
+ * be silently ignored. Parsing allocates; nothing after startup does.
  */
 #ifndef URRT_GATEWAY_CONFIG_H
 #define URRT_GATEWAY_CONFIG_H
@@ -19,6 +21,7 @@
 #include <stdio.h>
 
 #include "can_map.h"
+#include "can_run.h"
 #include "conf.h"
 #include "port.h"
 
@@ -81,26 +84,32 @@ typedef struct gw_config {
     gw_robot_config *robots;
     unsigned robot_count;
     struct can_map can;    /* [can] and [frame NAME]; disabled when absent */
+    struct can_run *can_run; /* can's tables, built with the file; NULL when disabled */
 } gw_config;
 
 /* Parse a file. Returns the number of errors (0: *cfg is complete and
- * valid), each written to err as "FILE:LINE: reason". */
+ * valid, its CAN tables built), each written to err as "FILE:LINE: reason". */
 int gw_config_load(gw_config *cfg, const char *path, FILE *err);
 /* The same from an open stream (left open), named path in the messages:
- * for a configuration that is not a file, and for the fuzz harness. */
+ * for a configuration that is not a file, and for the tests, their tools and
+ * the fuzz harness, which load configurations as the gateway does. */
 int gw_config_load_stream(gw_config *cfg, FILE *in, const char *path, FILE *err);
 void gw_config_free(gw_config *cfg);
 
-/* Writes the file grammar, for --help. */
+/* Writes the file grammar and every key, for --help. */
 void gw_config_usage(FILE *out);
+/* Every key of every section, one per line (conf_key_print), for
+ * --print-keys: what check-man holds the documents against. */
+void gw_config_print_keys(FILE *out);
 
 /* Parses a log level name ("err", "warning", "notice", "info", "debug"). */
 bool gw_parse_log_level(const char *text, urrt_log_level *level);
 
 /*
  * The section table (config.c: config_sections). A section's keys are a
- * table of conf.h keys: the front end finds the key (an unknown one is an
- * error with a "did you mean" hint), refuses it twice, and parses the value
+ * table of conf.h keys: the front end sets the keys' defaults, finds the key
+ * (an unknown one is an error with a "did you mean" hint), refuses it twice
+ * (the one place that rule is written), and parses the value
  * into the section's object, or hands it to set. A handler reports a
  * problem with config_error() and returns false; the parser goes on, so
  * that one run shows every error.
@@ -119,8 +128,9 @@ typedef struct config_section {
     void *(*object)(config_ctx *ctx, gw_config *cfg);
     /* Parses a key instead of conf_key_set: false with the reason in why. */
     bool (*set)(config_ctx *ctx, gw_config *cfg, const struct conf_key *key, const char *value, char *why, size_t n);
-    /* After the whole file: defaults and checks across sections. May be NULL. */
+    /* After the whole file: checks across sections. May be NULL. */
     void (*finish)(config_ctx *ctx, gw_config *cfg);
+    const char *usage;  /* one line for --help */
 } config_section;
 
 /* The one error channel: "FILE:LINE: reason", printed at the end, causes

@@ -5,9 +5,9 @@
  * Each robot has a link (port.h). Every complete packet of the expected
  * length is decoded once and handed to every output through one dispatch
  * (gw_output.packet); every output also gets a periodic tick, may add
- * descriptors to the poll set and counters to each robot's status. LCM is
- * one output (lcm_out.h); CAN is meant to be another, registered with
- * gw_add_output() next to it.
+ * descriptors to the poll set and counters to each robot's status. The
+ * outputs are LCM (lcm_out.h) and CAN (can_out.h), each registered with
+ * gw_add_output().
  *
  * Nothing here allocates after gw_init(): the per-packet path only reads
  * and writes memory the gateway already owns.

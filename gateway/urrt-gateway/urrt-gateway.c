@@ -45,6 +45,9 @@ static void usage(FILE *out)
         "      --print-c-tables   write CONFIG's CAN frames as C tables of lib/urrt_cantx.h\n"
         "                         for a firmware (docs/firmware.md), exit\n"
         "  -o, --output FILE      with --print-dbc or --print-c-tables: write to FILE\n"
+        "      --print-keys       every configuration key, one per line: section, key,\n"
+        "                         form, default, bounds, help (tab-separated), exit;\n"
+        "                         no CONFIG (check-man holds the documents to it)\n"
         "      --replay CAPTURE   send a raw capture's packets through the CAN side,\n"
         "                         clocked by their controller time, and exit: the\n"
         "                         frames a PLC would have received (interface =\n"
@@ -116,11 +119,16 @@ static void print_plan(const gw_config *cfg, const char *url)
 }
 
 /* What --print-dbc and --print-c-tables write. */
-typedef int (*writer_fn)(FILE *out, struct can_map *map, const char *source);
+typedef int (*writer_fn)(FILE *out, gw_config *cfg);
 
-static int dbc_writer(FILE *out, struct can_map *map, const char *source)
+static int dbc_writer(FILE *out, gw_config *cfg)
 {
-    return dbc_write(out, map, source);
+    return dbc_write(out, &cfg->can, cfg->path);
+}
+
+static int c_tables_writer(FILE *out, gw_config *cfg)
+{
+    return can_ctables_write(out, &cfg->can, cfg->can_run, cfg->path);
 }
 
 static int write_output(gw_config *cfg, const char *path, writer_fn write, const char *what)
@@ -135,7 +143,7 @@ static int write_output(gw_config *cfg, const char *path, writer_fn write, const
         fprintf(stderr, "urrt-gateway: cannot write %s: %s\n", path, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
-    ok = write(out, &cfg->can, cfg->path) == 0;
+    ok = write(out, cfg) == 0;
     ok = fflush(out) == 0 && ok;
     if (out != stdout) {
         ok = fclose(out) == 0 && ok;
@@ -164,11 +172,12 @@ typedef struct options {
 /* CLI_EXIT_* to stop with, or -1 to go on. */
 static int parse_options(int argc, char **argv, options *o)
 {
-    enum { OPT_C_TABLES = 256, OPT_REPLAY };
+    enum { OPT_C_TABLES = 256, OPT_REPLAY, OPT_PRINT_KEYS };
     static const struct option longopts[] = {
         {"check-config", no_argument, NULL, 'c'},
         {"print-dbc", no_argument, NULL, 'd'},
         {"print-c-tables", no_argument, NULL, OPT_C_TABLES},
+        {"print-keys", no_argument, NULL, OPT_PRINT_KEYS},
         {"replay", required_argument, NULL, OPT_REPLAY},
         {"output", required_argument, NULL, 'o'},
         {"summary", no_argument, NULL, 's'},
@@ -187,6 +196,7 @@ static int parse_options(int argc, char **argv, options *o)
         case 'd': o->print_dbc = true; break;
         case OPT_C_TABLES: o->print_c_tables = true; break;
         case OPT_REPLAY: o->replay_path = optarg; break;
+        case OPT_PRINT_KEYS: gw_config_print_keys(stdout); return CLI_EXIT_OK;
         case 'o': o->output_path = optarg; break;
         case 's': o->summary = true; break;
         case 'u': o->url_override = optarg; break;
@@ -237,14 +247,8 @@ static bool summary_clashes(const gw_config *cfg, const options *o)
 /* CLI_EXIT_* to stop with (cfg freed), or -1 with cfg loaded. */
 static int load_config(gw_config *cfg, const options *o)
 {
-    char err[512];
     if (gw_config_load(cfg, o->config_path, stderr) != 0) {
         fprintf(stderr, "urrt-gateway: %s is not valid; see `urrt-gateway --help` for the grammar\n", o->config_path);
-        gw_config_free(cfg);
-        return CLI_EXIT_USAGE;
-    }
-    if (can_map_enabled(&cfg->can) && can_map_build(&cfg->can, err, sizeof err) != 0) {
-        fprintf(stderr, "%s: %s\n", cfg->path, err);
         gw_config_free(cfg);
         return CLI_EXIT_USAGE;
     }
@@ -282,7 +286,7 @@ static int run(gw_config *cfg, const options *o)
     gw_add_output(&gw, &output);
     if (can_map_enabled(&cfg->can)) {
         char line[256];
-        can_out *can = can_out_new(&gw, &cfg->can);
+        can_out *can = can_out_new(&gw, &cfg->can, cfg->can_run);
         if (can == NULL) {
             urrt_log(URRT_LOG_ERR, "the CAN output cannot start (see above); fix [can] in %s", cfg->path);
             gw_close(&gw);
@@ -314,9 +318,9 @@ int main(int argc, char **argv)
     if (o.print_dbc) {
         rc = write_output(&cfg, o.output_path, dbc_writer, "DBC");
     } else if (o.print_c_tables) {
-        rc = write_output(&cfg, o.output_path, can_ctables_write, "C tables");
+        rc = write_output(&cfg, o.output_path, c_tables_writer, "C tables");
     } else if (o.replay_path != NULL) {
-        rc = can_replay(&cfg.can, o.replay_path);
+        rc = can_replay(&cfg.can, cfg.can_run, o.replay_path);
     } else if (o.check_only) {
         print_plan(&cfg, cfg.lcm.url);
         rc = CLI_EXIT_OK;

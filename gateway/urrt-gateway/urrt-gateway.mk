@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 # gateway/urrt-gateway/urrt-gateway.mk: urrt-gateway itself (its loop, the
-# freshness estimator, the configuration file, the LCM output; the CAN side is
-# gateway/can/), `make spy` and `make demo`.
+# freshness estimator, the configuration file, its two outputs, LCM and CAN;
+# the CAN mapping and tables are gateway/can/), `make spy` and `make demo`.
 
 # The demo cannot be mistaken for production: its own robot name, its own LCM
 # group and port (the default is 239.255.76.67:7667), ttl=0 (this host only), and
@@ -12,10 +12,11 @@ DEMO_ROBOT ?= demo
 DEMO_LCM_URL ?= udpm://239.255.76.68:7668?ttl=0
 
 # ---- urrt-gateway ------------------------------------------------------------------
-GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/urrt-gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_out.o)
+GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/urrt-gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_out.o \
+                  can_out.o)
 # Other folders append their objects (the CAN side); read at link time.
 GATEWAY_EXTRA_OBJS ?=
-GATEWAY_LIBS := -llcm -linih -lm
+GATEWAY_LIBS := -llcm -lm
 
 # The LCM types' headers are generated: they exist before anything includes them.
 $(BUILD)/gateway/urrt-gateway/%.o: gateway/urrt-gateway/%.c | $(LCMTYPES_H)

@@ -94,15 +94,6 @@ void urrt_canlink_config_defaults(urrt_canlink_config *cfg)
     cfg->hold_max_ms = 100;
 }
 
-const char *urrt_canlink_state_name(urrt_canlink_state state)
-{
-    switch (state) {
-    case URRT_CANLINK_DOWN: return "down";
-    case URRT_CANLINK_UP: return "up";
-    }
-    return "?";
-}
-
 /* ---- frames ---------------------------------------------------------------- */
 
 /* The limits are lib's (urrt_can.h); the link adds only that FD frames need

@@ -84,7 +84,7 @@ void urrt_link_config_defaults(urrt_link_config *cfg)
     cfg->host = NULL;
     cfg->port = URRT_LINK_PORT_RW;
     cfg->connect_timeout_ms = 2000;
-    cfg->silence_timeout_ms = 100;
+    cfg->silence_timeout_ms = URRT_LINK_SILENCE_TIMEOUT_MS;
     cfg->backoff_initial_ms = 100;
     cfg->backoff_max_ms = 5000;
 }

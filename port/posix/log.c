@@ -53,11 +53,6 @@ void urrt_log_set_level(urrt_log_level max_level)
     log_cfg.max_level = max_level;
 }
 
-urrt_log_level urrt_log_get_level(void)
-{
-    return log_cfg.max_level;
-}
-
 void urrt_log_set_sink(urrt_log_sink_fn sink, void *ctx)
 {
     log_cfg.sink = sink;

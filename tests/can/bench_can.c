@@ -5,7 +5,7 @@
  * packet), as ns and as a ratio. Prints `name: value` lines, asserts nothing.
  *
  *   can_pack_signal_ns      one 16-bit signal, urrt_can_pack
- *   can_map_packet_ns       urrt_cantx_on_packet + can_map_due for docs/examples/canopen.ini
+ *   can_map_packet_ns       urrt_cantx_on_packet + can_run_due for docs/examples/canopen.ini
  *                           (4 frames, 18 signals, heartbeat) at 500 Hz: the values
  *                           taken at every packet, each frame packed and sent at its
  *                           period (can_frames_per_packet)
@@ -21,9 +21,8 @@
 #include <string.h>
 #include <time.h>
 
-#include <ini.h>
-
-#include "can_map.h"
+#include "can_run.h"
+#include "config.h"
 
 #define BATCHES 9
 #define ITERATIONS 20000
@@ -37,32 +36,6 @@ static double now_ns(void)
     return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
 }
 
-struct loader {
-    struct can_map *map;
-    FILE *file;
-    int line;
-    int errors;
-};
-
-static char *read_line(char *str, int num, void *stream)
-{
-    struct loader *l = stream;
-    char *s = fgets(str, num, l->file);
-    l->line += s != NULL;
-    return s;
-}
-
-static int on_key(void *user, const char *section, const char *key, const char *value)
-{
-    struct loader *l = user;
-    char err[512];
-    if (can_map_ini(l->map, section, key, value, "canopen.ini", l->line, err, sizeof err) < 0) {
-        fprintf(stderr, "%s\n", err);
-        l->errors++;
-    }
-    return 1;
-}
-
 static void count_frame(void *ctx, const urrt_can_frame *f, uint64_t now_us)
 {
     (void)now_us;
@@ -73,10 +46,8 @@ static void count_frame(void *ctx, const urrt_can_frame *f, uint64_t now_us)
 int main(int argc, char **argv)
 {
     const char *path = argc > 1 ? argv[1] : "docs/examples/canopen.ini";
-    const struct can_map_robot robots[] = {{"arm1", 2000}};
-    struct can_map map;
-    struct loader l = {0};
-    char err[4096];
+    gw_config cfg;
+    struct can_run *run;
     urrt_state st;
     uint8_t packet[URRT_PACKET_KNOWN_MAX];
     urrt_can_signal sig = {0.0002, 0, -6.5536, 6.5534, 0, 0, 16, URRT_CAN_INTEL, URRT_CAN_SIGNED, 0};
@@ -86,17 +57,10 @@ int main(int argc, char **argv)
     uint64_t frames = 0;
     int b, i;
 
-    can_map_init(&map);
-    l.map = &map;
-    l.file = fopen(path, "r");
-    if (l.file == NULL) {
-        perror(path);
-        return 1;
-    }
-    ini_parse_stream(read_line, &l, on_key, &l);
-    fclose(l.file);
-    if (l.errors || can_map_finish(&map, robots, 1, err, sizeof err) < 0) {
-        fprintf(stderr, "bench-can: %s\n", err);
+    /* Loaded as the gateway loads it: its robot (version auto) sends at 500 Hz. */
+    if (gw_config_load(&cfg, path, stderr) != 0 || (run = cfg.can_run) == NULL) {
+        fprintf(stderr, "bench-can: %s: not a valid configuration with CAN frames\n", path);
+        gw_config_free(&cfg);
         return 1;
     }
     /* A packet as a robot sends it: every value finite (NaN, which a robot
@@ -111,15 +75,16 @@ int main(int argc, char **argv)
     }
     if (urrt_encode(&st, 1220, packet, sizeof packet) < 0 || urrt_decode(packet, 1220, &st) < 0) {
         fprintf(stderr, "bench-can: cannot build a packet\n");
+        gw_config_free(&cfg);
         return 1;
     }
-    can_map_start(&map, 0);
+    can_run_start(run, 0);
     for (b = 0; b < BATCHES; b++) {
         double t0 = now_ns();
         for (i = 0; i < ITERATIONS; i++) {
             now += 2000; /* 500 Hz */
-            urrt_cantx_on_packet(can_map_tx(&map), 0, &st, now);
-            can_map_due(&map, now, NULL, count_frame, &frames);
+            urrt_cantx_on_packet(can_run_tx(run), 0, &st, now);
+            can_run_due(run, now, NULL, count_frame, &frames);
         }
         double t1 = now_ns();
         for (i = 0; i < ITERATIONS; i++) {
@@ -140,6 +105,6 @@ int main(int argc, char **argv)
     printf("decode_packet_ns: %.1f\n", best_decode);
     printf("can_map_packet_vs_decode: %.2f\n", best_map / best_decode);
     printf("can_frames_per_packet: %.2f\n", (double)frames / (BATCHES * ITERATIONS));
-    can_map_free(&map);
+    gw_config_free(&cfg);
     return 0;
 }

@@ -1,11 +1,14 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * can_tool: drives gateway/can/can_map, gateway/can/dbc and lib/urrt_can from the
- * command line for the Python tests (tests/can/test_dbc.py), which hold
- * their output against python3-canmatrix and an independent reference.
+ * can_tool: drives gateway/can/can_map, gateway/can/can_run, gateway/can/dbc
+ * and lib/urrt_can from the command line for the Python tests
+ * (tests/can/test_dbc.py), which hold their output against python3-canmatrix
+ * and an independent reference. CONFIG is loaded as the gateway loads it
+ * (gw_config_load): its robots are its [robot NAME] sections, and their
+ * rates follow from their version.
  *
- * usage: can_tool [--robot NAME:PERIOD_US]... COMMAND CONFIG
- *   validate   parse and check; prints "ok load=PERCENT" or the errors (exit 1)
+ * usage: can_tool COMMAND CONFIG
+ *   validate   load and check; prints "ok load=PERCENT" or the errors (exit 1)
  *   dbc        the DBC on stdout
  *   pack       reads lines "FRAME NAME=VALUE ..." and prints
  *              "HEX OUTCOME..." per line: the payload (zeros elsewhere) packed
@@ -19,50 +22,17 @@
  *                tick T_US                             due(T)
  *                link ROBOT up|down
  *                stats DROPPED BUS_OFF ERROR_FRAMES DOWN_EVENTS SEND_ERRORS
- * Without --robot the robots are "arm" at 8000 us.
  */
 #include <ctype.h>
-#include <errno.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include <ini.h>
-
 #include "can_map.h"
+#include "can_run.h"
+#include "config.h"
 #include "dbc.h"
-
-struct load_ctx {
-    struct can_map *map;
-    FILE *file;
-    const char *path;
-    int line;
-    int errors;
-};
-
-static char *count_lines(char *str, int num, void *stream)
-{
-    struct load_ctx *ctx = stream;
-    char *s = fgets(str, num, ctx->file);
-    if (s != NULL) {
-        ctx->line++;
-    }
-    return s;
-}
-
-static int on_key(void *user, const char *section, const char *key, const char *value)
-{
-    struct load_ctx *ctx = user;
-    char err[512];
-    int rc = can_map_ini(ctx->map, section, key, value, ctx->path, ctx->line, err, sizeof err);
-    if (rc < 0) {
-        fprintf(stdout, "%s\n", err);
-        ctx->errors++;
-    }
-    /* rc == 0: a section of the gateway's own ([gateway], [robot NAME]): skipped. */
-    return 1;
-}
 
 static struct can_map_frame *frame_by_name(struct can_map *map, const char *name)
 {
@@ -194,7 +164,7 @@ static size_t robot_by_name(const struct can_map *map, const char *name)
     exit(1);
 }
 
-static int cmd_run(struct can_map *map)
+static int cmd_run(const struct can_map *map, struct can_run *can)
 {
     char line[8192];
     struct run_ctx run = {0};
@@ -233,12 +203,12 @@ static int cmd_run(struct can_map *map)
                     ((double *)(void *)((char *)&st + off))[elem] = strtod(eq + 1, NULL);
                     st.present |= UINT64_C(1) << id;
                 }
-                urrt_cantx_on_packet(can_map_tx(map), robot, &st, run.now);
+                urrt_cantx_on_packet(can_run_tx(can), robot, &st, run.now);
             }
-            can_map_due(map, run.now, &stats, print_frame, &run);
+            can_run_due(can, run.now, &stats, print_frame, &run);
         } else if (strcmp(cmd, "link") == 0) {
             size_t robot = robot_by_name(map, strtok_r(NULL, " \t\r\n", &save));
-            urrt_cantx_robot_link(can_map_tx(map), robot, strcmp(strtok_r(NULL, " \t\r\n", &save), "up") == 0);
+            urrt_cantx_robot_link(can_run_tx(can), robot, strcmp(strtok_r(NULL, " \t\r\n", &save), "up") == 0);
         } else if (strcmp(cmd, "stats") == 0) {
             uint64_t *slots[] = {&stats.dropped, &stats.bus_off, &stats.error_frames, &stats.down_events,
                                  &stats.send_errors};
@@ -256,79 +226,43 @@ static int cmd_run(struct can_map *map)
 
 int main(int argc, char **argv)
 {
-    struct can_map_robot robots[8];
-    size_t robot_count = 0;
-    struct can_map map;
-    struct load_ctx ctx;
-    char err[8192];
+    gw_config cfg;
+    struct can_map *map = &cfg.can;
     const char *cmd;
-    int i = 1;
     int rc;
 
-    while (i < argc && strcmp(argv[i], "--robot") == 0 && i + 1 < argc && robot_count < 8) {
-        char *colon = strchr(argv[i + 1], ':');
-        if (colon == NULL) {
-            fprintf(stderr, "can_tool: --robot NAME:PERIOD_US\n");
-            return 2;
-        }
-        *colon = '\0';
-        robots[robot_count].name = argv[i + 1];
-        robots[robot_count].period_us = (uint32_t)strtoul(colon + 1, NULL, 10);
-        robot_count++;
-        i += 2;
-    }
-    if (robot_count == 0) {
-        robots[0].name = "arm";
-        robots[0].period_us = 8000;
-        robot_count = 1;
-    }
-    if (argc - i != 2) {
-        fprintf(stderr, "usage: can_tool [--robot NAME:PERIOD_US]... validate|dbc|pack|unpack|run CONFIG\n");
+    if (argc != 3) {
+        fprintf(stderr, "usage: can_tool validate|dbc|pack|unpack|run CONFIG\n");
         return 2;
     }
-    cmd = argv[i];
-    can_map_init(&map);
-    memset(&ctx, 0, sizeof ctx);
-    ctx.map = &map;
-    ctx.path = argv[i + 1];
-    ctx.file = fopen(ctx.path, "r");
-    if (ctx.file == NULL) {
-        fprintf(stderr, "can_tool: %s: %s\n", ctx.path, strerror(errno));
-        return 2;
-    }
-    rc = ini_parse_stream(count_lines, &ctx, on_key, &ctx);
-    fclose(ctx.file);
-    if (rc != 0 && ctx.errors == 0) {
-        printf("%s:%d: INI syntax error\n", ctx.path, rc);
-        ctx.errors++;
-    }
-    if (ctx.errors > 0) {
-        can_map_free(&map);
+    cmd = argv[1];
+    if (gw_config_load(&cfg, argv[2], stdout) != 0) {
+        gw_config_free(&cfg);
         return 1;
     }
-    if (can_map_finish(&map, robots, robot_count, err, sizeof err) < 0) {
-        printf("%s\n", err);
-        can_map_free(&map);
+    if (cfg.can_run == NULL) {
+        printf("%s: no CAN output configured\n", argv[2]);
+        gw_config_free(&cfg);
         return 1;
     }
     if (strcmp(cmd, "validate") == 0) {
-        printf("ok load=%.4f\n", map.load * 100.0);
-        for (size_t k = 0; k < map.frame_count; k++) {
-            printf("frame %s load=%.4f\n", map.frames[k].name, map.frames[k].load * 100.0);
+        printf("ok load=%.4f\n", map->load * 100.0);
+        for (size_t k = 0; k < map->frame_count; k++) {
+            printf("frame %s load=%.4f\n", map->frames[k].name, map->frames[k].load * 100.0);
         }
         rc = 0;
     } else if (strcmp(cmd, "dbc") == 0) {
-        rc = dbc_write(stdout, &map, ctx.path) < 0;
+        rc = dbc_write(stdout, map, argv[2]) < 0;
     } else if (strcmp(cmd, "pack") == 0) {
-        rc = cmd_pack(&map);
+        rc = cmd_pack(map);
     } else if (strcmp(cmd, "unpack") == 0) {
-        rc = cmd_unpack(&map);
+        rc = cmd_unpack(map);
     } else if (strcmp(cmd, "run") == 0) {
-        rc = cmd_run(&map);
+        rc = cmd_run(map, cfg.can_run);
     } else {
         fprintf(stderr, "can_tool: unknown command %s\n", cmd);
         rc = 2;
     }
-    can_map_free(&map);
+    gw_config_free(&cfg);
     return rc;
 }

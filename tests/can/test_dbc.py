@@ -75,7 +75,7 @@ FIELDS = read_fields()
 
 def read_ini(path):
     """(section, key, value) triples in file order; ';' or '#' start a comment
-    line, ' ;' starts an inline comment, as libinih reads them."""
+    line, ' ;' starts an inline comment, as the gateway reads them."""
     section = None
     out = []
     for raw in open(path):
@@ -455,7 +455,19 @@ def random_config(rng, path, nframes):
             line = random_signal(rng, 8 * length, taken, i)
             if line:
                 lines.append('signal = ' + line)
+    # The robot, as the gateway loads it: a 3.10 controller sends every 8 ms.
+    lines += ['', '[robot arm]', 'host = 127.0.0.1', 'version = 3.10']
     open(path, 'w').write('\n'.join(lines) + '\n')
+
+
+def at_period(path, work, period_us):
+    """A copy of the configuration whose robots send every period_us: version
+    3.10 (125 Hz) for 8000 us, 5.10 (500 Hz) for 2000 us."""
+    text = re.sub(r'(?m)^version = .*$', 'version = %s' % ('3.10' if period_us == 8000 else '5.10'),
+                  open(path).read())
+    out = os.path.join(work, '%d-%s' % (period_us, os.path.basename(path)))
+    open(out, 'w').write(text)
+    return out
 
 
 def values_for(rng, sig):
@@ -556,10 +568,10 @@ def test_examples(tool, work):
     for name in examples:
         path = os.path.join(ROOT, 'docs', 'examples', name)
         for period in (2000, 8000):
-            rc, out, err = run(tool, ['--robot', 'arm1:%d' % period, 'validate', path])
+            rc, out, err = run(tool, ['validate', at_period(path, work, period)])
             check(rc == 0 and out.startswith('ok load='), '%s validates for a robot at %d us' % (name, period),
                   out + err)
-        rc, out, err = run(tool, ['--robot', 'arm1:2000', 'dbc', path])
+        rc, out, err = run(tool, ['dbc', at_period(path, work, 2000)])
         if not check(rc == 0, '%s: DBC written' % name, err):
             continue
         open(os.path.join(work, name.replace('.ini', '.dbc')), 'w').write(out)
@@ -573,7 +585,8 @@ def test_canopen_run(tool, work):
     """canopen.ini driven by a scripted robot: frames decode through the DBC to
     the robot's values; alive counters, validity, staleness, heartbeat."""
     path = os.path.join(ROOT, 'docs', 'examples', 'canopen.ini')
-    rc, dbc, _ = run(tool, ['--robot', 'arm1:8000', 'dbc', path])
+    robot_8ms = at_period(path, work, 8000)
+    rc, dbc, _ = run(tool, ['dbc', robot_8ms])
     db, _ = load_dbc(dbc)
     can, frames = parse_config(path)
     rng = random.Random(7)
@@ -593,7 +606,7 @@ def test_canopen_run(tool, work):
             script.append('tick %d' % t)
         else:
             script.append('tick %d' % t)
-    rc, out, err = run(tool, ['--robot', 'arm1:8000', 'run', path], '\n'.join(script) + '\n')
+    rc, out, err = run(tool, ['run', robot_8ms], '\n'.join(script) + '\n')
     check(rc == 0, 'canopen run', err)
     by_id = {}
     for line in out.splitlines():
@@ -668,13 +681,13 @@ def test_canopen_run(tool, work):
 
 def test_j1939_run(tool, work):
     """j1939.ini: "not available" raw values for NaN, offsets, 29-bit ids."""
-    path = os.path.join(ROOT, 'docs', 'examples', 'j1939.ini')
-    rc, dbc, _ = run(tool, ['--robot', 'arm1:2000', 'dbc', path])
+    path = at_period(os.path.join(ROOT, 'docs', 'examples', 'j1939.ini'), work, 2000)
+    rc, dbc, _ = run(tool, ['dbc', path])
     db, _ = load_dbc(dbc)
     script = ['packet 1000 arm1 q_actual[0]=1.5 q_actual[1]=-6.5 q_actual[2]=0 robot_mode=7 safety_mode=3 '
               'joint_modes[0]=253 joint_modes[1]=255 program_state=1 tool_vector_actual[0]=0.25',
               'tick 2000']
-    rc, out, err = run(tool, ['--robot', 'arm1:2000', 'run', path], '\n'.join(script) + '\n')
+    rc, out, err = run(tool, ['run', path], '\n'.join(script) + '\n')
     frames = {}
     for line in out.splitlines():
         t, frame = line.split()

@@ -1,9 +1,10 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * fuzz_config.c: libFuzzer harness for the urrt-gateway configuration, an
- * untrusted input like the robot's bytes: the loader (gateway/urrt-gateway/config.c and
- * libinih), the CAN mapping it feeds (gateway/can/can_map.c) and the DBC written
- * from it (gateway/can/dbc.c). Each input is one configuration file. It asserts:
+ * untrusted input like the robot's bytes: the loader (gateway/urrt-gateway/config.c,
+ * its reader included), the CAN mapping it feeds (gateway/can/can_map.c), the
+ * tables built from it (gateway/can/can_run.c) and the DBC written from it
+ * (gateway/can/dbc.c). Each input is one configuration file. It asserts:
  *
  *   - a rejected file gets exactly as many messages as errors counted, each
  *     one line "fuzz.ini:LINE: reason" with LINE within the file (or
@@ -12,8 +13,8 @@
  *     (file-wide ones first), without control characters;
  *   - an accepted file has no message, at least one robot with a host, and
  *     every text the gateway prints from it (the --check-config plan, the CAN
- *     description, the DBC) is free of control characters; every key libinih
- *     reads in it belongs to a section the loader took (none ignored);
+ *     description, the DBC) is free of control characters, and its CAN
+ *     tables are built when it has CAN frames;
  *   - its DBC is written and reads back (dbc_check below): every BO_ has a
  *     valid and unique id, a C identifier as name and a CAN length, every
  *     signal is a unique C identifier that fits its frame without overlap,
@@ -23,8 +24,9 @@
  *   - the scheduler runs on it (packets with ordinary, huge and NaN values, a
  *     stall, the link down): each frame sent is a configured one, with its
  *     id, length and FD flag, or the heartbeat;
- *   - the same for the CAN mapping fed key by key, bad keys left out
- *     (check_can_only), so that many more mappings reach the DBC writer.
+ *   - the same for the file with the lines the loader names left out, and
+ *     a robot added when it has none (check_can_only), so that many more
+ *     mappings reach the DBC writer and the scheduler.
  *
  * Any violation aborts with a description, so libFuzzer keeps the input.
  * Replay inputs with: fuzz_config FILE...
@@ -38,9 +40,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <ini.h>
-
 #include "can_map.h"
+#include "can_run.h"
 #include "config.h"
 #include "dbc.h"
 
@@ -236,74 +237,10 @@ static void check_accepted(const gw_config *cfg)
     if (can_map_enabled(&cfg->can)) {
         no_control_str("the CAN interface", cfg->can.interface);
     }
-}
-
-/* ---- an accepted file: no key ignored -------------------------------------------------- */
-
-/* The loader sees each line before libinih does and dispatches keys by
- * its own view of the section; libinih hands the keys over with its view.
- * Where the two disagree a key can be dropped without a word. So: every
- * key libinih finds in an accepted file sits in a section the loader took,
- * [gateway], [lcm], [can], or a [robot NAME] or [frame NAME] it has
- * (libinih keeps 49 characters of a header: then a prefix matches). */
-#define INIH_SECTION_MAX 49
-
-static bool section_is(const char *inih, const char *kind, const char *name)
-{
-    char want[128];
-    char got[128];
-    size_t n = 0;
-    const char *p = inih;
-    while (isspace((unsigned char)*p)) {
-        p++;
+    if (can_map_enabled(&cfg->can) != (cfg->can_run != NULL)) {
+        violated("accepted with CAN %s but its tables %s", can_map_enabled(&cfg->can) ? "on" : "off",
+                 cfg->can_run != NULL ? "built" : "not built");
     }
-    /* KIND NAME with the blanks between them and around taken out. */
-    while (*p != '\0' && n + 2 < sizeof got) {
-        if (isspace((unsigned char)*p)) {
-            while (isspace((unsigned char)*p)) {
-                p++;
-            }
-            if (*p != '\0') {
-                got[n++] = ' ';
-            }
-            continue;
-        }
-        got[n++] = *p++;
-    }
-    got[n] = '\0';
-    snprintf(want, sizeof want, "%s%s%s", kind, name ? " " : "", name ? name : "");
-    if (strlen(inih) >= INIH_SECTION_MAX) {
-        return strncmp(want, got, n) == 0;
-    }
-    return strcmp(want, got) == 0;
-}
-
-static int accepted_key(void *user, const char *section, const char *key, const char *value)
-{
-    const gw_config *cfg = user;
-    bool known = section_is(section, "gateway", NULL) || section_is(section, "lcm", NULL) ||
-                 section_is(section, "can", NULL);
-    (void)value;
-    for (unsigned i = 0; !known && i < cfg->robot_count; i++) {
-        known = section_is(section, "robot", cfg->robots[i].name);
-    }
-    for (size_t i = 0; !known && i < cfg->can.frame_count; i++) {
-        known = section_is(section, "frame", cfg->can.frames[i].name);
-    }
-    if (!known) {
-        violated("accepted, but libinih reads key \"%s\" in a section the loader does not have: [%s]", key, section);
-    }
-    return 1;
-}
-
-static void check_no_key_ignored(const char *data, size_t size, const gw_config *cfg)
-{
-    char *text = strndup(data, size);
-    if (text == NULL) {
-        abort();
-    }
-    ini_parse_string(text, accepted_key, (void *)cfg); /* the loader set libinih's options */
-    free(text);
 }
 
 /* ---- the DBC, read back --------------------------------------------------------------- */
@@ -659,32 +596,32 @@ static void fill_state(urrt_state *st, double v)
     st->length = 1220;
 }
 
-static void run_schedule(struct can_map *map)
+static void run_schedule(const struct can_map *map, struct can_run *run)
 {
     static const double values[] = {0.0, 1.5, -7.0, 1e300, -1e300, 4294967296.0, NAN, INFINITY};
     struct emitted e = {map, 0};
     urrt_canlink_stats stats;
     uint64_t now = 1000000;
     memset(&stats, 0, sizeof stats);
-    can_map_start(map, now);
+    can_run_start(run, now);
     for (size_t k = 0; k < sizeof values / sizeof values[0]; k++) {
         urrt_state st;
         fill_state(&st, values[k]);
         for (size_t r = 0; r < map->robot_count; r++) {
-            urrt_cantx_on_packet(can_map_tx(map), r, &st, now);
+            urrt_cantx_on_packet(can_run_tx(run), r, &st, now);
         }
-        can_map_due(map, now, &stats, on_frame, &e);
+        can_run_due(run, now, &stats, on_frame, &e);
         now += 4000;
-        can_map_due(map, now, &stats, on_frame, &e);
+        can_run_due(run, now, &stats, on_frame, &e);
         stats.sent = e.frames;
     }
     /* A stall past every stale_after_ms, then a robot that went away. */
     now += 61000000;
-    can_map_due(map, now, &stats, on_frame, &e);
-    urrt_cantx_robot_link(can_map_tx(map), 0, false);
+    can_run_due(run, now, &stats, on_frame, &e);
+    urrt_cantx_robot_link(can_run_tx(run), 0, false);
     now += 1000000;
-    can_map_due(map, now, &stats, on_frame, &e);
-    if (urrt_cantx_deadline(can_map_tx(map)) == URRT_CANTX_NEVER) {
+    can_run_due(run, now, &stats, on_frame, &e);
+    if (urrt_cantx_deadline(can_run_tx(run)) == URRT_CANTX_NEVER) {
         violated("nothing scheduled after start: the heartbeat is always due again");
     }
     if (e.frames == 0) {
@@ -692,51 +629,71 @@ static void run_schedule(struct can_map *map)
     }
 }
 
-/* ---- the CAN mapping alone -------------------------------------------------------------- */
+/* ---- the CAN mapping, with the bad lines left out ------------------------------------- */
 
-/* The loader rejects a file for its first mistake, so few mutated files
- * reach the DBC writer that way. Here every [can] and [frame NAME] key goes
- * to the map on its own, a bad key is left out, and whatever the map
- * accepts as a whole is written and run: the DBC writer and the scheduler
- * see far more mappings (as a tool that generates tables from an INI would
- * feed them). The robots are those the loader found (one if none). */
-static int can_only_key(void *user, const char *section, const char *key, const char *value)
+/* The loader rejects a file for any mistake, so few mutated files reach the
+ * DBC writer that way. Here the lines the loader names are left out (each
+ * becomes a blank line, so that the others keep their numbers) and the file
+ * is loaded again, through the same entry point, a few times over; a file
+ * without a robot gets one at its end. Whatever is then accepted is written
+ * and run: the DBC writer and the scheduler see far more mappings. */
+#define CAN_ONLY_ROUNDS 4
+
+/* Blanks every line a message of l names; false when none is named. */
+static bool blank_named_lines(char *text, size_t size, const struct loaded *l)
 {
-    can_map_ini(user, section, key, value, NAME, 1, NULL, 0);
-    return 1;
+    bool any = false;
+    for (const char *m = l->messages; m != NULL && *m != '\0';) {
+        const char *nl = strchr(m, '\n');
+        long line = 0;
+        if (sscanf(m, NAME ":%ld:", &line) == 1 && line > 0) {
+            long at = 1;
+            for (size_t i = 0; i < size; i++) {
+                if (at == line && text[i] != '\n') {
+                    text[i] = ' ';
+                    any = true;
+                }
+                at += text[i] == '\n';
+            }
+        }
+        m = nl != NULL ? nl + 1 : NULL;
+    }
+    return any;
 }
 
-static void check_can_only(const char *data, size_t size, const gw_config *cfg)
+static void check_can_only(const char *data, size_t size)
 {
-    struct can_map map;
-    struct can_map_robot robots[GW_MAX_ROBOTS] = {{"arm", 8000}};
-    size_t count = cfg->robot_count ? cfg->robot_count : 1;
-    char *text = strndup(data, size);
+    static const char robot[] = "\n[robot arm]\nhost = h\nversion = 3.10\n";
+    char *text = malloc(size + sizeof robot);
+    size_t len = size;
+    struct loaded l;
     if (text == NULL) {
         abort();
     }
-    for (unsigned i = 0; i < cfg->robot_count; i++) {
-        robots[i].name = cfg->robots[i].name;
-        robots[i].period_us = 1000000u / cfg->robots[i].max_rate_hz;
+    memcpy(text, data, size);
+    load(&l, text, len);
+    for (int round = 0; round < CAN_ONLY_ROUNDS && l.errors > 0; round++) {
+        bool changed = blank_named_lines(text, len, &l);
+        if (l.cfg.robot_count == 0 && len == size) {
+            memcpy(text + len, robot, sizeof robot - 1);
+            len += sizeof robot - 1;
+            changed = true;
+        }
+        unload(&l);
+        if (!changed) {
+            free(text);
+            return;
+        }
+        load(&l, text, len);
     }
-    can_map_init(&map);
-    ini_parse_string(text, can_only_key, &map); /* the loader set libinih's options */
-    if (can_map_finish(&map, robots, count, NULL, 0) == 0 && can_map_enabled(&map)) {
-        size_t len;
-        char *dbc = NULL;
-        FILE *out = open_memstream(&dbc, &len);
-        if (out == NULL) {
-            abort();
-        }
-        if (dbc_write(out, &map, NAME) != 0) {
-            violated("dbc_write failed on a finished map");
-        }
-        fclose(out);
-        dbc_check(dbc, len);
+    if (l.errors == 0 && l.cfg.can_run != NULL) {
+        size_t dbc_len;
+        char *dbc = write_dbc(&l.cfg, &dbc_len);
+        dbc_check(dbc, dbc_len);
         free(dbc);
-        run_schedule(&map);
+        run_schedule(&l.cfg.can, l.cfg.can_run);
     }
-    can_map_free(&map);
+    unload(&l);
     free(text);
 }
 
@@ -765,7 +722,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             violated("accepted, but with messages: %s", a.messages);
         }
         check_accepted(&a.cfg);
-        check_no_key_ignored((const char *)data, size, &a.cfg);
         if (can_map_enabled(&a.cfg.can)) {
             size_t len_a, len_b;
             char *dbc_a = write_dbc(&a.cfg, &len_a);
@@ -776,10 +732,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             dbc_check(dbc_a, len_a);
             free(dbc_a);
             free(dbc_b);
-            run_schedule(&a.cfg.can);
+            run_schedule(&a.cfg.can, a.cfg.can_run);
         }
     }
-    check_can_only((const char *)data, size, &b.cfg);
+    check_can_only((const char *)data, size);
     unload(&a);
     unload(&b);
     return 0;

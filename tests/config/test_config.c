@@ -13,6 +13,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "can_run.h"
 #include "check.h"
 #include "conf.h"
 #include "config.h"
@@ -115,11 +116,13 @@ static void test_control_characters_escaped(void)
     free(messages);
 }
 
-/* Finding 3: a NUL byte in a line longer than libinih's 200-byte buffer
+/* Finding 3: a NUL byte in a line longer than the reader's 200-byte buffer
  * hid the line's end from the reader (fgets then strlen), so the rest of
  * the line counted as a line of its own: every later message named a line
  * past the real one, up to lines the file does not have. The reader now
- * counts the bytes it reads, and a NUL byte is an error of its line. */
+ * counts the bytes it reads, and a NUL byte is an error of its line. A
+ * line holds 198 characters before its end (the message said 197, true of
+ * a "\r\n" line only). */
 static void test_nul_byte(void)
 {
     char text[512];
@@ -134,7 +137,7 @@ static void test_nul_byte(void)
     text[len++] = '\0';
     len += (size_t)sprintf(text + len, "0\n");
     CHECK_ERRORS(load(text, len, &messages, &cfg), 3);
-    CHECK_EQ_STR(messages, "t.ini:3: line longer than 197 characters\n"
+    CHECK_EQ_STR(messages, "t.ini:3: line longer than 198 characters\n"
                            "t.ini:4: port must be a whole number from 1 to 65535, not \"0\"\n"
                            "t.ini:5: a NUL byte: the configuration must be a text file\n");
     CHECK_EQ_STR(cfg.robots[0].expected, "auto");
@@ -155,10 +158,10 @@ static void test_control_characters_refused(void)
 }
 
 /* Finding 5 (found reading the loader while writing the harness, not by
- * the fuzzer): libinih truncates section names to 49 characters, the
- * loader compared its name with the whole header and, on a mismatch,
- * skipped the section's keys silently: a robot named with 44 to 64
- * characters (valid names) was rejected as having no host. */
+ * the fuzzer): libinih, which read the file then, truncated section names
+ * to 49 characters, the loader compared its name with the whole header
+ * and, on a mismatch, skipped the section's keys silently: a robot named
+ * with 44 to 64 characters (valid names) was rejected as having no host. */
 static void test_long_robot_name(void)
 {
     static const char name[] = "a123456789012345678901234567890123456789012345678901234567890123";
@@ -180,11 +183,12 @@ static void test_long_robot_name(void)
 
 /* Finding 6 (the harness's "no key ignored" check, on a hand-made input;
  * the fuzzer did not reach it in 4 minutes): the loader took a line for a
- * section header after spaces and tabs only, libinih after any blank. A
- * header after a form feed was then libinih's section but not the
- * loader's, and when the line also held a '=' (so that the loader did not
- * call it a syntax error) the keys below it were dropped without a word
- * (here port = 0: the file was accepted). */
+ * section header after spaces and tabs only, libinih (which then split
+ * the keys) after any blank. A header after a form feed was then libinih's
+ * section but not the loader's, and when the line also held a '=' (so that
+ * the loader did not call it a syntax error) the keys below it were
+ * dropped without a word (here port = 0: the file was accepted). One
+ * reader now reads each line once. */
 static void test_header_after_form_feed(void)
 {
     char *messages = NULL;
@@ -430,11 +434,14 @@ struct table_test {
 static void test_key_table(void)
 {
     static const struct conf_key keys[] = {
-        {"port", CONF_UINT, CONF_FIELD(struct table_test, port), 1, 65535, NULL, "%1$s: 1 to 65535, not %2$s", false},
-        {"on", CONF_BOOL, CONF_FIELD(struct table_test, on), 0, 0, NULL, NULL, false},
-        {"wait", CONF_MS, CONF_FIELD(struct table_test, wait_ms), 1, 1000, NULL, NULL, false},
-        {"period_ms", CONF_MS, CONF_FIELD(struct table_test, period_ms), 1, 1000, NULL, NULL, false},
-        {"bad", CONF_MS, CONF_FIELD(struct table_test, port), 1, 1000, NULL, NULL, false},
+        {"port", CONF_UINT, CONF_FIELD(struct table_test, port), 1, 65535, NULL, "%1$s: 1 to 65535, not %2$s", false,
+         NULL, "80", NULL, "a port"},
+        {"on", CONF_BOOL, CONF_FIELD(struct table_test, on), 0, 0, NULL, NULL, false, NULL, "yes", NULL, NULL},
+        {"wait", CONF_MS, CONF_FIELD(struct table_test, wait_ms), 1, 1000, NULL, NULL, false, NULL, NULL, "required",
+         "a wait"},
+        {"period_ms", CONF_MS, CONF_FIELD(struct table_test, period_ms), 1, 1000, NULL, NULL, false, NULL, "0.5 s",
+         NULL, NULL},
+        {"bad", CONF_MS, CONF_FIELD(struct table_test, port), 1, 1000, NULL, NULL, false, NULL, NULL, NULL, NULL},
     };
     struct table_test t = {0};
     struct conf_at at = {"t.ini", 1};
@@ -458,6 +465,117 @@ static void test_key_table(void)
     conf_unknown_key(keys, 4, "colour", "x", why, sizeof why);
     CHECK_EQ_STR(why, "unknown key \"colour\" in [x] (keys: port, on, wait, period_ms)");
     CHECK(conf_suggest("o", keys, 4, sizeof keys[0]) == NULL, "no hint from one letter");
+    /* What the table says of its keys: defaults set, bounds, one line each. */
+    memset(&t, 0, sizeof t);
+    CHECK(conf_key_defaults(keys, 4, &t, why, sizeof why), "defaults: %s", why);
+    CHECK(t.port == 80 && t.on && t.wait_ms == 0 && t.period_ms == 500, "defaults set");
+    CHECK_EQ_STR(conf_key_bounds(&keys[0], why, sizeof why), "1..65535");
+    CHECK_EQ_STR(conf_key_bounds(&keys[1], why, sizeof why), "");
+    CHECK_EQ_STR(conf_key_bounds(&keys[2], why, sizeof why), "1 ms..1 s");
+    CHECK_EQ_STR(conf_key_bounds(&keys[3], why, sizeof why), "1..1000");
+    {
+        char *text = NULL;
+        size_t size = 0;
+        FILE *out = open_memstream(&text, &size);
+        conf_key_print(out, "x", keys, 3);
+        fclose(out);
+        CHECK_EQ_STR(text, "x\tport\tN\t80\t1..65535\ta port\n"
+                           "x\ton\tyes|no\tyes\t-\t-\n"
+                           "x\twait\tDURATION\t(required)\t1 ms..1 s\ta wait\n");
+        free(text);
+    }
+}
+
+/* Every table's defaults parse (a bug otherwise), and a file that sets
+ * nothing gets them: the loader applies the table, the one source. */
+static void test_table_defaults(void)
+{
+    static const char text[] = "[robot a]\nhost = h\n";
+    char *messages = NULL;
+    gw_config cfg;
+    CHECK_ERRORS(load(text, strlen(text), &messages, &cfg), 0);
+    CHECK_EQ_STR(messages, "");
+    if (cfg.robot_count == 1) {
+        const gw_robot_config *r = &cfg.robots[0];
+        CHECK_EQ_INT(r->link.silence_timeout_ms, URRT_LINK_SILENCE_TIMEOUT_MS);
+        CHECK(r->port == 30003 && r->link.connect_timeout_ms == 2000 && r->link.backoff_initial_ms == 100 &&
+                  r->link.backoff_max_ms == 5000 && r->expected_length == 0 && strcmp(r->expected, "auto") == 0,
+              "robot defaults");
+    }
+    CHECK(cfg.log_level == URRT_LOG_NOTICE && !cfg.summary, "[gateway] defaults");
+    CHECK_EQ_STR(cfg.lcm.url, GW_DEFAULT_LCM_URL);
+    CHECK_EQ_STR(cfg.lcm.channel[GW_KIND_GATEWAY], "GATEWAY");
+    CHECK(cfg.lcm.rate[GW_KIND_STATE].mode == GW_RATE_EVERY && cfg.lcm.rate[GW_KIND_STATUS].hz == 10 &&
+              cfg.lcm.rate[GW_KIND_GATEWAY].hz == 1 && cfg.lcm.channel_line[GW_KIND_STATE] == 0,
+          "[lcm] defaults");
+    CHECK(cfg.can.bitrate == 500000 && cfg.can.max_load_percent == 50 && cfg.can.hb_period_ms == 100 &&
+              cfg.can.stale_after_ms == 100 && cfg.can.generation == URRT_GEN_3X &&
+              strcmp(cfg.can.node, "URRT_GATEWAY") == 0 && strcmp(cfg.can.receiver, "Vector__XXX") == 0,
+          "[can] defaults");
+    CHECK(cfg.can_run == NULL, "no CAN output: no tables");
+    gw_config_free(&cfg);
+    free(messages);
+}
+
+/* The CAN tables are built with the file: --check-config proves they
+ * build, and a frame's defaults come from its table. */
+static void test_tables_built(void)
+{
+    static const char text[] = "[robot a]\nhost = h\n" CAN_TEXT FRAME_TEXT;
+    char *messages = NULL;
+    gw_config cfg;
+    CHECK_ERRORS(load(text, strlen(text), &messages, &cfg), 0);
+    CHECK_EQ_STR(messages, "");
+    CHECK(cfg.can_run != NULL && can_run_heartbeat_index(cfg.can_run) == 1, "tables built with the file");
+    if (cfg.can.frame_count == 1) {
+        CHECK(cfg.can.frames[0].len == 8 && cfg.can.frames[0].stale_policy == CAN_MAP_STALE_STOP &&
+                  cfg.can.frames[0].stale_after_ms == 100,
+              "frame defaults");
+    }
+    gw_config_free(&cfg);
+    free(messages);
+}
+
+/* The reader: each line read once, as libinih read it before (a ':' for
+ * '=', comments after a blank, a byte order mark, "\r\n" ends), and its
+ * own messages. */
+static void test_reader(void)
+{
+    static const struct { const char *text; const char *want; } cases[] = {
+        {"\xEF\xBB\xBF[robot a]\r\nhost: h ; the arm\r\nport = 30013# not a comment\r\n",
+         "t.ini:3: port must be a whole number from 1 to 65535, not \"30013# not a comment\"\n"},
+        {"host = h\n[robot a]\nhost = h\n",
+         "t.ini:1: \"host\" is outside of any section: put it under [gateway], [lcm] or [robot NAME]\n"},
+        {"[robot a]\nhost = h\nport ;30013 = 1\n",
+         "t.ini:3: expected \"[section]\" or \"key = value\", not \"port ;30013 = 1\"\n"},
+        {"[robot a]\nhost = h\nport = 1\nport = 2\n", "t.ini:4: port is set again (first at line 3)\n"},
+        {"[robot a\nhost = h\n",
+         "t.ini:1: section header without ']'\n"
+         "t.ini:2: \"host\" is outside of any section: put it under [gateway], [lcm] or [robot NAME]\n"
+         "t.ini: no robot: edit t.ini and add a section \"[robot NAME]\" with \"host = ADDRESS\" (the installed "
+         "file has one commented out)\n"},
+        {"[robot a]\nhost =\n", "t.ini:2: host has no value\nt.ini:1: [robot a] has no host: add \"host = ADDRESS\"\n"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char *messages = NULL;
+        load_str(cases[k].text, &messages);
+        CHECK(strcmp(messages, cases[k].want) == 0, "case %zu:\n  got:  %s  want: %s", k, messages, cases[k].want);
+        free(messages);
+    }
+    /* 198 characters before the line's end, "\r\n" or "\n", and no more. */
+    for (int crlf = 0; crlf < 2; crlf++) {
+        char text[512];
+        char *messages = NULL;
+        int n = snprintf(text, sizeof text, "[robot a]\nhost = h\n#");
+        memset(text + n, 'x', 197);
+        snprintf(text + n + 197, sizeof text - (size_t)n - 197, "%s", crlf ? "\r\n" : "\n");
+        CHECK_ERRORS(load_str(text, &messages), 0);
+        free(messages);
+        snprintf(text + n + 197, sizeof text - (size_t)n - 197, "y%s", crlf ? "\r\n" : "\n");
+        CHECK_ERRORS(load_str(text, &messages), 1);
+        CHECK_EQ_STR(messages, "t.ini:3: line longer than 198 characters\n");
+        free(messages);
+    }
 }
 
 /* Causes first: a typo'd key or section before what it then lacks. */
@@ -505,6 +623,9 @@ int main(void)
     test_same_everywhere();
     test_refusals();
     test_key_table();
+    test_table_defaults();
+    test_tables_built();
+    test_reader();
     test_causes_first();
     return check_report();
 }

@@ -3,14 +3,14 @@
 # Proof that lib/ is freestanding: every lib/*.c compiled alone for a
 # Cortex-M4 under the library's strict warnings, linked with -nostdlib into a
 # small image (tests/cross/startup.c), and the footprint compared with the
-# figures README.md states; then for every core of README's symbol table at
-# -Os and -O2, what lib/ needs from outside (libgcc only).
+# figures docs/footprint.md states; then for every core of that page's symbol
+# table at -Os and -O2, what lib/ needs from outside (libgcc only).
 #
-# usage: check.sh OUTDIR README "LIB_WARN flags" lib/a.c lib/b.c ...
+# usage: check.sh OUTDIR FOOTPRINT_MD "LIB_WARN flags" lib/a.c lib/b.c ...
 # Needs arm-none-eabi-gcc, -nm and -size, and riscv64-unknown-elf-gcc. RESULT (if set) receives the
 # closing "N passed, N failed" line.
 set -u
-out=$1; readme=$2; warn=$3; shift 3
+out=$1; doc=$2; warn=$3; shift 3
 . "$(dirname "$0")/../lib.sh"
 
 CROSS=arm-none-eabi-
@@ -21,7 +21,7 @@ ARCH="-mcpu=cortex-m4 -mthumb"
 CFLAGS="$ARCH -ffreestanding -Os $warn -ffunction-sections -fdata-sections -fstack-usage -Ilib"
 CFLAGS="$CFLAGS -nostdinc -isystem $(${CROSS}gcc -print-file-name=include)"
 LDFLAGS="$ARCH -nostdlib -Wl,--gc-sections -T tests/cross/link.ld"
-# Percentage by which a measured text size may differ from README's.
+# Percentage by which a measured text size may differ from the stated one.
 TOLERANCE=10
 
 mkdir -p "$out"
@@ -44,9 +44,12 @@ for src in "$@"; do
   fi
 done
 # The decoder's NEON path (ARMv7-A with NEON, as on an i.MX or Raspberry Pi
-# class edge box) under the same warnings: compiled only, nothing here runs it.
-for src in "$@"; do
-  check "$src compiles for Cortex-A7 with NEON (vector path)" \
+# class edge box) is lib/vector/urrt_vector.c, the host build's lib/urrt.c
+# with the vector paths (lib/lib.mk); it and every lib/*.c under the same
+# warnings for that core: compiled only, nothing here runs it.
+vector_src=lib/vector/urrt_vector.c
+for src in "$@" "$vector_src"; do
+  check "$src compiles for Cortex-A7 with NEON" \
     ${CROSS}gcc -mcpu=cortex-a7 -mfpu=neon-vfpv4 -mfloat-abi=hard -ffreestanding -O2 $warn -Ilib \
       -c "$src" -o "$out/$(basename "$src" .c).neon.o"
 done
@@ -56,16 +59,16 @@ done
 # Nothing here runs big-endian code, so the check is on the choice of path.
 be_macros="$out/urrt.be.macros"
 if ${CROSS}gcc -mbig-endian -mcpu=cortex-a7 -mfpu=neon-vfpv4 -mfloat-abi=hard -ffreestanding -O2 $warn -Ilib \
-     -c lib/urrt.c -o "$out/urrt.be.o" &&
+     -c "$vector_src" -o "$out/urrt.be.o" &&
    ${CROSS}gcc -mbig-endian -mcpu=cortex-a7 -mfpu=neon-vfpv4 -mfloat-abi=hard -ffreestanding -O2 -Ilib \
-     -E -dM lib/urrt.c > "$be_macros"; then
+     -E -dM "$vector_src" > "$be_macros"; then
   if grep -q '^#define URRT_VECTOR ' "$be_macros"; then
-    fail "lib/urrt.c byte-swaps doubles with NEON on a big-endian target (regression_big_endian_neon)"
+    fail "$vector_src byte-swaps doubles with NEON on a big-endian target (regression_big_endian_neon)"
   else
-    ok "lib/urrt.c compiles for big-endian NEON without the byte-swapping vector path"
+    ok "$vector_src compiles for big-endian NEON without the byte-swapping vector path"
   fi
 else
-  fail "lib/urrt.c does not compile for big-endian Cortex-A7 with NEON"
+  fail "$vector_src does not compile for big-endian Cortex-A7 with NEON"
 fi
 # URRT_MAX_DOUBLES is a documented knob: the library must build at the
 # smallest allowed value and a large one, and refuse values its structs cannot
@@ -88,8 +91,8 @@ check "size probe compiles" ${CROSS}gcc $CFLAGS -c tests/cross/probe.c -o "$out/
 # -Os and -O2 (GCC may emit memcpy/memset calls for loops at -O2, or call
 # memcpy for a __builtin_memcpy it cannot inline): every symbol an object
 # leaves undefined that no lib/ object defines. Each must come from that
-# core's libgcc (checked against libgcc.a itself) and README.md's table must
-# list exactly these symbols and cores.
+# core's libgcc (checked against libgcc.a itself) and the symbol table of
+# docs/footprint.md must list exactly these symbols and cores.
 #   name|compiler|flags
 CORES="m0+|arm-none-eabi-gcc|-mcpu=cortex-m0plus -mthumb
 m4|arm-none-eabi-gcc|-mcpu=cortex-m4 -mthumb
@@ -133,18 +136,18 @@ done <<EOF_CORES
 $CORES
 EOF_CORES
 needed=$(sort -u "$pairs" | awk '{ c[$1] = c[$1] ? c[$1] " " $2 : $2 } END { for (s in c) print s ": " c[s] }' | sort)
-listed=$(sed -n '/<!-- cross-symbols:begin/,/<!-- cross-symbols:end/p' "$readme" |
+listed=$(sed -n '/<!-- cross-symbols:begin/,/<!-- cross-symbols:end/p' "$doc" |
          sed -n 's/^| *`\([A-Za-z_][A-Za-z0-9_]*\)` *| *[^|]*| *\([^|]*[^ |]\) *|.*/\1: \2/p' | sort)
 echo "cross: symbols lib/ needs from the toolchain, and on which cores:"
 echo "$needed" | sed 's/^/cross:   /'
 if [ "$core_ok" = yes ]; then
   if [ "$needed" = "$listed" ]; then
-    ok "README.md's cross-symbols table lists exactly these symbols and cores"
+    ok "$doc's cross-symbols table lists exactly these symbols and cores"
   else
-    fail "README.md's cross-symbols table differs from what lib/ needs (symbol: cores, measured above): update it"
+    fail "$doc's cross-symbols table differs from what lib/ needs (symbol: cores, measured above): update it"
     echo "$listed" > "$out/listed-pairs"
     echo "$needed" > "$out/needed-sorted"
-    diff "$out/listed-pairs" "$out/needed-sorted" | sed 's/^/cross:   README vs measured: /'
+    diff "$out/listed-pairs" "$out/needed-sorted" | sed "s|^|cross:   $doc vs measured: |"
   fi
 fi
 
@@ -217,13 +220,13 @@ for obj in $objs; do cat "${obj%.o}.su"; done | sort -t "$(printf '\t')" -k2 -n 
 echo "cross: footprint (arm-none-eabi-size; bytes):"
 sed 's/^/cross:   /' "$measured"
 
-# README must state the same figures: text within TOLERANCE %, the rest exact.
-stated=$(sed -n '/<!-- footprint:begin/,/<!-- footprint:end/p' "$readme")
+# docs/footprint.md must state the same figures: text within TOLERANCE %, the rest exact.
+stated=$(sed -n '/<!-- footprint:begin/,/<!-- footprint:end/p' "$doc")
 while IFS= read -r line; do
   name=$(echo "$line" | awk -F'|' '{ gsub(/^ +| +$/, "", $2); print $2 }')
   want=$(echo "$stated" | awk -F'|' -v n="$name" '{ k = $2; gsub(/^ +| +$/, "", k) } k == n { print; exit }')
   if [ -z "$want" ]; then
-    fail "README.md footprint table has no row \"$name\": add it with the measured figures"
+    fail "$doc footprint table has no row \"$name\": add it with the measured figures"
     continue
   fi
   m=$(echo "$line" | awk -F'|' '{ for (i = 3; i < NF; i++) { v = $i; gsub(/[ ,]/, "", v); printf "%s ", v } }')
@@ -236,9 +239,9 @@ while IFS= read -r line; do
         if (s[1] == 0 || d * 100 > tol * s[1]) exit 1; # text: within tolerance
         for (i = 2; i <= n; i++) if (m[i] != s[i]) exit 1;
         exit 0 }'; then
-    ok "README.md states \"$name\" ($s; measured $m)"
+    ok "$doc states \"$name\" ($s; measured $m)"
   else
-    fail "README.md says \"$name\" is $s, measured $m: update the footprint table"
+    fail "$doc says \"$name\" is $s, measured $m: update the footprint table"
   fi
 done < "$measured"
 finish

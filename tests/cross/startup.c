@@ -4,7 +4,7 @@
  * handler that frames, decodes and random-reads packets from a static
  * receive buffer, so that the linker keeps what a firmware would use.
  * Linked with -nostdlib: any symbol lib/ needs from outside shows up as an
- * undefined reference (tests/cross/check.sh compares them with README.md).
+ * undefined reference (tests/cross/check.sh compares them with docs/footprint.md).
  */
 #include "urrt.h"
 

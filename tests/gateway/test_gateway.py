@@ -950,7 +950,8 @@ def t_install(args):
 def t_cli(args):
     h = subprocess.run([args.gateway, "--help"], capture_output=True, text=True, timeout=10)
     check(h.returncode == 0 and "--check-config" in h.stdout and "[robot NAME]" in h.stdout and
-          "KIND_rate = every | N Hz | off" in h.stdout and "Examples:" in h.stdout,
+          "state_rate = every|N Hz|off" in h.stdout and "(default 100 ms; 20 ms..10 min)" in h.stdout and
+          "Examples:" in h.stdout,
           "--help documents options, the file grammar and examples")
     v = subprocess.run([args.gateway, "--version"], capture_output=True, text=True, timeout=10)
     check(v.returncode == 0 and v.stdout.startswith("urrt-gateway "), "--version")

@@ -5,7 +5,7 @@
  *
  * Expected values come from tests/ref/urrt_ref.py (an independent reference
  * written from UR's table), read from the vector file given as argv[1], and
- * from tables typed here from protocol-facts.md. Packets for the framer tests
+ * from tables typed here from docs/sources.md. Packets for the framer tests
  * are the reference's packets, so nothing here is produced by the code under
  * test and then checked against itself.
  */
@@ -547,7 +547,7 @@ static void test_framer_zero_length_feeds(void)
     CHECK_EQ_INT(urrt_framer_finish(&framer), 0);
 }
 
-/* The 1460-byte read of protocol-facts.md "A real capture": one 812-byte
+/* The 1460-byte read of docs/sources.md "The CB2 1.8 capture": one 812-byte
  * 1.8 packet and the first 648 bytes of the next. */
 static void test_real_capture(void)
 {
@@ -883,7 +883,7 @@ static void test_bitmask(void)
     CHECK_EQ_INT(urrt_bitmask(5.0, NULL), URRT_E_ARG);
 }
 
-/* The enumerations, typed from protocol-facts.md. */
+/* The enumerations, typed from docs/sources.md "Enumerations". */
 static const struct {
     urrt_enum_kind kind;
     int first;
@@ -1033,7 +1033,7 @@ static void test_field_metadata(void)
     CHECK_EQ_STR(URRT_VERSION_STRING, "0.1.0");
 }
 
-/* "since" of every field agrees with the lengths table of protocol-facts.md:
+/* "since" of every field agrees with the lengths table of docs/sources.md:
  * it is the first version of the first documented length whose packets
  * hold the field (presence itself is checked against the reference). */
 static void test_field_since_follows_lengths(void)
@@ -1207,7 +1207,7 @@ static void test_vector_width(void)
 
 /* ---- controller versions and time ---------------------------------------- */
 
-/* Every version of protocol-facts.md's length table, with its size and rate
+/* Every version of docs/sources.md's length table, with its size and rate
  * (125 Hz on CB2/CB3, 500 Hz on e-series), typed here from that page. */
 static const struct {
     const char *version;

@@ -2,8 +2,8 @@
 # SPDX-License-Identifier: MIT
 """check-man: each man page documents exactly its program's options.
 
-The options come from the getopt_long table and option string in the program's
-source, and again from its --help; the page's are the `### ` headings of its
+The options come from the option table in the program's source (cli.h's
+cli_option rows, or getopt_long's table and option string), and again from its --help; the page's are the `### ` headings of its
 OPTIONS section (gateway/man/*.md). Both directions: every option documented,
 nothing documented that does not exist. Each rendered page is also read by
 man(1) with warnings on, and must produce none."""
@@ -23,11 +23,18 @@ def check(ok, what):
     else:
         FAILED += 1
         print("FAIL: " + what)
+    return ok
 
 
 def table_options(source):
-    """{(short or None, long)} from the struct option table, plus shorts without a long."""
+    """{(short or None, long)} from the program's option table: a cli_option table (cli.h: one row per
+    option, its long name and letter first), or getopt_long's struct option table and option string,
+    plus shorts without a long."""
     text = open(source).read()
+    rows = re.search(r"cli_option \w+\[\]\s*=\s*\{(.*?)\};", text, re.S)
+    if rows:
+        return {(None if short == "0" else short[1], long_name)
+                for long_name, short in re.findall(r'\{"([\w-]+)",\s*(\'.\'|0),', rows.group(1))}
     table = re.search(r"struct option \w+\[\]\s*=\s*\{(.*?)\};", text, re.S).group(1)
     optstring = re.search(r'getopt_long\(argc, argv, "([^"]*)"', text).group(1)
     shorts = set(optstring.replace(":", ""))
@@ -74,8 +81,142 @@ def show(pairs):
     return ", ".join(sorted(("-%s " % s if s else "") + ("--" + l if l else "") for s, l in pairs)) or "none"
 
 
+# ---- the configuration keys ------------------------------------------------------------
+
+
+def table_keys(program):
+    """{section: {key: {'form', 'default', 'absent', 'bounds'}}} in table order."""
+    out = subprocess.run([program, "--print-keys"], capture_output=True, text=True, timeout=10).stdout
+    keys = {}
+    for line in out.splitlines():
+        section, key, form, default, bounds, _help = line.split("\t")
+        absent = default[1:-1] if default.startswith("(") else None
+        keys.setdefault(section, {})[key] = {"form": form, "default": None if absent else default,
+                                             "absent": absent, "bounds": None if bounds == "-" else bounds}
+    return keys
+
+
+def kinds(keys):
+    """state, joints, ...: the KIND of [lcm]'s KIND_channel and KIND_rate, in table order."""
+    return [k[:-len("_channel")] for k in keys["lcm"] if k.endswith("_channel")]
+
+
+def expand(keys, section, name, default):
+    """A documented key and its default: KIND_x is one key per kind, its default
+    a list in kind order ("`STATE`, `JOINTS`, ...") or by kind ("`every` for state,
+    joints and tool; `10 Hz` for status")."""
+    if not name.startswith("KIND_"):
+        return [(name, default)]
+    per_kind = {}
+    if " for " in default:
+        for part in default.split(";"):
+            m = re.match(r"\s*`([^`]*)` for (.*)", part)
+            for kind in re.split(r",\s*|\s+and\s+", m.group(2).strip().rstrip(".")) if m else []:
+                per_kind[kind.strip()] = "`%s`" % m.group(1)
+    else:
+        per_kind = dict(zip(kinds(keys), ("`%s`" % v for v in re.findall(r"`([^`]*)`", default))))
+    return [(k + name[len("KIND"):], per_kind.get(k, "")) for k in kinds(keys)]
+
+
+def check_key(keys, where, section, name, default, text):
+    """One documented key: it exists, its default (a cell or the text after
+    "default") is the table's, and its bounds appear in text as `BOUNDS`."""
+    key = keys.get(section, {}).get(name)
+    if not check(key is not None, "%s: [%s] %s is a key of the table" % (where, section, name)):
+        return
+    said = default.replace("`", "").strip()
+    want = key["default"] if key["default"] is not None else key["absent"]
+    check(said == want, "%s: [%s] %s: default %r, the table's %r" % (where, section, name, said, want))
+    if key["bounds"]:
+        check("`%s`" % key["bounds"] in text, "%s: [%s] %s: bounds `%s` written" % (where, section, name,
+                                                                                    key["bounds"]))
+
+
+def check_all_listed(keys, where, section, listed):
+    missing = [k for k in keys[section] if k not in listed]
+    check(not missing, "%s: every key of [%s] listed (missing: %s)" % (where, section, ", ".join(missing) or "none"))
+
+
+def check_doc_tables(keys, path, heading, sections):
+    """Markdown tables `| `key` | values | default |` under headings such as
+    "### `[robot NAME]`": each row against the table."""
+    section, listed = None, {}
+    for line in open(path):
+        if line.startswith("#"):
+            m = re.match(heading, line)
+            section = m.group(1) if m and m.group(1) in sections else None
+            continue
+        row = re.match(r"\| `(\w+)` \|(.*)\|(.*)\|\s*$", line)
+        if section and row:
+            for name, default in expand(keys, section, row.group(1), row.group(3)):
+                listed.setdefault(section, set()).add(name)
+                check_key(keys, path, section, name, default, row.group(2))
+    for section in sections:
+        check_all_listed(keys, path, section, listed.get(section, set()))
+
+
+def check_man_keys(keys, path, sections):
+    """urrt-gateway.ini(5): a `### key = FORM` heading per key, its default in
+    "(default `X`" (or "Required"), its bounds as `BOUNDS` in its paragraph."""
+    section, key, body, listed = None, None, [], {s: set() for s in sections}
+
+    def flush():
+        if section in sections and key:
+            text = " ".join(body)
+            listed_defaults = re.search(r"Defaults: (.*?)\.(?:\s|$)", text)
+            one = re.search(r"[Dd]efault `([^`]*)`", text)
+            default = listed_defaults.group(1) if listed_defaults else "`%s`" % one.group(1) if one else ""
+            default = "required" if text.startswith("Required") else default
+            for name, value in expand(keys, section, key, default):
+                listed[section].add(name)
+                check_key(keys, path, section, name, value, text)
+
+    for line in open(path):
+        if line.startswith("# "):
+            flush()
+            section, key, body = line[2:].strip().strip("[]").split(" ")[0].lower(), None, []
+        elif line.startswith("### "):
+            flush()
+            key, body = line[4:].split("=")[0].strip(), []
+        elif key:
+            body.append(line.strip())
+    flush()
+    for s in sections:
+        check_all_listed(keys, path, s, listed[s])
+
+
+def check_example(keys, path, sections):
+    """The example configuration sets every key of its sections to its default."""
+    section, listed = None, {s: set() for s in sections}
+    for line in open(path):
+        line = line.strip()
+        if line.startswith("["):
+            section = line[1:line.index("]")].split()[0]
+        elif line and line[0] not in "#;" and section in sections:
+            name, value = (x.strip() for x in line.split("=", 1))
+            listed[section].add(name)
+            key = keys[section].get(name)
+            if check(key is not None, "%s: [%s] %s is a key of the table" % (path, section, name)) and \
+                    key["default"] is not None:
+                check(value == key["default"], "%s: [%s] %s = %r, the table's default %r" %
+                      (path, section, name, value, key["default"]))
+    for s in sections:
+        check_all_listed(keys, path, s, listed[s])
+
+
+def check_keys(build):
+    keys = table_keys(os.path.join(build, "bin", "urrt-gateway"))
+    check(len(keys) == 5 and len(keys.get("robot", {})) >= 7, "--print-keys lists the sections' keys (%s)" %
+          ", ".join("%s: %d" % (s, len(k)) for s, k in keys.items()))
+    check_man_keys(keys, "gateway/man/urrt-gateway.ini.5.md", ["gateway", "lcm", "robot"])
+    check_doc_tables(keys, "docs/gateway.md", r"### `\[(\w+)[ \w]*\]`", ["gateway", "lcm", "robot"])
+    check_doc_tables(keys, "docs/can.md", r"## `\[(\w+)[ \w]*\]`", ["can", "frame"])
+    check_example(keys, "gateway/install/urrt-gateway.example.ini", ["gateway", "lcm", "robot"])
+
+
 def main():
     build = sys.argv[1]
+    check_keys(build)
     # program: (man section, the source with its option table)
     programs = {"urrt-gateway": ("8", "gateway/urrt-gateway/urrt-gateway.c"),
                 "urrt-dump": ("1", "gateway/tools/urrt-dump.c"), "urrt-sim": ("1", "gateway/tools/urrt-sim.c")}

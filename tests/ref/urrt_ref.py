@@ -2,10 +2,11 @@
 # SPDX-License-Identifier: MIT
 """Independent reference for the Universal Robots RealTime packet layout.
 
-Written from UR's seed table (shared/seeds/000_*.txt: the 3.x layout at 1116
-bytes) and shared/protocol-facts.md, NOT from lib/urrt.h: the column tables
-below were typed from those documents, so a mistake in the C field table
-shows up as a disagreement instead of being copied into the expectations.
+Written from docs/sources.md (UR's RealTime table at 1116 bytes, as that
+page records it, and what public sources add), NOT from lib/urrt.h: the
+column tables below were typed from that page, so a mistake in the C field
+table shows up as a disagreement instead of being copied into the
+expectations.
 
 It writes test vectors: packets with seeded values, and for each the decode
 the library must produce (every field and element as raw IEEE-754 bits or
@@ -35,9 +36,9 @@ import sys
 
 # 3.x/5.x grid: (name, element count, first column). Columns are UR's
 # "Gnuplot col." (column 1 = time, the first double after the size). Rows
-# 1-139 from the seed table; 140-152 from protocol-facts.md ("Columns after
-# the seed's last one"). UR's unnamed "used by Universal Robots software
-# only" rows are kept as reserved_<first column>.
+# 1-139 from UR's table at 1116 bytes and 140-152 from UR's 2021 document,
+# both as docs/sources.md records them. UR's unnamed "used by Universal Robots software only" rows
+# are kept as reserved_<first column>.
 GRID_3X = [
     ("time", 1, 1),
     ("q_target", 6, 2),
@@ -84,10 +85,10 @@ GRID_3X = [
 ]
 LAST_KNOWN_COLUMN = 152
 
-# 1.x (CB1/CB2): protocol-facts.md "1.x meaning differs at the same
-# positions". Columns 1-49, 68-73 and 86-101 as in 3.x; 50-52 the tool
-# accelerometer (1.7 and later), 53-67 unused, 74-79 / 80-85 tool vector and
-# TCP speed with UR's 1.x names (neither "actual" nor "target").
+# 1.x (CB1/CB2): docs/sources.md "1.x differences". Columns 1-49, 68-73 and
+# 86-101 as in 3.x; 50-52 the tool accelerometer (1.7 and later), 53-67
+# unused, 74-79 / 80-85 tool vector and TCP speed with UR's 1.x names
+# (neither "actual" nor "target").
 GRID_1X = [row for row in GRID_3X if row[2] + row[1] - 1 <= 49] + [
     ("tool_accelerometer", 3, 50),
     ("unused_53", 15, 53),
@@ -126,7 +127,7 @@ VERSIONS = {
     1220: "5.10 or later",
 }
 
-# Enumerations from protocol-facts.md.
+# Enumerations from docs/sources.md ("Enumerations").
 ROBOT_MODE_3X = {-1: "NO_CONTROLLER", 0: "DISCONNECTED", 1: "CONFIRM_SAFETY", 2: "BOOTING",
                  3: "POWER_OFF", 4: "POWER_ON", 5: "IDLE", 6: "BACKDRIVE", 7: "RUNNING",
                  8: "UPDATING_FIRMWARE"}
@@ -356,8 +357,8 @@ def write_vector(out, name, cols):
 
 
 def capture_columns(rng, time):
-    """The 1.8 packet of protocol-facts.md "A real capture" (values the facts
-    do not give are seeded)."""
+    """The 1.8 packet of docs/sources.md "The CB2 1.8 capture" (values the
+    page does not give are seeded)."""
     cols = make_columns(rng, MAX_1X_DOUBLES, False, 0.0)
     lay = layout(MAX_1X_DOUBLES)
 

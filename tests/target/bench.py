@@ -17,10 +17,10 @@ flash wait states: an estimate, not a measurement.
 
 Checks: the trace and SysTick agree on the instruction counts; decode of
 1116 bytes at -O2 within 2x of a byte-swapping copy of the same bytes; the
-table between <!-- m4-bench:begin --> and <!-- m4-bench:end --> in README.md
-states these figures (within 5 %).
+table between <!-- m4-bench:begin --> and <!-- m4-bench:end --> in
+docs/performance.md states these figures (within 5 %).
 
-Usage: bench.py README QEMU_CMD LABEL=IMAGE...
+Usage: bench.py PERFORMANCE_MD QEMU_CMD LABEL=IMAGE...
        bench.py --not-slower QEMU_CMD LABEL=IMAGE LABEL=IMAGE: decode of 1116
        bytes takes no more instructions in the first image than in the second
        (the Cortex-M0 word path against the portable byte path)."""
@@ -142,7 +142,7 @@ def not_slower(qemu, specs):
 def main():
     if sys.argv[1] == "--not-slower":
         return not_slower(sys.argv[2].split(), sys.argv[3:])
-    readme, qemu, images = sys.argv[1], sys.argv[2].split(), sys.argv[3:]
+    doc, qemu, images = sys.argv[1], sys.argv[2].split(), sys.argv[3:]
     passed = failed = 0
 
     def result(ok, text):
@@ -199,8 +199,8 @@ def main():
         print("%s: decode of 1116 bytes is %.2fx the byte-swapping copy of the same bytes" % (l, d / max(s, 1)))
         if l == "-O2":
             result(d <= 2 * s, "-O2: decode of 1116 bytes (%d) is not within 2x of the byte-swapping copy (%d)" % (d, s))
-    # README: the same rows, each number within TOLERANCE.
-    text = open(readme).read()
+    # The page: the same rows, each number within TOLERANCE.
+    text = open(doc).read()
     m = re.search(r"<!-- m4-bench:begin[^\n]*-->\n(.*?)<!-- m4-bench:end -->", text, re.S)
     stated = [l for l in (m.group(1).splitlines() if m else []) if l.startswith("|")]
     numbers = lambda row: [float(x) for x in re.findall(r"\d+(?:\.\d+)?", row.split("|", 2)[2])]
@@ -208,7 +208,7 @@ def main():
         a.split("|")[1] == b.split("|")[1] and len(numbers(a)) == len(numbers(b)) and
         all(abs(x - y) <= TOLERANCE * max(y, 1) for x, y in zip(numbers(a), numbers(b)))
         for a, b in zip(stated[2:], rows[2:]))
-    result(ok, "README.md's m4-bench table differs from the figures above (by more than 5 %): replace it")
+    result(ok, "%s's m4-bench table differs from the figures above (by more than 5 %%): replace it" % doc)
     print("%d passed, %d failed" % (passed, failed))
     return 0 if failed == 0 else 1
 

@@ -3,8 +3,8 @@
 """Worst stack of every public lib/ function: the high-water marks a target
 run painted (its "stack: NAME BYTES" lines) beside the worst path of
 -fstack-usage frames through gcc's call graph (-fcallgraph-info=su .ci files
-of the same build), and README.md's table between <!-- stack:begin --> and
-<!-- stack:end -->, which must be these rows.
+of the same build), and the table between <!-- stack:begin --> and
+<!-- stack:end --> of docs/footprint.md, which must be these rows.
 
 Agreement: for a function whose calls all stay in lib/, painted and static
 must be equal (within TOLERANCE bytes: the frame of a path the run did not
@@ -14,7 +14,7 @@ painted mark must cover the static lib/ part, and the difference is libgcc's.
 
 Every function lib/*.h declares must have been measured.
 
-Usage: stack.py RUN_LOG README CI_FILE... (prints the table, then
+Usage: stack.py RUN_LOG FOOTPRINT_MD CI_FILE... (prints the table, then
 "N passed, N failed")"""
 import glob
 import re
@@ -61,7 +61,7 @@ def worst(name, frames, edges, seen=()):
 
 
 def main():
-    log, readme, cis = sys.argv[1], sys.argv[2], sys.argv[3:]
+    log, doc, cis = sys.argv[1], sys.argv[2], sys.argv[3:]
     frames, edges = call_graph(cis)
     painted = [(m.group(1), int(m.group(2)))
                for m in re.finditer(r"^stack: (\w+) (\d+)$", open(log).read(), re.M)]
@@ -99,10 +99,10 @@ def main():
         result(ok, "%s: %s" % (name, why))
         rows.append("| `%s` | %d | %s |" % (name, measured, note))
     print("\n".join(rows))
-    text = open(readme).read()
+    text = open(doc).read()
     m = re.search(r"<!-- stack:begin[^\n]*-->\n(.*?)<!-- stack:end -->", text, re.S)
     stated = [l for l in (m.group(1).splitlines() if m else []) if l.startswith("|")]
-    result(stated == rows, "README.md's stack table differs from the measured one above: replace it")
+    result(stated == rows, "%s's stack table differs from the measured one above: replace it" % doc)
     print("%d passed, %d failed" % (passed, failed))
     return 0 if failed == 0 else 1
 

@@ -4,7 +4,7 @@
  * public lib/ function, painted below the caller's stack pointer before the
  * call and scanned after it, worst over calls that take each function's
  * deepest paths. Printed as "stack: NAME BYTES" lines, which
- * tests/target/stack.py compares with -fstack-usage and README.md.
+ * tests/target/stack.py compares with -fstack-usage and docs/footprint.md.
  */
 
 typedef struct stack_mark {

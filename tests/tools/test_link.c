@@ -592,7 +592,6 @@ static void test_cli(void)
     uint16_t port = 0;
     uint64_t v = 0;
     uint32_t v32 = 0;
-    double d = 0;
 
     CHECK(cli_parse_host_port("robot", 30003, host, sizeof host, &port) == NULL, "host");
     CHECK_EQ_STR(host, "robot");
@@ -634,10 +633,6 @@ static void test_cli(void)
     CHECK(cli_parse_u64("12abc", 0, UINT64_MAX, &v) != NULL, "trailing text");
     CHECK(cli_parse_u64("99999999999999999999999", 0, UINT64_MAX, &v) != NULL, "overflow");
     CHECK(cli_parse_u32("4294967296", 0, UINT32_MAX, &v32) != NULL, "u32 overflow");
-    CHECK(cli_parse_double("2.5", 0.1, 10, &d) == NULL && d == 2.5, "double");
-    CHECK(cli_parse_double("nan", 0, 10, &d) != NULL, "nan");
-    CHECK(cli_parse_double("1e400", 0, 1e300, &d) != NULL, "overflow");
-    CHECK(cli_parse_double("", 0, 1, &d) != NULL, "empty");
 
     cli_format_host_port("::1", 30003, host, sizeof host);
     CHECK_EQ_STR(host, "[::1]:30003");

@@ -7,8 +7,8 @@
 
 struct can_out {
     gateway *gw;
-    struct can_map *map;
-    urrt_cantx *tx;         /* the map's CAN core */
+    struct can_run *run;
+    urrt_cantx *tx;         /* run's CAN core */
     urrt_canlink *link;
     uint64_t refused;       /* frames the link refused (cannot happen with a checked map) */
     bool robot_up[GW_MAX_ROBOTS];
@@ -30,7 +30,7 @@ static void run_due(can_out *out, uint64_t now_us)
     if (urrt_canlink_get_state(out->link) != URRT_CANLINK_UP) {
         return;
     }
-    can_map_due(out->map, now_us, urrt_canlink_get_stats(out->link), emit, out);
+    can_run_due(out->run, now_us, urrt_canlink_get_stats(out->link), emit, out);
 }
 
 static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
@@ -100,7 +100,7 @@ static unsigned on_counters(void *ctx, const gw_robot *robot, gw_counter *counte
         {"can_error_frames", s->error_frames},
         {"can_bus_off", s->bus_off},
         {"can_restarts", s->restarts},
-        {"can_clamped", can_map_clamped(out->map)},
+        {"can_clamped", can_run_clamped(out->run)},
     };
     unsigned n = 0;
     (void)robot;
@@ -117,7 +117,7 @@ static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *b
     (void)robot;
     return snprintf(buf, size, " | CAN %s %s, sent %llu, dropped %llu, bus-off %llu",
                     urrt_canlink_get_state(out->link) == URRT_CANLINK_UP ? "up" : "DOWN",
-                    urrt_cantx_state_name(can_map_state(out->map, now_us)), (unsigned long long)s->sent,
+                    urrt_cantx_state_name(can_run_state(out->run, now_us)), (unsigned long long)s->sent,
                     (unsigned long long)s->dropped, (unsigned long long)s->bus_off);
 }
 
@@ -128,7 +128,7 @@ static void on_close(void *ctx)
     free(out);
 }
 
-can_out *can_out_new(gateway *gw, struct can_map *map)
+can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run)
 {
     urrt_canlink_config cfg;
     can_out *out = calloc(1, sizeof *out);
@@ -144,15 +144,9 @@ can_out *can_out_new(gateway *gw, struct can_map *map)
         return NULL;
     }
     out->gw = gw;
-    out->map = map;
-    can_map_start(map, urrt_port_monotonic_us());
-    out->tx = can_map_tx(map);
-    if (out->tx == NULL) {
-        urrt_log(URRT_LOG_ERR, "CAN output: the frame tables could not be built (out of memory?)");
-        urrt_canlink_free(out->link);
-        free(out);
-        return NULL;
-    }
+    out->run = run;
+    out->tx = can_run_tx(run);
+    can_run_start(run, urrt_port_monotonic_us());
     return out;
 }
 
