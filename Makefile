@@ -39,6 +39,21 @@ BENCHES :=
 .PHONY: all check check-suites bench fuzz clean install uninstall deps deps-build deps-spy deps-list demo
 all:
 
+# $(call suite,NAME,COMMAND): the one way a suite runs. COMMAND's output is
+# shown as it comes and kept in $(BUILD)/results/NAME.log; the last
+# "N passed, N failed" line it printed is the suite's result
+# (NAME.result, which tests/summary.sh adds up). The suite passes when
+# COMMAND exits 0 and that line says 0 failed: a suite that printed no such
+# line has not run, whatever its exit status.
+define suite
+	@mkdir -p $(BUILD)/results
+	@rm -f $(BUILD)/results/$(1).result; \
+	  { $(2); echo $$? > $(BUILD)/results/$(1).rc; } 2>&1 | tee $(BUILD)/results/$(1).log; \
+	  rc=$$(cat $(BUILD)/results/$(1).rc); \
+	  grep -E '^[0-9]+ passed, [0-9]+ failed' $(BUILD)/results/$(1).log | tail -n 1 > $(BUILD)/results/$(1).result; \
+	  grep -qE '^[0-9]+ passed, 0 failed' $(BUILD)/results/$(1).result || rc=1; exit $$rc
+endef
+
 include lib/lib.mk
 include port/port.mk
 # gateway/: the definitions other folders use at parse time first (the flags every
@@ -46,7 +61,10 @@ include port/port.mk
 GATEWAY_MK_FIRST := gateway/common/common.mk gateway/lcmtypes/lcmtypes.mk
 include $(GATEWAY_MK_FIRST)
 include $(filter-out $(GATEWAY_MK_FIRST),$(sort $(wildcard gateway/*/*.mk)))
-include $(sort $(wildcard tests/*.mk))
+# tests/: one folder per layer (lib, port, gateway/...) and per whole-system
+# check (cross, target, vm, fw, ...), each with the .mk of its suites, in
+# sorted order (tests/lib/ before tests/target/, whose prerequisites use it).
+include $(sort $(wildcard tests/*.mk tests/*/*.mk tests/*/*/*.mk))
 
 all: $(PROGRAMS)
 

@@ -14,8 +14,11 @@ URRT_CAN_STATIC_ASSERT(float_is_binary32, sizeof(float) == 4 && FLT_MANT_DIG == 
 URRT_CAN_STATIC_ASSERT(errors_apart_from_urrt, (int)URRT_CAN_E_SIGNAL < (int)URRT_E_UNKNOWN_FIELD);
 
 #define PAYLOAD_BITS (8u * URRT_CAN_MAX_LEN)
-#define TWO_POW_52 4503599627370496.0
-#define TWO_POW_64 18446744073709551616.0
+#define SIGN_BIT UINT64_C(0x8000000000000000)
+#define ABS_BITS UINT64_C(0x7FFFFFFFFFFFFFFF)
+#define INFINITY_BITS UINT64_C(0x7FF0000000000000)
+#define FRACTION_BITS UINT64_C(0x000FFFFFFFFFFFFF)
+#define HIDDEN_BIT UINT64_C(0x0010000000000000)
 #define FLOAT32_QUIET_NAN UINT64_C(0x7FC00000)
 #define FLOAT64_QUIET_NAN UINT64_C(0x7FF8000000000000)
 
@@ -107,9 +110,35 @@ static uint64_t low_mask(unsigned length)
     return length >= 64u ? ~UINT64_C(0) : (UINT64_C(1) << length) - 1u;
 }
 
+typedef union {
+    float f;
+    uint32_t u;
+} float_bits;
+
+typedef union {
+    double d;
+    uint64_t u;
+} double_bits;
+
+static uint64_t bits_of(double x)
+{
+    double_bits b;
+    b.d = x;
+    return b.u;
+}
+
+/* Doubles are compared as integers, which a core without a double FPU does
+ * in a few instructions instead of a call into libgcc. */
 static bool is_finite(double x)
 {
-    return x == x && x <= DBL_MAX && x >= -DBL_MAX;
+    return (bits_of(x) & ABS_BITS) < INFINITY_BITS;
+}
+
+/* An integer in the numeric order of the (non-NaN) doubles, -0 equal to +0. */
+static int64_t order_key(uint64_t bits)
+{
+    int64_t magnitude = (int64_t)(bits & ABS_BITS);
+    return (bits & SIGN_BIT) != 0u ? -magnitude : magnitude;
 }
 
 static bool descriptor_valid(const urrt_can_signal *sig)
@@ -132,8 +161,8 @@ static bool descriptor_valid(const urrt_can_signal *sig)
         break;
     default: return false;
     }
-    if (!is_finite(sig->factor) || sig->factor == 0.0 || !is_finite(sig->offset) || !is_finite(sig->min) ||
-        !is_finite(sig->max) || !(sig->min <= sig->max)) {
+    if (!is_finite(sig->factor) || (bits_of(sig->factor) & ABS_BITS) == 0u || !is_finite(sig->offset) ||
+        !is_finite(sig->min) || !is_finite(sig->max) || order_key(bits_of(sig->min)) > order_key(bits_of(sig->max))) {
         return false;
     }
     if ((sig->flags & ~URRT_CAN_SIG_INVALID_RAW) != 0u) {
@@ -486,73 +515,347 @@ int urrt_can_layout_check(const urrt_can_signal *sigs, size_t count, unsigned fr
 
 /* ---- values ------------------------------------------------------------------------ */
 
-typedef union {
-    float f;
-    uint32_t u;
-} float_bits;
+/*
+ * Integer signals are scaled exactly, in integers: raw = (value - offset) /
+ * factor rounded half away from zero, on the exact binary values of the
+ * three doubles. With |factor| = divisor * 2^(half_exponent + 1), divisor
+ * odd, and X = floor(2 |value - offset| / 2^(half_exponent + 1)) (the
+ * difference exact, in units of half the factor's last bit), the rounded
+ * magnitude is floor((X + divisor) / (2 divisor)): the bits of the
+ * difference below that unit cannot move it, since the divisor is an
+ * integer. The division by the divisor is a multiplication by its
+ * reciprocal, prepared once (urrt_can_scale_prepare) and corrected exactly
+ * by the remainder, so that packing needs no division and no
+ * floating-point arithmetic at all (soft-float cores spend thousands of
+ * instructions on one double division).
+ */
 
-typedef union {
-    double d;
-    uint64_t u;
-} double_bits;
+/* |x| = mantissa * 2^exponent. */
+typedef struct {
+    uint64_t mantissa;
+    int exponent;
+} dyadic;
 
-/* Round half away from zero, for finite x. Past 2^52 every double is an
- * integer; below it the truncation through int64_t is exact and defined. */
-static double round_half_away(double x)
+static dyadic magnitude_of(uint64_t bits)
 {
-    double t;
-    if (!(x > -TWO_POW_52 && x < TWO_POW_52)) {
-        return x;
+    dyadic d;
+    unsigned biased = (unsigned)(bits >> 52) & 0x7FFu;
+    d.mantissa = bits & FRACTION_BITS;
+    d.exponent = -1074; /* subnormal */
+    if (biased != 0u) {
+        d.mantissa |= HIDDEN_BIT;
+        d.exponent = (int)biased - 1075;
     }
-    t = (double)(int64_t)x;
-    if (x - t >= 0.5) {
-        t += 1.0;
-    } else if (x - t <= -0.5) {
-        t -= 1.0;
-    }
-    return t;
+    return d;
 }
 
-/* Scaled value to an integer raw: range checked in floating point first,
- * so that the conversion below always has a value it can represent. */
-static int integer_raw(const urrt_can_signal *sig, double scaled, uint64_t *raw)
+/* An unsigned 128-bit integer. */
+typedef struct {
+    uint64_t hi;
+    uint64_t lo;
+} wide;
+
+static wide wide_of(uint64_t x)
+{
+    wide w;
+    w.hi = 0;
+    w.lo = x;
+    return w;
+}
+
+static wide wide_left(wide x, unsigned k) /* k < 128 */
+{
+    if (k >= 64u) {
+        x.hi = x.lo << (k - 64u);
+        x.lo = 0;
+    } else if (k > 0u) {
+        x.hi = x.hi << k | x.lo >> (64u - k);
+        x.lo <<= k;
+    }
+    return x;
+}
+
+static wide wide_right(wide x, unsigned k)
+{
+    if (k >= 128u) {
+        return wide_of(0);
+    }
+    if (k >= 64u) {
+        x.lo = x.hi >> (k - 64u);
+        x.hi = 0;
+    } else if (k > 0u) {
+        x.lo = x.lo >> k | x.hi << (64u - k);
+        x.hi >>= k;
+    }
+    return x;
+}
+
+static wide wide_add(wide x, uint64_t y)
+{
+    x.lo += y;
+    x.hi += x.lo < y;
+    return x;
+}
+
+static wide wide_sub(wide x, uint64_t y)
+{
+    x.hi -= x.lo < y;
+    x.lo -= y;
+    return x;
+}
+
+/* x < 2^bits, for bits <= 128. */
+static bool wide_below(wide x, unsigned bits)
+{
+    if (bits >= 64u) {
+        return bits >= 128u || x.hi >> (bits - 64u) == 0u;
+    }
+    return x.hi == 0u && x.lo >> bits == 0u;
+}
+
+/* The high half of a * b. */
+static uint64_t mul_high(uint64_t a, uint64_t b)
+{
+#if defined(__GNUC__) && defined(__SIZEOF_INT128__)
+    __extension__ typedef unsigned __int128 u128;
+    return (uint64_t)(((u128)a * b) >> 64);
+#else
+    uint64_t a_lo = (uint32_t)a;
+    uint64_t a_hi = a >> 32;
+    uint64_t b_lo = (uint32_t)b;
+    uint64_t b_hi = b >> 32;
+    uint64_t lo_lo = a_lo * b_lo;
+    uint64_t hi_lo = a_hi * b_lo;
+    uint64_t lo_hi = a_lo * b_hi;
+    uint64_t middle = (lo_lo >> 32) + (uint32_t)hi_lo + lo_hi; /* below 3 * 2^32 */
+    return a_hi * b_hi + (hi_lo >> 32) + (middle >> 32);
+#endif
+}
+
+/* floor((2^128 - 1) / d) - 2^64 for d >= 2^63: Moller and Granlund,
+ * "Improved division by invariant integers" (IEEE Trans. Computers, 2011),
+ * algorithm 3, with its 256-entry table computed by one 32-bit division. */
+static uint64_t reciprocal_of(uint64_t d)
+{
+    uint32_t v0 = UINT32_C(0x7FD00) / (uint32_t)(d >> 55);
+    uint64_t d40 = (d >> 24) + 1u;
+    uint64_t v1 = ((uint64_t)v0 << 11) - (uint32_t)(((uint64_t)v0 * v0 * d40) >> 40) - 1u;
+    uint64_t v2 = (v1 << 13) + ((v1 * ((UINT64_C(1) << 60) - v1 * d40)) >> 47);
+    uint64_t d0 = d & 1u;
+    uint64_t e = ((v2 >> 1) & (0u - d0)) - v2 * ((d >> 1) + d0);
+    uint64_t v3 = (mul_high(v2, e) >> 1) + (v2 << 31);
+    uint64_t low = v3 * d;
+    uint64_t high = mul_high(v3, d) + (low + d < low);
+    return v3 - high - d;
+}
+
+/* Trailing zero bits and bit length of a non-zero x, by halving: no libgcc
+ * call on cores without a count-leading-zeros instruction. */
+static unsigned trailing_zeros(uint64_t x)
+{
+    unsigned n = 0;
+    unsigned half;
+    for (half = 32u; half > 0u; half /= 2u) {
+        if ((x & ((UINT64_C(1) << half) - 1u)) == 0u) {
+            x >>= half;
+            n += half;
+        }
+    }
+    return n;
+}
+
+static unsigned bit_length(uint64_t x)
+{
+    unsigned n = 0;
+    unsigned half;
+    for (half = 32u; half > 0u; half /= 2u) {
+        if (x >> half != 0u) {
+            x >>= half;
+            n += half;
+        }
+    }
+    return n + (unsigned)x;
+}
+
+/* The factor of a valid descriptor (finite, non-zero). */
+static void scale_of(double factor, urrt_can_scale *scale)
+{
+    uint64_t bits = bits_of(factor);
+    dyadic f = magnitude_of(bits);
+    unsigned zeros = trailing_zeros(f.mantissa);
+    unsigned length;
+    f.mantissa >>= zeros;
+    length = bit_length(f.mantissa);
+    scale->divisor = f.mantissa;
+    scale->reciprocal = f.mantissa > 1u ? reciprocal_of(f.mantissa << (64u - length)) : 0u;
+    scale->half_exponent = (int16_t)(f.exponent + (int)zeros - 1);
+    scale->divisor_bits = (uint8_t)length;
+    scale->negative = (bits & SIGN_BIT) != 0u;
+}
+
+int urrt_can_scale_prepare(const urrt_can_signal *sig, urrt_can_scale *scale)
+{
+    if (sig == NULL || scale == NULL) {
+        return URRT_E_ARG;
+    }
+    if (!descriptor_valid(sig)) {
+        return URRT_CAN_E_SIGNAL;
+    }
+    scale_of(sig->factor, scale);
+    return 0;
+}
+
+/* Exact sums need the larger term's bits shifted this far at most. */
+#define ALIGN_BITS 70u
+
+/* The difference is kept below this many bits; anything larger gives a
+ * raw value of at least 2^121 / 2^54, past every integer type. */
+#define DIFFERENCE_BITS 121u
+
+/* n * 2^shift as a whole number: floor for a negative shift. */
+static bool to_units(wide n, int shift, wide *x)
+{
+    if (shift <= 0) {
+        *x = wide_right(n, (unsigned)-shift);
+        return wide_below(*x, DIFFERENCE_BITS);
+    }
+    if ((unsigned)shift >= DIFFERENCE_BITS || !wide_below(n, DIFFERENCE_BITS - (unsigned)shift)) {
+        return false;
+    }
+    *x = wide_left(n, (unsigned)shift);
+    return true;
+}
+
+/*
+ * floor(|v - o| / 2^unit) for finite v and o (bits), on their exact values:
+ * *x, and *negative for v < o; false when it is 2^121 or more. The smaller
+ * term, when it lies wholly below the larger one's last bit by more than
+ * ALIGN_BITS, is kept to that many bits and a borrow: enough for the floor,
+ * as the result then either has no bits below 2^unit or is too large.
+ */
+static bool exact_difference(uint64_t v, uint64_t o, int unit, wide *x, bool *negative)
+{
+    uint64_t big = v;
+    uint64_t small = o ^ SIGN_BIT; /* v - o = v + (-o) */
+    bool subtract;
+    dyadic b;
+    dyadic s;
+    wide n;
+    int at;
+    if ((big & ABS_BITS) < (small & ABS_BITS)) {
+        big = small;
+        small = v;
+    }
+    b = magnitude_of(big);
+    s = magnitude_of(small);
+    *negative = (big & SIGN_BIT) != 0u;
+    subtract = ((big ^ small) & SIGN_BIT) != 0u;
+    n = wide_of(b.mantissa);
+    at = b.exponent;
+    if (s.mantissa != 0u) {
+        unsigned apart = (unsigned)(b.exponent - s.exponent); /* b >= s */
+        uint64_t term = s.mantissa;
+        if (apart <= ALIGN_BITS) {
+            n = wide_left(n, apart);
+            at = s.exponent;
+        } else {
+            unsigned drop = apart - ALIGN_BITS;
+            bool borrow = subtract && (drop >= 64u || s.mantissa << (64u - drop) != 0u);
+            term = (drop < 64u ? s.mantissa >> drop : 0u) + borrow;
+            n = wide_left(n, ALIGN_BITS);
+            at = b.exponent - (int)ALIGN_BITS;
+            if (at > unit) {
+                return false; /* |v - o| >= 2^(52 + ALIGN_BITS - 1) units */
+            }
+        }
+        n = subtract ? wide_sub(n, term) : wide_add(n, term);
+    }
+    return to_units(n, at - unit, x);
+}
+
+/* floor((x + divisor) / (2 divisor)), x below 2^121: false when it is 2^64
+ * or more. The estimate through the reciprocal is at most 3 below the
+ * quotient; the remainder corrects it. */
+static bool rounded_quotient(const urrt_can_scale *scale, wide x, uint64_t *q)
+{
+    uint64_t divisor = scale->divisor;
+    unsigned bits = scale->divisor_bits;
+    wide z = wide_right(wide_add(x, divisor), 1);
+    uint64_t top;
+    uint64_t rest;
+    if (divisor == 1u) {
+        *q = z.lo;
+        return z.hi == 0u;
+    }
+    if (z.hi >= divisor) {
+        return false;
+    }
+    top = z.hi << (64u - bits) | z.lo >> bits;
+    *q = top + mul_high(top, scale->reciprocal);
+    rest = z.lo - *q * divisor;
+    while (rest >= divisor) {
+        rest -= divisor;
+        ++*q;
+    }
+    return true;
+}
+
+/* The raw value of an integer signal for a finite value (bits), clamped to
+ * the raw type's range. */
+static int integer_raw(const urrt_can_signal *sig, const urrt_can_scale *scale, uint64_t value, uint64_t *raw)
 {
     uint64_t mask = low_mask(sig->length);
-    double r = round_half_away(scaled); /* +-inf pass through */
-
-    if (sig->type == (uint8_t)URRT_CAN_UNSIGNED) {
-        double limit = sig->length >= 64u ? TWO_POW_64 : (double)(mask + 1u);
-        if (r >= limit) {
-            *raw = mask;
-            return URRT_CAN_PACK_SATURATED;
-        }
-        if (r < 0.0) {
-            *raw = 0;
-            return URRT_CAN_PACK_SATURATED;
-        }
-        *raw = (uint64_t)r;
-        return URRT_CAN_PACK_OK;
-    } else {
-        uint64_t top = mask >> 1; /* 2^(length-1) - 1 */
-        double limit = (double)top + 1.0; /* exact: a power of two */
-        if (r >= limit) {
-            *raw = top;
-            return URRT_CAN_PACK_SATURATED;
-        }
-        if (r < -limit) {
-            *raw = (top + 1u) & mask; /* the most negative value */
-            return URRT_CAN_PACK_SATURATED;
-        }
-        if (r < 0.0) {
-            /* Two's complement without relying on the implementation-defined
-             * conversion of an out-of-range unsigned value. */
-            uint64_t magnitude = (uint64_t)(-r);
-            *raw = (~magnitude + 1u) & mask;
-        } else {
-            *raw = (uint64_t)r;
-        }
-        return URRT_CAN_PACK_OK;
+    uint64_t top = sig->type == (uint8_t)URRT_CAN_SIGNED ? mask >> 1 : mask;
+    uint64_t n = 0;
+    wide x;
+    bool negative;
+    bool fits = exact_difference(value, bits_of(sig->offset), scale->half_exponent, &x, &negative) &&
+                rounded_quotient(scale, x, &n);
+    negative = negative != (scale->negative != 0u);
+    if (negative && fits && n == 0u) {
+        negative = false; /* -0 */
     }
+    if (!negative) {
+        *raw = fits && n <= top ? n : top;
+        return fits && n <= top ? URRT_CAN_PACK_OK : URRT_CAN_PACK_SATURATED;
+    }
+    if (sig->type == (uint8_t)URRT_CAN_UNSIGNED) {
+        *raw = 0;
+        return URRT_CAN_PACK_SATURATED;
+    }
+    if (!fits || n > top + 1u) {
+        *raw = (top + 1u) & mask; /* the most negative value */
+        return URRT_CAN_PACK_SATURATED;
+    }
+    *raw = (~n + 1u) & mask; /* two's complement, in length bits */
+    return URRT_CAN_PACK_OK;
+}
+
+/* An integer signal: clamped to [min, max] (compared as integers), NaN
+ * as physical 0 clamped into them, then scaled. */
+static int scaled_to_raw(const urrt_can_signal *sig, const urrt_can_scale *scale, double value, uint64_t *raw)
+{
+    uint64_t bits = bits_of(value);
+    uint64_t min = bits_of(sig->min);
+    uint64_t max = bits_of(sig->max);
+    int outcome = URRT_CAN_PACK_OK;
+    int raw_outcome;
+    if ((bits & ABS_BITS) > INFINITY_BITS) {
+        if ((sig->flags & URRT_CAN_SIG_INVALID_RAW) != 0u) {
+            *raw = sig->invalid_raw;
+            return URRT_CAN_PACK_NAN;
+        }
+        bits = order_key(min) > 0 ? min : order_key(max) < 0 ? max : 0u;
+        outcome = URRT_CAN_PACK_NAN;
+    } else if (order_key(bits) < order_key(min)) {
+        bits = min; /* -inf too */
+        outcome = URRT_CAN_PACK_SATURATED;
+    } else if (order_key(bits) > order_key(max)) {
+        bits = max;
+        outcome = URRT_CAN_PACK_SATURATED;
+    }
+    raw_outcome = integer_raw(sig, scale, bits, raw);
+    return outcome > raw_outcome ? outcome : raw_outcome;
 }
 
 static int clamp_to_limits(const urrt_can_signal *sig, double *value)
@@ -568,77 +871,70 @@ static int clamp_to_limits(const urrt_can_signal *sig, double *value)
     return URRT_CAN_PACK_OK;
 }
 
-/* A finite value within [min, max] to raw. */
-static int finite_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
+/* A float32 or float64 signal: its raw is a float, so it is scaled in
+ * double precision and rounded to the raw type as the FPU rounds. */
+static int float_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
 {
-    double scaled = (value - sig->offset) / sig->factor; /* may overflow to +-inf: defined */
-
-    switch ((urrt_can_value_type)sig->type) {
-    case URRT_CAN_FLOAT32: {
-        float_bits b;
-        int outcome = URRT_CAN_PACK_OK;
-        if (scaled > (double)FLT_MAX) {
-            scaled = (double)FLT_MAX;
-            outcome = URRT_CAN_PACK_SATURATED;
-        } else if (scaled < -(double)FLT_MAX) {
-            scaled = -(double)FLT_MAX;
-            outcome = URRT_CAN_PACK_SATURATED;
-        }
-        b.f = (float)scaled;
-        *raw = b.u;
-        return outcome;
-    }
-    case URRT_CAN_FLOAT64: {
-        double_bits b;
-        int outcome = URRT_CAN_PACK_OK;
-        if (scaled > DBL_MAX) {
-            scaled = DBL_MAX;
-            outcome = URRT_CAN_PACK_SATURATED;
-        } else if (scaled < -DBL_MAX) {
-            scaled = -DBL_MAX;
-            outcome = URRT_CAN_PACK_SATURATED;
-        }
-        b.d = scaled;
-        *raw = b.u;
-        return outcome;
-    }
-    default: return integer_raw(sig, scaled, raw);
-    }
-}
-
-/* urrt_can_to_raw for a descriptor known to be valid. */
-static int to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
-{
+    bool single = sig->type == (uint8_t)URRT_CAN_FLOAT32;
+    double limit = single ? (double)FLT_MAX : DBL_MAX;
+    double scaled;
     int outcome;
-    int raw_outcome;
+    int raw_outcome = URRT_CAN_PACK_OK;
     if (value != value) {
-        if ((sig->flags & URRT_CAN_SIG_INVALID_RAW) != 0u) {
-            *raw = sig->invalid_raw;
-        } else if (sig->type == (uint8_t)URRT_CAN_FLOAT32) {
-            *raw = FLOAT32_QUIET_NAN;
-        } else if (sig->type == (uint8_t)URRT_CAN_FLOAT64) {
-            *raw = FLOAT64_QUIET_NAN;
-        } else {
-            double neutral = 0.0;
-            (void)clamp_to_limits(sig, &neutral);
-            (void)finite_to_raw(sig, neutral, raw);
-        }
+        *raw = (sig->flags & URRT_CAN_SIG_INVALID_RAW) != 0u ? sig->invalid_raw
+               : single                                    ? FLOAT32_QUIET_NAN
+                                                           : FLOAT64_QUIET_NAN;
         return URRT_CAN_PACK_NAN;
     }
     outcome = clamp_to_limits(sig, &value); /* infinities end here too */
-    raw_outcome = finite_to_raw(sig, value, raw);
+    scaled = (value - sig->offset) / sig->factor; /* may overflow to +-inf: defined */
+    if (scaled > limit || scaled < -limit) {
+        scaled = scaled > 0.0 ? limit : -limit;
+        raw_outcome = URRT_CAN_PACK_SATURATED;
+    }
+    if (single) {
+        float_bits b;
+        b.f = (float)scaled;
+        *raw = b.u;
+    } else {
+        *raw = bits_of(scaled);
+    }
     return outcome > raw_outcome ? outcome : raw_outcome;
+}
+
+static bool is_float(const urrt_can_signal *sig)
+{
+    return sig->type == (uint8_t)URRT_CAN_FLOAT32 || sig->type == (uint8_t)URRT_CAN_FLOAT64;
+}
+
+static int prepared_to_raw(const urrt_can_signal *sig, const urrt_can_scale *scale, double value, uint64_t *raw)
+{
+    return is_float(sig) ? float_to_raw(sig, value, raw) : scaled_to_raw(sig, scale, value, raw);
+}
+
+/* urrt_can_to_raw for a descriptor known to be valid: its scale prepared
+ * here, for callers that kept none. */
+static int to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
+{
+    urrt_can_scale scale;
+    scale_of(sig->factor, &scale);
+    return prepared_to_raw(sig, &scale, value, raw);
 }
 
 int urrt_can_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
 {
-    if (sig == NULL || raw == NULL) {
+    urrt_can_scale scale;
+    int rc;
+    if (raw == NULL) {
         return URRT_E_ARG;
     }
-    if (!descriptor_valid(sig)) {
-        return URRT_CAN_E_SIGNAL;
-    }
-    return to_raw(sig, value, raw);
+    rc = urrt_can_scale_prepare(sig, &scale); /* checks the descriptor */
+    return rc < 0 ? rc : prepared_to_raw(sig, &scale, value, raw);
+}
+
+int urrt_can_to_raw_scaled(const urrt_can_signal *sig, const urrt_can_scale *scale, double value, uint64_t *raw)
+{
+    return prepared_to_raw(sig, scale, value, raw);
 }
 
 double urrt_can_from_raw(const urrt_can_signal *sig, uint64_t raw)
@@ -688,10 +984,7 @@ int urrt_can_pack(const urrt_can_signal *sig, double value, uint8_t *data, unsig
     if (rc < 0) {
         return rc;
     }
-    outcome = urrt_can_to_raw(sig, value, &raw);
-    if (outcome < 0) {
-        return outcome;
-    }
+    outcome = to_raw(sig, value, &raw); /* the descriptor was checked above */
     (void)move_bits(sig, data, raw, true);
     return outcome;
 }
@@ -700,6 +993,15 @@ int urrt_can_pack_checked(const urrt_can_signal *sig, double value, uint8_t data
 {
     uint64_t raw;
     int outcome = to_raw(sig, value, &raw);
+    put_bits_in_frame(sig, data, raw);
+    return outcome;
+}
+
+int urrt_can_pack_scaled(const urrt_can_signal *sig, const urrt_can_scale *scale, double value,
+                         uint8_t data[URRT_CAN_MAX_LEN])
+{
+    uint64_t raw;
+    int outcome = prepared_to_raw(sig, scale, value, &raw);
     put_bits_in_frame(sig, data, raw);
     return outcome;
 }

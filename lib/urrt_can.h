@@ -9,10 +9,11 @@
  * Like lib/urrt.c this module is C99 and freestanding: it includes only
  * <stddef.h>, <stdint.h>, <stdbool.h> and <float.h>, never allocates, keeps
  * no state and does no I/O, so a firmware gateway uses the same code as
- * urrt-gateway. It does use double arithmetic (scaling is (value - offset) /
- * factor); on a core without a double-precision FPU the compiler's runtime
- * (libgcc's soft-float routines) provides it: link with -lgcc even under
- * -nostdlib.
+ * urrt-gateway. Integer signals are scaled in integer arithmetic, exactly
+ * (see "Values"); float32 and float64 signals, limits and unpacking use
+ * double arithmetic, which on a core without a double-precision FPU the
+ * compiler's runtime (libgcc's soft-float routines) provides: link with
+ * -lgcc even under -nostdlib.
  *
  * ---- Bit numbering (the DBC convention) ------------------------------------
  *
@@ -49,10 +50,18 @@
  * and float64 signals hold raw as an IEEE-754 binary32 / binary64 bit
  * pattern in 32 / 64 bits (factor and offset apply to them too).
  *
+ * An integer signal's raw value is (value - offset) / factor rounded half
+ * away from zero, computed exactly on the binary values of the three
+ * doubles (not rounded once for the subtraction and again for the
+ * division), in integer arithmetic: no division once the signal's scale is
+ * prepared (urrt_can_scale_prepare), no floating-point operation at all.
+ * Float signals are scaled in double precision, then rounded to the raw
+ * type as the FPU rounds.
+ *
  * Packing is total: every double, NaN and infinities included, gives a
  * defined payload, and no conversion is undefined behaviour (ranges are
- * checked in floating point before any float-to-integer or double-to-float
- * conversion). The outcome says whether the value was sent as it is:
+ * checked before any double-to-float conversion; integer signals convert
+ * nothing). The outcome says whether the value was sent as it is:
  *   URRT_CAN_PACK_OK         the value fit (after rounding half away from zero)
  *   URRT_CAN_PACK_SATURATED  it was out of [min, max] or of the raw type's
  *                            range (infinities included) and was clamped
@@ -215,6 +224,30 @@ int urrt_can_layout_check(const urrt_can_signal *sigs, size_t count, unsigned fr
  */
 int urrt_can_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw);
 
+/*
+ * A signal's scaling prepared once, for packing without a division: the
+ * factor as an odd integer and a power of two, and that integer's
+ * reciprocal. urrt_can_to_raw, urrt_can_pack and urrt_can_pack_checked
+ * prepare it on every call; a caller that packs the same signals again and
+ * again keeps one per signal (urrt_cantx_prepare does so for the CAN core).
+ * Float signals do not use it.
+ */
+typedef struct urrt_can_scale {
+    uint64_t divisor;      /* |factor| = divisor * 2^(half_exponent + 1), divisor odd */
+    uint64_t reciprocal;   /* floor(2^(64 + divisor_bits) / divisor) - 2^64 (0 for divisor 1) */
+    int16_t half_exponent;
+    uint8_t divisor_bits;  /* the divisor's bit length, 1..53 */
+    uint8_t negative;      /* the factor is negative */
+} urrt_can_scale;
+
+/* The scale of a valid descriptor: 0, URRT_CAN_E_SIGNAL or URRT_E_ARG. */
+int urrt_can_scale_prepare(const urrt_can_signal *sig, urrt_can_scale *scale);
+
+/* urrt_can_to_raw with the scale urrt_can_scale_prepare made of sig (it
+ * checks nothing: passing a scale not made of this descriptor, or of an
+ * invalid one, is undefined behaviour). */
+int urrt_can_to_raw_scaled(const urrt_can_signal *sig, const urrt_can_scale *scale, double value, uint64_t *raw);
+
 /* Raw bits (the low `length` bits are used) to the physical value. */
 double urrt_can_from_raw(const urrt_can_signal *sig, uint64_t raw);
 
@@ -238,6 +271,10 @@ int urrt_can_pack(const urrt_can_signal *sig, double value, uint8_t *data, unsig
  */
 int urrt_can_pack_checked(const urrt_can_signal *sig, double value, uint8_t data[URRT_CAN_MAX_LEN]);
 void urrt_can_put_raw_checked(const urrt_can_signal *sig, uint64_t raw, uint8_t data[URRT_CAN_MAX_LEN]);
+/* urrt_can_pack_checked with the signal's prepared scale: for an integer
+ * signal, integer operations only. */
+int urrt_can_pack_scaled(const urrt_can_signal *sig, const urrt_can_scale *scale, double value,
+                         uint8_t data[URRT_CAN_MAX_LEN]);
 
 /* urrt_can_get_raw then urrt_can_from_raw. */
 int urrt_can_unpack(const urrt_can_signal *sig, const uint8_t *data, unsigned frame_len, double *value);

@@ -48,7 +48,7 @@ const char *urrt_cantx_strerror(int result)
     case URRT_CANTX_E_ROBOT: return "a frame's robot index is out of range";
     case URRT_CANTX_E_POLICY: return "a frame's stale policy is unknown or needs what the frame lacks";
     case URRT_CANTX_E_DUPLICATE: return "two frames have the same id";
-    case URRT_CANTX_E_STORAGE: return "the values array is shorter than the tables' signals";
+    case URRT_CANTX_E_STORAGE: return "the values (or scales) array is shorter than the tables' signals";
     default: return urrt_can_strerror(result);
     }
 }
@@ -171,6 +171,9 @@ static void frame_init(urrt_cantx_frame_state *fs, const urrt_cantx_frame *f, si
         fs->fields_end = takes_field(f->sources[i].kind) ? (uint16_t)(i + 1u) : fs->fields_end;
     }
     fs->frame.id = f->id;
+    fs->period_us = f->period_us;
+    fs->closed = false;
+    fs->stopped = false; /* until urrt_cantx_start: what urrt_cantx_set_period reads */
     fs->frame.extended = (f->flags & URRT_CANTX_EXTENDED) != 0u;
     fs->frame.fd = (f->flags & URRT_CANTX_FD) != 0u;
     fs->frame.len = f->len;
@@ -217,6 +220,7 @@ int urrt_cantx_init(urrt_cantx *tx, const urrt_cantx_tables *tables, urrt_cantx_
     tx->frames = frame_states;
     tx->robots = robots;
     tx->values = values;
+    tx->scales = NULL;
     tx->user = NULL;
     link_zero(&tx->link);
     link_zero(&tx->link_seen);
@@ -233,6 +237,27 @@ int urrt_cantx_init(urrt_cantx *tx, const urrt_cantx_tables *tables, urrt_cantx_
         robots[i].up = false;
     }
     tx->started = false;
+    return 0;
+}
+
+int urrt_cantx_prepare(urrt_cantx *tx, urrt_can_scale *scales, size_t count)
+{
+    size_t slot = 0;
+    size_t i;
+    size_t k;
+    if (tx == NULL || tx->tables == NULL || (scales == NULL && count > 0u)) {
+        return URRT_E_ARG;
+    }
+    if (count < urrt_cantx_value_count(tx->tables)) {
+        return URRT_CANTX_E_STORAGE;
+    }
+    for (i = 0; i < tx->tables->frame_count; i++) {
+        const urrt_cantx_frame *f = &tx->tables->frames[i];
+        for (k = 0; k < f->signal_count; k++) {
+            (void)urrt_can_scale_prepare(&f->signals[k], &scales[slot++]); /* init checked them */
+        }
+    }
+    tx->scales = scales;
     return 0;
 }
 
@@ -274,6 +299,14 @@ static double mask_value(double v)
     return urrt_bitmask(v, &mask) < 0 ? nan_value() : (double)mask;
 }
 
+/* One signal into the frame, with its prepared scale when the caller keeps
+ * them (urrt_cantx_prepare): the same bits either way. */
+static int pack_signal(const urrt_cantx *tx, size_t slot, const urrt_can_signal *sig, double value, uint8_t *data)
+{
+    return tx->scales != NULL ? urrt_can_pack_scaled(sig, &tx->scales[slot], value, data)
+                              : urrt_can_pack_checked(sig, value, data);
+}
+
 /* The fields' bits of the frame; each write replaces the signal's own bits
  * (urrt_cantx_init saw that signals do not overlap). */
 static void pack_fields(urrt_cantx *tx, size_t index)
@@ -293,9 +326,9 @@ static void pack_fields(urrt_cantx *tx, size_t index)
         if (!takes_field(kind)) {
             continue;
         }
-        outcome = urrt_can_pack_checked(&f->signals[i], kind == (uint8_t)URRT_CANTX_FIELD_MASK ? mask_value(values[i])
-                                                                                              : values[i],
-                                        fs->frame.data);
+        outcome = pack_signal(tx, fs->first_value + i, &f->signals[i],
+                              kind == (uint8_t)URRT_CANTX_FIELD_MASK ? mask_value(values[i]) : values[i],
+                              fs->frame.data);
         if (outcome != URRT_CAN_PACK_OK) {
             tx->clamped++;
             worst = outcome > worst ? outcome : worst;
@@ -323,7 +356,7 @@ static const urrt_can_frame *build(urrt_cantx *tx, size_t index, uint64_t now_us
         switch ((urrt_cantx_kind)f->sources[i].kind) {
         case URRT_CANTX_ALIVE: urrt_can_put_raw_checked(sig, fs->alive, fs->frame.data); break;
         case URRT_CANTX_VALID: urrt_can_put_raw_checked(sig, valid ? 1u : 0u, fs->frame.data); break;
-        case URRT_CANTX_FILLED: (void)urrt_can_pack_checked(sig, values[i], fs->frame.data); break;
+        case URRT_CANTX_FILLED: (void)pack_signal(tx, fs->first_value + i, sig, values[i], fs->frame.data); break;
         default: break;
         }
     }
@@ -417,7 +450,7 @@ void urrt_cantx_start(urrt_cantx *tx, uint64_t now_us)
         fs->sent_invalid = 0;
         fs->stale_stops = 0;
         fs->stopped = f->stale == (uint8_t)URRT_CANTX_STALE_STOP;
-        fs->next_due_us = f->period_us == URRT_CANTX_EVERY_PACKET || fs->stopped ? URRT_CANTX_NEVER : now_us;
+        fs->next_due_us = fs->period_us == URRT_CANTX_EVERY_PACKET || fs->stopped ? URRT_CANTX_NEVER : now_us;
     }
     tx->wake_us = next_wake(tx);
     tx->clamped = 0; /* the NaNs above are no packet's values */
@@ -464,7 +497,7 @@ void urrt_cantx_on_packet(urrt_cantx *tx, size_t robot, const urrt_state *st, ui
             continue;
         }
         take_fields(tx, i, st);
-        if (t->frames[i].period_us == URRT_CANTX_EVERY_PACKET) {
+        if (fs->period_us == URRT_CANTX_EVERY_PACKET) {
             fs->pending = true;
             tx->wake_us = 0;
         } else if (fs->stopped) {
@@ -495,12 +528,25 @@ static size_t run_every(urrt_cantx *tx, size_t i, uint64_t now_us, bool fresh, u
         return 0;
     }
     fs->pending = false;
+    if (fs->closed) {
+        return 0;
+    }
     if (!fresh) {
         fs->stale_stops++;
         return 0;
     }
     send_frame(tx, i, now_us, true, emit, ctx);
     return 1;
+}
+
+/* The next slot after one due at or before now_us: keep the cadence; after
+ * a stall, skip the missed slots rather than send a burst. */
+static void next_slot(urrt_cantx_frame_state *fs, uint64_t now_us)
+{
+    fs->next_due_us += fs->period_us;
+    if (fs->next_due_us <= now_us) {
+        fs->next_due_us = now_us + fs->period_us;
+    }
 }
 
 static size_t run_periodic(urrt_cantx *tx, size_t i, uint64_t now_us, bool fresh, urrt_cantx_emit_fn emit,
@@ -511,6 +557,11 @@ static size_t run_periodic(urrt_cantx *tx, size_t i, uint64_t now_us, bool fresh
     if (fs->next_due_us == URRT_CANTX_NEVER || now_us < fs->next_due_us) {
         return 0;
     }
+    if (fs->closed) {
+        /* The slot passes unsent, so that the cadence holds when the gate opens. */
+        next_slot(fs, now_us);
+        return 0;
+    }
     if (!fresh && f->stale == (uint8_t)URRT_CANTX_STALE_STOP) {
         fs->stopped = true;
         fs->stale_stops++;
@@ -518,12 +569,7 @@ static size_t run_periodic(urrt_cantx *tx, size_t i, uint64_t now_us, bool fresh
         return 0;
     }
     send_frame(tx, i, now_us, fresh, emit, ctx);
-    /* Keep the cadence; after a stall, skip the missed slots rather than
-     * send a burst. */
-    fs->next_due_us += f->period_us;
-    if (fs->next_due_us <= now_us) {
-        fs->next_due_us = now_us + f->period_us;
-    }
+    next_slot(fs, now_us);
     return 1;
 }
 
@@ -544,8 +590,8 @@ size_t urrt_cantx_run(urrt_cantx *tx, uint64_t now_us, urrt_cantx_emit_fn emit, 
     for (i = 0; i < tx->tables->frame_count; i++) {
         const urrt_cantx_frame *f = &tx->tables->frames[i];
         bool fresh = urrt_cantx_fresh(tx, f->robot, now_us, f->stale_after_us);
-        sent += f->period_us == URRT_CANTX_EVERY_PACKET ? run_every(tx, i, now_us, fresh, emit, ctx)
-                                                         : run_periodic(tx, i, now_us, fresh, emit, ctx);
+        sent += tx->frames[i].period_us == URRT_CANTX_EVERY_PACKET ? run_every(tx, i, now_us, fresh, emit, ctx)
+                                                                    : run_periodic(tx, i, now_us, fresh, emit, ctx);
     }
     tx->wake_us = next_wake(tx);
     return sent;
@@ -564,6 +610,75 @@ size_t urrt_cantx_catch_up(urrt_cantx *tx, uint64_t until_us, urrt_cantx_emit_fn
         sent += urrt_cantx_run(tx, due > tx->run_us ? due : tx->run_us, emit, ctx);
     }
     return sent;
+}
+
+/* ---- run-time changes: a CANopen node's PDO parameters ------------------------- */
+
+void urrt_cantx_gate(urrt_cantx *tx, size_t frame, bool open)
+{
+    if (tx != NULL && frame < tx->tables->frame_count) {
+        tx->frames[frame].closed = !open;
+    }
+}
+
+int urrt_cantx_set_id(urrt_cantx *tx, size_t frame, uint32_t id)
+{
+    if (tx == NULL || frame >= tx->tables->frame_count) {
+        return URRT_E_ARG;
+    }
+    if (!urrt_can_id_valid(id, tx->frames[frame].frame.extended)) {
+        return URRT_CAN_E_ID;
+    }
+    tx->frames[frame].frame.id = id;
+    return 0;
+}
+
+int urrt_cantx_set_period(urrt_cantx *tx, size_t frame, uint32_t period_us, uint64_t now_us)
+{
+    const urrt_cantx_frame *f;
+    urrt_cantx_frame_state *fs;
+    if (tx == NULL || frame >= tx->tables->frame_count) {
+        return URRT_E_ARG;
+    }
+    f = &tx->tables->frames[frame];
+    fs = &tx->frames[frame];
+    if (period_us == URRT_CANTX_EVERY_PACKET && f->stale != (uint8_t)URRT_CANTX_STALE_STOP) {
+        return URRT_CANTX_E_POLICY; /* as urrt_cantx_init's check_policy */
+    }
+    fs->period_us = period_us;
+    fs->pending = false;
+    if (period_us == URRT_CANTX_EVERY_PACKET || fs->stopped) {
+        /* A frame sent per packet with the stop policy starts stopped (as
+         * urrt_cantx_start leaves it): made periodic, it waits for data. */
+        fs->stopped = f->stale == (uint8_t)URRT_CANTX_STALE_STOP;
+        fs->next_due_us = URRT_CANTX_NEVER;
+    } else {
+        fs->next_due_us = now_us;
+    }
+    if (tx->started) {
+        tx->wake_us = next_wake(tx);
+    }
+    return 0;
+}
+
+size_t urrt_cantx_trigger(urrt_cantx *tx, size_t frame, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    const urrt_cantx_frame *f;
+    bool fresh;
+    if (tx == NULL || frame >= tx->tables->frame_count) {
+        return 0;
+    }
+    if (!tx->started) {
+        urrt_cantx_start(tx, now_us);
+    }
+    f = &tx->tables->frames[frame];
+    fresh = urrt_cantx_fresh(tx, f->robot, now_us, f->stale_after_us);
+    if (!fresh && f->stale == (uint8_t)URRT_CANTX_STALE_STOP) {
+        tx->frames[frame].stale_stops++;
+        return 0;
+    }
+    send_frame(tx, frame, now_us, fresh, emit, ctx);
+    return 1;
 }
 
 /* ---- the heartbeat ------------------------------------------------------------ */
@@ -604,9 +719,13 @@ const char *urrt_cantx_state_name(urrt_cantx_state state)
     }
 }
 
-static urrt_cantx_state robot_state(const urrt_cantx *tx, size_t i, uint64_t now_us, uint32_t stale_after_us)
+urrt_cantx_state urrt_cantx_robot_state(const urrt_cantx *tx, size_t i, uint64_t now_us, uint32_t stale_after_us)
 {
-    const urrt_cantx_robot *r = &tx->robots[i];
+    const urrt_cantx_robot *r;
+    if (tx == NULL || i >= tx->tables->robot_count) {
+        return URRT_CANTX_STARTING;
+    }
+    r = &tx->robots[i];
     bool starting = tx->started && now_us - tx->start_us < tx->tables->startup_us;
     if (!r->has_data) {
         return starting ? URRT_CANTX_STARTING : r->up ? URRT_CANTX_DATA_STALE : URRT_CANTX_DISCONNECTED;
@@ -638,7 +757,7 @@ urrt_cantx_state urrt_cantx_gateway_state(const urrt_cantx *tx, size_t hb, uint6
     }
     stale_after_us = tx->tables->frames[hb].stale_after_us;
     for (i = 0; i < tx->tables->robot_count; i++) {
-        urrt_cantx_state s = robot_state(tx, i, now_us, stale_after_us);
+        urrt_cantx_state s = urrt_cantx_robot_state(tx, i, now_us, stale_after_us);
         worst = severity(s) > severity(worst) ? s : worst;
     }
     return worst;

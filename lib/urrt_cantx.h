@@ -21,7 +21,9 @@
  *     static urrt_cantx_robot robots[TABLE_ROBOTS];
  *     static double values[TABLE_VALUES];
  *     static urrt_cantx tx;
+ *     static urrt_can_scale scales[TABLE_VALUES];
  *     urrt_cantx_init(&tx, &table, states, robots, values, TABLE_VALUES, &where);
+ *     urrt_cantx_prepare(&tx, scales, TABLE_VALUES);
  *     urrt_cantx_start(&tx, now);
  *     on a decoded packet:  urrt_cantx_on_packet(&tx, 0, &state, now);
  *     on the link's state:  urrt_cantx_robot_link(&tx, 0, up);
@@ -56,7 +58,7 @@ enum urrt_cantx_result {
     URRT_CANTX_E_ROBOT = -41,    /* robot index out of range */
     URRT_CANTX_E_POLICY = -42,   /* stale policy unknown, or "invalid" without a validity bit */
     URRT_CANTX_E_DUPLICATE = -43, /* two frames with the same id and format */
-    URRT_CANTX_E_STORAGE = -44   /* values[] shorter than the tables' signals */
+    URRT_CANTX_E_STORAGE = -44   /* values[] (or scales[]) shorter than the tables' signals */
 };
 
 /* A short English text for any urrt_cantx, urrt_can or urrt result. */
@@ -137,6 +139,7 @@ typedef struct urrt_cantx_frame_state {
     uint64_t stale_stops;      /* times it stopped (or dropped a packet's frame) for stale data */
     uint16_t first_value;      /* its signals' slots in values[] */
     uint16_t fields_end;       /* no signal from this index on carries a robot field */
+    uint32_t period_us;        /* the table's, until urrt_cantx_set_period */
     urrt_can_frame frame;      /* as last built: the field values last taken (packed when
                                   first needed), then the alive counter, validity bit and
                                   filled values of its latest send; emit receives it */
@@ -145,6 +148,7 @@ typedef struct urrt_cantx_frame_state {
     bool unpacked;             /* values taken since the payload was packed */
     bool pending;              /* every packet: a packet came since the last send */
     bool stopped;              /* periodic, stop policy: waiting for fresh data */
+    bool closed;               /* urrt_cantx_gate: its schedule sends nothing */
 } urrt_cantx_frame_state;
 
 /* Run-time state of a robot (caller-owned, one per robot). */
@@ -172,6 +176,7 @@ typedef struct urrt_cantx {
     urrt_cantx_frame_state *frames;
     urrt_cantx_robot *robots;
     double *values;
+    const urrt_can_scale *scales; /* urrt_cantx_prepare's, or NULL */
     void *user;                /* for the caller's fill functions: set it after urrt_cantx_init */
     urrt_cantx_link link;      /* as last set */
     urrt_cantx_link link_seen; /* at the previous heartbeat */
@@ -202,6 +207,18 @@ int urrt_cantx_init(urrt_cantx *tx, const urrt_cantx_tables *tables, urrt_cantx_
 
 /* Total signals of the tables: the values[] urrt_cantx_init needs. */
 size_t urrt_cantx_value_count(const urrt_cantx_tables *tables);
+
+/*
+ * After urrt_cantx_init: prepares every signal's scale once
+ * (urrt_can_scale_prepare) into the caller's scales[], at least
+ * urrt_cantx_value_count entries (indexed as values[]), which the core then
+ * packs with: no division per signal packed, a tenth of the instructions on
+ * a core without a double-precision FPU. Without it each packing prepares
+ * its signal's scale again, to the same bits. Returns 0,
+ * URRT_CANTX_E_STORAGE (scales[] too short) or URRT_E_ARG; urrt_cantx_init
+ * forgets the scales.
+ */
+int urrt_cantx_prepare(urrt_cantx *tx, urrt_can_scale *scales, size_t count);
 
 /* Starts (or restarts) the schedule at now_us: periodic frames with the
  * invalid or ignore policy are due now (invalid until data comes), frames
@@ -246,6 +263,32 @@ void urrt_cantx_peek(urrt_cantx *tx, size_t frame, uint64_t now_us, urrt_can_fra
 /* Whether robot `robot`'s data is no older than max_age_us at now_us. */
 bool urrt_cantx_fresh(const urrt_cantx *tx, size_t robot, uint64_t now_us, uint32_t max_age_us);
 
+/* ---- run-time changes ---------------------------------------------------------
+ * For a CANopen node (urrt_co.h), whose PDOs are frames of these tables: the
+ * manager switches them on and off, moves their ids and periods, or has them
+ * sent on its SYNC. urrt_cantx_init leaves every frame open, with the
+ * table's id and period; urrt_cantx_start keeps what these calls set. */
+
+/* Opens or closes the frame's schedule. A closed frame's slots pass unsent
+ * (a periodic frame keeps its cadence, a per-packet frame forgets the
+ * packet); urrt_cantx_trigger still sends it. */
+void urrt_cantx_gate(urrt_cantx *tx, size_t frame, bool open);
+
+/* The frame's id from now on (its format stays): URRT_CAN_E_ID if the id is
+ * not valid for it. Unlike urrt_cantx_init it does not compare the id with
+ * the other frames': the caller keeps the ids it sends apart. */
+int urrt_cantx_set_id(urrt_cantx *tx, size_t frame, uint32_t id);
+
+/* The frame's period from now on, due first at now_us (a stop-policy frame
+ * waiting for data still waits); URRT_CANTX_EVERY_PACKET only for a frame
+ * with the stop policy (else URRT_CANTX_E_POLICY, as urrt_cantx_init). */
+int urrt_cantx_set_period(urrt_cantx *tx, size_t frame, uint32_t period_us, uint64_t now_us);
+
+/* Sends the frame now, whatever its schedule or gate, under its stale
+ * policy (stop: nothing while the data is stale; invalid: the validity bit
+ * cleared). Returns the number sent, 0 or 1. */
+size_t urrt_cantx_trigger(urrt_cantx *tx, size_t frame, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx);
+
 /* ---- the heartbeat ---------------------------------------------------------- */
 
 /* The gateway's state, ordered by value as on the bus. */
@@ -255,6 +298,10 @@ typedef enum urrt_cantx_state {
     URRT_CANTX_DATA_STALE = 2,     /* a robot's data older than the heartbeat's stale_after_us */
     URRT_CANTX_DISCONNECTED = 3    /* a robot's link is down */
 } urrt_cantx_state;
+
+/* Robot `robot`'s state at now_us, its data judged stale past stale_after_us. */
+urrt_cantx_state urrt_cantx_robot_state(const urrt_cantx *tx, size_t robot, uint64_t now_us,
+                                        uint32_t stale_after_us);
 
 /* The worst state over every robot at now_us, judged by frame hb's
  * stale_after_us (the heartbeat's). */

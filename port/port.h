@@ -186,7 +186,9 @@ void urrt_link_set_tap(urrt_link *link, urrt_bytes_fn fn, void *ctx);
 /*
  * A transmit-mostly CAN link: a SocketCAN raw socket on POSIX, or a file in
  * candump's log format (replayable with canplayer) for boxes without a CAN
- * interface.
+ * interface. It receives only the 11-bit data frames it is configured for
+ * (a CANopen node's NMT, SYNC and SDO requests), filtered in the kernel, so
+ * that a flooded bus costs the loop nothing; a log link receives nothing.
  *
  * Sending never blocks the loop. A frame the driver cannot take (ENOBUFS
  * from a full transmit queue, EAGAIN from a full socket buffer) waits in a
@@ -202,7 +204,11 @@ void urrt_link_set_tap(urrt_link *link, urrt_bytes_fn fn, void *ctx);
  * dropped and counted, and it is reopened every reopen_interval_ms until it
  * is up again, which is reported once too. Error frames (bus-off,
  * restarted, controller problems, ...) are received and counted; data frames
- * from other nodes are not received at all.
+ * are received only for the configured rx_ids (CAN_RAW_FILTER, kept across
+ * reopens; remote requests and 29-bit frames never), handed to the rx
+ * function from urrt_canlink_service, at most URRT_CANLINK_RX_BURST per
+ * call. Frames the kernel dropped because the socket's queue was full are
+ * counted (SO_RXQ_OVFL).
  *
  * The interface string:
  *   "can0"                      a SocketCAN interface: it must exist when the
@@ -218,7 +224,7 @@ void urrt_link_set_tap(urrt_link *link, urrt_bytes_fn fn, void *ctx);
  * "(SEC.USEC) IFNAME ID##FDATA" for FD frames (F: the flags nibble, 4, or 5
  * with the bit rate switch, as candump shows FD frames on current kernels),
  * ID in 3 hex digits (11-bit) or 8 (29-bit), DATA in upper-case hex,
- * wall-clock time.
+ * wall-clock time (or, with log_caller_clock, the caller's now_us).
  */
 typedef struct urrt_canlink_config {
     const char *interface;     /* "can0", or "log:PATH[,ifname=NAME]" ("log:-" is stdout) */
@@ -227,9 +233,20 @@ typedef struct urrt_canlink_config {
     uint32_t reopen_interval_ms;
     uint32_t retry_interval_ms; /* held frames retried at least this often */
     uint32_t hold_max_ms;       /* a held frame older than this is stale: dropped */
+    const uint32_t *rx_ids;     /* 11-bit standard ids to receive, filtered in the kernel
+                                   (CAN_RAW_FILTER); NULL or rx_id_count 0: receive nothing.
+                                   Copied by urrt_canlink_new. */
+    size_t rx_id_count;         /* at most URRT_CANLINK_RX_IDS_MAX */
+    bool log_caller_clock;      /* log: links: each line carries the now_us given to
+                                   urrt_canlink_send (seconds.microseconds of that clock)
+                                   instead of the wall clock (urrt-gateway --replay) */
 } urrt_canlink_config;
 
-/* Defaults: no FD, reopen every 1000 ms, retry every 5 ms, hold 100 ms. */
+/* The kernel's limit on one socket's filter list (CAN_RAW_FILTER_MAX). */
+#define URRT_CANLINK_RX_IDS_MAX 512
+
+/* Defaults: no FD, reopen every 1000 ms, retry every 5 ms, hold 100 ms,
+ * nothing received, wall-clock log times. */
 void urrt_canlink_config_defaults(urrt_canlink_config *cfg);
 
 typedef enum urrt_canlink_state {
@@ -249,13 +266,18 @@ typedef struct urrt_canlink_stats {
     uint64_t restarts;
     uint32_t last_error_class; /* CAN_ERR_* class bits of the last error frame */
     uint32_t pending;          /* frames held for a retry right now */
+    bool error_passive;        /* the controller said error passive (receive or transmit) and has not
+                                  said error active again nor restarted since */
+    uint64_t received;         /* data frames received (handed to the rx function, if one is set) */
+    uint64_t rx_overflows;     /* frames the kernel dropped: the socket's receive queue was full (SO_RXQ_OVFL) */
 } urrt_canlink_stats;
 
 typedef struct urrt_canlink urrt_canlink;
 
 /* NULL with a logged reason when the configuration cannot work: no such
  * interface, not a CAN interface, an FD link on an interface without the FD
- * MTU, a log file that cannot be created. An interface that exists but is
+ * MTU, a log file that cannot be created, an rx id that is not 11-bit or
+ * more than URRT_CANLINK_RX_IDS_MAX of them. An interface that exists but is
  * down gives a link in URRT_CANLINK_DOWN that opens when the interface comes up. */
 urrt_canlink *urrt_canlink_new(const urrt_canlink_config *cfg);
 void urrt_canlink_free(urrt_canlink *can);
@@ -266,18 +288,28 @@ void urrt_canlink_free(urrt_canlink *can);
  * link, a length FD does not have, an ID out of range). */
 int urrt_canlink_send(urrt_canlink *can, const urrt_can_frame *frame, uint64_t now_us);
 
+/* Received frames are handed to fn from urrt_canlink_service, at most
+ * URRT_CANLINK_RX_BURST per call, so that a flooded bus never starves the
+ * robot link; rx_us is the kernel's receive time on the monotonic clock
+ * where available, else the time read. The frame is valid during the call
+ * only. NULL fn: frames that pass the filter are read and discarded. */
+#define URRT_CANLINK_RX_BURST 32
+typedef void (*urrt_canlink_rx_fn)(void *ctx, const urrt_can_frame *frame, uint64_t rx_us);
+void urrt_canlink_set_rx(urrt_canlink *can, urrt_canlink_rx_fn fn, void *ctx);
+
 /* The descriptor to wait on and the events (POLLIN, plus POLLOUT while
  * frames wait for socket buffer space), or -1 when there is none (down, or
  * a log file). It changes across reopens: ask again before each wait. */
 int urrt_canlink_poll_fd(const urrt_canlink *can, short *events);
 
 /* Monotonic time by which urrt_canlink_service must run again at the latest
- * (UINT64_MAX when nothing is due). */
+ * (UINT64_MAX when nothing is due; the last service's now, i.e. already due,
+ * while received frames may remain after a burst). */
 uint64_t urrt_canlink_deadline(const urrt_canlink *can);
 
-/* Does what is due: reads error frames (bounded per call), notices the
- * interface going down, retries and expires held frames, reopens. Never
- * blocks. */
+/* Does what is due: reads received and error frames (bounded per call),
+ * notices the interface going down, retries and expires held frames,
+ * reopens. Never blocks. */
 void urrt_canlink_service(urrt_canlink *can, uint64_t now_us);
 
 urrt_canlink_state urrt_canlink_get_state(const urrt_canlink *can);

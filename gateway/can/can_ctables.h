@@ -2,9 +2,12 @@
 /*
  * can_ctables: `urrt-gateway --print-c-tables`. The CAN frames of a
  * configuration as C source of lib/urrt_cantx.h tables (the very tables
- * urrt-gateway runs on, can_run.h), with their storage and an init
- * function, so that a firmware sends the same frames without a mapping
- * written by hand. docs/firmware.md shows one in use.
+ * urrt-gateway runs on, can_run.h), with their storage (the prepared
+ * scales too) and an init function that checks the tables and prepares the
+ * scales, so that a firmware sends the same frames, packed as cheaply,
+ * without a mapping written by hand; with [canopen], the CANopen node's
+ * urrt_co_desc too.
+ * docs/firmware.md shows one in use.
  */
 #ifndef URRT_GATEWAY_CAN_CTABLES_H
 #define URRT_GATEWAY_CAN_CTABLES_H
@@ -13,10 +16,13 @@
 
 #include "can_map.h"
 #include "can_run.h"
+#include "co_run.h"
 
-/* Writes the C source of run, the tables of map (source: the
- * configuration's path, for the header comment). 0, or -1 when the stream
- * failed. */
-int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run, const char *source);
+/* Writes the C source of run, the tables of map, and with node (NULL:
+ * none) the CANopen node's description over them (urrt_gateway_node,
+ * urrt_gateway_co_init; source: the configuration's path, for the header
+ * comment). 0, or -1 when the stream failed. */
+int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run, struct co_run *node,
+                      const char *source);
 
 #endif

@@ -13,10 +13,18 @@
 
 #include "can_map.h"
 #include "can_run.h"
+#include "co_run.h"
 
 /* Sends the capture's frames, run's (the tables of map; NULL: no CAN
- * output configured), on map's [can] interface (log:PATH is the usual
- * choice). Returns a CLI_EXIT_* status; reasons go to the log. */
-int can_replay(const struct can_map *map, struct can_run *run, const char *capture_path);
+ * output configured), or with node (NULL: none) the CANopen node's over
+ * them, booted at the first packet's time, on map's [can] interface
+ * (log:PATH is the usual choice; each line carries the frame's time on the
+ * capture's clock). rx_path (NULL: none) names the frames the node
+ * received, candump -l lines ("(SEC.USEC) can0 605#4000100000000000")
+ * timed on the capture's clock: each goes to urrt_co_on_frame at its time,
+ * between the packets, as a firmware's CAN receive interrupt would hand it
+ * over. Returns a CLI_EXIT_* status; reasons go to the log. */
+int can_replay(const struct can_map *map, struct can_run *run, struct co_run *node, const char *capture_path,
+               const char *rx_path);
 
 #endif

@@ -15,6 +15,7 @@ struct can_run {
     urrt_cantx_frame_state *states;
     urrt_cantx_robot *robots;
     double *values;
+    urrt_can_scale *scales;          /* one per value: packing without a division (urrt_cantx_prepare) */
 };
 
 void can_run_free(struct can_run *run)
@@ -30,6 +31,7 @@ void can_run_free(struct can_run *run)
     free(run->states);
     free(run->robots);
     free(run->values);
+    free(run->scales);
     free(run);
 }
 
@@ -100,7 +102,8 @@ static int init_core(struct can_run *run, const struct can_map *map, char *err, 
     size_t bad_signal;
     int rc;
     run->values = calloc(count ? count : 1, sizeof *run->values);
-    if (run->values == NULL) {
+    run->scales = calloc(count ? count : 1, sizeof *run->scales);
+    if (run->values == NULL || run->scales == NULL) {
         snprintf(err, errlen, "CAN tables: out of memory");
         return -1;
     }
@@ -116,6 +119,8 @@ static int init_core(struct can_run *run, const struct can_map *map, char *err, 
                  signal ? ", signal " : "", signal ? signal : "", urrt_cantx_strerror(rc));
         return -1;
     }
+    /* Cannot fail: the tables were just accepted and scales[] holds count. */
+    (void)urrt_cantx_prepare(&run->tx, run->scales, count);
     return 0;
 }
 
@@ -172,7 +177,7 @@ void can_run_start(struct can_run *run, uint64_t now_us)
     urrt_cantx_start(&run->tx, now_us);
 }
 
-static void set_link(struct can_run *run, const urrt_canlink_stats *stats)
+void can_run_set_link(struct can_run *run, const urrt_canlink_stats *stats)
 {
     urrt_cantx_link link = {stats->bus_off, stats->error_frames, stats->down_events, stats->send_errors,
                             stats->dropped};
@@ -193,7 +198,7 @@ void can_run_due(struct can_run *run, uint64_t now_us, const urrt_canlink_stats 
                  void *ctx)
 {
     if (stats != NULL) {
-        set_link(run, stats);
+        can_run_set_link(run, stats);
     }
     urrt_cantx_run(&run->tx, now_us, emit, ctx);
 }
@@ -202,7 +207,7 @@ void can_run_heartbeat_frame(struct can_run *run, uint64_t now_us, const urrt_ca
                              urrt_can_frame *frame)
 {
     if (stats != NULL) {
-        set_link(run, stats);
+        can_run_set_link(run, stats);
     }
     urrt_cantx_peek(&run->tx, can_run_heartbeat_index(run), now_us, frame);
 }

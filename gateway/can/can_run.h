@@ -3,7 +3,9 @@
  * can_run: a finished CAN mapping (can_map.h) as the tables of
  * lib/urrt_cantx.h, and the CAN core over them: the map's frames in
  * configuration order, then the heartbeat. These are the tables
- * urrt-gateway runs on and --print-c-tables writes for a firmware.
+ * urrt-gateway runs on and --print-c-tables writes for a firmware; the core
+ * packs with every signal's scale prepared (urrt_cantx_prepare), as a
+ * firmware's does.
  *
  * Built once, when the configuration is loaded (config.c), so that
  * --check-config proves they build; the map must outlive them (the frames'
@@ -41,6 +43,10 @@ void can_run_start(struct can_run *run, uint64_t now_us);
  * through emit (urrt_cantx_run). */
 void can_run_due(struct can_run *run, uint64_t now_us, const urrt_canlink_stats *stats, urrt_cantx_emit_fn emit,
                  void *ctx);
+
+/* The CAN link's counters, for the heartbeat's flags and a CANopen node's
+ * EMCYs (urrt_cantx_set_link). */
+void can_run_set_link(struct can_run *run, const urrt_canlink_stats *stats);
 
 /* The heartbeat as it would go out at now_us with these link counters,
  * without sending it (urrt_cantx_peek): for status displays and tests. */

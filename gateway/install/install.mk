@@ -23,12 +23,12 @@ TYPES_JAR := urrt-lcmtypes-$(URRT_VERSION).jar
 DOCS := README.md $(sort $(wildcard docs/*.md))
 DOC_IMAGES := $(sort $(wildcard docs/img/*.png))
 EXAMPLES := $(sort $(wildcard docs/examples/*.ini))
-DIST_FILES := $(DIST)/urrt-spy $(DIST)/urrt-gateway.service $(DIST)/urrt.pc $(DIST)/gateway.ini \
-              $(DIST)/$(TYPES_JAR)
+DIST_FILES := $(DIST)/urrt-spy $(DIST)/urrt-gateway.service $(DIST)/urrt-gateway@.service $(DIST)/urrt.pc \
+              $(DIST)/gateway.ini $(DIST)/$(TYPES_JAR)
 
 INSTALL_ITEMS = $(foreach f,$(PROGRAMS) $(DIST)/urrt-spy,$(f):$(BINDIR):0755) \
   $(DIST)/$(TYPES_JAR):$(JAVADIR):0644 \
-  $(DIST)/urrt-gateway.service:$(UNITDIR):0644 \
+  $(DIST)/urrt-gateway.service:$(UNITDIR):0644 $(DIST)/urrt-gateway@.service:$(UNITDIR):0644 \
   gateway/install/urrt-gateway.example.ini:$(DATADIR)/urrt:0644 \
   $(foreach f,$(LCMTYPES),$(f):$(DATADIR)/urrt/lcmtypes:0644) \
   $(foreach f,$(MAN_PAGES),$(f):$(MANDIR)/man$(subst .,,$(suffix $(f))):0644) \
@@ -36,6 +36,7 @@ INSTALL_ITEMS = $(foreach f,$(PROGRAMS) $(DIST)/urrt-spy,$(f):$(BINDIR):0755) \
   $(foreach f,$(DOC_IMAGES),$(f):$(DOCDIR)/img:0644) \
   $(foreach f,$(EXAMPLES),$(f):$(DOCDIR)/examples:0644) \
   lib/urrt.h:$(INCLUDEDIR):0644 lib/urrt_can.h:$(INCLUDEDIR):0644 lib/urrt_cantx.h:$(INCLUDEDIR):0644 \
+  lib/urrt_co.h:$(INCLUDEDIR):0644 \
   $(LIBURRT):$(LIBDIR):0644 \
   $(DIST)/urrt.pc:$(PKGCONFIGDIR):0644
 # Symbolic links: TARGET:LINK (TARGET relative to the link's directory).
@@ -49,6 +50,29 @@ CONFIG_FILE = $(SYSCONFDIR)/urrt/gateway.ini
 $(DIST)/urrt-gateway.service: gateway/install/urrt-gateway.service
 	@mkdir -p $(@D)
 	sed -e 's|/usr/bin/urrt-gateway|$(BINDIR)/urrt-gateway|g; s|/etc/urrt/|$(SYSCONFDIR)/urrt/|g' $< > $@
+
+# The template unit, urrt-gateway@NAME.service: one more gateway reading $(SYSCONFDIR)/urrt/NAME.ini
+# (docs/gateway.md, "Scaling"). Written from the plain unit so that the two share every line of
+# hardening and restart policy; what differs per instance is its header, Description=, the
+# configuration in ExecStart= and LogsDirectory= (instances run as different dynamic users, and
+# systemd hands each its own directory: one shared by two would be taken over by the last started).
+$(DIST)/urrt-gateway@.service: $(DIST)/urrt-gateway.service
+	sed -e '1i # SPDX-License-Identifier: MIT' \
+	    -e '1i # urrt-gateway@NAME: one more urrt-gateway, reading $(SYSCONFDIR)/urrt/NAME.ini' \
+	    -e '1i # (check it with `urrt-gateway --check-config $(SYSCONFDIR)/urrt/NAME.ini`).' \
+	    -e '1i # Written by gateway/install/install.mk from urrt-gateway.service: the same' \
+	    -e '1i # hardening and restart policy. One instance per configuration:' \
+	    -e '1i #   systemctl enable --now urrt-gateway@NAME' \
+	    -e '1i # Logs: journalctl -u urrt-gateway@NAME' \
+	    -e '/^\[Unit\]/,$$!d' \
+	    -e 's|^Description=urrt-gateway: |Description=urrt-gateway %i: |' \
+	    -e 's|^\(ExecStart=[^ ]* .*/urrt/\)gateway\.ini$$|\1%i.ini|' \
+	    -e 's|^LogsDirectory=urrt$$|LogsDirectory=urrt-%i|; s|/var/log/urrt/|/var/log/urrt-NAME/|g; s|/var/log/urrt,|/var/log/urrt-NAME,|' \
+	    $< > $@
+	@grep -q '^ExecStart=.*/%i\.ini$$' $@ && grep -q '^LogsDirectory=urrt-%i$$' $@ || \
+	  { echo "$@: the plain unit's ExecStart= or LogsDirectory= changed: update this rule"; rm -f $@; exit 1; }
+# check-man holds both units' Documentation= to the man page.
+check-man: $(DIST)/urrt-gateway@.service
 
 $(DIST)/urrt-spy: gateway/install/urrt-spy
 	@mkdir -p $(@D)

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 # gateway/man/man.mk: the man pages, rendered from gateway/man/*.md by
 # gateway/man/render.awk (awk only: no documentation toolchain to install).
-# tests/man.mk checks that each page documents exactly its program's options.
+# tests/man/man.mk checks that each page documents exactly its program's options.
 MAN_SRCS := $(sort $(wildcard gateway/man/*.md))
 MAN_PAGES := $(MAN_SRCS:gateway/man/%.md=$(BUILD)/man/%)
 URRT_VERSION := $(shell sed -n 's/^\#define URRT_VERSION_STRING "\(.*\)"/\1/p' lib/urrt.h)

@@ -9,6 +9,8 @@ struct can_out {
     gateway *gw;
     struct can_run *run;
     urrt_cantx *tx;         /* run's CAN core */
+    urrt_co *node;          /* the CANopen node over tx, or NULL: tx runs alone */
+    uint64_t node_us;       /* the node's latest time: a frame received earlier is handed over at it */
     urrt_canlink *link;
     uint64_t refused;       /* frames the link refused (cannot happen with a checked map) */
     bool robot_up[GW_MAX_ROBOTS];
@@ -22,6 +24,17 @@ static void emit(void *ctx, const urrt_can_frame *frame, uint64_t now_us)
     }
 }
 
+/* The node's view of the link: frames lost on the way in (the socket's
+ * queue overflowed) are a CAN overrun as much as those lost on the way out,
+ * and the controller's error passive state is the node's EMCY 0x8120. */
+static void node_link(can_out *out)
+{
+    urrt_canlink_stats stats = *urrt_canlink_get_stats(out->link);
+    stats.dropped += stats.rx_overflows;
+    can_run_set_link(out->run, &stats);
+    urrt_co_set_error_passive(out->node, stats.error_passive);
+}
+
 /* Nothing is scheduled while the link is down: frames would only be
  * dropped, and a heartbeat dropped there would take its "interface was
  * down" flag with it. The first heartbeat after the outage carries it. */
@@ -30,7 +43,24 @@ static void run_due(can_out *out, uint64_t now_us)
     if (urrt_canlink_get_state(out->link) != URRT_CANLINK_UP) {
         return;
     }
+    if (out->node != NULL) {
+        node_link(out);
+        out->node_us = now_us > out->node_us ? now_us : out->node_us;
+        urrt_co_run(out->node, out->node_us, emit, out);
+        return;
+    }
     can_run_due(out->run, now_us, urrt_canlink_get_stats(out->link), emit, out);
+}
+
+/* A frame the link let through its filter (NMT, SYNC, this node's SDO):
+ * the node answers at once, at the time it was received (its clock never
+ * goes back: a frame read after a run is handed over at that run's time). */
+static void on_frame(void *ctx, const urrt_can_frame *frame, uint64_t rx_us)
+{
+    can_out *out = ctx;
+    unsigned flags = frame->extended ? URRT_CO_RX_EXTENDED : 0u;
+    out->node_us = rx_us > out->node_us ? rx_us : out->node_us;
+    urrt_co_on_frame(out->node, frame->id, flags, frame->data, frame->len, out->node_us, emit, out);
 }
 
 static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
@@ -82,7 +112,7 @@ static void on_service(void *ctx, const struct pollfd *fds, unsigned count, uint
 static uint64_t on_deadline(void *ctx)
 {
     can_out *out = ctx;
-    uint64_t map_due = urrt_cantx_deadline(out->tx);
+    uint64_t map_due = out->node != NULL ? urrt_co_deadline(out->node) : urrt_cantx_deadline(out->tx);
     uint64_t link_due = urrt_canlink_deadline(out->link);
     return map_due < link_due ? map_due : link_due;
 }
@@ -101,10 +131,13 @@ static unsigned on_counters(void *ctx, const gw_robot *robot, gw_counter *counte
         {"can_bus_off", s->bus_off},
         {"can_restarts", s->restarts},
         {"can_clamped", can_run_clamped(out->run)},
+        {"can_received", s->received},          /* a CANopen node's only: it receives */
+        {"can_rx_overflows", s->rx_overflows},
     };
+    unsigned count = sizeof all / sizeof all[0] - (out->node != NULL ? 0u : 2u);
     unsigned n = 0;
     (void)robot;
-    for (; n < max && n < sizeof all / sizeof all[0]; n++) {
+    for (; n < max && n < count; n++) {
         counters[n] = all[n];
     }
     return n;
@@ -115,9 +148,10 @@ static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *b
     can_out *out = ctx;
     const urrt_canlink_stats *s = urrt_canlink_get_stats(out->link);
     (void)robot;
-    return snprintf(buf, size, " | CAN %s %s, sent %llu, dropped %llu, bus-off %llu",
+    return snprintf(buf, size, " | CAN %s %s%s%s, sent %llu, dropped %llu, bus-off %llu",
                     urrt_canlink_get_state(out->link) == URRT_CANLINK_UP ? "up" : "DOWN",
-                    urrt_cantx_state_name(can_run_state(out->run, now_us)), (unsigned long long)s->sent,
+                    urrt_cantx_state_name(can_run_state(out->run, now_us)), out->node != NULL ? ", node " : "",
+                    out->node != NULL ? urrt_co_state_name(urrt_co_state(out->node)) : "", (unsigned long long)s->sent,
                     (unsigned long long)s->dropped, (unsigned long long)s->bus_off);
 }
 
@@ -128,7 +162,7 @@ static void on_close(void *ctx)
     free(out);
 }
 
-can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run)
+can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run, struct co_run *node)
 {
     urrt_canlink_config cfg;
     can_out *out = calloc(1, sizeof *out);
@@ -138,6 +172,9 @@ can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run
     }
     urrt_canlink_config_defaults(&cfg);
     can_map_link_config(map, &cfg);
+    if (node != NULL) {
+        cfg.rx_ids = co_run_rx_ids(node, &cfg.rx_id_count); /* the node's own ids, filtered by the kernel */
+    }
     out->link = urrt_canlink_new(&cfg);
     if (out->link == NULL) {
         free(out);
@@ -146,7 +183,14 @@ can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run
     out->gw = gw;
     out->run = run;
     out->tx = can_run_tx(run);
-    can_run_start(run, urrt_port_monotonic_us());
+    out->node = node != NULL ? co_run_node(node) : NULL;
+    if (out->node != NULL) {
+        urrt_canlink_set_rx(out->link, on_frame, out);
+        out->node_us = urrt_port_monotonic_us();
+        urrt_co_start(out->node, out->node_us, emit, out); /* boot-up; starts tx */
+    } else {
+        can_run_start(run, urrt_port_monotonic_us());
+    }
     return out;
 }
 

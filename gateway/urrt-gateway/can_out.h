@@ -10,15 +10,18 @@
 
 #include "can_map.h"
 #include "can_run.h"
+#include "co_run.h"
 #include "gateway.h"
 
 typedef struct can_out can_out;
 
-/* Opens the link map's [can] names and starts run's schedule. NULL (logged)
+/* Opens the link map's [can] names and starts run's schedule, or with a
+ * CANopen node (co_run.h; NULL: none) the node over it: its boot-up, its
+ * received frames (the link filters the node's ids), its EMCYs. NULL (logged)
  * when it can never work: a bad interface name, an FD mapping on a
  * classic-MTU interface. An interface that is merely down or missing is
  * retried while the gateway runs. */
-can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run);
+can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run, struct co_run *node);
 gw_output can_out_output(can_out *out);
 
 #endif

@@ -577,7 +577,35 @@ static bool frame_begin(config_ctx *ctx, gw_config *cfg, const char *name)
 static bool can_set(config_ctx *ctx, gw_config *cfg, const struct conf_key *key, const char *value, char *why,
                     size_t n)
 {
-    return can_map_set(&cfg->can, ctx->frame, key, value, (struct conf_at){ctx->path, ctx->line}, why, n);
+    struct conf_at at = {ctx->path, ctx->line};
+    if (ctx->frame != NULL && key >= canopen_map_frame_keys && key < canopen_map_frame_keys + CANOPEN_FK_COUNT) {
+        return canopen_map_frame_set(&cfg->co, (size_t)(ctx->frame - cfg->can.frames), key, value, at, why, n);
+    }
+    return can_map_set(&cfg->can, ctx->frame, key, value, at, why, n);
+}
+
+static bool canopen_begin(config_ctx *ctx, gw_config *cfg, const char *name)
+{
+    (void)name;
+    ctx->frame = NULL;
+    canopen_map_begin(&cfg->co, (struct conf_at){ctx->path, ctx->line});
+    return true;
+}
+
+static bool canopen_set(config_ctx *ctx, gw_config *cfg, const struct conf_key *key, const char *value, char *why,
+                        size_t n)
+{
+    return canopen_map_set(&cfg->co, key, value, (struct conf_at){ctx->path, ctx->line}, why, n);
+}
+
+/* The CANopen node over the CAN tables: built here, once, as they are. */
+static void canopen_build(config_ctx *ctx, gw_config *cfg)
+{
+    char why[CONF_WHY_MAX];
+    cfg->co_run = co_run_build(&cfg->co, &cfg->can, cfg->can_run, why, sizeof why);
+    if (cfg->co_run == NULL) {
+        config_error(ctx, 0, "%s", why);
+    }
 }
 
 /* The whole-file checks, then the run-time tables: built here, once, so that
@@ -590,13 +618,17 @@ static void can_finish(config_ctx *ctx, gw_config *cfg)
         robots[i].name = cfg->robots[i].name;
         robots[i].period_us = 1000000u / cfg->robots[i].max_rate_hz;
     }
+    bool node = canopen_map_enabled(&cfg->co);
+    int node_errors = node ? canopen_map_prepare(&cfg->co, &cfg->can) : canopen_map_orphans(&cfg->co, &cfg->can);
     if (can_map_finish(&cfg->can, robots, cfg->robot_count, NULL, 0) != 0 || !can_map_enabled(&cfg->can) ||
-        ctx->errors > 0) {
+        node_errors > 0 || (node && canopen_map_check(&cfg->co, &cfg->can) > 0) || ctx->errors > 0) {
         return;
     }
     cfg->can_run = can_run_build(&cfg->can, why, sizeof why);
     if (cfg->can_run == NULL) {
         config_error(ctx, 0, "%s", why);
+    } else if (node) {
+        canopen_build(ctx, cfg);
     }
 }
 
@@ -623,14 +655,16 @@ static void *robot_object(config_ctx *ctx, gw_config *cfg)
 #define KEYS(table) table, sizeof table / sizeof table[0]
 
 static const config_section config_sections[] = {
-    {"gateway", false, false, NULL, KEYS(gateway_keys), gateway_object, NULL, NULL, "optional, once"},
+    {"gateway", false, false, NULL, KEYS(gateway_keys), gateway_object, NULL, NULL, "optional, once", NULL, 0},
     {"robot", true, true, robot_begin, KEYS(robot_keys), robot_object, NULL, robot_finish,
-     "one per robot; NAME prefixes its channels"},
-    {"lcm", false, false, NULL, KEYS(lcm_keys), lcm_object, NULL, lcm_finish, "optional, once"},
+     "one per robot; NAME prefixes its channels", NULL, 0},
+    {"lcm", false, false, NULL, KEYS(lcm_keys), lcm_object, NULL, lcm_finish, "optional, once", NULL, 0},
     {"can", false, false, can_begin, can_map_can_keys, CAN_MAP_CK_COUNT, NULL, can_set, can_finish,
-     "the CAN output (optional; docs/can.md)"},
+     "the CAN output (optional; docs/can.md)", NULL, 0},
     {"frame", true, true, frame_begin, can_map_frame_keys, CAN_MAP_FK_COUNT, NULL, can_set, NULL,
-     "one per CAN frame; NAME is its DBC name"},
+     "one per CAN frame; NAME is its DBC name", canopen_map_frame_keys, CANOPEN_FK_COUNT},
+    {"canopen", false, false, canopen_begin, canopen_map_keys, CANOPEN_K_COUNT, NULL, canopen_set, NULL,
+     "the CAN output as a CANopen node, its [frame]s TPDOs (optional; docs/canopen.md)", NULL, 0},
 };
 #define CONFIG_SECTION_COUNT (sizeof config_sections / sizeof config_sections[0])
 
@@ -865,6 +899,9 @@ static void on_key(config_ctx *ctx, const char *key, const char *value)
         return; /* the header's error was reported */
     }
     k = conf_key_find(sec->keys, sec->key_count, key);
+    if (k == NULL && sec->more_keys != NULL) {
+        k = conf_key_find(sec->more_keys, sec->more_key_count, key);
+    }
     if (k == NULL) {
         conf_unknown_key(sec->keys, sec->key_count, key, ctx->section_label, why, sizeof why);
         config_error(ctx, ctx->line, "%s", why);
@@ -889,6 +926,7 @@ static void config_defaults(gw_config *cfg, const char *path)
     memset(cfg, 0, sizeof *cfg);
     cfg->path = path;
     can_map_init(&cfg->can);
+    canopen_map_init(&cfg->co);
 }
 
 static int config_parse(gw_config *cfg, FILE *in, FILE *err)
@@ -953,8 +991,10 @@ void gw_config_free(gw_config *cfg)
         free(cfg->robots[i].expected);
     }
     free(cfg->robots);
+    co_run_free(cfg->co_run); /* before the CAN tables it runs on */
     can_run_free(cfg->can_run); /* before the map: its tables are the map's */
     can_map_free(&cfg->can);
+    canopen_map_free(&cfg->co);
     memset(cfg, 0, sizeof *cfg);
 }
 
@@ -971,6 +1011,9 @@ void gw_config_usage(FILE *out)
         const config_section *sec = &config_sections[i];
         fprintf(out, "\n  [%s%s]  %s\n", sec->kind, sec->named ? " NAME" : "", sec->usage);
         conf_key_usage(out, sec->keys, sec->key_count);
+        if (sec->more_keys != NULL) {
+            conf_key_usage(out, sec->more_keys, sec->more_key_count);
+        }
     }
 }
 
@@ -978,5 +1021,9 @@ void gw_config_print_keys(FILE *out)
 {
     for (size_t i = 0; i < CONFIG_SECTION_COUNT; i++) {
         conf_key_print(out, config_sections[i].kind, config_sections[i].keys, config_sections[i].key_count);
+        if (config_sections[i].more_keys != NULL) {
+            conf_key_print(out, config_sections[i].kind, config_sections[i].more_keys,
+                           config_sections[i].more_key_count);
+        }
     }
 }

@@ -22,6 +22,8 @@
 
 #include "can_map.h"
 #include "can_run.h"
+#include "canopen_map.h"
+#include "co_run.h"
 #include "conf.h"
 #include "port.h"
 
@@ -85,6 +87,8 @@ typedef struct gw_config {
     unsigned robot_count;
     struct can_map can;    /* [can] and [frame NAME]; disabled when absent */
     struct can_run *can_run; /* can's tables, built with the file; NULL when disabled */
+    struct canopen_map co; /* [canopen] and the [frame]s' CANopen keys; disabled when absent */
+    struct co_run *co_run; /* the CANopen node over can_run, built with the file; NULL without [canopen] */
 } gw_config;
 
 /* Parse a file. Returns the number of errors (0: *cfg is complete and
@@ -131,6 +135,10 @@ typedef struct config_section {
     /* After the whole file: checks across sections. May be NULL. */
     void (*finish)(config_ctx *ctx, gw_config *cfg);
     const char *usage;  /* one line for --help */
+    /* Keys another part adds to the section ([frame]'s CANopen keys), handed
+     * to set as well; NULL: none. */
+    const struct conf_key *more_keys;
+    size_t more_key_count;
 } config_section;
 
 /* The one error channel: "FILE:LINE: reason", printed at the end, causes

@@ -15,6 +15,7 @@
 #include "can_ctables.h"
 #include "can_out.h"
 #include "can_replay.h"
+#include "eds.h"
 #include "cli.h"
 #include "config.h"
 #include "dbc.h"
@@ -36,15 +37,20 @@ static void usage(FILE *out)
         "NAME.JOINTS, NAME.TOOL, NAME.STATUS, and NAME.GATEWAY (urrt.gateway_t: link\n"
         "state and counters, once per second even while the robot is unreachable).\n"
         "With a [can] section it also sends the [frame NAME]s of CONFIG on a CAN bus,\n"
-        "with a heartbeat frame, and --print-dbc describes them for the PLC side.\n"
+        "with a heartbeat frame, and --print-dbc describes them for the PLC side;\n"
+        "with a [canopen] section it is a CANopen node, its frames TPDOs, and\n"
+        "--print-eds writes its EDS.\n"
         "Never writes to a robot. Stops on SIGINT or SIGTERM.\n"
         "\n"
         "Options:\n"
         "  -c, --check-config     validate CONFIG, print what would run, exit\n"
         "  -d, --print-dbc        write the DBC of CONFIG's CAN frames, exit\n"
         "      --print-c-tables   write CONFIG's CAN frames as C tables of lib/urrt_cantx.h\n"
-        "                         for a firmware (docs/firmware.md), exit\n"
-        "  -o, --output FILE      with --print-dbc or --print-c-tables: write to FILE\n"
+        "                         (and its CANopen node, lib/urrt_co.h) for a firmware\n"
+        "                         (docs/firmware.md), exit\n"
+        "      --print-eds        write the EDS (CiA 306) of CONFIG's CANopen node, exit\n"
+        "  -o, --output FILE      with --print-dbc, --print-c-tables or --print-eds:\n"
+        "                         write to FILE\n"
         "      --print-keys       every configuration key, one per line: section, key,\n"
         "                         form, default, bounds, help (tab-separated), exit;\n"
         "                         no CONFIG (check-man holds the documents to it)\n"
@@ -52,6 +58,9 @@ static void usage(FILE *out)
         "                         clocked by their controller time, and exit: the\n"
         "                         frames a PLC would have received (interface =\n"
         "                         log:PATH); the capture is the first robot's\n"
+        "      --replay-rx FILE   with --replay and [canopen]: the frames the node\n"
+        "                         received (candump -l lines timed on the capture's\n"
+        "                         clock), fed to it between the packets\n"
         "  -s, --summary          one line per robot each second on stdout\n"
         "                         (state, data age, reconnects, messages/s per channel)\n"
         "  -u, --lcm-url URL      publish on URL instead of [lcm] url\n"
@@ -80,10 +89,11 @@ static void usage(FILE *out)
         "  urrt-gateway -u 'udpm://239.255.76.67:7667?ttl=1' -l info gateway.ini\n"
         "  urrt-gateway --print-dbc -o robot.dbc gateway.ini\n"
         "  urrt-gateway --print-c-tables -o can_tables.c gateway.ini\n"
+        "  urrt-gateway --print-eds -o urrt.eds canopen.ini\n"
         "  urrt-gateway --replay capture.bin gateway.ini\n"
         "\n"
-        "Exit status: 0 stopped by a signal (or the configuration is valid, the DBC or\n"
-        "C tables were written, the capture was replayed),\n"
+        "Exit status: 0 stopped by a signal (or the configuration is valid, the DBC,\n"
+        "C tables or EDS were written, the capture was replayed),\n"
         "1 runtime failure, 2 bad command line or configuration.\n",
         out);
 }
@@ -96,6 +106,11 @@ static void print_plan(const gw_config *cfg, const char *url)
         char line[256];
         can_map_describe(&cfg->can, line, sizeof line);
         printf("can %s\n", line);
+    }
+    if (cfg->co_run != NULL) {
+        char line[256];
+        co_run_describe(cfg->co_run, line, sizeof line);
+        printf("canopen %s\n", line);
     }
     for (unsigned i = 0; i < cfg->robot_count; i++) {
         const gw_robot_config *r = &cfg->robots[i];
@@ -128,7 +143,12 @@ static int dbc_writer(FILE *out, gw_config *cfg)
 
 static int c_tables_writer(FILE *out, gw_config *cfg)
 {
-    return can_ctables_write(out, &cfg->can, cfg->can_run, cfg->path);
+    return can_ctables_write(out, &cfg->can, cfg->can_run, cfg->co_run, cfg->path);
+}
+
+static int eds_writer(FILE *out, gw_config *cfg)
+{
+    return eds_write(out, cfg->co_run, &cfg->co, &cfg->can, cfg->path);
 }
 
 static int write_output(gw_config *cfg, const char *path, writer_fn write, const char *what)
@@ -137,6 +157,11 @@ static int write_output(gw_config *cfg, const char *path, writer_fn write, const
     bool ok;
     if (!can_map_enabled(&cfg->can)) {
         fprintf(stderr, "urrt-gateway: %s has no [can] section or [frame NAME]: no %s to write\n", cfg->path, what);
+        return CLI_EXIT_USAGE;
+    }
+    if (write == eds_writer && cfg->co_run == NULL) {
+        fprintf(stderr, "urrt-gateway: %s has no [canopen] section: no EDS to write (docs/canopen.md shows one)\n",
+                cfg->path);
         return CLI_EXIT_USAGE;
     }
     if (path != NULL && (out = fopen(path, "w")) == NULL) {
@@ -161,9 +186,11 @@ typedef struct options {
     bool summary;
     bool print_dbc;
     bool print_c_tables;
+    bool print_eds;
     const char *output_path;
     const char *url_override;
     const char *replay_path;
+    const char *replay_rx_path;
     const char *config_path;
     urrt_log_level level;
     bool level_given;
@@ -172,13 +199,15 @@ typedef struct options {
 /* CLI_EXIT_* to stop with, or -1 to go on. */
 static int parse_options(int argc, char **argv, options *o)
 {
-    enum { OPT_C_TABLES = 256, OPT_REPLAY, OPT_PRINT_KEYS };
+    enum { OPT_C_TABLES = 256, OPT_REPLAY, OPT_PRINT_KEYS, OPT_EDS, OPT_REPLAY_RX };
     static const struct option longopts[] = {
         {"check-config", no_argument, NULL, 'c'},
         {"print-dbc", no_argument, NULL, 'd'},
         {"print-c-tables", no_argument, NULL, OPT_C_TABLES},
         {"print-keys", no_argument, NULL, OPT_PRINT_KEYS},
+        {"print-eds", no_argument, NULL, OPT_EDS},
         {"replay", required_argument, NULL, OPT_REPLAY},
+        {"replay-rx", required_argument, NULL, OPT_REPLAY_RX},
         {"output", required_argument, NULL, 'o'},
         {"summary", no_argument, NULL, 's'},
         {"lcm-url", required_argument, NULL, 'u'},
@@ -195,7 +224,9 @@ static int parse_options(int argc, char **argv, options *o)
         case 'c': o->check_only = true; break;
         case 'd': o->print_dbc = true; break;
         case OPT_C_TABLES: o->print_c_tables = true; break;
+        case OPT_EDS: o->print_eds = true; break;
         case OPT_REPLAY: o->replay_path = optarg; break;
+        case OPT_REPLAY_RX: o->replay_rx_path = optarg; break;
         case OPT_PRINT_KEYS: gw_config_print_keys(stdout); return CLI_EXIT_OK;
         case 'o': o->output_path = optarg; break;
         case 's': o->summary = true; break;
@@ -222,13 +253,18 @@ static int parse_options(int argc, char **argv, options *o)
                 optind == argc ? "no CONFIG file given" : "only one CONFIG file is read");
         return CLI_EXIT_USAGE;
     }
-    if ((int)o->print_dbc + (int)o->print_c_tables + (int)o->check_only + (o->replay_path != NULL) > 1) {
-        fprintf(stderr, "urrt-gateway: --check-config, --print-dbc, --print-c-tables and --replay are "
+    if ((int)o->print_dbc + (int)o->print_c_tables + (int)o->print_eds + (int)o->check_only +
+            (o->replay_path != NULL) > 1) {
+        fprintf(stderr, "urrt-gateway: --check-config, --print-dbc, --print-c-tables, --print-eds and --replay are "
                         "separate jobs: give one\nTry 'urrt-gateway --help'.\n");
         return CLI_EXIT_USAGE;
     }
-    if (o->output_path != NULL && !o->print_dbc && !o->print_c_tables) {
-        fprintf(stderr, "urrt-gateway: --output goes with --print-dbc or --print-c-tables\n"
+    if (o->replay_rx_path != NULL && o->replay_path == NULL) {
+        fprintf(stderr, "urrt-gateway: --replay-rx goes with --replay\nTry 'urrt-gateway --help'.\n");
+        return CLI_EXIT_USAGE;
+    }
+    if (o->output_path != NULL && !o->print_dbc && !o->print_c_tables && !o->print_eds) {
+        fprintf(stderr, "urrt-gateway: --output goes with --print-dbc, --print-c-tables or --print-eds\n"
                         "Try 'urrt-gateway --help'.\n");
         return CLI_EXIT_USAGE;
     }
@@ -241,6 +277,7 @@ static bool summary_clashes(const gw_config *cfg, const options *o)
 {
     const char *iface = cfg->can.interface;
     return (o->summary || cfg->summary) && o->replay_path == NULL && !o->print_dbc && !o->print_c_tables &&
+           !o->print_eds &&
            can_map_enabled(&cfg->can) && strncmp(iface, "log:-", 5) == 0 && (iface[5] == '\0' || iface[5] == ',');
 }
 
@@ -286,7 +323,7 @@ static int run(gw_config *cfg, const options *o)
     gw_add_output(&gw, &output);
     if (can_map_enabled(&cfg->can)) {
         char line[256];
-        can_out *can = can_out_new(&gw, &cfg->can, cfg->can_run);
+        can_out *can = can_out_new(&gw, &cfg->can, cfg->can_run, cfg->co_run);
         if (can == NULL) {
             urrt_log(URRT_LOG_ERR, "the CAN output cannot start (see above); fix [can] in %s", cfg->path);
             gw_close(&gw);
@@ -296,6 +333,10 @@ static int run(gw_config *cfg, const options *o)
         gw_add_output(&gw, &output);
         can_map_describe(&cfg->can, line, sizeof line);
         urrt_log(URRT_LOG_NOTICE, "CAN: %s", line);
+        if (cfg->co_run != NULL) {
+            co_run_describe(cfg->co_run, line, sizeof line);
+            urrt_log(URRT_LOG_NOTICE, "CANopen %s", line);
+        }
     }
     urrt_log(URRT_LOG_NOTICE, "started: %u robot%s, LCM %s", cfg->robot_count, cfg->robot_count == 1 ? "" : "s",
              cfg->lcm.url);
@@ -319,8 +360,10 @@ int main(int argc, char **argv)
         rc = write_output(&cfg, o.output_path, dbc_writer, "DBC");
     } else if (o.print_c_tables) {
         rc = write_output(&cfg, o.output_path, c_tables_writer, "C tables");
+    } else if (o.print_eds) {
+        rc = write_output(&cfg, o.output_path, eds_writer, "EDS");
     } else if (o.replay_path != NULL) {
-        rc = can_replay(&cfg.can, cfg.can_run, o.replay_path);
+        rc = can_replay(&cfg.can, cfg.can_run, cfg.co_run, o.replay_path, o.replay_rx_path);
     } else if (o.check_only) {
         print_plan(&cfg, cfg.lcm.url);
         rc = CLI_EXIT_OK;

@@ -4,9 +4,16 @@
  * alternative.
  *
  * Why it is shaped this way:
- * - A raw socket bound to one interface, non-blocking, with no data filter
- *   (we only transmit) and the error mask fully open, so that bus-off and
- *   restarts wake the loop.
+ * - A raw socket bound to one interface, non-blocking, with the error mask
+ *   fully open, so that bus-off and restarts wake the loop, and a data filter
+ *   of exactly the configured rx ids (none: an empty list), so that a bus
+ *   flooded with other ids is dropped by the kernel and never reaches the
+ *   loop. What passes is read at most URRT_CANLINK_RX_BURST frames per
+ *   service call, and the deadline says "now" while more may wait: the
+ *   caller's other work (the robot link) gets its turn between bursts.
+ * - Receive-queue overflows are the kernel's to count (SO_RXQ_OVFL gives
+ *   the socket's running drop count with each frame); receive times are the
+ *   kernel's (SO_TIMESTAMP, wall clock) moved onto the monotonic clock.
  * - A CAN driver that cannot take a frame makes the qdisc drop it and the
  *   socket return ENOBUFS, while poll() still reports POLLOUT (the socket
  *   buffer is not full). So a refused frame waits in a one-deep slot per ID
@@ -27,6 +34,7 @@
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <sys/time.h>
 #include <unistd.h>
 
 #include <linux/can.h>
@@ -45,7 +53,9 @@
 /* A link serving more distinct IDs than this has a configuration problem;
  * the bound keeps a bug from turning into unbounded memory. */
 #define MAX_HELD_IDS 4096
-/* Error frames read per service call: a babbling bus cannot starve the loop. */
+/* Frames read per service call (received and error frames together): a
+ * babbling bus cannot starve the loop. Data frames handed on are bounded
+ * further by URRT_CANLINK_RX_BURST. */
 #define MAX_READS_PER_SERVICE 64
 
 /* Outage reasons: compared by address to log a change of reason once. */
@@ -80,6 +90,13 @@ struct urrt_canlink {
     int last_send_errno;         /* logged once until it changes */
     held_frame *held;            /* insertion order = retry order */
     size_t n_held, cap_held;
+    uint32_t *rx_ids;            /* the caller's rx ids, copied: the socket filter */
+    size_t rx_count;
+    urrt_canlink_rx_fn rx_fn;
+    void *rx_ctx;
+    bool rx_more;                /* the last service stopped at its bound: frames may wait */
+    uint64_t rx_more_at_us;      /* that service's now: the deadline then */
+    uint32_t ovfl_seen;          /* this socket's SO_RXQ_OVFL count already added */
     urrt_canlink_stats stats;
 };
 
@@ -149,12 +166,12 @@ static size_t format_log_line(char *out, size_t size, const char *ifname, uint64
     return pos;
 }
 
-static int log_write(urrt_canlink *can, const urrt_can_frame *f)
+static int log_write(urrt_canlink *can, const urrt_can_frame *f, uint64_t now_us)
 {
     /* "(" 10 "." 6 ") " IFNAMSIZ " " 8 "##" 1 128 "\n" */
     char line[32 + IFNAMSIZ + 16 + 2 * URRT_CAN_MAX_LEN];
-    size_t len = format_log_line(line, sizeof(line), can->ifname, urrt_port_realtime_us(), f,
-                                 can->cfg.fd_brs);
+    uint64_t line_us = can->cfg.log_caller_clock ? now_us : urrt_port_realtime_us();
+    size_t len = format_log_line(line, sizeof(line), can->ifname, line_us, f, can->cfg.fd_brs);
     size_t done = 0;
     while (done < len) {
         ssize_t w = write(can->fd, line + done, len - done);
@@ -314,6 +331,7 @@ static void go_down(urrt_canlink *can, uint64_t now_us, const char *reason, int 
         can->dropped_at_down = can->stats.dropped;
     }
     can->state = URRT_CANLINK_DOWN;
+    can->rx_more = false;
     discard_held(can);
     can->busy = false;
     can->wait_writable = false;
@@ -382,6 +400,32 @@ static int check_interface(urrt_canlink *can, int sock, bool at_creation, unsign
     return (ifr.ifr_flags & IFF_UP) ? 1 : 0;
 }
 
+/* What the socket receives: exactly the rx ids as 11-bit data frames (the
+ * mask takes in the EFF and RTR flags, so a 29-bit frame or a remote
+ * request with the same number does not pass; no ids: an empty list, no data
+ * frames at all), every error frame, the kernel's receive time and its
+ * count of frames dropped on a full receive queue. NULL, or what failed. */
+static const char *configure_receive(const urrt_canlink *can, int sock)
+{
+    struct can_filter filters[URRT_CANLINK_RX_IDS_MAX];
+    for (size_t i = 0; i < can->rx_count; i++) {
+        filters[i].can_id = can->rx_ids[i];
+        filters[i].can_mask = CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG;
+    }
+    if (setsockopt(sock, SOL_CAN_RAW, CAN_RAW_FILTER, can->rx_count ? filters : NULL,
+                   (socklen_t)(can->rx_count * sizeof(filters[0]))) < 0)
+        return "set the receive filter";
+    can_err_mask_t err_mask = CAN_ERR_MASK;
+    if (setsockopt(sock, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &err_mask, sizeof(err_mask)) < 0)
+        return "subscribe to error frames";
+    int on = 1;
+    if (setsockopt(sock, SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof(on)) < 0)
+        return "count receive overflows (SO_RXQ_OVFL)";
+    if (setsockopt(sock, SOL_SOCKET, SO_TIMESTAMP, &on, sizeof(on)) < 0)
+        return "stamp received frames (SO_TIMESTAMP)";
+    return NULL;
+}
+
 /* Opens and binds the socket when the interface is up. Returns as
  * check_interface does. */
 static int open_socket(urrt_canlink *can, uint64_t now_us, bool at_creation)
@@ -407,12 +451,7 @@ static int open_socket(urrt_canlink *can, uint64_t now_us, bool at_creation)
         return usable;
     }
 
-    /* No data frames wanted: an empty filter list receives none. */
-    setsockopt(sock, SOL_CAN_RAW, CAN_RAW_FILTER, NULL, 0);
-    can_err_mask_t err_mask = CAN_ERR_MASK;
-    const char *failed = NULL;
-    if (setsockopt(sock, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &err_mask, sizeof(err_mask)) < 0)
-        failed = "subscribe to error frames";
+    const char *failed = configure_receive(can, sock);
     int on = 1;
     if (failed == NULL && can->cfg.fd &&
         setsockopt(sock, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof(on)) < 0)
@@ -436,6 +475,7 @@ static int open_socket(urrt_canlink *can, uint64_t now_us, bool at_creation)
 
     can->fd = sock;
     can->state = URRT_CANLINK_UP;
+    can->ovfl_seen = 0; /* a new socket counts its drops from 0 */
     can->stats.opens++;
     if (can->reported_down && !at_creation)
         urrt_log(URRT_LOG_NOTICE, "CAN %s: up again after %.1f s; %llu frames dropped meanwhile",
@@ -550,8 +590,16 @@ static void note_error_frame(urrt_canlink *can, const struct can_frame *cf)
         urrt_log(URRT_LOG_ERR, "CAN %s: bus-off (the controller stopped; it restarts if restart-ms is set: "
                  "`ip link set %s type can restart-ms 100`)", can->ifname, can->ifname);
     }
+    if (class & CAN_ERR_CRTL) {
+        /* A CANopen node reports error passive as EMCY 0x8120 until it ends. */
+        if (cf->data[1] & (CAN_ERR_CRTL_RX_PASSIVE | CAN_ERR_CRTL_TX_PASSIVE))
+            can->stats.error_passive = true;
+        if (cf->data[1] & CAN_ERR_CRTL_ACTIVE)
+            can->stats.error_passive = false;
+    }
     if (class & CAN_ERR_RESTARTED) {
         can->stats.restarts++;
+        can->stats.error_passive = false; /* a restarted controller is error active */
         urrt_log(URRT_LOG_NOTICE, "CAN %s: controller restarted after bus-off", can->ifname);
     }
     if (class & ~(uint32_t)(CAN_ERR_BUSOFF | CAN_ERR_RESTARTED))
@@ -559,27 +607,163 @@ static void note_error_frame(urrt_canlink *can, const struct can_frame *cf)
                  (unsigned)class, cf->data[0], cf->data[1], cf->data[2], cf->data[3]);
 }
 
+/* The ancillary data of one recvmsg: the kernel's receive time and the
+ * socket's running count of frames dropped on a full receive queue. */
+typedef struct rx_meta {
+    bool stamped;
+    struct timeval stamp;
+    bool has_drops;
+    uint32_t drops;
+} rx_meta;
+
+static rx_meta read_meta(struct msghdr *msg)
+{
+    rx_meta m;
+    memset(&m, 0, sizeof(m));
+    for (struct cmsghdr *c = CMSG_FIRSTHDR(msg); c != NULL; c = CMSG_NXTHDR(msg, c)) {
+        if (c->cmsg_level != SOL_SOCKET)
+            continue;
+        if (c->cmsg_type == SO_TIMESTAMP && c->cmsg_len >= CMSG_LEN(sizeof(m.stamp))) {
+            memcpy(&m.stamp, CMSG_DATA(c), sizeof(m.stamp));
+            m.stamped = true;
+        } else if (c->cmsg_type == SO_RXQ_OVFL && c->cmsg_len >= CMSG_LEN(sizeof(m.drops))) {
+            memcpy(&m.drops, CMSG_DATA(c), sizeof(m.drops));
+            m.has_drops = true;
+        }
+    }
+    return m;
+}
+
+/* The kernel's receive time on the monotonic clock: now less the frame's
+ * age on the wall clock (read once per burst), never after now; now itself
+ * when there is no stamp or it lies ahead (the wall clock was stepped). */
+static uint64_t monotonic_rx_us(const rx_meta *m, uint64_t now_us, uint64_t wall_us)
+{
+    if (!m->stamped)
+        return now_us;
+    uint64_t stamp_us = (uint64_t)m->stamp.tv_sec * 1000000u + (uint64_t)m->stamp.tv_usec;
+    if (stamp_us > wall_us || wall_us - stamp_us > now_us)
+        return now_us;
+    return now_us - (wall_us - stamp_us);
+}
+
+/* A received data frame as urrt_can_frame: false for what the filter lets
+ * through only by accident of the API (29-bit, remote requests). */
+static bool to_frame(const struct canfd_frame *k, size_t size, urrt_can_frame *f)
+{
+    if (k->can_id & (CAN_EFF_FLAG | CAN_RTR_FLAG))
+        return false;
+    memset(f, 0, sizeof(*f));
+    f->id = k->can_id & CAN_SFF_MASK;
+    f->fd = size == CANFD_MTU;
+    f->len = k->len; /* can_dlc of a classic frame: 0..8 */
+    if (f->len > (f->fd ? CANFD_MAX_DLEN : CAN_MAX_DLEN))
+        return false;
+    memcpy(f->data, k->data, f->len);
+    return true;
+}
+
+/* 1 a frame read into *k (its size in *size), 0 nothing more for now, -1
+ * the link went down or the read failed (logged). */
+static int receive_one(urrt_canlink *can, uint64_t now_us, struct canfd_frame *k, size_t *size, rx_meta *meta)
+{
+    struct iovec iov = {.iov_base = k, .iov_len = sizeof(*k)};
+    union {
+        char buf[CMSG_SPACE(sizeof(struct timeval)) + CMSG_SPACE(sizeof(uint32_t))];
+        struct cmsghdr align;
+    } control;
+    struct msghdr msg;
+    memset(&msg, 0, sizeof(msg));
+    msg.msg_iov = &iov;
+    msg.msg_iovlen = 1;
+    msg.msg_control = control.buf;
+    msg.msg_controllen = sizeof(control.buf);
+    ssize_t r = recvmsg(can->fd, &msg, MSG_DONTWAIT);
+    if (r < 0) {
+        int err = errno;
+        if (err == EAGAIN || err == EINTR)
+            return 0;
+        if (is_down_errno(err))
+            go_down(can, now_us, err == ENODEV ? REASON_REMOVED : REASON_DOWN, err);
+        else
+            urrt_log(URRT_LOG_WARNING, "CAN %s: receive failed: %s", can->ifname, strerror(err));
+        return -1;
+    }
+    *size = (size_t)r;
+    *meta = read_meta(&msg);
+    if (meta->has_drops) {
+        can->stats.rx_overflows += (uint32_t)(meta->drops - can->ovfl_seen);
+        can->ovfl_seen = meta->drops;
+    }
+    return 1;
+}
+
+/* Reads what is queued, at most MAX_READS_PER_SERVICE frames and
+ * URRT_CANLINK_RX_BURST data frames handed on; rx_more tells the deadline
+ * whether it stopped at a bound. The rx function may send (an SDO answer),
+ * and a send may take the link down: the state is checked before each read. */
 static void read_socket(urrt_canlink *can, uint64_t now_us)
 {
-    for (int i = 0; i < MAX_READS_PER_SERVICE && can->state == URRT_CANLINK_UP; i++) {
-        struct canfd_frame buf;
-        ssize_t r = recv(can->fd, &buf, sizeof(buf), MSG_DONTWAIT);
-        if (r < 0) {
-            int err = errno;
-            if (err == EAGAIN || err == EINTR)
-                return;
-            if (is_down_errno(err))
-                go_down(can, now_us, err == ENODEV ? REASON_REMOVED : REASON_DOWN, err);
-            else
-                urrt_log(URRT_LOG_WARNING, "CAN %s: receive failed: %s", can->ifname, strerror(err));
+    unsigned handed = 0;
+    uint64_t wall_us = 0;
+    can->rx_more = false;
+    for (int i = 0; i < MAX_READS_PER_SERVICE; i++) {
+        if (can->state != URRT_CANLINK_UP)
             return;
+        if (handed == URRT_CANLINK_RX_BURST)
+            break;
+        struct canfd_frame k;
+        size_t size = 0;
+        rx_meta meta;
+        if (receive_one(can, now_us, &k, &size, &meta) <= 0)
+            return;
+        if (size >= sizeof(struct can_frame) && (k.can_id & CAN_ERR_FLAG)) {
+            note_error_frame(can, (const struct can_frame *)&k);
+            continue;
         }
-        if ((size_t)r >= sizeof(struct can_frame) && (buf.can_id & CAN_ERR_FLAG))
-            note_error_frame(can, (const struct can_frame *)&buf);
+        urrt_can_frame f;
+        if ((size != CAN_MTU && size != CANFD_MTU) || !to_frame(&k, size, &f))
+            continue;
+        if (wall_us == 0)
+            wall_us = urrt_port_realtime_us();
+        can->stats.received++;
+        handed++;
+        if (can->rx_fn != NULL)
+            can->rx_fn(can->rx_ctx, &f, monotonic_rx_us(&meta, now_us, wall_us));
     }
+    can->rx_more = can->state == URRT_CANLINK_UP;
+    can->rx_more_at_us = now_us;
 }
 
 /* ---- the API ------------------------------------------------------------------- */
+
+/* The rx ids, checked and copied: the socket filter of every (re)open. */
+static bool copy_rx_ids(urrt_canlink *can, const urrt_canlink_config *cfg)
+{
+    size_t n = cfg->rx_ids != NULL ? cfg->rx_id_count : 0;
+    if (n > URRT_CANLINK_RX_IDS_MAX) {
+        urrt_log(URRT_LOG_ERR, "CAN link %s: %zu receive ids, more than the kernel's filter takes (%d); "
+                 "receive fewer ids", cfg->interface, n, URRT_CANLINK_RX_IDS_MAX);
+        return false;
+    }
+    for (size_t i = 0; i < n; i++) {
+        if (cfg->rx_ids[i] > CAN_SFF_MASK) {
+            urrt_log(URRT_LOG_ERR, "CAN link %s: receive id 0x%X is not an 11-bit standard id (0 to 0x7FF)",
+                     cfg->interface, (unsigned)cfg->rx_ids[i]);
+            return false;
+        }
+    }
+    if (n == 0)
+        return true;
+    can->rx_ids = malloc(n * sizeof(can->rx_ids[0]));
+    if (can->rx_ids == NULL) {
+        urrt_log(URRT_LOG_ERR, "CAN link %s: out of memory for the receive ids", cfg->interface);
+        return false;
+    }
+    memcpy(can->rx_ids, cfg->rx_ids, n * sizeof(can->rx_ids[0]));
+    can->rx_count = n;
+    return true;
+}
 
 urrt_canlink *urrt_canlink_new(const urrt_canlink_config *cfg)
 {
@@ -592,8 +776,13 @@ urrt_canlink *urrt_canlink_new(const urrt_canlink_config *cfg)
         return NULL;
     can->cfg = *cfg;
     can->cfg.interface = NULL; /* not owned; ifname/log_path hold what we need */
+    can->cfg.rx_ids = NULL;    /* not owned; copied into rx_ids */
     can->fd = -1;
     can->state = URRT_CANLINK_DOWN;
+    if (!copy_rx_ids(can, cfg)) {
+        free(can);
+        return NULL;
+    }
 
     if (strncmp(cfg->interface, LOG_PREFIX, strlen(LOG_PREFIX)) == 0) {
         if (!parse_log_interface(can, cfg->interface) || !open_log(can)) {
@@ -606,14 +795,14 @@ urrt_canlink *urrt_canlink_new(const urrt_canlink_config *cfg)
     if (strlen(cfg->interface) >= IFNAMSIZ) {
         urrt_log(URRT_LOG_ERR, "CAN interface \"%s\": name longer than %d characters", cfg->interface,
                  IFNAMSIZ - 1);
-        free(can);
+        urrt_canlink_free(can);
         return NULL;
     }
     memcpy(can->ifname, cfg->interface, strlen(cfg->interface) + 1);
     uint64_t now_us = urrt_port_monotonic_us();
     int r = open_socket(can, now_us, true);
     if (r < 0) {
-        free(can);
+        urrt_canlink_free(can);
         return NULL;
     }
     if (r == 0) {
@@ -635,7 +824,16 @@ void urrt_canlink_free(urrt_canlink *can)
     }
     free(can->log_path);
     free(can->held);
+    free(can->rx_ids);
     free(can);
+}
+
+void urrt_canlink_set_rx(urrt_canlink *can, urrt_canlink_rx_fn fn, void *ctx)
+{
+    if (can == NULL)
+        return;
+    can->rx_fn = fn;
+    can->rx_ctx = ctx;
 }
 
 int urrt_canlink_send(urrt_canlink *can, const urrt_can_frame *frame, uint64_t now_us)
@@ -643,7 +841,7 @@ int urrt_canlink_send(urrt_canlink *can, const urrt_can_frame *frame, uint64_t n
     if (can == NULL || frame == NULL || !frame_valid(can, frame))
         return URRT_E_ARG;
     if (can->log_path != NULL)
-        return log_write(can, frame);
+        return log_write(can, frame, now_us);
     if (can->state != URRT_CANLINK_UP) {
         can->stats.dropped++;
         return 0;
@@ -690,6 +888,8 @@ uint64_t urrt_canlink_deadline(const urrt_canlink *can)
         return UINT64_MAX;
     if (can->state != URRT_CANLINK_UP)
         return can->reopen_at_us;
+    if (can->rx_more)
+        return can->rx_more_at_us;
     if (can->n_held == 0)
         return UINT64_MAX;
     uint64_t deadline = can->retry_at_us;

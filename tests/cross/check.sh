@@ -7,8 +7,7 @@
 # table at -Os and -O2, what lib/ needs from outside (libgcc only).
 #
 # usage: check.sh OUTDIR FOOTPRINT_MD "LIB_WARN flags" lib/a.c lib/b.c ...
-# Needs arm-none-eabi-gcc, -nm and -size, and riscv64-unknown-elf-gcc. RESULT (if set) receives the
-# closing "N passed, N failed" line.
+# Needs arm-none-eabi-gcc, -nm and -size, and riscv64-unknown-elf-gcc.
 set -u
 out=$1; doc=$2; warn=$3; shift 3
 . "$(dirname "$0")/../lib.sh"

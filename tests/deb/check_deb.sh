@@ -2,8 +2,8 @@
 # SPDX-License-Identifier: MIT
 # check-deb: the Debian package as a user gets it.
 #  - make deb builds it; lintian finds no error and no warning (debian/ overrides justify any)
-#  - its contents: programs, unit (not enabled), conffile, man pages, docs, examples, .lcm, jar,
-#    C header, library and pkg-config file
+#  - its contents: programs, unit and template unit (neither enabled), conffile, man pages, docs,
+#    examples, .lcm, jar, C header, library and pkg-config file
 #  - dpkg installs it into a scratch root (a bootstrap of busybox and a dpkg database holding its
 #    dependencies as the host has them: no container, no root of the host touched), the programs
 #    run from there, the shipped example passes --check-config, the unedited /etc/urrt/gateway.ini
@@ -11,7 +11,6 @@
 set -u
 BUILD=${BUILD:-build}
 MAKE=${MAKE:-make}
-RESULT=$BUILD/results/check-deb.result
 passed=0; failed=0
 check() {
   what=$1; shift
@@ -19,7 +18,7 @@ check() {
   else failed=$((failed + 1)); echo "FAIL: $what"; fi
 }
 finish() {
-  echo "$passed passed, $failed failed" | tee "$RESULT"
+  echo "$passed passed, $failed failed"
   [ "$failed" = 0 ]; exit $?
 }
 T=$(mktemp -d); trap 'rm -rf "$T"' EXIT
@@ -38,12 +37,13 @@ check "lintian: no error, no warning" sh -c "! grep -q '^[EW]: ' '$T/lintian'"
 
 dpkg-deb -c "$deb" | awk '{print $6}' | sed 's|^\./|/|' > "$T/contents"
 for f in /usr/bin/urrt-gateway /usr/bin/urrt-dump /usr/bin/urrt-sim /usr/bin/urrt-spy \
-         /lib/systemd/system/urrt-gateway.service /etc/urrt/gateway.ini \
+         /lib/systemd/system/urrt-gateway.service /lib/systemd/system/urrt-gateway@.service /etc/urrt/gateway.ini \
          /usr/share/man/man8/urrt-gateway.8.gz /usr/share/man/man5/urrt-gateway.ini.5.gz \
          /usr/share/man/man1/urrt-dump.1.gz /usr/share/man/man1/urrt-sim.1.gz /usr/share/man/man1/urrt-spy.1.gz \
          /usr/share/doc/urrt/copyright /usr/share/doc/urrt/gateway.md.gz /usr/share/doc/urrt/examples/canopen.ini \
          /usr/share/urrt/urrt-gateway.example.ini /usr/share/urrt/lcmtypes/state_t.lcm \
-         /usr/share/java/urrt-lcmtypes.jar /usr/include/urrt.h /usr/include/urrt_can.h /usr/include/urrt_cantx.h; do
+         /usr/share/java/urrt-lcmtypes.jar /usr/include/urrt.h /usr/include/urrt_can.h /usr/include/urrt_cantx.h \
+         /usr/include/urrt_co.h; do
   check "contents: $f" grep -qx "$f" "$T/contents"
 done
 check "contents: liburrt.a and urrt.pc under /usr/lib/<multiarch>" \
@@ -52,6 +52,11 @@ dpkg-deb --ctrl-tarfile "$deb" | tar -x -C "$T" ./conffiles ./postinst 2>/dev/nu
 check "conffiles: /etc/urrt/gateway.ini alone" sh -c "[ \"\$(cat '$T/conffiles')\" = /etc/urrt/gateway.ini ]"
 check "the unit is not enabled on install (only if it was enabled before)" \
   sh -c "grep -q 'was-enabled' '$T/postinst' && ! grep -q 'systemctl.*start' '$T/postinst' && ! grep -q 'wants/' '$T/contents'"
+check "the template unit is never enabled by the package (the administrator enables urrt-gateway@NAME)" \
+  sh -c "! grep -q 'urrt-gateway@' '$T/postinst'"
+dpkg-deb --fsys-tarfile "$deb" | tar -xO ./lib/systemd/system/urrt-gateway@.service > "$T/template" 2>/dev/null
+check "the template unit runs /usr/bin/urrt-gateway on /etc/urrt/NAME.ini" \
+  grep -qx 'ExecStart=/usr/bin/urrt-gateway /etc/urrt/%i.ini' "$T/template"
 
 # The scratch root: busybox for the maintainer scripts, a dpkg database that
 # knows the dependencies (copied from the host's), and a regular file for /dev/null.

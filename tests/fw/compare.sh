@@ -7,8 +7,10 @@
 # bit rate switch setting, not the frame's: it is not compared. The capture
 # must also have made both show what it is there for: every frame of the
 # configuration and the heartbeat, a heartbeat that said "ok" and one that
-# said "data stale"; for canopen.ini also frames sent invalid (stall, clamp,
-# NaN) and the stop-policy frame stopping during the stall.
+# said "data stale" (canopen.ini, a CANopen node: the boot-up, an operational
+# heartbeat, the stale EMCY and its reset, and fed a manager's frames, the SDO
+# answers CiA 301 gives, a second boot-up, TPDO4 on SYNC); for canopen.ini also frames sent
+# invalid (stall, clamp, NaN) and the stop-policy frame stopping during the stall.
 #   compare.sh GATEWAY_LOG FIRMWARE_OUTPUT IDS HEARTBEAT_ID NAME
 set -u
 gw_log=$1; fw_out=$2; want_ids=$3; hb=$4; name=$5
@@ -30,18 +32,47 @@ END {
         if (same) passed++; else failed++
         split(gw[i], part, "#"); ids[part[1]]++; data = gw[i]; sub(/^[0-9A-F]+##?/, "", data)
         if (part[1] == hb) state[substr(data, 2, 1)]++
-        if (part[1] == "185" && substr(data, 15, 1) ~ /[0-7]/) invalid++
+        if (part[1] == "185" && substr(data, 15, 2) == "00") invalid++   # canopen.ini: byte 7, the validity bit of TPDO1
     }
     check(length(ids) == want_ids, "frames of " length(ids) " ids, not the " want_ids " of the configuration")
-    check(state["1"] > 0, "no heartbeat said ok")
-    check(state["2"] > 0, "no heartbeat said data stale")
+    if (name == "canopen") {
+        # A CANopen node: boot-up [00], then heartbeats [05] (operational); the EMCY of stale data
+        # (0xFF02) during the stall and its reset (0x0000) after it.
+        check(gw[1] == hb "#00", "the first frame is not the boot-up " hb "#00")
+        check(state["5"] > 0, "no heartbeat said operational")
+        for (i = 1; i <= n; i++) {
+            if (gw[i] ~ /^085#02FF/) stale_emcy++
+            if (gw[i] ~ /^085#0000..02FF/) reset_emcy++
+        }
+        check(stale_emcy > 0, "no EMCY 0xFF02 (robot data stale) during the stall")
+        check(reset_emcy > 0, "no EMCY reset of 0xFF02 after the stall")
+        if (ids["585"] > 0) {
+            # Fed tests/fw/master_frames.py: the answers, worked out by hand from CiA 301, in order.
+            split("585#4300100000000000 585#410810000C000000 585#00757272742D6761 585#1574657761790000 " \
+                  "585#6017100000000000 585#8000600000000206 585#8000100002000106 585#8000000010000706", want, " ")
+            k = 1
+            for (i = 1; i <= n && k <= 8; i++) if (gw[i] == want[k]) k++
+            check(k == 9, "the SDO answers (device type, segmented 0x1008, 0x1017 written, 3 aborts): " \
+                  "missing from " want[k])
+            for (i = 1; i <= n; i++) if (gw[i] == hb "#00") boots++
+            check(boots == 2, "boot-up at power-on and after NMT reset node: " boots + 0)
+            check(ids["485"] > 0, "no SYNC-driven TPDO4 (0x485)")
+        }
+    } else {
+        check(state["1"] > 0, "no heartbeat said ok")
+        check(state["2"] > 0, "no heartbeat said data stale")
+    }
     if (name == "canopen") {
         check(invalid > 0, "no 0x185 frame went out invalid (stall, clamp, NaN)")
         check(ids["385"] < ids["185"] / 2 - 5, "0x385 (stop policy, 20 ms) did not stop during the stall")
     }
     printf "%s: frames compared: %d; per id:", name, n
     for (id in ids) printf " %s %d", id, ids[id]
-    printf "; heartbeat ok %d, stale %d%s\n", state["1"], state["2"], name == "canopen" ? "; 0x185 invalid " invalid : ""
+    if (name == "canopen")
+        printf "; heartbeat operational %d, EMCY stale %d, reset %d; 0x185 invalid %d\n", state["5"], stale_emcy,
+            reset_emcy, invalid
+    else
+        printf "; heartbeat ok %d, stale %d\n", state["1"], state["2"]
     printf "%d passed, %d failed\n", passed, failed
     exit failed > 0
 }' "$tmp.fw"

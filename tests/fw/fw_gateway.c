@@ -11,6 +11,18 @@
  * semihosting in TCP-sized chunks, the time is each packet's controller
  * time (as `urrt-gateway --replay` takes it), and each frame is printed as
  * candump prints it ("185#0102...") for comparison with urrt-gateway's log.
+ *
+ * The generated init prepares every signal's scale (urrt_cantx_prepare), as
+ * urrt-gateway's own tables do: both pack exactly, so the frames are the
+ * same bits.
+ *
+ * Built with -DFW_CANOPEN for a configuration with [canopen]: the CANopen
+ * node of lib/urrt_co.h runs over the CAN core (the generated tables carry
+ * its description, urrt_gateway_co_init), booted at the first packet as
+ * `urrt-gateway --replay` boots it: boot-up, heartbeats, EMCYs, TPDOs. A
+ * manager's frames (tests/fw/fw_rx.h: what a board's CAN receive interrupt
+ * would hand over) go to urrt_co_on_frame at their time, between the
+ * packets, as `urrt-gateway --replay-rx` feeds the same frames.
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -18,10 +30,17 @@
 #include "target.h"
 #include "urrt.h"
 #include "urrt_cantx.h"
+#ifdef FW_CANOPEN
+#include "fw_rx.h"
+#include "urrt_co.h"
+#endif
 
 /* From the generated tables. */
 extern const urrt_cantx_tables urrt_gateway_tables;
 int urrt_gateway_cantx_init(urrt_cantx *tx, size_t *bad_frame, size_t *bad_signal);
+#ifdef FW_CANOPEN
+int urrt_gateway_co_init(urrt_co *co, urrt_cantx *tx, size_t *bad_item);
+#endif
 
 #define CHUNK 1460 /* one TCP segment on Ethernet */
 
@@ -67,6 +86,66 @@ static void can_transmit(void *ctx, const urrt_can_frame *f, uint64_t now_us)
 
 /* ---- the gateway: the same for every board ------------------------------------ */
 
+#ifdef FW_CANOPEN
+static urrt_co node;
+static uint64_t node_us; /* the node's latest run */
+static int booted;
+
+/* A board wakes at every deadline (urrt_co_deadline) on its timer; here the
+ * clock jumps from packet to packet, so run the node at each deadline first. */
+static void node_catch_up(uint64_t until_us)
+{
+    for (;;) {
+        uint64_t due = urrt_co_deadline(&node);
+        due = due < node_us ? node_us : due;
+        if (due >= until_us) {
+            return;
+        }
+        urrt_co_run(&node, due, can_transmit, NULL);
+        if (due == node_us && urrt_co_deadline(&node) <= due) {
+            return;
+        }
+        node_us = due;
+    }
+}
+
+/* The manager's frames up to now_us, each at its own time. */
+static void rx_until(uint64_t now_us)
+{
+    static unsigned next;
+    for (; next < fw_rx_count && fw_rx_frames[next].t_us <= now_us; next++) {
+        const struct fw_rx_frame *f = &fw_rx_frames[next];
+        uint64_t at = f->t_us < node_us ? node_us : f->t_us;
+        node_catch_up(at);
+        urrt_co_on_frame(&node, f->id, 0, f->data, f->len, at, can_transmit, NULL);
+        node_us = at;
+    }
+}
+
+static void packet_at(uint64_t now_us)
+{
+    if (!booted) {
+        booted = 1; /* power-on at the first packet: the boot-up frame */
+        node_us = now_us;
+        urrt_co_start(&node, now_us, can_transmit, NULL);
+    }
+    rx_until(now_us);
+    node_catch_up(now_us);
+    urrt_cantx_on_packet(&tx, 0, &state, now_us);
+    urrt_co_run(&node, now_us, can_transmit, NULL);
+    node_us = now_us;
+}
+#else
+static void packet_at(uint64_t now_us)
+{
+    /* A board wakes at every deadline (urrt_cantx_deadline) on its timer;
+     * here the clock jumps from packet to packet, so catch up first. */
+    urrt_cantx_catch_up(&tx, now_us, can_transmit, NULL);
+    urrt_cantx_on_packet(&tx, 0, &state, now_us);
+    urrt_cantx_run(&tx, now_us, can_transmit, NULL);
+}
+#endif
+
 /* One complete packet: its values to the CAN core, then whatever is due. */
 static void on_packet(const uint8_t *pkt, size_t len)
 {
@@ -75,11 +154,7 @@ static void on_packet(const uint8_t *pkt, size_t len)
         urrt_time_us(state.time[0], &now_us) != URRT_OK) {
         return; /* no usable clock in it: nothing to send it by */
     }
-    /* A board wakes at every deadline (urrt_cantx_deadline) on its timer;
-     * here the clock jumps from packet to packet, so catch up first. */
-    urrt_cantx_catch_up(&tx, (uint64_t)now_us, can_transmit, NULL);
-    urrt_cantx_on_packet(&tx, 0, &state, (uint64_t)now_us);
-    urrt_cantx_run(&tx, (uint64_t)now_us, can_transmit, NULL);
+    packet_at((uint64_t)now_us);
 }
 
 /* Bytes as the TCP stack hands them over, in any chunking. */
@@ -108,9 +183,20 @@ int main(void)
         return 1;
     }
     if (urrt_gateway_cantx_init(&tx, &bad_frame, &bad_signal) != 0) {
-        target_puts("fw_gateway: the generated tables are refused by urrt_cantx_init\n");
+        target_puts("fw_gateway: the generated tables are refused by urrt_cantx_init or urrt_cantx_prepare\n");
         return 1;
     }
+    if (tx.scales == NULL) {
+        target_puts("fw_gateway: urrt_gateway_cantx_init left the scales unprepared: the generated init must call "
+                    "urrt_cantx_prepare (gateway/can/can_ctables.c)\n");
+        return 1;
+    }
+#ifdef FW_CANOPEN
+    if (urrt_gateway_co_init(&node, &tx, &bad_frame) != 0) {
+        target_puts("fw_gateway: the generated node is refused by urrt_co_init\n");
+        return 1;
+    }
+#endif
     urrt_framer_init(&framer);
     while ((n = target_read(capture, chunk, sizeof chunk)) > 0) {
         on_tcp_bytes(chunk, n);

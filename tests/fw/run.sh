@@ -11,15 +11,29 @@ for name in "$@"; do
   dir=$fw/$name
   ini=$dir/gateway.ini
   rm -f "$dir/gateway.log"
-  "$build/bin/urrt-gateway" --replay "$fw/capture.bin" "$ini" 2> "$dir/replay.err" || {
+  # A CANopen node is fed the manager's frames (fw.mk writes rx.log for it).
+  rx=; [ -f "$dir/rx.log" ] && rx="--replay-rx $dir/rx.log"
+  # shellcheck disable=SC2086
+  "$build/bin/urrt-gateway" --replay "$fw/capture.bin" $rx "$ini" 2> "$dir/replay.err" || {
     echo "FAIL: $name: urrt-gateway --replay: $(cat "$dir/replay.err")"; failed=$((failed + 1)); continue; }
   qemu-system-arm -nographic -monitor none -serial none \
     -semihosting-config "enable=on,target=native,arg=$fw/capture.bin" \
     -M mps2-an386 -kernel "$dir/fw_gateway.elf" > "$dir/firmware.out" 2>&1
   # What the configuration says: its frames and the heartbeat, as the log writes their ids.
-  ids=$(( $(grep -c '^\[frame ' "$ini") + 1 ))
-  hb=$(sed -n 's/^heartbeat_id = 0x//p' "$ini" | tr a-f A-F)
-  if grep -q '^heartbeat_extended = yes' "$ini"; then hb=$(printf '%08X' "0x$hb"); else hb=$(printf '%03X' "0x$hb"); fi
+  # A CANopen node: its heartbeat 0x700 + node id and its EMCY 0x080 + node id, no status
+  # TPDO (off until enabled), and without a manager's frames no SYNC-driven TPDO either.
+  node=$(sed -n 's/^node_id = //p' "$ini")
+  if [ -n "$node" ] && [ -f "$dir/rx.log" ]; then
+    ids=$(( $(grep -c '^\[frame ' "$ini") + 3 ))   # and the SDO answers 0x580 + node id; SYNCs come
+    hb=$(printf '%03X' $((0x700 + node)))
+  elif [ -n "$node" ]; then
+    ids=$(( $(grep -c '^\[frame ' "$ini") - $(grep -c '^transmission = sync' "$ini") + 2 ))
+    hb=$(printf '%03X' $((0x700 + node)))
+  else
+    ids=$(( $(grep -c '^\[frame ' "$ini") + 1 ))
+    hb=$(sed -n 's/^heartbeat_id = 0x//p' "$ini" | tr a-f A-F)
+    if grep -q '^heartbeat_extended = yes' "$ini"; then hb=$(printf '%08X' "0x$hb"); else hb=$(printf '%03X' "0x$hb"); fi
+  fi
   echo "== $name: $ids ids, heartbeat $hb"
   sh tests/fw/compare.sh "$dir/gateway.log" "$dir/firmware.out" "$ids" "$hb" "$name" > "$dir/compare.log"
   grep -v ' passed, ' "$dir/compare.log"

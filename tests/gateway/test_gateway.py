@@ -18,7 +18,7 @@ packet with the wall clock (--clock realtime), LCM stamps each message with
 the kernel's receive time (recv_utime), and the difference is how old the
 data was when it reached the subscriber.
 
-Usage: test_gateway.py --build DIR [--result FILE] [--only NAME]
+Usage: test_gateway.py --build DIR [--only NAME]
 """
 import argparse
 import json
@@ -875,14 +875,15 @@ def t_install(args):
     p = make("install")
     files = ["usr/bin/urrt-gateway", "usr/bin/urrt-dump", "usr/bin/urrt-sim", "usr/bin/urrt-spy",
              "usr/share/java/urrt-lcmtypes.jar", "usr/share/urrt/urrt-gateway.example.ini",
-             "unit/urrt-gateway.service", "etc/urrt/gateway.ini",
+             "unit/urrt-gateway.service", "unit/urrt-gateway@.service", "etc/urrt/gateway.ini",
              "usr/share/man/man8/urrt-gateway.8", "usr/share/man/man5/urrt-gateway.ini.5",
              "usr/share/man/man1/urrt-dump.1", "usr/share/man/man1/urrt-sim.1", "usr/share/man/man1/urrt-spy.1",
              "usr/share/doc/urrt/README.md", "usr/share/doc/urrt/gateway.md", "usr/share/doc/urrt/can.md",
              "usr/share/doc/urrt/LICENSE", "usr/share/doc/urrt/examples/canopen.ini",
              "usr/share/doc/urrt/examples/fd.ini", "usr/share/doc/urrt/examples/j1939.ini",
              "usr/share/urrt/lcmtypes/state_t.lcm", "usr/share/urrt/lcmtypes/gateway_t.lcm",
-             "usr/include/urrt.h", "usr/include/urrt_can.h", "usr/include/urrt_cantx.h", "usr/lib/liburrt.a",
+             "usr/include/urrt.h", "usr/include/urrt_can.h", "usr/include/urrt_cantx.h", "usr/include/urrt_co.h",
+             "usr/lib/liburrt.a",
              "usr/lib/pkgconfig/urrt.pc", "usr/share/doc/urrt/firmware.md", "usr/share/doc/urrt/architecture.md"]
     missing = [f for f in files if not os.path.exists(os.path.join(root, f))]
     check(p.returncode == 0 and not missing, "install: %d files in place (missing: %s; %s)" %
@@ -898,6 +899,19 @@ def t_install(args):
           "install: a bad configuration (exit 2 of the main process) is not restarted in a loop")
     check("ProtectSystem=strict" in unit and "LogsDirectory=urrt" in unit,
           "install: the read-only system leaves /var/log/urrt writable for a CAN log")
+    template = os.path.join(unitdir, "urrt-gateway@.service")
+    template_lines = open(template).read().splitlines() if os.path.exists(template) else []
+    check("ExecStart=%s/bin/urrt-gateway %s/urrt/%%i.ini" % (prefix, etc) in template_lines and
+          "LogsDirectory=urrt-%i" in template_lines,
+          "install: the template unit urrt-gateway@NAME reads %s/urrt/NAME.ini and logs to its own directory" % etc)
+    # Every setting but the per-instance ones is the plain unit's: the same hardening and restart policy.
+    per_instance = ("Description=", "ExecStart=", "LogsDirectory=")
+
+    def shared(lines):
+        return [l for l in lines if l and not l.startswith("#") and not l.startswith(per_instance)]
+    check(shared(template_lines) and shared(template_lines) == shared(unit.splitlines()),
+          "install: the template unit has the plain unit's every other line (%s)" %
+          sorted(set(shared(template_lines)) ^ set(shared(unit.splitlines())))[:3])
     spy = open(os.path.join(prefix, "bin", "urrt-spy")).read() if os.path.exists(prefix) else ""
     check("URRT_JAR_DEFAULT=%s/share/java/urrt-lcmtypes.jar" % prefix in spy, "install: urrt-spy knows the jar")
     conf = os.path.join(etc, "urrt", "gateway.ini")
@@ -926,10 +940,12 @@ def t_install(args):
           "urrt-gateway.service")).read(), "install: for PREFIX=/usr the unit is gateway/install/urrt-gateway.service as it is")
     make("dist-files")
     if subprocess.run(["which", "systemd-analyze"], capture_output=True).returncode == 0:
-        v = subprocess.run(["systemd-analyze", "verify", os.path.join(unitdir, "urrt-gateway.service")],
-                           capture_output=True, text=True, timeout=60,
-                           env=dict(os.environ, MANPATH=os.path.join(prefix, "share", "man")))
-        check(v.returncode == 0, "install: systemd-analyze verify accepts the unit (%s)" % v.stderr.strip()[:300])
+        # A template is verified as an instance of it (systemd-analyze names one itself).
+        for name in ("urrt-gateway.service", "urrt-gateway@.service"):
+            v = subprocess.run(["systemd-analyze", "verify", os.path.join(unitdir, name)],
+                               capture_output=True, text=True, timeout=60,
+                               env=dict(os.environ, MANPATH=os.path.join(prefix, "share", "man")))
+            check(v.returncode == 0, "install: systemd-analyze verify accepts %s (%s)" % (name, v.stderr.strip()[:300]))
     with open(conf, "a") as f:
         f.write("# edited\n")
     make("install")
@@ -962,7 +978,6 @@ def t_cli(args):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", required=True)
-    ap.add_argument("--result")
     ap.add_argument("--only")
     args = ap.parse_args()
     b = args.build
@@ -1004,9 +1019,6 @@ def main():
         print("-- %s: %.1f s" % (name, time.monotonic() - t0))
     line = "%d passed, %d failed" % (PASSED, FAILED)
     print(line)
-    if args.result:
-        with open(args.result, "w") as f:
-            f.write(line + "\n")
     subprocess.run(["rm", "-rf", args.tmp])
     return 0 if FAILED == 0 else 1
 

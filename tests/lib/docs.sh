@@ -4,7 +4,6 @@
 # lib/'s metadata) between the markers of docs/protocol.md.
 #   docs.sh DOC_TABLE DOC            rewrite DOC in place (make docs)
 #   docs.sh DOC_TABLE DOC --check    fail if DOC differs (make check-docs)
-# RESULT (if set) receives the closing "N passed, N failed" line.
 set -u
 gen=$1; doc=$2; mode=${3:-}
 . "$(dirname "$0")/../lib.sh"

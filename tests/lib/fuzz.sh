@@ -7,7 +7,6 @@
 # WORKDIR (kept between runs, so `make fuzz` builds on earlier runs). With
 # --check the run uses a fixed seed, so make check is repeatable. A crash
 # leaves its input in WORKDIR/artifacts/; replay it with: FUZZER FILE
-# RESULT (if set) receives the closing "N passed, N failed" line.
 set -u
 fuzzer=$1; seeds=$2; work=$3; seconds=$4; mode=${5:-}
 . "$(dirname "$0")/../lib.sh"

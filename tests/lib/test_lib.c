@@ -12,6 +12,7 @@
 #include "urrt.h"
 #include "state_slot.h"
 #include "check.h"
+#include "testutil.h"
 
 #include <inttypes.h>
 #include <math.h>
@@ -34,40 +35,6 @@ static double double_of(uint64_t u)
     memcpy(&d, &u, sizeof d);
     return d;
 }
-
-static void put_be32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)(v >> 24);
-    p[1] = (uint8_t)(v >> 16);
-    p[2] = (uint8_t)(v >> 8);
-    p[3] = (uint8_t)v;
-}
-
-static void put_be64(uint8_t *p, uint64_t v)
-{
-    put_be32(p, (uint32_t)(v >> 32));
-    put_be32(p + 4, (uint32_t)v);
-}
-
-static uint64_t get_be64(const uint8_t *p)
-{
-    uint64_t v = 0;
-    for (int i = 0; i < 8; i++) {
-        v = (v << 8) | p[i];
-    }
-    return v;
-}
-
-static uint64_t rng_state = 0x9E3779B97F4A7C15u;
-
-static uint64_t rng_next(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return rng_state;
-}
-
 
 /* ---- reference vectors ---------------------------------------------------- */
 
@@ -1148,7 +1115,7 @@ static void test_state_clear_and_encoder(void)
     /* A state set by hand, encoded at every length the library accepts. */
     for (int id = 0; id < URRT_FIELD_COUNT; id++) {
         for (unsigned i = 0; i < urrt_field((urrt_field_id)id)->count; i++) {
-            state_slot(&st, id)[i] = double_of(rng_next());
+            state_slot(&st, id)[i] = double_of(test_rng());
         }
     }
     for (uint32_t len = URRT_PACKET_MIN; len <= URRT_PACKET_MAX; len += 8) {

@@ -23,7 +23,12 @@ docs/performance.md states these figures (within 5 %).
 Usage: bench.py PERFORMANCE_MD QEMU_CMD LABEL=IMAGE...
        bench.py --not-slower QEMU_CMD LABEL=IMAGE LABEL=IMAGE: decode of 1116
        bytes takes no more instructions in the first image than in the second
-       (the Cortex-M0 word path against the portable byte path)."""
+       (the Cortex-M0 word path against the portable byte path).
+       bench.py --can PERFORMANCE_MD QEMU_CMD LABEL=MACHINE:IMAGE...: packing
+       canopen.ini's TPDO1 on each core (instructions, SysTick under -icount):
+       the table between <!-- can-bench:begin --> and <!-- can-bench:end -->
+       states them (within 5 %), and the prepared packing stays within
+       CAN_BUDGET (a Cortex-M4 without a double-precision FPU, soft-float)."""
 import re
 import subprocess
 import sys
@@ -34,10 +39,14 @@ OPS = [("decode_1116", "full decode, 1116 bytes"), ("decode_1220", "full decode,
        ("swap_copy_1116", "byte-swapping copy of the same 1116 bytes (floor)"),
        ("framer_feed_1460", "framer feed, one 1460-byte segment of 1116-byte packets"),
        ("read10_1116", "10 fields by random access, 1116 bytes"),
-       ("can_pack_tpdo1", "pack one CAN frame (canopen.ini TPDO1: 3 scaled joints, alive, valid)")]
+       ("can_pack_tpdo1", "pack one CAN frame (canopen.ini TPDO1: 3 scaled joints, alive, valid)"),
+       ("can_pack_frame_tpdo1", "the same frame by urrt_can_pack_frame (each signal checked, its scale prepared)")]
 # Trace segments, in the order bench_target.c times them.
 ORDER = ["overhead", "calibration", "decode_1116", "swap_copy_1116", "read10_1116", "decode_1220",
-         "swap_copy_1220", "framer_feed_1460", "can_pack_tpdo1"]
+         "swap_copy_1220", "framer_feed_1460", "can_pack_tpdo1", "can_pack_frame_tpdo1"]
+# --can: TPDO1's packing on each core, and the most its prepared packing may take (instructions).
+CAN_OPS = ["can_pack_tpdo1", "can_pack_frame_tpdo1"]
+CAN_BUDGET = {"M4 -O2": 2000, "M4 -Os": 2500}
 
 
 def disassembly(image):
@@ -139,9 +148,54 @@ def not_slower(qemu, specs):
     return 0 if ok else 1
 
 
+def stated_table(doc, marker):
+    """The table rows between <!-- MARKER:begin ... --> and <!-- MARKER:end --> of doc."""
+    text = open(doc).read()
+    m = re.search(r"<!-- %s:begin[^\n]*-->\n(.*?)<!-- %s:end -->" % (marker, marker), text, re.S)
+    return [l for l in (m.group(1).splitlines() if m else []) if l.startswith("|")]
+
+
+def same_rows(stated, rows):
+    """The same rows, each number within TOLERANCE."""
+    numbers = lambda row: [float(x) for x in re.findall(r"\d+(?:\.\d+)?", row.split("|", 2)[2])]
+    return len(stated) == len(rows) and all(
+        a.split("|")[1] == b.split("|")[1] and len(numbers(a)) == len(numbers(b)) and
+        all(abs(x - y) <= TOLERANCE * max(y, 1) for x, y in zip(numbers(a), numbers(b)))
+        for a, b in zip(stated[2:], rows[2:]))
+
+
+def can_cores(doc, qemu, specs):
+    passed = failed = 0
+    rows = ["| core (`lib/` build) | TPDO1, scales prepared (instructions) | TPDO1 by `urrt_can_pack_frame` |",
+            "|---|---:|---:|"]
+    for spec in specs:
+        label, target = spec.split("=", 1)
+        machine, image = target.split(":", 1)
+        out = subprocess.run(qemu + ["-M", machine, "-icount", "shift=6", "-kernel", image], capture_output=True,
+                             text=True, timeout=60)
+        figures = dict((m.group(1), int(m.group(2)))
+                       for m in re.finditer(r"^bench: (\w+) (\d+)$", out.stdout + out.stderr, re.M))
+        counts = [figures.get(name, -1) for name in CAN_OPS]
+        ok = out.returncode == 0 and min(counts) > 0 and counts[0] <= CAN_BUDGET.get(label, counts[0])
+        print("%s: %s%s" % ("ok" if ok else "FAIL", label, "".join(
+            " %s %d" % (name, n) for name, n in zip(CAN_OPS, counts)) + (
+            " (at most %d)" % CAN_BUDGET[label] if label in CAN_BUDGET else "")))
+        passed, failed = passed + ok, failed + (not ok)
+        rows.append("| %s | %s |" % (label, " | ".join(str(n) for n in counts)))
+    print("\n".join(rows))
+    ok = same_rows(stated_table(doc, "can-bench"), rows)
+    if not ok:
+        print("FAIL: %s's can-bench table differs from the figures above (by more than 5 %%): replace it" % doc)
+    passed, failed = passed + ok, failed + (not ok)
+    print("%d passed, %d failed" % (passed, failed))
+    return 0 if failed == 0 else 1
+
+
 def main():
     if sys.argv[1] == "--not-slower":
         return not_slower(sys.argv[2].split(), sys.argv[3:])
+    if sys.argv[1] == "--can":
+        return can_cores(sys.argv[2], sys.argv[3].split(), sys.argv[4:])
     doc, qemu, images = sys.argv[1], sys.argv[2].split(), sys.argv[3:]
     passed = failed = 0
 
@@ -200,14 +254,7 @@ def main():
         if l == "-O2":
             result(d <= 2 * s, "-O2: decode of 1116 bytes (%d) is not within 2x of the byte-swapping copy (%d)" % (d, s))
     # The page: the same rows, each number within TOLERANCE.
-    text = open(doc).read()
-    m = re.search(r"<!-- m4-bench:begin[^\n]*-->\n(.*?)<!-- m4-bench:end -->", text, re.S)
-    stated = [l for l in (m.group(1).splitlines() if m else []) if l.startswith("|")]
-    numbers = lambda row: [float(x) for x in re.findall(r"\d+(?:\.\d+)?", row.split("|", 2)[2])]
-    ok = len(stated) == len(rows) and all(
-        a.split("|")[1] == b.split("|")[1] and len(numbers(a)) == len(numbers(b)) and
-        all(abs(x - y) <= TOLERANCE * max(y, 1) for x, y in zip(numbers(a), numbers(b)))
-        for a, b in zip(stated[2:], rows[2:]))
+    ok = same_rows(stated_table(doc, "m4-bench"), rows)
     result(ok, "%s's m4-bench table differs from the figures above (by more than 5 %%): replace it" % doc)
     print("%d passed, %d failed" % (passed, failed))
     return 0 if failed == 0 else 1

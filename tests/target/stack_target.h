@@ -7,17 +7,23 @@
  * tests/target/stack.py compares with -fstack-usage and docs/footprint.md.
  */
 
+#include "../lib/co_fixture.h"
+
 typedef struct stack_mark {
     const char *name;
     unsigned bytes;
 } stack_mark;
 
-static stack_mark stack_marks[80];
+static stack_mark stack_marks[88];
 static unsigned stack_mark_count;
 
-static void stack_note(const char *fn, unsigned bytes)
+/* fn's mark: the paint below sp, lowest the deepest word it changed. */
+static void stack_note(const char *fn, uintptr_t sp, uintptr_t lowest)
 {
+    unsigned bytes = (unsigned)(sp - lowest);
     unsigned i;
+    CHECK(lowest > target_stack_limit(), "the stack reached its limit: raise STACK_SIZE in the board's .ld", fn,
+          sp, lowest);
     for (i = 0; i < stack_mark_count && !same_text(stack_marks[i].name, fn); i++) {
     }
     if (i == stack_mark_count) {
@@ -39,7 +45,7 @@ static void stack_note(const char *fn, unsigned bytes)
         uintptr_t sp_ = target_sp();                                           \
         target_stack_paint(sp_);                                               \
         (void)fn args;                                                         \
-        stack_note(#fn, (unsigned)(sp_ - target_stack_lowest_used(sp_)));      \
+        stack_note(#fn, sp_, target_stack_lowest_used(sp_));                   \
     } while (0)
 
 /* Filled in place: a struct copy may be a call to memcpy on Cortex-M0. */
@@ -65,6 +71,13 @@ static void stack_emit(void *ctx, const urrt_can_frame *f, uint64_t now_us)
     (void)now_us;
 }
 
+/* The CAN core's storage, for stack_cantx's tables and then the CANopen node's
+ * (one set: the Cortex-M0 board has 16 KiB of RAM). */
+static urrt_cantx core_tx;
+static urrt_cantx_frame_state core_states[2];
+static urrt_cantx_robot core_robots[1];
+static double core_values[8 + URRT_CANTX_HB_COUNT];
+
 /* The CAN core on the signals below (one 64-byte FD frame) and the heartbeat. */
 static void stack_cantx(urrt_can_signal *sigs)
 {
@@ -74,60 +87,132 @@ static void stack_cantx(urrt_can_signal *sigs)
         {URRT_CANTX_FIELD, URRT_F_ROBOT_MODE, 0},     {URRT_CANTX_FIELD_MASK, URRT_F_DIGITAL_INPUT_BITS, 0},
         {URRT_CANTX_FIELD, URRT_F_SAFETY_MODE, 0},    {URRT_CANTX_FIELD, URRT_F_Q_TARGET, 3},
     };
-    static urrt_cantx_frame frames[2];
-    static urrt_cantx_tables tables;
-    static urrt_cantx_frame_state states[2];
-    static urrt_cantx_robot robots[1];
-    static double values[8 + URRT_CANTX_HB_COUNT];
-    static urrt_cantx tx;
+    static urrt_cantx_frame frames_fd[2];
+    static urrt_cantx_tables tables_fd;
+    static urrt_can_scale scales[8 + URRT_CANTX_HB_COUNT];
     static urrt_cantx_link link;
-    static urrt_can_frame out;
+    urrt_can_frame out;
     size_t z1, z2;
-    frames[0].signals = sigs;
-    frames[0].sources = srcs;
-    frames[0].signal_count = 8;
-    frames[0].len = 64;
-    frames[0].flags = URRT_CANTX_FD;
-    frames[0].id = 0x123;
-    frames[0].period_us = 10000;
-    frames[0].stale_after_us = 100000;
-    frames[1].signals = urrt_cantx_heartbeat_signals;
-    frames[1].sources = urrt_cantx_heartbeat_sources;
-    frames[1].signal_count = URRT_CANTX_HB_COUNT;
-    frames[1].len = URRT_CANTX_HB_LEN;
-    frames[1].id = 0x700;
-    frames[1].period_us = 100000;
-    frames[1].stale_after_us = 100000;
-    frames[1].stale = URRT_CANTX_STALE_IGNORE;
-    frames[1].fill = urrt_cantx_heartbeat_fill;
-    tables.frames = frames;
-    tables.frame_count = 2;
-    tables.robot_count = 1;
-    tables.startup_us = 5000000;
+    frames_fd[0].signals = sigs;
+    frames_fd[0].sources = srcs;
+    frames_fd[0].signal_count = 8;
+    frames_fd[0].len = 64;
+    frames_fd[0].flags = URRT_CANTX_FD;
+    frames_fd[0].id = 0x123;
+    frames_fd[0].period_us = 10000;
+    frames_fd[0].stale_after_us = 100000;
+    frames_fd[1].signals = urrt_cantx_heartbeat_signals;
+    frames_fd[1].sources = urrt_cantx_heartbeat_sources;
+    frames_fd[1].signal_count = URRT_CANTX_HB_COUNT;
+    frames_fd[1].len = URRT_CANTX_HB_LEN;
+    frames_fd[1].id = 0x700;
+    frames_fd[1].period_us = 100000;
+    frames_fd[1].stale_after_us = 100000;
+    frames_fd[1].stale = URRT_CANTX_STALE_IGNORE;
+    frames_fd[1].fill = urrt_cantx_heartbeat_fill;
+    tables_fd.frames = frames_fd;
+    tables_fd.frame_count = 2;
+    tables_fd.robot_count = 1;
+    tables_fd.startup_us = 5000000;
     link.bus_off = 1;
     STACK(urrt_cantx_strerror, (URRT_CANTX_E_POLICY));
-    STACK(urrt_cantx_value_count, (&tables));
-    STACK(urrt_cantx_init, (&tx, &tables, states, robots, values, 8 + URRT_CANTX_HB_COUNT, &z1, &z2));
+    STACK(urrt_cantx_value_count, (&tables_fd));
+    STACK(urrt_cantx_init,
+          (&core_tx, &tables_fd, core_states, core_robots, core_values, 8 + URRT_CANTX_HB_COUNT, &z1, &z2));
     /* Deepest paths: a first packet starts the schedule (packing every frame);
      * a heartbeat after a packet packs the frames it took. */
-    STACK(urrt_cantx_on_packet, (&tx, 0, &st, 2000));
-    STACK(urrt_cantx_start, (&tx, 1000));
-    STACK(urrt_cantx_set_link, (&tx, &link));
-    STACK(urrt_cantx_on_packet, (&tx, 0, &st, 2000));
-    STACK(urrt_cantx_run, (&tx, 2000, stack_emit, NULL));
-    urrt_cantx_on_packet(&tx, 0, &st, 3000); /* catch-up's first frame packs new values */
-    STACK(urrt_cantx_catch_up, (&tx, 250000, stack_emit, NULL));
-    STACK(urrt_cantx_on_packet, (&tx, 0, &st, 255000));
-    STACK(urrt_cantx_gateway_state, (&tx, 1, 260000));
-    STACK(urrt_cantx_heartbeat_fill, (&tx, 1, 260000, false, values + 8));
-    STACK(urrt_cantx_on_packet, (&tx, 0, &st, 256000));
-    STACK(urrt_cantx_peek, (&tx, 1, 260000, &out));
-    STACK(urrt_cantx_robot_link, (&tx, 0, false));
-    STACK(urrt_cantx_deadline, (&tx));
-    STACK(urrt_cantx_fresh, (&tx, 0, 260000, 100000));
+    STACK(urrt_cantx_on_packet, (&core_tx, 0, &st, 2000));
+    STACK(urrt_cantx_start, (&core_tx, 1000));
+    STACK(urrt_cantx_set_link, (&core_tx, &link));
+    STACK(urrt_cantx_on_packet, (&core_tx, 0, &st, 2000));
+    STACK(urrt_cantx_run, (&core_tx, 2000, stack_emit, NULL));
+    urrt_cantx_on_packet(&core_tx, 0, &st, 3000); /* catch-up's first frame packs new values */
+    STACK(urrt_cantx_catch_up, (&core_tx, 250000, stack_emit, NULL));
+    STACK(urrt_cantx_on_packet, (&core_tx, 0, &st, 255000));
+    STACK(urrt_cantx_gateway_state, (&core_tx, 1, 260000));
+    STACK(urrt_cantx_heartbeat_fill, (&core_tx, 1, 260000, false, core_values + 8));
+    STACK(urrt_cantx_on_packet, (&core_tx, 0, &st, 256000));
+    /* The run-time changes a CANopen node makes. A trigger packs the frame's
+     * values of the latest packet, if no heartbeat packed them to report
+     * clamping: unprepared here, prepared below. */
+    STACK(urrt_cantx_gate, (&core_tx, 0, false));
+    STACK(urrt_cantx_trigger, (&core_tx, 0, 258000, stack_emit, NULL));
+    STACK(urrt_cantx_gate, (&core_tx, 0, true));
+    urrt_cantx_on_packet(&core_tx, 0, &st, 259000);
+    STACK(urrt_cantx_peek, (&core_tx, 1, 260000, &out));
+    STACK(urrt_cantx_robot_state, (&core_tx, 0, 260000, 100000)); /* fresh data: judged by its age */
+    STACK(urrt_cantx_set_id, (&core_tx, 0, 0x124));
+    STACK(urrt_cantx_set_period, (&core_tx, 0, 20000, 260000));
+    STACK(urrt_cantx_prepare, (&core_tx, scales, 8 + URRT_CANTX_HB_COUNT));
+    urrt_cantx_on_packet(&core_tx, 0, &st, 261000);
+    STACK(urrt_cantx_trigger, (&core_tx, 0, 261000, stack_emit, NULL));
+    STACK(urrt_cantx_robot_link, (&core_tx, 0, false));
+    STACK(urrt_cantx_deadline, (&core_tx));
+    STACK(urrt_cantx_fresh, (&core_tx, 0, 260000, 100000));
     STACK(urrt_cantx_state_name, (URRT_CANTX_DATA_STALE));
-    CHECK(tx.frames[0].sent > 0 && tx.frames[1].sent > 0, "CAN core frames sent in the stack test", "stack",
-          tx.frames[0].sent, tx.frames[1].sent);
+    CHECK(core_tx.frames[0].sent > 0 && core_tx.frames[1].sent > 0, "CAN core frames sent in the stack test",
+          "stack", core_tx.frames[0].sent, core_tx.frames[1].sent);
+}
+
+/* An SDO request to the fixture's node. */
+static void stack_sdo(urrt_co *co, uint8_t cmd, uint16_t index, uint8_t sub, uint32_t value, uint64_t now_us)
+{
+    uint8_t req[8];
+    unsigned i;
+    req[0] = cmd;
+    req[1] = (uint8_t)index;
+    req[2] = (uint8_t)(index >> 8);
+    req[3] = sub;
+    for (i = 0; i < 4; i++) {
+        req[4 + i] = (uint8_t)(value >> (8 * i));
+    }
+    STACK(urrt_co_on_frame, (co, 0x600 + NODE, 0, req, 8, now_us, stack_emit, NULL));
+}
+
+/* The CANopen node of tests/lib/co_fixture.h over the CAN core's storage,
+ * initialised again for the fixture's tables, on the decoded packet in st:
+ * every urrt_co_* call, urrt_co_on_frame on each
+ * kind of frame (an SDO upload of a robot value packs its frame, a SYNC
+ * sends a TPDO, a write of a TPDO's parameters moves its id and period),
+ * urrt_co_run with the core's frames, a heartbeat and EMCYs. */
+static void stack_co(void)
+{
+    static urrt_co co;
+    static urrt_co_tpdo_state tpdo_states[2];
+    static uint32_t vars[2];
+    static const uint8_t nmt_start[2] = {URRT_CO_NMT_START, 0};
+    static const uint8_t sync[1] = {1};
+    size_t bad;
+    urrt_cantx_init(&core_tx, &tables, core_states, core_robots, core_values, 8, NULL, NULL);
+    STACK(urrt_co_strerror, (URRT_CO_E_OBJECT));
+    STACK(urrt_co_init, (&co, &co_fixture_node, &core_tx, tpdo_states, vars, 2, &bad));
+    STACK(urrt_co_start, (&co, 0, stack_emit, NULL));
+    urrt_cantx_on_packet(&core_tx, 0, &st, 1000);
+    STACK(urrt_co_on_frame, (&co, 0x000, 0, nmt_start, 2, 1000, stack_emit, NULL));
+    stack_sdo(&co, 0x40, 0x2000, 1, 0, 1000);             /* a robot value: its frame packed */
+    stack_sdo(&co, 0x40, 0x1018, 2, 0, 1000);             /* identity */
+    stack_sdo(&co, 0x2B, 0x2100, 0, 500, 1000);           /* a variable */
+    stack_sdo(&co, 0x40, 0x1008, 0, 0, 1000);             /* device name: a segmented upload */
+    stack_sdo(&co, 0x60, 0, 0, 0, 1000);                  /* its first segment */
+    stack_sdo(&co, 0x23, 0x1800, 1, 0x8000018Au, 1000);   /* TPDO1 invalid, */
+    stack_sdo(&co, 0x2B, 0x1800, 5, 20, 1000);            /* its event timer, */
+    stack_sdo(&co, 0x23, 0x1800, 1, 0x0000019Au, 1000);   /* valid at a new id */
+    stack_sdo(&co, 0x2F, 0x1801, 2, 1, 1000);             /* TPDO2 on every SYNC */
+    stack_sdo(&co, 0x23, 0x1234, 0, 0, 1000);             /* an abort */
+    urrt_cantx_on_packet(&core_tx, 0, &st, 2000); /* new values: the SYNC's TPDO packs them */
+    STACK(urrt_co_on_frame, (&co, 0x080, 0, sync, 1, 2000, stack_emit, NULL));
+    urrt_cantx_on_packet(&core_tx, 0, &st, 3000); /* and TPDO1's, due since its new id */
+    STACK(urrt_co_run, (&co, 3000, stack_emit, NULL));
+    STACK(urrt_co_run, (&co, 100000, stack_emit, NULL));  /* stale data: EMCY, heartbeat, TPDO1 */
+    STACK(urrt_co_set_error_passive, (&co, true));
+    STACK(urrt_co_run, (&co, 200000, stack_emit, NULL));
+    STACK(urrt_co_deadline, (&co));
+    STACK(urrt_co_state, (&co));
+    STACK(urrt_co_state_name, (URRT_CO_STOPPED));
+    STACK(urrt_co_error_register, (&co));
+    CHECK(urrt_co_state(&co) == URRT_CO_OPERATIONAL && urrt_co_error_register(&co) != 0,
+          "CANopen node operational with an error in the stack test", "stack", urrt_co_state(&co),
+          urrt_co_error_register(&co));
 }
 
 static void test_stack(void)
@@ -136,6 +221,7 @@ static void test_stack(void)
     static urrt_can_signal sigs[8];
     static const double values[8] = {1.5, -2.25, 1e30, -1e30, 0.0, 3.75, 100.0, -7.0};
     static uint8_t outcomes[8];
+    static urrt_can_scale scale;
     uint8_t frame[64];
     double d, lo, hi;
     uint64_t raw;
@@ -227,12 +313,16 @@ static void test_stack(void)
     for (i = 0; i < 8; i++) {
         STACK(urrt_can_pack_checked, (&sigs[i], values[i], frame));
         STACK(urrt_can_put_raw_checked, (&sigs[i], 0x5555555555555555ull, frame));
+        STACK(urrt_can_scale_prepare, (&sigs[i], &scale));
+        STACK(urrt_can_to_raw_scaled, (&sigs[i], &scale, -values[i] * 1e10, &raw));
+        STACK(urrt_can_pack_scaled, (&sigs[i], &scale, values[i], frame));
     }
     STACK(urrt_can_layout_check, (sigs, 8, 64, &z1, &z2));
     STACK(urrt_can_pack_frame, (sigs, values, 8, frame, 64, outcomes));
     CHECK(urrt_can_layout_check(sigs, 8, 64, &z1, &z2) == 0, "CAN layout of the stack test", name, z1, z2);
     urrt_decode(v3->packet, v3->length, &st);
     stack_cantx(sigs);
+    stack_co();
 
     for (i = 0; i < stack_mark_count; i++) {
         target_puts("stack: ");
@@ -241,5 +331,5 @@ static void test_stack(void)
         target_put_uint(stack_marks[i].bytes);
         target_puts("\n");
     }
-    CHECK(stack_mark_count == 63, "public functions measured", name, stack_mark_count, 63);
+    CHECK(stack_mark_count == 82, "public functions measured", name, stack_mark_count, 82);
 }

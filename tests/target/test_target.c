@@ -11,6 +11,7 @@
 #include "test_vectors.h"
 #include "urrt.h"
 #include "../lib/state_slot.h"
+#include "../testutil.h"
 #include "urrt_can.h"
 #include "urrt_cantx.h"
 
@@ -200,15 +201,6 @@ static void test_vector(const tv_vector *v)
 
 /* ---- the framer -------------------------------------------------------------------- */
 
-static uint32_t rng = 0x2545F491u;
-static uint32_t rng_next(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 17;
-    rng ^= rng << 5;
-    return rng;
-}
-
 static urrt_framer framer;
 #define STREAM_PACKETS 3
 static uint8_t stream[STREAM_PACKETS * URRT_PACKET_MAX + 2 * 64];
@@ -225,9 +217,9 @@ static size_t make_stream(uint32_t length, size_t *at, size_t *garbage)
     for (p = 0; p < STREAM_PACKETS; p++) {
         size_t i;
         if (p > 0) {
-            size_t g = 1u + rng_next() % 64u;
+            size_t g = 1u + (uint32_t)test_rng() % 64u;
             for (i = 0; i < g; i++) {
-                stream[n++] = (uint8_t)(1u + rng_next() % 255u);
+                stream[n++] = (uint8_t)(1u + (uint32_t)test_rng() % 255u);
             }
             *garbage += g;
         }
@@ -237,7 +229,7 @@ static size_t make_stream(uint32_t length, size_t *at, size_t *garbage)
         stream[n++] = (uint8_t)(length >> 8);
         stream[n++] = (uint8_t)length;
         for (i = 4; i < length; i++) {
-            stream[n++] = (uint8_t)rng_next();
+            stream[n++] = (uint8_t)test_rng();
         }
     }
     return n;

@@ -45,8 +45,8 @@ Exit status: the script's, 124 when it (or the VM) timed out, 125 when the
 VM could not be prepared or gave no result (the reason is printed).
 
 Examples:
-  tests/vm/run.sh --script tests/vm/can-link.sh --modules sch_plug \
-      --files 'build/tests/can_link_test tests/lib.sh'
+  tests/vm/run.sh --script tests/port/can-link.sh --modules sch_plug \
+      --files 'build/tests/port/can_link_test tests/lib.sh tests/vm/counts.sh'
   tests/vm/run.sh -v --script my.sh --files 'build/bin/urrt-sim build/bin/urrt-gateway gw.ini' \
       --vcan 'vcan0:16' --out /tmp/e2e
 EOF

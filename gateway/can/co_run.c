@@ -1,0 +1,236 @@
+/* SPDX-License-Identifier: MIT */
+/* co_run.c: see co_run.h. */
+#include "co_run.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TYPE_EVENT 254u
+#define SDO_RX_BASE 0x600u
+#define SYNC_DEFAULT 0x080u
+
+struct co_run {
+    urrt_co co;
+    urrt_co_desc desc;
+    urrt_co_tpdo *tpdos;            /* the [frame]s' in TPDO order, then the status TPDO */
+    uint32_t *mappings;             /* URRT_CO_MAX_MAPPED per TPDO */
+    urrt_co_object *objects;
+    urrt_co_tpdo_state *states;
+    uint32_t var;                   /* no variables: urrt_co_init wants storage all the same */
+    uint32_t rx_ids[CO_RUN_RX_IDS];
+};
+
+void co_run_free(struct co_run *run)
+{
+    if (run == NULL) {
+        return;
+    }
+    free(run->tpdos);
+    free(run->mappings);
+    free(run->objects);
+    free(run->states);
+    free(run);
+}
+
+uint16_t co_run_values_index(unsigned tpdo)
+{
+    return (uint16_t)(CANOPEN_VALUES_INDEX + tpdo - 1u);
+}
+
+static uint32_t map_entry(uint16_t index, uint8_t sub, unsigned bits)
+{
+    return (uint32_t)index << 16 | (uint32_t)sub << 8 | bits;
+}
+
+/* A frame TPDO's mapping: its signals by byte, a dummy byte where none is. */
+static uint8_t frame_mapping(const struct can_map_frame *f, unsigned tpdo, uint32_t *out)
+{
+    uint8_t count = 0;
+    for (unsigned byte = 0; byte < f->len; byte++) {
+        bool mapped = false;
+        for (size_t k = 0; k < f->count && !mapped; k++) {
+            uint8_t type;
+            unsigned bytes;
+            if (f->sigs[k].start / 8u == byte &&
+                canopen_signal_object(&f->sigs[k], &f->meta[k], &type, &bytes, NULL, 0)) {
+                out[count++] = map_entry(co_run_values_index(tpdo), (uint8_t)(k + 1u), 8u * bytes);
+                byte += bytes - 1u;
+                mapped = true;
+            }
+        }
+        if (!mapped) {
+            out[count++] = map_entry(CANOPEN_DUMMY_U8, 0, 8);
+        }
+    }
+    return count;
+}
+
+static uint8_t status_type(const urrt_can_signal *sig)
+{
+    bool wide = sig->length > 8u;
+    if (sig->type == URRT_CAN_SIGNED) {
+        return wide ? URRT_CO_INTEGER16 : URRT_CO_INTEGER8;
+    }
+    return wide ? URRT_CO_UNSIGNED16 : URRT_CO_UNSIGNED8;
+}
+
+static urrt_co_object signal_object(uint16_t index, size_t sub, uint8_t type, size_t frame, size_t item)
+{
+    urrt_co_object o = {index, (uint8_t)sub, type, URRT_CO_RO, URRT_CO_SIGNAL, (uint16_t)frame, (uint16_t)item,
+                        0, 0, 0};
+    return o;
+}
+
+/* The status TPDO and its objects: [can]'s heartbeat frame. A signal that
+ * fills whole bytes is mapped; a byte of bit fields (state and alive counter,
+ * generation and flags) is an UNSIGNED8 dummy, as CiA 301 wants a mapped
+ * length to be its object's size: those objects are read by SDO. */
+static void status_tpdo(struct co_run *r, const struct can_map *can, size_t hb, size_t n, size_t *objects)
+{
+    uint32_t *mapping = &r->mappings[n * URRT_CO_MAX_MAPPED];
+    uint8_t count = 0;
+    for (size_t k = 0; k < URRT_CANTX_HB_COUNT; k++) {
+        r->objects[(*objects)++] = signal_object(CANOPEN_STATUS_INDEX, k + 1u,
+                                                 status_type(&urrt_cantx_heartbeat_signals[k]), hb, k);
+    }
+    for (unsigned byte = 0; byte < URRT_CANTX_HB_LEN; byte++) {
+        uint32_t entry = map_entry(CANOPEN_DUMMY_U8, 0, 8);
+        for (size_t k = 0; k < URRT_CANTX_HB_COUNT; k++) {
+            const urrt_can_signal *sig = &urrt_cantx_heartbeat_signals[k];
+            if (sig->start == 8u * byte && sig->length % 8u == 0u) {
+                entry = map_entry(CANOPEN_STATUS_INDEX, (uint8_t)(k + 1u), sig->length);
+                byte += sig->length / 8u - 1u;
+            }
+        }
+        mapping[count++] = entry;
+    }
+    r->tpdos[n] = (urrt_co_tpdo){mapping, URRT_CO_COB_INVALID | can->hb_id, (uint16_t)hb, 0, TYPE_EVENT, count};
+}
+
+static void frame_tpdos(struct co_run *r, const struct canopen_map *co, const struct can_map *can, size_t *objects)
+{
+    for (size_t i = 0; i < can->frame_count; i++) {
+        const struct can_map_frame *f = &can->frames[i];
+        unsigned tpdo = co->tpdo_of[i];
+        uint32_t *mapping = &r->mappings[(tpdo - 1u) * URRT_CO_MAX_MAPPED];
+        for (size_t k = 0; k < f->count; k++) {
+            uint8_t type = 0;
+            unsigned bytes;
+            (void)canopen_signal_object(&f->sigs[k], &f->meta[k], &type, &bytes, NULL, 0);
+            r->objects[(*objects)++] = signal_object(co_run_values_index(tpdo), k + 1u, type, i, k);
+        }
+        r->tpdos[tpdo - 1u] = (urrt_co_tpdo){
+            mapping, co->frames[i].own_id ? f->id : URRT_CO_COB_DEFAULT, (uint16_t)i, 0,
+            (uint8_t)(co->frames[i].sync_every != 0 ? co->frames[i].sync_every : TYPE_EVENT),
+            frame_mapping(f, tpdo, mapping)};
+    }
+}
+
+static void describe(struct co_run *r, const struct canopen_map *co, const struct can_map *can, size_t tpdos,
+                     size_t objects)
+{
+    urrt_co_desc *d = &r->desc;
+    d->node_id = (uint8_t)co->node_id;
+    d->nmt_start = co->nmt_start;
+    d->heartbeat_ms = (uint16_t)co->heartbeat_ms;
+    d->sdo_timeout_ms = (uint16_t)co->sdo_timeout_ms;
+    d->stale_after_us = can->stale_after_ms * 1000u;
+    d->device_type = co->device_type;
+    d->vendor_id = co->vendor_id;
+    d->product_code = co->product_code;
+    d->revision = co->revision;
+    d->serial = co->serial;
+    d->device_name = co->device_name;
+    d->hardware_version = co->hardware_version;
+    d->software_version = URRT_VERSION_STRING;
+    d->tpdos = r->tpdos;
+    d->tpdo_count = tpdos;
+    d->objects = r->objects;
+    d->object_count = objects;
+    r->rx_ids[0] = 0x000u;
+    r->rx_ids[1] = SYNC_DEFAULT;
+    r->rx_ids[2] = SDO_RX_BASE + co->node_id;
+}
+
+static int node_init(struct co_run *r, struct can_run *run, char *err, size_t errlen)
+{
+    size_t bad;
+    int rc = urrt_co_init(&r->co, &r->desc, can_run_tx(run), r->states, &r->var, 1, &bad);
+    if (rc < 0) {
+        snprintf(err, errlen, "the CANopen node (lib/urrt_co) refuses the configuration (%s %zu): %s",
+                 rc == URRT_CO_E_OBJECT ? "object" : "TPDO", bad == SIZE_MAX ? 0 : bad + 1, urrt_co_strerror(rc));
+    }
+    return rc;
+}
+
+struct co_run *co_run_build(const struct canopen_map *co, const struct can_map *can, struct can_run *run, char *err,
+                            size_t errlen)
+{
+    size_t tpdos = can->frame_count + 1u;
+    size_t objects = URRT_CANTX_HB_COUNT;
+    size_t made = 0;
+    struct co_run *r = calloc(1, sizeof *r);
+    for (size_t i = 0; i < can->frame_count; i++) {
+        objects += can->frames[i].count;
+    }
+    if (r != NULL) {
+        r->tpdos = calloc(tpdos, sizeof *r->tpdos);
+        r->mappings = calloc(tpdos * URRT_CO_MAX_MAPPED, sizeof *r->mappings);
+        r->objects = calloc(objects, sizeof *r->objects);
+        r->states = calloc(tpdos, sizeof *r->states);
+    }
+    if (r == NULL || r->tpdos == NULL || r->mappings == NULL || r->objects == NULL || r->states == NULL) {
+        co_run_free(r);
+        snprintf(err, errlen, "CANopen node: out of memory");
+        return NULL;
+    }
+    frame_tpdos(r, co, can, &made);
+    status_tpdo(r, can, can_run_heartbeat_index(run), tpdos - 1u, &made);
+    describe(r, co, can, tpdos, made);
+    if (node_init(r, run, err, errlen) < 0) {
+        co_run_free(r);
+        return NULL;
+    }
+    return r;
+}
+
+urrt_co *co_run_node(struct co_run *run)
+{
+    return &run->co;
+}
+
+const urrt_co_desc *co_run_desc(const struct co_run *run)
+{
+    return &run->desc;
+}
+
+bool co_run_mapped(const struct co_run *run, uint16_t index, uint8_t sub)
+{
+    const urrt_co_desc *d = &run->desc;
+    for (size_t n = 0; n < d->tpdo_count; n++) {
+        for (size_t i = 0; i < d->tpdos[n].mapping_count; i++) {
+            if (d->tpdos[n].mapping[i] >> 8 == ((uint32_t)index << 8 | sub)) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+const uint32_t *co_run_rx_ids(const struct co_run *run, size_t *count)
+{
+    *count = CO_RUN_RX_IDS;
+    return run->rx_ids;
+}
+
+int co_run_describe(const struct co_run *run, char *buf, size_t size)
+{
+    const urrt_co_desc *d = &run->desc;
+    return snprintf(buf, size,
+                    "node %u: TPDO1..%zu + status TPDO%zu (off until enabled), heartbeat %u ms at 0x%X, EMCY 0x%X, "
+                    "SDO 0x%X/0x%X, starts %s",
+                    (unsigned)d->node_id, d->tpdo_count - 1u, d->tpdo_count, (unsigned)d->heartbeat_ms,
+                    0x700u + d->node_id, 0x080u + d->node_id, SDO_RX_BASE + d->node_id, 0x580u + d->node_id,
+                    canopen_nmt_start_name(d->nmt_start));
+}

@@ -1,0 +1,28 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * eds: `urrt-gateway --print-eds`, the Electronic Data Sheet (CiA 306,
+ * version 4.0) of a configuration's CANopen node, written from the very
+ * description the node runs on (co_run.h): the TPDOs, their mappings and
+ * defaults, the manufacturer objects. A PLC's CANopen manager (CODESYS,
+ * TwinCAT, ...) imports it; it cannot disagree with the node.
+ *
+ * Where a PLC engineer sees the scaling: each mapped value's ParameterName
+ * carries its physical meaning ("q0: q_actual[0], rad = raw x 0.0002"), the
+ * name an import shows beside each PDO channel; [Comments] repeats every
+ * value with its limits and the raw value that means "not available".
+ */
+#ifndef URRT_GATEWAY_EDS_H
+#define URRT_GATEWAY_EDS_H
+
+#include <stdio.h>
+
+#include "can_map.h"
+#include "canopen_map.h"
+#include "co_run.h"
+
+/* Writes the EDS (source: the configuration's name for FileInfo's
+ * Description; NULL: none). 0, or -1 when the stream failed. */
+int eds_write(FILE *out, struct co_run *run, const struct canopen_map *co, const struct can_map *can,
+              const char *source);
+
+#endif

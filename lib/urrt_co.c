@@ -1,0 +1,1084 @@
+/* SPDX-License-Identifier: MIT */
+/* urrt_co: see urrt_co.h and docs/canopen.md. Freestanding C99, like urrt_cantx.c. */
+#include "urrt_co.h"
+
+#include <stdint.h>
+
+#define NONE SIZE_MAX
+#define MAX_NODE_ID 127u
+#define MAX_TPDOS 512u
+#define ID_MASK 0x7FFu
+#define COB_RTR UINT32_C(0x40000000)   /* TPDO COB-ID bit 30: no RTR allowed (stored, never served) */
+#define SYNC_DEFAULT 0x080u
+#define EMCY_BASE 0x080u
+#define SDO_RX_BASE 0x600u
+#define SDO_TX_BASE 0x580u
+#define NMT_EC_BASE 0x700u             /* boot-up and heartbeat */
+#define TPDO_COMM 0x1800u
+#define TPDO_MAP 0x1A00u
+#define TPDO_COMM_SUBS 5u              /* 0x1800+n sub 0: highest sub-index (4 is reserved, 6 unsupported) */
+#define IDENTITY_SUBS 4u
+#define MFR_FIRST 0x2000u
+#define MFR_LAST 0x5FFFu
+#define SYNC_MAX_N 240u                /* transmission types 1..240: every nth SYNC */
+#define TYPE_EVENT_MFR 254u            /* 254, 255: the event timer */
+#define SEG_BYTES 7u                   /* data bytes of an SDO segment */
+#define SDO_LEN 8u
+
+/* SDO command bytes (CiA 301 7.2.4.3): the command specifier in bits 7..5. */
+#define CS_DOWNLOAD_SEGMENT 0u
+#define CS_DOWNLOAD 1u
+#define CS_UPLOAD 2u
+#define CS_UPLOAD_SEGMENT 3u
+#define CS_ABORT 4u
+#define SDO_EXPEDITED 0x02u
+#define SDO_SIZE_SET 0x01u
+#define SDO_TOGGLE 0x10u
+#define SDO_LAST 0x01u
+
+/* Conditions: bit i of urrt_co.active, with its EMCY code and error register bits. */
+enum { COND_LINK, COND_STALE, COND_OVERRUN, COND_PASSIVE, COND_BUS_OFF };
+#define ERR_GENERIC 0x01u
+#define ERR_COMMUNICATION 0x10u
+#define ERR_MANUFACTURER 0x80u
+static const uint16_t condition_codes[URRT_CO_CONDITIONS] = {
+    URRT_CO_EMCY_ROBOT_LINK, URRT_CO_EMCY_ROBOT_STALE, URRT_CO_EMCY_CAN_OVERRUN, URRT_CO_EMCY_ERROR_PASSIVE,
+    URRT_CO_EMCY_BUS_OFF,
+};
+#define ROBOT_CONDITIONS ((1u << COND_LINK) | (1u << COND_STALE))
+
+const char *urrt_co_strerror(int result)
+{
+    switch (result) {
+    case URRT_CO_E_NODE_ID: return "the node id is outside 1..127, or nmt_start is unknown";
+    case URRT_CO_E_TPDO: return "a TPDO's frame, transmission type, period, mapping or COB-ID is not usable";
+    case URRT_CO_E_OBJECT: return "a manufacturer object's index, type, access, source or range is not usable";
+    case URRT_CO_E_STORAGE: return "the CANopen node lacks its urrt_cantx, TPDO states or variables";
+    default: return urrt_cantx_strerror(result);
+    }
+}
+
+/* ---- small helpers ------------------------------------------------------------ */
+
+static void put_le(uint8_t *to, uint32_t value, uint32_t bytes)
+{
+    uint32_t i;
+    for (i = 0; i < bytes; i++) {
+        to[i] = (uint8_t)(value >> (8u * i));
+    }
+}
+
+static uint32_t get_le32(const uint8_t *from)
+{
+    return (uint32_t)from[0] | (uint32_t)from[1] << 8 | (uint32_t)from[2] << 16 | (uint32_t)from[3] << 24;
+}
+
+static uint32_t text_len(const char *s)
+{
+    uint32_t n = 0;
+    while (s != NULL && s[n] != '\0' && n < UINT16_MAX) {
+        n++;
+    }
+    return n;
+}
+
+static uint32_t type_size(uint8_t type)
+{
+    switch (type) {
+    case URRT_CO_INTEGER8:
+    case URRT_CO_UNSIGNED8: return 1;
+    case URRT_CO_INTEGER16:
+    case URRT_CO_UNSIGNED16: return 2;
+    case URRT_CO_INTEGER32:
+    case URRT_CO_UNSIGNED32:
+    case URRT_CO_REAL32: return 4;
+    default: return 0;
+    }
+}
+
+static bool type_signed(uint8_t type)
+{
+    return type == URRT_CO_INTEGER8 || type == URRT_CO_INTEGER16 || type == URRT_CO_INTEGER32;
+}
+
+static uint32_t size_mask(uint32_t bytes)
+{
+    return bytes >= 4u ? UINT32_MAX : (UINT32_C(1) << (8u * bytes)) - 1u;
+}
+
+/* An order-keeping unsigned key for a value of the type: signed values with
+ * their sign bit flipped compare as unsigned ones (no implementation-defined
+ * conversion to int32_t). */
+static uint32_t order_key(uint32_t raw, uint8_t type)
+{
+    uint32_t bytes = type_size(type);
+    uint32_t sign = UINT32_C(1) << (8u * bytes - 1u);
+    if (!type_signed(type)) {
+        return raw;
+    }
+    raw &= size_mask(bytes);
+    if ((raw & sign) != 0u) {
+        raw |= ~size_mask(bytes);
+    }
+    return raw ^ UINT32_C(0x80000000);
+}
+
+static uint64_t min64(uint64_t a, uint64_t b)
+{
+    return a < b ? a : b;
+}
+
+static bool cob_valid(uint32_t cob)
+{
+    return (cob & URRT_CO_COB_INVALID) == 0u;
+}
+
+/* CiA 301's restricted CAN-IDs: NMT, SYNC/EMCY of others, SDO, NMT error
+ * control and the LSS range; no PDO, EMCY or SYNC may use them. */
+static bool id_restricted(uint32_t id)
+{
+    return id <= 0x07Fu || (id >= 0x101u && id <= 0x180u) || (id >= 0x581u && id <= 0x5FFu) ||
+           (id >= 0x601u && id <= 0x67Fu) || (id >= 0x6E0u && id <= 0x6FFu) || id >= 0x701u;
+}
+
+/* A COB-ID with a "not valid" bit 31 (EMCY, TPDO): 11-bit ids only, the
+ * id changes only while the old value is invalid (CiA 301: set bit 31,
+ * write the new id, clear bit 31), and a valid id is not a restricted one. */
+static uint32_t cob_check(uint32_t old, uint32_t value, uint32_t also_allowed)
+{
+    if ((value & ~(URRT_CO_COB_INVALID | also_allowed | ID_MASK)) != 0u) {
+        return URRT_CO_ABORT_VALUE;
+    }
+    if (cob_valid(old) && ((old ^ value) & ID_MASK) != 0u) {
+        return URRT_CO_ABORT_VALUE;
+    }
+    return cob_valid(value) && id_restricted(value & ID_MASK) ? URRT_CO_ABORT_VALUE : 0u;
+}
+
+/* ---- checks, once --------------------------------------------------------------- */
+
+static bool type_supported(uint8_t type)
+{
+    return type_size(type) != 0u;
+}
+
+static int check_tpdo(const urrt_co_desc *d, const urrt_cantx *tx, size_t n)
+{
+    const urrt_co_tpdo *p = &d->tpdos[n];
+    const urrt_cantx_frame *f;
+    uint32_t bits = 0;
+    size_t i;
+    if (p->frame >= tx->tables->frame_count || p->mapping_count > URRT_CO_MAX_MAPPED ||
+        (p->mapping_count > 0u && p->mapping == NULL)) {
+        return URRT_CO_E_TPDO;
+    }
+    for (i = 0; i < n; i++) {
+        if (d->tpdos[i].frame == p->frame) {
+            return URRT_CO_E_TPDO;
+        }
+    }
+    f = &tx->tables->frames[p->frame];
+    for (i = 0; i < p->mapping_count; i++) {
+        bits += p->mapping[i] & 0xFFu;
+    }
+    if ((f->flags & (URRT_CANTX_EXTENDED | URRT_CANTX_FD)) != 0u || bits > 8u * f->len ||
+        f->period_us % 1000u != 0u || f->period_us / 1000u > UINT16_MAX) {
+        return URRT_CO_E_TPDO;
+    }
+    if (p->transmission_type == 0u || (p->transmission_type > SYNC_MAX_N && p->transmission_type < TYPE_EVENT_MFR)) {
+        return URRT_CO_E_TPDO;
+    }
+    return p->cob_id != URRT_CO_COB_DEFAULT && cob_check(URRT_CO_COB_INVALID, p->cob_id, COB_RTR) != 0u
+               ? URRT_CO_E_TPDO
+               : 0;
+}
+
+static bool signal_fits(const urrt_co_object *o, const urrt_cantx *tx)
+{
+    const urrt_cantx_frame *f;
+    const urrt_can_signal *sig;
+    if (o->frame >= tx->tables->frame_count || o->item >= tx->tables->frames[o->frame].signal_count ||
+        o->access != URRT_CO_RO) {
+        return false;
+    }
+    f = &tx->tables->frames[o->frame];
+    sig = &f->signals[o->item];
+    if ((o->type == URRT_CO_REAL32) != (sig->type == (uint8_t)URRT_CAN_FLOAT32)) {
+        return false;
+    }
+    return sig->length <= 8u * type_size(o->type);
+}
+
+static bool var_fits(const urrt_co_object *o, const uint32_t *vars, size_t var_count)
+{
+    uint32_t def = order_key(o->def, o->type);
+    return vars != NULL && o->item < var_count && (o->def & ~size_mask(type_size(o->type))) == 0u &&
+           def >= order_key(o->min, o->type) && def <= order_key(o->max, o->type);
+}
+
+static int check_object(const urrt_co_desc *d, const urrt_cantx *tx, size_t i, const uint32_t *vars,
+                        size_t var_count)
+{
+    const urrt_co_object *o = &d->objects[i];
+    bool ok = o->index >= MFR_FIRST && o->index <= MFR_LAST && type_supported(o->type) && o->access >= URRT_CO_RO &&
+              o->access <= URRT_CO_RW;
+    size_t j;
+    if (ok) {
+        ok = o->kind == URRT_CO_SIGNAL ? signal_fits(o, tx) : o->kind == URRT_CO_VAR && var_fits(o, vars, var_count);
+    }
+    for (j = 0; ok && j < i; j++) {
+        const urrt_co_object *e = &d->objects[j];
+        ok = e->index != o->index || (e->sub != o->sub && e->sub != 0u && o->sub != 0u);
+    }
+    return ok ? 0 : URRT_CO_E_OBJECT;
+}
+
+static int check_desc(const urrt_co_desc *d, const urrt_cantx *tx, const uint32_t *vars, size_t var_count,
+                      size_t *bad)
+{
+    int rc = 0;
+    size_t i;
+    if (d->node_id < 1u || d->node_id > MAX_NODE_ID || d->nmt_start > URRT_CO_START_OPERATIONAL) {
+        return URRT_CO_E_NODE_ID;
+    }
+    if (d->tpdo_count > MAX_TPDOS) {
+        return URRT_CO_E_TPDO;
+    }
+    for (i = 0; rc == 0 && i < d->tpdo_count; i++) {
+        *bad = i;
+        rc = check_tpdo(d, tx, i);
+    }
+    for (i = 0; rc == 0 && i < d->object_count; i++) {
+        *bad = i;
+        rc = check_object(d, tx, i, vars, var_count);
+    }
+    return rc;
+}
+
+int urrt_co_init(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urrt_co_tpdo_state *tpdo_states,
+                 uint32_t *vars, size_t var_count, size_t *bad_item)
+{
+    size_t bad = NONE;
+    int rc = 0;
+    if (co == NULL || desc == NULL) {
+        rc = URRT_E_ARG;
+    } else if (tx == NULL || tx->tables == NULL ||
+               (desc->tpdo_count > 0u && (tpdo_states == NULL || desc->tpdos == NULL)) ||
+               (desc->object_count > 0u && desc->objects == NULL)) {
+        rc = URRT_CO_E_STORAGE;
+    } else {
+        rc = check_desc(desc, tx, vars, var_count, &bad);
+    }
+    if (bad_item != NULL) {
+        *bad_item = rc == 0 ? NONE : bad;
+    }
+    if (rc < 0) {
+        return rc;
+    }
+    co->desc = desc;
+    co->tx = tx;
+    co->tpdos = tpdo_states;
+    co->vars = vars;
+    co->state = (uint8_t)URRT_CO_INITIALISING;
+    co->heartbeat_due_us = URRT_CANTX_NEVER;
+    co->sdo_busy = false;
+    co->error_passive = false;
+    return 0;
+}
+
+/* ---- frames out ------------------------------------------------------------------- */
+
+static uint8_t *frame_begin(urrt_co *co, uint32_t id, uint8_t len)
+{
+    unsigned i;
+    co->out.id = id;
+    co->out.extended = false;
+    co->out.fd = false;
+    co->out.len = len;
+    for (i = 0; i < URRT_CAN_CLASSIC_MAX_LEN; i++) {
+        co->out.data[i] = 0;
+    }
+    return co->out.data;
+}
+
+static size_t frame_send(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    if (emit != NULL) {
+        emit(ctx, &co->out, now_us);
+    }
+    return 1;
+}
+
+/* ---- TPDOs: the node's 0x18xx values onto urrt_cantx --------------------------------- */
+
+static const urrt_co_tpdo *tpdo_desc(const urrt_co *co, size_t n)
+{
+    return &co->desc->tpdos[n];
+}
+
+static void gates_apply(urrt_co *co)
+{
+    bool operational = co->state == (uint8_t)URRT_CO_OPERATIONAL;
+    size_t i;
+    for (i = 0; i < co->tx->tables->frame_count; i++) {
+        urrt_cantx_gate(co->tx, i, operational);
+    }
+    for (i = 0; i < co->desc->tpdo_count; i++) {
+        const urrt_co_tpdo_state *t = &co->tpdos[i];
+        urrt_cantx_gate(co->tx, tpdo_desc(co, i)->frame,
+                        operational && cob_valid(t->cob_id) && t->type >= TYPE_EVENT_MFR);
+    }
+}
+
+/* The frame's period from the event timer and the inhibit time: the later
+ * of the two (0: with every packet). Refused when the frame's stale policy
+ * needs a period. */
+static uint32_t tpdo_timing(urrt_co *co, size_t n, uint16_t inhibit_100us, uint16_t event_ms, uint64_t now_us)
+{
+    uint32_t event_us = (uint32_t)event_ms * 1000u;
+    uint32_t inhibit_us = (uint32_t)inhibit_100us * 100u;
+    urrt_co_tpdo_state *t = &co->tpdos[n];
+    if (urrt_cantx_set_period(co->tx, tpdo_desc(co, n)->frame, event_us > inhibit_us ? event_us : inhibit_us,
+                              now_us) < 0) {
+        return URRT_CO_ABORT_TOO_LOW;
+    }
+    t->inhibit_100us = inhibit_100us;
+    t->event_ms = event_ms;
+    return 0;
+}
+
+static uint32_t tpdo_cob_default(const urrt_co *co, size_t n)
+{
+    const urrt_co_tpdo *p = tpdo_desc(co, n);
+    if (p->cob_id != URRT_CO_COB_DEFAULT) {
+        return p->cob_id;
+    }
+    return n < 4u ? 0x180u + 0x100u * (uint32_t)n + co->desc->node_id : URRT_CO_COB_INVALID;
+}
+
+static void tpdo_defaults(urrt_co *co, uint64_t now_us)
+{
+    size_t n;
+    for (n = 0; n < co->desc->tpdo_count; n++) {
+        const urrt_co_tpdo *p = tpdo_desc(co, n);
+        urrt_co_tpdo_state *t = &co->tpdos[n];
+        /* A 32-bit division, at a reset only; urrt_co_init saw it fits. */
+        uint16_t event_ms = (uint16_t)(co->tx->tables->frames[p->frame].period_us / 1000u);
+        t->cob_id = tpdo_cob_default(co, n);
+        t->type = p->transmission_type;
+        t->syncs = 0;
+        (void)urrt_cantx_set_id(co->tx, p->frame, t->cob_id & ID_MASK);
+        (void)tpdo_timing(co, n, p->inhibit_100us, event_ms, now_us);
+    }
+}
+
+/* No two valid TPDOs on one id. */
+static bool tpdo_id_taken(const urrt_co *co, size_t n, uint32_t id)
+{
+    size_t i;
+    for (i = 0; i < co->desc->tpdo_count; i++) {
+        if (i != n && cob_valid(co->tpdos[i].cob_id) && (co->tpdos[i].cob_id & ID_MASK) == id) {
+            return true;
+        }
+    }
+    return false;
+}
+
+static uint32_t tpdo_write(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
+{
+    urrt_co_tpdo_state *t = &co->tpdos[n];
+    uint32_t abort = 0;
+    switch (sub) {
+    case 1:
+        abort = cob_check(t->cob_id, value, COB_RTR);
+        if (abort == 0u && cob_valid(value) && tpdo_id_taken(co, n, value & ID_MASK)) {
+            abort = URRT_CO_ABORT_VALUE;
+        }
+        if (abort == 0u) {
+            t->cob_id = value;
+            (void)urrt_cantx_set_id(co->tx, tpdo_desc(co, n)->frame, value & ID_MASK);
+        }
+        break;
+    case 2:
+        if (value == 0u) {
+            return URRT_CO_ABORT_TOO_LOW; /* acyclic synchronous: not supported */
+        }
+        if (value > SYNC_MAX_N && value < TYPE_EVENT_MFR) {
+            return URRT_CO_ABORT_TOO_HIGH; /* reserved, or RTR only: not supported */
+        }
+        t->type = (uint8_t)value;
+        t->syncs = 0;
+        break;
+    case 3:
+        /* CiA 301: the inhibit time changes only while the PDO is not valid. */
+        return cob_valid(t->cob_id) ? URRT_CO_ABORT_VALUE
+                                    : tpdo_timing(co, n, (uint16_t)value, t->event_ms, now_us);
+    default: return tpdo_timing(co, n, t->inhibit_100us, (uint16_t)value, now_us);
+    }
+    gates_apply(co);
+    return abort;
+}
+
+/* ---- errors: 0x1001, 0x1003, EMCY ----------------------------------------------------- */
+
+uint8_t urrt_co_error_register(const urrt_co *co)
+{
+    uint8_t reg = 0;
+    if (co == NULL || co->active == 0u) {
+        return 0;
+    }
+    reg = (co->active & ROBOT_CONDITIONS) != 0u ? ERR_MANUFACTURER : 0u;
+    reg = (uint8_t)(reg | ((co->active & ~ROBOT_CONDITIONS) != 0u ? ERR_COMMUNICATION : 0u));
+    return (uint8_t)(reg | ERR_GENERIC);
+}
+
+static void history_push(urrt_co *co, uint16_t code)
+{
+    unsigned i;
+    for (i = URRT_CO_HISTORY - 1u; i > 0u; i--) {
+        co->errors[i] = co->errors[i - 1u];
+    }
+    co->errors[0] = code;
+    co->error_count = (uint8_t)(co->error_count < URRT_CO_HISTORY ? co->error_count + 1u : URRT_CO_HISTORY);
+}
+
+static void errors_reset(urrt_co *co)
+{
+    co->active = 0;
+    co->reported = 0;
+    co->error_count = 0;
+    co->emcy_sent = false;
+    co->seen_dropped = co->tx->link.dropped;
+    co->seen_bus_off = co->tx->link.bus_off;
+    co->overrun_until_us = 0;
+    co->bus_off_until_us = 0;
+}
+
+static uint8_t robot_conditions(const urrt_co *co, uint64_t now_us)
+{
+    uint8_t found = 0;
+    size_t i;
+    for (i = 0; i < co->tx->tables->robot_count; i++) {
+        urrt_cantx_state s = urrt_cantx_robot_state(co->tx, i, now_us, co->desc->stale_after_us);
+        found = (uint8_t)(found | (s == URRT_CANTX_DISCONNECTED ? 1u << COND_LINK : 0u) |
+                          (s == URRT_CANTX_DATA_STALE ? 1u << COND_STALE : 0u));
+    }
+    return found;
+}
+
+static void conditions_update(urrt_co *co, uint64_t now_us)
+{
+    const urrt_cantx_link *link = &co->tx->link;
+    uint8_t active = robot_conditions(co, now_us);
+    uint8_t started;
+    unsigned i;
+    if (link->dropped != co->seen_dropped) {
+        co->seen_dropped = link->dropped;
+        co->overrun_until_us = now_us + URRT_CO_EVENT_HOLD_US;
+    }
+    if (link->bus_off != co->seen_bus_off) {
+        co->seen_bus_off = link->bus_off;
+        co->bus_off_until_us = now_us + URRT_CO_EVENT_HOLD_US;
+    }
+    active = (uint8_t)(active | (now_us < co->overrun_until_us ? 1u << COND_OVERRUN : 0u) |
+                       (co->error_passive ? 1u << COND_PASSIVE : 0u) |
+                       (now_us < co->bus_off_until_us ? 1u << COND_BUS_OFF : 0u));
+    started = (uint8_t)(active & ~co->active);
+    for (i = 0; i < URRT_CO_CONDITIONS; i++) {
+        if (((unsigned)started >> i & 1u) != 0u) {
+            history_push(co, condition_codes[i]);
+        }
+    }
+    co->active = active;
+}
+
+static bool emcy_may_send(const urrt_co *co)
+{
+    return (co->state == (uint8_t)URRT_CO_PRE_OPERATIONAL || co->state == (uint8_t)URRT_CO_OPERATIONAL) &&
+           co->active != co->reported;
+}
+
+static uint64_t emcy_due(const urrt_co *co)
+{
+    return co->emcy_sent ? co->emcy_last_us + (uint64_t)co->emcy_inhibit_100us * 100u : 0u;
+}
+
+/* One EMCY per condition that started or ended since the last, in order,
+ * as the inhibit time (0x1015) allows. A reset EMCY names the code it
+ * clears in its manufacturer bytes 3-4. */
+static size_t emcy_send(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    size_t sent = 0;
+    unsigned i;
+    if (!emcy_may_send(co)) {
+        return 0;
+    }
+    if (!cob_valid(co->emcy_cob_id)) {
+        co->reported = co->active; /* no EMCY object: nothing to tell later */
+        return 0;
+    }
+    for (i = 0; i < URRT_CO_CONDITIONS && now_us >= emcy_due(co); i++) {
+        uint8_t bit = (uint8_t)(1u << i);
+        uint8_t *data;
+        if (((co->active ^ co->reported) & bit) == 0u) {
+            continue;
+        }
+        data = frame_begin(co, co->emcy_cob_id & ID_MASK, 8);
+        if ((co->active & bit) != 0u) {
+            put_le(data, condition_codes[i], 2);
+        } else {
+            put_le(data + 3, condition_codes[i], 2);
+        }
+        data[2] = urrt_co_error_register(co);
+        co->reported ^= bit;
+        co->emcy_last_us = now_us;
+        co->emcy_sent = true;
+        sent += frame_send(co, now_us, emit, ctx);
+    }
+    return sent;
+}
+
+void urrt_co_set_error_passive(urrt_co *co, bool passive)
+{
+    if (co != NULL) {
+        co->error_passive = passive;
+    }
+}
+
+/* ---- NMT ------------------------------------------------------------------------------ */
+
+urrt_co_nmt urrt_co_state(const urrt_co *co)
+{
+    return co == NULL ? URRT_CO_INITIALISING : (urrt_co_nmt)co->state;
+}
+
+const char *urrt_co_state_name(urrt_co_nmt state)
+{
+    switch (state) {
+    case URRT_CO_INITIALISING: return "INITIALISING";
+    case URRT_CO_STOPPED: return "STOPPED";
+    case URRT_CO_OPERATIONAL: return "OPERATIONAL";
+    case URRT_CO_PRE_OPERATIONAL: return "PRE-OPERATIONAL";
+    default: return "UNKNOWN";
+    }
+}
+
+static void nmt_enter(urrt_co *co, urrt_co_nmt state)
+{
+    size_t n;
+    if (state == URRT_CO_OPERATIONAL && co->state != (uint8_t)URRT_CO_OPERATIONAL) {
+        for (n = 0; n < co->desc->tpdo_count; n++) {
+            co->tpdos[n].syncs = 0;
+        }
+    }
+    if (state == URRT_CO_STOPPED) {
+        co->sdo_busy = false; /* no SDO while stopped: the client times out */
+    }
+    co->state = (uint8_t)state;
+    gates_apply(co);
+}
+
+static void heartbeat_restart(urrt_co *co, uint64_t now_us)
+{
+    co->heartbeat_due_us = co->heartbeat_ms == 0u ? URRT_CANTX_NEVER : now_us + (uint64_t)co->heartbeat_ms * 1000u;
+}
+
+/* Reset communication: 0x1000-0x1FFF to their defaults, then the boot-up.
+ * Reset node also resets the application: the variables and urrt_cantx. */
+static size_t boot(urrt_co *co, uint64_t now_us, bool whole_node, urrt_cantx_emit_fn emit, void *ctx)
+{
+    const urrt_co_desc *d = co->desc;
+    size_t i;
+    if (whole_node) {
+        for (i = 0; i < d->object_count; i++) {
+            if (d->objects[i].kind == URRT_CO_VAR) {
+                co->vars[d->objects[i].item] = d->objects[i].def;
+            }
+        }
+        urrt_cantx_start(co->tx, now_us);
+    }
+    co->state = (uint8_t)URRT_CO_INITIALISING;
+    co->sdo_busy = false;
+    co->heartbeat_ms = d->heartbeat_ms;
+    co->sync_cob_id = SYNC_DEFAULT;
+    co->emcy_cob_id = EMCY_BASE + d->node_id;
+    co->emcy_inhibit_100us = 0;
+    errors_reset(co);
+    tpdo_defaults(co, now_us);
+    frame_begin(co, NMT_EC_BASE + d->node_id, 1);
+    (void)frame_send(co, now_us, emit, ctx);
+    nmt_enter(co, d->nmt_start == URRT_CO_START_OPERATIONAL ? URRT_CO_OPERATIONAL : URRT_CO_PRE_OPERATIONAL);
+    heartbeat_restart(co, now_us);
+    return 1;
+}
+
+size_t urrt_co_start(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    return co == NULL || co->desc == NULL ? 0 : boot(co, now_us, true, emit, ctx);
+}
+
+/* [cs, node]: node 0 is every node; unknown commands are ignored. */
+static size_t nmt_command(urrt_co *co, const uint8_t *data, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    if (data[1] != 0u && data[1] != co->desc->node_id) {
+        return 0;
+    }
+    switch (data[0]) {
+    case URRT_CO_NMT_START: nmt_enter(co, URRT_CO_OPERATIONAL); return 0;
+    case URRT_CO_NMT_STOP: nmt_enter(co, URRT_CO_STOPPED); return 0;
+    case URRT_CO_NMT_PRE_OPERATIONAL: nmt_enter(co, URRT_CO_PRE_OPERATIONAL); return 0;
+    case URRT_CO_NMT_RESET_NODE: return boot(co, now_us, true, emit, ctx);
+    case URRT_CO_NMT_RESET_COMM: return boot(co, now_us, false, emit, ctx);
+    default: return 0;
+    }
+}
+
+/* Every nth SYNC, in OPERATIONAL, a valid TPDO of type n goes out. */
+static size_t sync_received(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    size_t sent = 0;
+    size_t n;
+    if (co->state != (uint8_t)URRT_CO_OPERATIONAL) {
+        return 0;
+    }
+    for (n = 0; n < co->desc->tpdo_count; n++) {
+        urrt_co_tpdo_state *t = &co->tpdos[n];
+        if (t->type > SYNC_MAX_N || ++t->syncs < t->type) {
+            continue;
+        }
+        t->syncs = 0;
+        if (cob_valid(t->cob_id)) {
+            sent += urrt_cantx_trigger(co->tx, tpdo_desc(co, n)->frame, now_us, emit, ctx);
+        }
+    }
+    return sent;
+}
+
+/* ---- the object dictionary ------------------------------------------------------------- */
+
+typedef struct od_entry {
+    uint32_t value;
+    const char *text;               /* a string: its bytes, `size` of them */
+    const urrt_co_object *object;   /* a manufacturer object */
+    uint32_t size;
+    uint8_t access;
+} od_entry;
+
+static uint32_t od_value(od_entry *e, uint32_t value, uint32_t size, uint8_t access)
+{
+    e->value = value;
+    e->size = size;
+    e->access = access;
+    return 0;
+}
+
+static uint32_t od_var(od_entry *e, uint8_t sub, uint32_t value, uint32_t size, uint8_t access)
+{
+    return sub != 0u ? URRT_CO_ABORT_NO_SUB : od_value(e, value, size, access);
+}
+
+static uint32_t od_text(od_entry *e, uint8_t sub, const char *text)
+{
+    if (sub != 0u) {
+        return URRT_CO_ABORT_NO_SUB;
+    }
+    e->text = text != NULL ? text : "";
+    return od_value(e, 0, text_len(text), URRT_CO_RO);
+}
+
+static uint32_t od_identity(const urrt_co_desc *d, od_entry *e, uint8_t sub)
+{
+    switch (sub) {
+    case 0: return od_value(e, IDENTITY_SUBS, 1, URRT_CO_RO);
+    case 1: return od_value(e, d->vendor_id, 4, URRT_CO_RO);
+    case 2: return od_value(e, d->product_code, 4, URRT_CO_RO);
+    case 3: return od_value(e, d->revision, 4, URRT_CO_RO);
+    case 4: return od_value(e, d->serial, 4, URRT_CO_RO);
+    default: return URRT_CO_ABORT_NO_SUB;
+    }
+}
+
+static uint32_t od_errors(const urrt_co *co, od_entry *e, uint8_t sub)
+{
+    if (sub == 0u) {
+        return od_value(e, co->error_count, 1, URRT_CO_RW);
+    }
+    if (sub > URRT_CO_HISTORY) {
+        return URRT_CO_ABORT_NO_SUB;
+    }
+    return sub > co->error_count ? URRT_CO_ABORT_NO_DATA : od_value(e, co->errors[sub - 1u], 4, URRT_CO_RO);
+}
+
+/* 0x1000-0x1018. */
+static uint32_t od_comm(const urrt_co *co, uint16_t index, uint8_t sub, od_entry *e)
+{
+    const urrt_co_desc *d = co->desc;
+    switch (index) {
+    case 0x1000: return od_var(e, sub, d->device_type, 4, URRT_CO_RO);
+    case 0x1001: return od_var(e, sub, urrt_co_error_register(co), 1, URRT_CO_RO);
+    case 0x1003: return od_errors(co, e, sub);
+    case 0x1005: return od_var(e, sub, co->sync_cob_id, 4, URRT_CO_RW);
+    case 0x1008: return od_text(e, sub, d->device_name);
+    case 0x1009: return od_text(e, sub, d->hardware_version);
+    case 0x100A: return od_text(e, sub, d->software_version);
+    case 0x1014: return od_var(e, sub, co->emcy_cob_id, 4, URRT_CO_RW);
+    case 0x1015: return od_var(e, sub, co->emcy_inhibit_100us, 2, URRT_CO_RW);
+    case 0x1017: return od_var(e, sub, co->heartbeat_ms, 2, URRT_CO_RW);
+    case 0x1018: return od_identity(d, e, sub);
+    default: return URRT_CO_ABORT_NO_OBJECT;
+    }
+}
+
+/* 0x1800+n and 0x1A00+n. */
+static uint32_t od_pdo(const urrt_co *co, uint16_t index, uint8_t sub, od_entry *e)
+{
+    size_t n = (size_t)(index - (index >= TPDO_MAP ? TPDO_MAP : TPDO_COMM));
+    const urrt_co_tpdo_state *t;
+    if (n >= co->desc->tpdo_count) {
+        return URRT_CO_ABORT_NO_OBJECT;
+    }
+    t = &co->tpdos[n];
+    if (index >= TPDO_MAP) {
+        const urrt_co_tpdo *p = tpdo_desc(co, n);
+        if (sub == 0u) {
+            return od_value(e, p->mapping_count, 1, URRT_CO_RO);
+        }
+        return sub > p->mapping_count ? URRT_CO_ABORT_NO_SUB : od_value(e, p->mapping[sub - 1u], 4, URRT_CO_RO);
+    }
+    switch (sub) {
+    case 0: return od_value(e, TPDO_COMM_SUBS, 1, URRT_CO_RO);
+    case 1: return od_value(e, t->cob_id, 4, URRT_CO_RW);
+    case 2: return od_value(e, t->type, 1, URRT_CO_RW);
+    case 3: return od_value(e, t->inhibit_100us, 2, URRT_CO_RW);
+    case 5: return od_value(e, t->event_ms, 2, URRT_CO_RW);
+    default: return URRT_CO_ABORT_NO_SUB;
+    }
+}
+
+/* A signal's raw bits as its frame would go out now, sign-extended for INTEGERn. */
+static uint32_t signal_value(urrt_co *co, const urrt_co_object *o, uint64_t now_us)
+{
+    const urrt_can_signal *sig = &co->tx->tables->frames[o->frame].signals[o->item];
+    uint64_t raw = 0;
+    uint32_t value;
+    urrt_cantx_peek(co->tx, o->frame, now_us, &co->out);
+    (void)urrt_can_get_raw(sig, co->out.data, co->out.len, &raw);
+    value = (uint32_t)raw; /* urrt_co_init saw the signal fits the type's 32 bits at most */
+    if (type_signed(o->type) && sig->length < 32u && (value >> (sig->length - 1u) & 1u) != 0u) {
+        value |= UINT32_MAX << sig->length;
+    }
+    return value & size_mask(type_size(o->type));
+}
+
+/* 0x2000-0x5FFF: the description's objects; a record's sub 0 is its highest sub. */
+static uint32_t od_mfr(urrt_co *co, uint16_t index, uint8_t sub, uint64_t now_us, od_entry *e)
+{
+    const urrt_co_desc *d = co->desc;
+    bool known = false;
+    uint8_t highest = 0;
+    size_t i;
+    for (i = 0; i < d->object_count; i++) {
+        const urrt_co_object *o = &d->objects[i];
+        if (o->index != index) {
+            continue;
+        }
+        known = true;
+        highest = o->sub > highest ? o->sub : highest;
+        if (o->sub == sub) {
+            e->object = o;
+            return od_value(e, o->kind == URRT_CO_VAR ? co->vars[o->item] : signal_value(co, o, now_us),
+                            type_size(o->type), o->access);
+        }
+    }
+    if (known && sub == 0u) {
+        return od_value(e, highest, 1, URRT_CO_RO);
+    }
+    return known ? URRT_CO_ABORT_NO_SUB : URRT_CO_ABORT_NO_OBJECT;
+}
+
+static uint32_t od_find(urrt_co *co, uint16_t index, uint8_t sub, uint64_t now_us, od_entry *e)
+{
+    e->text = NULL;
+    e->object = NULL;
+    if (index >= TPDO_COMM && index < TPDO_MAP + MAX_TPDOS) {
+        return od_pdo(co, index, sub, e);
+    }
+    if (index >= MFR_FIRST && index <= MFR_LAST) {
+        return od_mfr(co, index, sub, now_us, e);
+    }
+    return od_comm(co, index, sub, e);
+}
+
+static uint32_t var_write(urrt_co *co, const urrt_co_object *o, uint32_t value)
+{
+    uint32_t key = order_key(value, o->type);
+    if (key < order_key(o->min, o->type)) {
+        return URRT_CO_ABORT_TOO_LOW;
+    }
+    if (key > order_key(o->max, o->type)) {
+        return URRT_CO_ABORT_TOO_HIGH;
+    }
+    co->vars[o->item] = value;
+    return 0;
+}
+
+/* SYNC consumer only: bit 30 (generate) and 29-bit ids are refused. */
+static uint32_t sync_write(urrt_co *co, uint32_t value)
+{
+    if ((value & ~(URRT_CO_COB_INVALID | ID_MASK)) != 0u || id_restricted(value & ID_MASK)) {
+        return URRT_CO_ABORT_VALUE;
+    }
+    co->sync_cob_id = value;
+    return 0;
+}
+
+/* A write the entry's access and size allow: its value's rules. */
+static uint32_t od_write(urrt_co *co, uint16_t index, uint8_t sub, const od_entry *e, uint32_t value,
+                         uint64_t now_us)
+{
+    uint32_t abort = 0;
+    if (e->object != NULL) {
+        return var_write(co, e->object, value);
+    }
+    if (index >= TPDO_COMM && index < TPDO_MAP) {
+        return tpdo_write(co, (size_t)(index - TPDO_COMM), sub, value, now_us);
+    }
+    switch (index) {
+    case 0x1003:
+        /* Only 0 clears the history (CiA 301). */
+        abort = value != 0u ? URRT_CO_ABORT_VALUE : 0u;
+        co->error_count = value != 0u ? co->error_count : 0u;
+        return abort;
+    case 0x1005: return sync_write(co, value);
+    case 0x1014:
+        abort = cob_check(co->emcy_cob_id, value, 0);
+        co->emcy_cob_id = abort != 0u ? co->emcy_cob_id : value;
+        return abort;
+    case 0x1015: co->emcy_inhibit_100us = (uint16_t)value; return 0;
+    default: /* 0x1017 */
+        co->heartbeat_ms = (uint16_t)value;
+        heartbeat_restart(co, now_us);
+        return 0;
+    }
+}
+
+/* ---- the SDO server ------------------------------------------------------------------ */
+
+static uint8_t *sdo_begin(urrt_co *co, uint8_t command, uint16_t index, uint8_t sub)
+{
+    uint8_t *data = frame_begin(co, SDO_TX_BASE + co->desc->node_id, SDO_LEN);
+    data[0] = command;
+    put_le(data + 1, index, 2);
+    data[3] = sub;
+    return data;
+}
+
+static size_t sdo_abort(urrt_co *co, uint16_t index, uint8_t sub, uint32_t code, uint64_t now_us,
+                        urrt_cantx_emit_fn emit, void *ctx)
+{
+    put_le(sdo_begin(co, CS_ABORT << 5, index, sub) + 4, code, 4);
+    co->sdo_busy = false;
+    return frame_send(co, now_us, emit, ctx);
+}
+
+static uint64_t sdo_timeout_us(const urrt_co *co)
+{
+    uint16_t ms = co->desc->sdo_timeout_ms;
+    return (uint64_t)(ms != 0u ? ms : URRT_CO_SDO_TIMEOUT_MS) * 1000u;
+}
+
+/* Up to 4 bytes in the answer itself; a longer (or empty) string segmented. */
+static size_t upload(urrt_co *co, uint16_t index, uint8_t sub, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    od_entry e;
+    uint32_t abort = od_find(co, index, sub, now_us, &e);
+    uint8_t *data;
+    uint32_t i;
+    if (abort == 0u && e.access == URRT_CO_WO) {
+        abort = URRT_CO_ABORT_WRITE_ONLY;
+    }
+    if (abort != 0u) {
+        return sdo_abort(co, index, sub, abort, now_us, emit, ctx);
+    }
+    if (e.text != NULL && (e.size == 0u || e.size > 4u)) {
+        data = sdo_begin(co, CS_UPLOAD << 5 | SDO_SIZE_SET, index, sub);
+        put_le(data + 4, e.size, 4);
+        co->sdo_busy = true;
+        co->sdo_text = e.text;
+        co->sdo_size = e.size;
+        co->sdo_offset = 0;
+        co->sdo_toggle = 0;
+        co->sdo_index = index;
+        co->sdo_sub = sub;
+        co->sdo_deadline_us = now_us + sdo_timeout_us(co);
+        return frame_send(co, now_us, emit, ctx);
+    }
+    data = sdo_begin(co, (uint8_t)(CS_UPLOAD << 5 | (4u - e.size) << 2 | SDO_EXPEDITED | SDO_SIZE_SET), index, sub);
+    for (i = 0; i < e.size; i++) {
+        data[4 + i] = (uint8_t)(e.text != NULL ? (unsigned char)e.text[i] : e.value >> (8u * i));
+    }
+    return frame_send(co, now_us, emit, ctx);
+}
+
+static size_t upload_segment(urrt_co *co, uint8_t command, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    uint8_t toggle = command & SDO_TOGGLE;
+    uint32_t n = co->sdo_size - co->sdo_offset;
+    uint8_t *data;
+    uint32_t i;
+    if (toggle != co->sdo_toggle) {
+        return sdo_abort(co, co->sdo_index, co->sdo_sub, URRT_CO_ABORT_TOGGLE, now_us, emit, ctx);
+    }
+    n = n > SEG_BYTES ? SEG_BYTES : n;
+    data = frame_begin(co, SDO_TX_BASE + co->desc->node_id, SDO_LEN);
+    for (i = 0; i < n; i++) {
+        data[1 + i] = (uint8_t)co->sdo_text[co->sdo_offset + i];
+    }
+    co->sdo_offset += n;
+    co->sdo_busy = co->sdo_offset < co->sdo_size;
+    data[0] = (uint8_t)(toggle | (SEG_BYTES - n) << 1 | (co->sdo_busy ? 0u : SDO_LAST));
+    co->sdo_toggle ^= SDO_TOGGLE;
+    co->sdo_deadline_us = now_us + sdo_timeout_us(co);
+    return frame_send(co, now_us, emit, ctx);
+}
+
+/* Expedited only: a segmented download is an unknown command here. */
+static size_t download(urrt_co *co, const uint8_t *req, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    uint16_t index = (uint16_t)(req[1] | req[2] << 8);
+    uint8_t sub = req[3];
+    uint32_t bytes = (req[0] & SDO_SIZE_SET) != 0u ? 4u - (uint32_t)(req[0] >> 2 & 3u) : 0u;
+    od_entry e;
+    uint32_t abort = (req[0] & SDO_EXPEDITED) == 0u ? URRT_CO_ABORT_COMMAND : od_find(co, index, sub, now_us, &e);
+    if (abort == 0u && (e.access & URRT_CO_WO) == 0u) {
+        abort = URRT_CO_ABORT_READ_ONLY;
+    }
+    if (abort == 0u && bytes != 0u && bytes != e.size) {
+        abort = bytes > e.size ? URRT_CO_ABORT_TOO_LONG : URRT_CO_ABORT_TOO_SHORT;
+    }
+    if (abort == 0u) {
+        abort = od_write(co, index, sub, &e, get_le32(req + 4) & size_mask(e.size), now_us);
+    }
+    if (abort != 0u) {
+        return sdo_abort(co, index, sub, abort, now_us, emit, ctx);
+    }
+    (void)sdo_begin(co, 0x60u, index, sub);
+    return frame_send(co, now_us, emit, ctx);
+}
+
+/* One answer per request at most. A request that is not the next segment
+ * while an upload is in progress aborts that upload (0x05040001, with its
+ * index) and is not served: the client's retry is (as CANopenNode). */
+static size_t sdo_request(urrt_co *co, const uint8_t *req, size_t len, uint64_t now_us, urrt_cantx_emit_fn emit,
+                          void *ctx)
+{
+    uint8_t cs = len > 0u ? (uint8_t)(req[0] >> 5) : 0u;
+    if (len > 0u && cs == CS_ABORT) {
+        co->sdo_busy = false; /* the client's abort is never answered */
+        return 0;
+    }
+    if (co->sdo_busy) {
+        if (len == SDO_LEN && cs == CS_UPLOAD_SEGMENT) {
+            return upload_segment(co, req[0], now_us, emit, ctx);
+        }
+        return sdo_abort(co, co->sdo_index, co->sdo_sub, len < SDO_LEN ? URRT_CO_ABORT_LENGTH : URRT_CO_ABORT_COMMAND,
+                         now_us, emit, ctx);
+    }
+    if (len < SDO_LEN) {
+        return sdo_abort(co, (uint16_t)(len >= 3u ? (unsigned)req[1] | (unsigned)req[2] << 8 : 0u), len >= 4u ? req[3] : 0u,
+                         URRT_CO_ABORT_LENGTH, now_us, emit, ctx);
+    }
+    switch (cs) {
+    case CS_UPLOAD: return upload(co, (uint16_t)(req[1] | req[2] << 8), req[3], now_us, emit, ctx);
+    case CS_DOWNLOAD: return download(co, req, now_us, emit, ctx);
+    default:
+        return sdo_abort(co, (uint16_t)(req[1] | req[2] << 8), req[3], URRT_CO_ABORT_COMMAND, now_us, emit, ctx);
+    }
+}
+
+/* ---- frames in, time passing ------------------------------------------------------------ */
+
+size_t urrt_co_on_frame(urrt_co *co, uint32_t id, unsigned flags, const uint8_t *data, size_t len, uint64_t now_us,
+                        urrt_cantx_emit_fn emit, void *ctx)
+{
+    uint8_t state;
+    if (co == NULL || co->state == (uint8_t)URRT_CO_INITIALISING ||
+        (flags & (URRT_CO_RX_EXTENDED | URRT_CO_RX_RTR)) != 0u ||
+        len > URRT_CAN_CLASSIC_MAX_LEN || (len > 0u && data == NULL)) {
+        return 0;
+    }
+    state = co->state;
+    if (id == 0u) {
+        return len == 2u ? nmt_command(co, data, now_us, emit, ctx) : 0u;
+    }
+    if (state == (uint8_t)URRT_CO_STOPPED) {
+        return 0; /* only NMT */
+    }
+    if (id == (co->sync_cob_id & ID_MASK)) {
+        return len <= 1u ? sync_received(co, now_us, emit, ctx) : 0u;
+    }
+    if (id == SDO_RX_BASE + co->desc->node_id) {
+        return sdo_request(co, data, len, now_us, emit, ctx);
+    }
+    return 0;
+}
+
+static size_t heartbeat(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    uint64_t period_us = (uint64_t)co->heartbeat_ms * 1000u;
+    if (co->heartbeat_due_us == URRT_CANTX_NEVER || now_us < co->heartbeat_due_us) {
+        return 0;
+    }
+    frame_begin(co, NMT_EC_BASE + co->desc->node_id, 1)[0] = co->state;
+    /* The cadence holds; after a stall the missed beats are skipped. */
+    co->heartbeat_due_us += period_us;
+    if (co->heartbeat_due_us <= now_us) {
+        co->heartbeat_due_us = now_us + period_us;
+    }
+    return frame_send(co, now_us, emit, ctx);
+}
+
+size_t urrt_co_run(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    size_t sent;
+    if (co == NULL || co->state == (uint8_t)URRT_CO_INITIALISING) {
+        return 0;
+    }
+    sent = heartbeat(co, now_us, emit, ctx);
+    if (co->sdo_busy && now_us >= co->sdo_deadline_us) {
+        sent += sdo_abort(co, co->sdo_index, co->sdo_sub, URRT_CO_ABORT_TIMEOUT, now_us, emit, ctx);
+    }
+    conditions_update(co, now_us);
+    sent += emcy_send(co, now_us, emit, ctx);
+    return sent + urrt_cantx_run(co->tx, now_us, emit, ctx);
+}
+
+/* When a condition may change without a call: a robot's data turning
+ * stale, a counter's hold ending. Only instants after the latest run. */
+static uint64_t conditions_deadline(const urrt_co *co)
+{
+    const urrt_cantx *tx = co->tx;
+    uint64_t after = tx->run_us;
+    uint64_t next = URRT_CANTX_NEVER;
+    size_t i;
+    for (i = 0; i < tx->tables->robot_count; i++) {
+        const urrt_cantx_robot *r = &tx->robots[i];
+        uint64_t stale_us = r->data_us + co->desc->stale_after_us + 1u;
+        next = r->has_data && r->up && stale_us > after ? min64(next, stale_us) : next;
+    }
+    next = tx->start_us + tx->tables->startup_us > after ? min64(next, tx->start_us + tx->tables->startup_us) : next;
+    next = co->overrun_until_us > after ? min64(next, co->overrun_until_us) : next;
+    return co->bus_off_until_us > after ? min64(next, co->bus_off_until_us) : next;
+}
+
+uint64_t urrt_co_deadline(const urrt_co *co)
+{
+    uint64_t next;
+    if (co == NULL || co->state == (uint8_t)URRT_CO_INITIALISING) {
+        return URRT_CANTX_NEVER;
+    }
+    next = min64(urrt_cantx_deadline(co->tx), co->heartbeat_due_us);
+    next = co->sdo_busy ? min64(next, co->sdo_deadline_us) : next;
+    next = emcy_may_send(co) ? min64(next, emcy_due(co)) : next;
+    return min64(next, conditions_deadline(co));
+}

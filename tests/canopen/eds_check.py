@@ -1,0 +1,169 @@
+# SPDX-License-Identifier: MIT
+"""eds_check.py EDS [NODE_ID]: checks an EDS against CiA 306's rules, independently of
+the code that wrote it. Prints each problem and "N passed, N failed" last.
+
+Rules: the sections [FileInfo], [DeviceInfo], [MandatoryObjects], [OptionalObjects],
+[ManufacturerObjects]; each list's SupportedObjects equals its entries 1..n, each entry
+has its object section, no object is listed twice or left unlisted, mandatory ones
+(0x1000, 0x1001, 0x1018) are in MandatoryObjects and optional/manufacturer ones in the
+right range; ObjectType, DataType, AccessType, PDOMapping take legal values; a RECORD
+or ARRAY has SubNumber sections [XXXXsubN], sub 0 among them; every DefaultValue
+parses for its type ($NODEID forms included); 0x1017 is there (no node guarding);
+each TPDO mapping (0x1A00+n) names existing objects marked PDOMapping=1 whose size
+matches the bit length, fits 64 bits, and has its communication object 0x1800+n;
+NrOfTXPDO equals the number of TPDOs and NrOfRXPDO the RPDOs.
+"""
+import struct
+import sys
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+import eds  # noqa: E402
+
+MANDATORY = {0x1000, 0x1001, 0x1018}
+
+
+class Checker:
+    def __init__(self):
+        self.passed = self.failed = 0
+
+    def check(self, desc, ok, detail=''):
+        if ok:
+            self.passed += 1
+        else:
+            self.failed += 1
+            print('FAIL: EDS: %s%s' % (desc, (': ' + detail) if detail else ''))
+        return ok
+
+
+def value_ok(dtype, text, node_id):
+    """Whether a DefaultValue parses for its type and lies in its range."""
+    name, size, fmt = eds.DATA_TYPES[dtype]
+    if size == 0:
+        return True
+    try:
+        if dtype in (0x0008, 0x0011):
+            v = float(text)
+            struct.pack(fmt, v)
+            return True
+        v = eds.resolve(text, node_id)
+        struct.pack(fmt, v)
+        return True
+    except (ValueError, struct.error):
+        return False
+
+
+def check_sections(c, cp):
+    for name in ('FileInfo', 'DeviceInfo', 'MandatoryObjects', 'OptionalObjects', 'ManufacturerObjects'):
+        c.check('[%s] present' % name, cp.has_section(name))
+    info = cp['DeviceInfo'] if cp.has_section('DeviceInfo') else {}
+    for key in ('VendorName', 'ProductName', 'NrOfRXPDO', 'NrOfTXPDO', 'SimpleBootUpSlave', 'Granularity'):
+        c.check('[DeviceInfo] %s' % key, key in info)
+    rates = [k for k in info if k.startswith('BaudRate_')]
+    c.check('[DeviceInfo] BaudRate_* entries', bool(rates) and all(info[k].strip() in ('0', '1') for k in rates))
+
+
+def check_lists(c, cp):
+    lists = eds.listed(cp)
+    seen = {}
+    for name, indices in lists.items():
+        sec = cp[name] if cp.has_section(name) else {}
+        count = eds.parse_int(sec.get('SupportedObjects', '-1'))
+        entries = [k for k in sec if k != 'SupportedObjects']
+        c.check('[%s] SupportedObjects=%d matches its %d entries' % (name, count, len(entries)),
+                count == len(entries) == len(indices) and sorted(entries, key=int) == [str(i) for i in
+                                                                                     range(1, count + 1)])
+        for i in indices:
+            c.check('0x%04X listed once' % i, i not in seen, 'also in %s' % seen.get(i))
+            seen[i] = name
+            c.check('0x%04X (in %s) has its section [%04X]' % (i, name, i), cp.has_section('%04X' % i))
+    for i in MANDATORY:
+        c.check('mandatory 0x%04X in MandatoryObjects' % i, i in lists['MandatoryObjects'])
+    c.check('0x1017 producer heartbeat time present (no node guarding)', 0x1017 in seen)
+    for i in lists['ManufacturerObjects']:
+        c.check('manufacturer object 0x%04X in 0x2000..0x5FFF' % i, 0x2000 <= i <= 0x5FFF)
+    for i in lists['OptionalObjects']:
+        c.check('optional object 0x%04X outside the manufacturer range' % i,
+                not 0x2000 <= i <= 0x5FFF and i not in MANDATORY)
+    objs = {i for (i, _sub) in eds.objects(cp)}
+    c.check('every object section is listed', objs <= set(seen), ' '.join('%04X' % i for i in sorted(objs - set(seen))))
+
+
+def check_variable(c, where, sec, node_id):
+    dtype = eds.parse_int(sec.get('DataType', '0'))
+    c.check('%s DataType 0x%04X known' % (where, dtype), dtype in eds.DATA_TYPES)
+    access = sec.get('AccessType', '').strip().lower()
+    c.check('%s AccessType "%s"' % (where, access), access in eds.ACCESS_TYPES)
+    c.check('%s PDOMapping 0/1' % where, sec.get('PDOMapping', '0').strip() in ('0', '1'))
+    c.check('%s ParameterName' % where, bool(sec.get('ParameterName', '').strip()))
+    if 'DefaultValue' in sec and dtype in eds.DATA_TYPES:
+        c.check('%s DefaultValue "%s" is a %s' % (where, sec['DefaultValue'], eds.DATA_TYPES[dtype][0]),
+                value_ok(dtype, sec['DefaultValue'], node_id))
+
+
+def check_objects(c, cp, node_id):
+    for index in sorted({i for (i, _sub) in eds.objects(cp)}):
+        name = '%04X' % index
+        if not cp.has_section(name):
+            continue
+        sec = cp[name]
+        otype = eds.parse_int(sec.get('ObjectType', '0x7'))
+        c.check('[%s] ObjectType 0x%X legal' % (name, otype), otype in eds.OBJECT_TYPES)
+        if otype == 0x7:
+            check_variable(c, '[%s]' % name, sec, node_id)
+            continue
+        subs = sorted(int(s[len(name) + 3:], 16) for s in cp.sections()
+                      if s.upper().startswith(name + 'SUB'))
+        number = eds.parse_int(sec.get('SubNumber', '-1'))
+        c.check('[%s] SubNumber %d = its %d sub-sections' % (name, number, len(subs)), number == len(subs))
+        c.check('[%s] has sub 0' % name, 0 in subs)
+        for s in subs:
+            check_variable(c, '[%ssub%X]' % (name, s), cp['%ssub%X' % (name, s)], node_id)
+
+
+def check_pdos(c, cp, node_id):
+    objs = eds.objects(cp)
+    tps = eds.tpdos(cp, node_id)
+    for t in tps:
+        total = 0
+        for index, sub, bits in t['mapping']:
+            total += bits
+            if index < 0x1000:  # a dummy: the data type's own size
+                c.check('TPDO%d dummy 0x%04X of a known type' % (t['n'], index), index in eds.DATA_TYPES)
+                continue
+            sec = objs.get((index, sub))
+            where = 'TPDO%d maps 0x%04X sub %d' % (t['n'], index, sub)
+            if not c.check('%s: it exists' % where, sec is not None):
+                continue
+            c.check('%s: PDOMapping=1' % where, sec.get('PDOMapping', '0').strip() == '1')
+            size = eds.DATA_TYPES.get(eds.parse_int(sec.get('DataType', '0')), ('', -1))[1]
+            c.check('%s: %d bits = its type\'s size' % (where, bits), size * 8 == bits, '%d bytes' % size)
+        c.check('TPDO%d mapping fits 64 bits (%d)' % (t['n'], total), total <= 64)
+    info = cp['DeviceInfo'] if cp.has_section('DeviceInfo') else {}
+    c.check('NrOfTXPDO = %d TPDOs' % len(tps), eds.parse_int(info.get('NrOfTXPDO', '-1')) == len(tps))
+    rx = sum(1 for n in range(512) if (0x1400 + n, 1) in objs)
+    c.check('NrOfRXPDO = %d RPDOs' % rx, eds.parse_int(info.get('NrOfRXPDO', '-1')) == rx)
+    for n in range(512):
+        c.check('0x%04X has its communication object 0x%04X' % (0x1A00 + n, 0x1800 + n),
+                not cp.has_section('%04X' % (0x1A00 + n)) or cp.has_section('%04X' % (0x1800 + n)))
+
+
+def check(path, node_id=1):
+    c = Checker()
+    cp = eds.read(path)
+    check_sections(c, cp)
+    check_lists(c, cp)
+    check_objects(c, cp, node_id)
+    check_pdos(c, cp, node_id)
+    return c
+
+
+def main():
+    if len(sys.argv) not in (2, 3):
+        sys.exit('usage: eds_check.py EDS [NODE_ID]')
+    c = check(sys.argv[1], int(sys.argv[2]) if len(sys.argv) == 3 else 1)
+    print('%d passed, %d failed' % (c.passed, c.failed))
+    return 0 if c.failed == 0 else 1
+
+
+if __name__ == '__main__':
+    sys.exit(main())

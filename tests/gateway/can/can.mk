@@ -1,0 +1,43 @@
+# SPDX-License-Identifier: MIT
+# tests/gateway/can/can.mk: the gateway's CAN mapping (gateway/can/), on top of lib/urrt_can.
+#   check-can-map      tests/gateway/can/test_can_map.c: configurations loaded by the gateway's
+#                      loader and their rejections with FILE:LINE, bus load, the urrt_cantx
+#                      tables, scheduling and the heartbeat on a fake clock, the DBC text
+#   check-can-map-san  the same under ASan + UBSan, lib/ and gateway/ compiled with them
+#   check-can-dbc      DBCs and payloads against python3-canmatrix and an independent
+#                      Python reference; the example configurations in docs/examples/
+#   bench-can          ns per packet for the CAN mapping beside urrt_decode of the same packet
+
+CANT := $(BUILD)/tests/gateway/can
+CAN_TEST_SRCS = $(CAN_GATEWAY_OBJS:$(BUILD)/%.o=%.c) gateway/common/conf.c gateway/urrt-gateway/config.c
+# The tests load configurations as the gateway does: its loader (config.o, which
+# needs no LCM), conf.o (gateway/common/common.mk) and the port's link defaults.
+CAN_TEST_OBJS := $(CAN_GATEWAY_OBJS) $(BUILD)/gateway/urrt-gateway/config.o $(CONF_OBJ)
+CAN_TEST_CFLAGS := $(PROG_WARN) $(CPPFLAGS) $(GATEWAY_INC) -Itests
+
+CHECKS += check-can-map check-can-map-san check-can-dbc
+BENCHES += bench-can
+.PHONY: check-can-map check-can-map-san check-can-dbc bench-can
+
+# test_can_map, can_tool and bench_can: one source each, the same objects.
+$(CANT)/%: tests/gateway/can/%.c tests/check.h tests/testutil.h tests/gateway/bench.h $(CAN_TEST_OBJS) $(LIBPORT) $(LIBURRT)
+	@mkdir -p $(@D)
+	$(CC) $(CAN_TEST_CFLAGS) $(OPT) $< $(CAN_TEST_OBJS) $(LIBPORT) $(LIBURRT) -lm -o $@
+
+$(CANT)/test_can_map_san: tests/gateway/can/test_can_map.c tests/check.h tests/testutil.h $(CAN_TEST_SRCS) \
+  $(GATEWAY_HDRS) $(LIB_SRCS) $(LIBPORT)
+	@mkdir -p $(@D)
+	$(CC) $(CAN_TEST_CFLAGS) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $< $(CAN_TEST_SRCS) $(LIB_SRCS) \
+	  $(LIBPORT) -lm -o $@
+
+check-can-map: $(CANT)/test_can_map
+	$(call suite,$@,$<)
+
+check-can-map-san: $(CANT)/test_can_map_san
+	$(call suite,$@,ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $<)
+
+check-can-dbc: $(CANT)/can_tool
+	$(call suite,$@,$(PYTHON) tests/gateway/can/test_dbc.py --tool $< --work $(CANT)/work)
+
+bench-can: $(CANT)/bench_can
+	@$< docs/examples/canopen.ini

@@ -1,0 +1,940 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * check-can-map: gateway/can/can_map with its tables, gateway/can/can_run
+ * (configurations loaded as the gateway loads them, and their rejections
+ * with FILE:LINE, bus load against hand-computed figures, scheduling,
+ * staleness, alive counters and the heartbeat on a fake clock) and the DBC
+ * text. The bit packing underneath is tests/lib/test_can.c's; the DBC and
+ * bulk packing are checked against python3-canmatrix by test_dbc.py.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "can_map.h"
+#include "can_run.h"
+#include "check.h"
+#include "config.h"
+#include "dbc.h"
+#include "testutil.h"
+#include "urrt_can.h"
+
+/* ---- can_map: configuration ---------------------------------------------------------- */
+
+/* The CAN side as the gateway has it: the file loaded by the gateway's
+ * loader (gateway/urrt-gateway/config.c), the map and its tables kept. */
+
+/* The tables of the map load() gave last: what the scheduling tests run
+ * (unload() frees both). */
+static struct can_run *loaded_run;
+
+static const struct can_map_robot one_robot[] = {{"arm", 8000}};
+
+/* Loads text as "t.ini" through the gateway's loader, with a [robot NAME]
+ * section after it for each of robots (its period from its version: 8000
+ * us a 3.10 controller's, else 5.10's 2000), and keeps its map in *map and
+ * its tables in loaded_run: 0, or -1 with the messages in err, causes
+ * first, one per line. */
+static int load(struct can_map *map, const char *text, const struct can_map_robot *robots, size_t n, char *err,
+                size_t errlen)
+{
+    char *file = NULL, *messages = NULL;
+    size_t file_size = 0, size = 0;
+    FILE *in = open_memstream(&file, &file_size);
+    FILE *out = open_memstream(&messages, &size);
+    gw_config cfg;
+    int errors;
+    fputs(text, in);
+    for (size_t i = 0; i < n; i++) {
+        fprintf(in, "\n[robot %s]\nhost = h\nversion = %s\n", robots[i].name,
+                robots[i].period_us == 8000 ? "3.10" : "5.10");
+    }
+    fclose(in);
+    in = fmemopen(file, file_size, "r");
+    errors = gw_config_load_stream(&cfg, in, "t.ini", out);
+    fclose(in);
+    fclose(out);
+    snprintf(err, errlen, "%.*s", (int)(size > 0 && messages[size - 1] == '\n' ? size - 1 : size), messages);
+    *map = cfg.can;
+    loaded_run = cfg.can_run;
+    memset(&cfg.can, 0, sizeof cfg.can);
+    cfg.can_run = NULL;
+    gw_config_free(&cfg);
+    free(file);
+    free(messages);
+    return errors == 0 ? 0 : -1;
+}
+
+static void unload(struct can_map *map)
+{
+    can_run_free(loaded_run);
+    loaded_run = NULL;
+    can_map_free(map);
+}
+
+#define CAN_HEAD "[can]\ninterface = vcan0\nheartbeat_id = 0x701\n"
+
+static const char *const good_config =
+    "; a comment\n"
+    "[can]\n"
+    "interface = vcan0\n"
+    "bitrate = 500000\n"
+    "heartbeat_id = 0x701\n"
+    "\n"
+    "[frame joints]\n"
+    "id = 0x181\n"
+    "period_ms = 10\n"
+    "signal = q_actual[0] @0|16 intel signed factor=0.0001 unit=rad\n"
+    "signal = q_actual[1] @16|16 intel signed factor=0.0001\n"
+    "signal = tool_vector_actual[4] @39|16 motorola signed factor=0.0001 name=rx\n"
+    "alive_counter = 56\n"
+    "validity_bit = 63\n"
+    "\n"
+    "[frame status]\n"
+    "id = 0x18FF0080\n"
+    "extended = yes\n"
+    "period_ms = every\n"
+    "length = 4\n"
+    "signal = robot_mode @0|8 intel signed\n"
+    "signal = digital_input_bits @8|18 intel unsigned\n"
+    "signal = v_robot @26|6 intel unsigned factor=2 offset=0 min=0 max=60 unit=\"V DC\"\n";
+
+static void test_config_good(void)
+{
+    struct can_map map;
+    char err[2048] = "";
+    int rc = load(&map, good_config, one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "good config rejected: %s", err);
+    if (rc != 0) {
+        unload(&map);
+        return;
+    }
+    CHECK(can_map_enabled(&map), "enabled");
+    {
+        urrt_canlink_config cfg;
+        char line[256];
+        memset(&cfg, 0, sizeof cfg);
+        cfg.reopen_interval_ms = 1234;
+        can_map_link_config(&map, &cfg);
+        CHECK(cfg.interface == map.interface && !cfg.fd && !cfg.fd_brs && cfg.reopen_interval_ms == 1234,
+              "link configuration");
+        can_map_describe(&map, line, sizeof line);
+        CHECK_EQ_STR(line, "2 frames + heartbeat 0x701 on vcan0, worst-case bus load 6.0% of 500000 bit/s (max 50%)");
+        /* 2.7 % + 29-bit 4 bytes (54+32+13+21 = 120 bits, 240 us) every 8 ms 3.0 % + 0.27 % */
+    }
+    CHECK_EQ_STR(map.interface, "vcan0");
+    CHECK_EQ_INT(map.frame_count, 2);
+    CHECK_EQ_INT(map.hb_id, 0x701);
+    {
+        const struct can_map_frame *j = &map.frames[0];
+        CHECK_EQ_STR(j->name, "joints");
+        CHECK(j->id == 0x181 && !j->extended && !j->fd && j->len == 8 && j->period_ms == 10 && !j->every, "joints");
+        CHECK_EQ_INT(j->count, 5);
+        CHECK_EQ_STR(j->meta[0].name, "q_actual_0");
+        CHECK_EQ_STR(j->meta[0].unit, "rad");
+        CHECK_EQ_STR(j->meta[1].unit, "rad"); /* from the field table */
+        CHECK_EQ_STR(j->meta[2].name, "rx");
+        CHECK_EQ_STR(j->meta[2].unit, "rad"); /* "m, rad": element 4 is a rotation */
+        CHECK(j->sigs[0].min == -3.2768 && j->sigs[0].max == 3.2767, "q range %.17g %.17g", j->sigs[0].min,
+              j->sigs[0].max);
+        CHECK(j->sigs[2].byte_order == URRT_CAN_MOTOROLA && j->sigs[2].start == 39, "motorola parsed");
+        CHECK(j->alive_index == 3 && j->valid_index == 4, "alive %d valid %d", j->alive_index, j->valid_index);
+        CHECK_EQ_INT(j->stale_after_ms, 100u);
+        CHECK(j->stale_policy == CAN_MAP_STALE_STOP, "default policy stop");
+        CHECK_EQ_INT(j->key_loc[CAN_MAP_FK_ID].line, 8);
+    }
+    {
+        const struct can_map_frame *s = &map.frames[1];
+        CHECK(s->id == 0x18FF0080 && s->extended && s->every && s->len == 4, "status frame");
+        CHECK_EQ_STR(s->meta[0].unit, "");
+        CHECK(s->meta[1].bitmask, "digital inputs are a bit mask");
+        CHECK_EQ_STR(s->meta[2].unit, "V DC");
+        CHECK(s->sigs[2].min == 0 && s->sigs[2].max == 60, "v_robot limits");
+    }
+    unload(&map);
+
+    /* No CAN configuration at all: finishes, stays disabled. */
+    rc = load(&map, "[other]\nkey = 1\n", one_robot, 1, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, "t.ini:1: unknown section [other]") == err, "[other] is no section: %s", err);
+    unload(&map);
+    can_map_init(&map);
+    CHECK_EQ_INT(can_map_finish(&map, one_robot, 1, err, sizeof err), 0);
+    CHECK(!can_map_enabled(&map), "no CAN sections: disabled");
+    unload(&map);
+}
+
+struct rejection {
+    const char *config;
+    const char *expect; /* the first error begins with this */
+};
+
+static const struct rejection rejections[] = {
+    /* Syntax of keys and values. */
+    {CAN_HEAD "bogus = 1\n", "t.ini:4: unknown key \"bogus\" in [can]"},
+    {CAN_HEAD "interface = can1\n", "t.ini:4: interface is set again (first at line 2)"},
+    {CAN_HEAD "heartbeat_period_ms = 1001\n", "t.ini:4: heartbeat_period_ms = '1001': give 10..1000"},
+    {CAN_HEAD "bitrate = fast\n", "t.ini:4: bitrate = 'fast': give bits per second"},
+    {CAN_HEAD "[frame 9lives]\nid = 1\n", "t.ini:4: [frame 9lives]: the frame name is its DBC name"},
+    {CAN_HEAD "[frame urrt_heartbeat]\nid = 1\n", "t.ini:4: [frame urrt_heartbeat]: that name is the heartbeat's"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nid = 0x101\n", "t.ini:6: id is set again (first at line 5)"},
+    {CAN_HEAD "[frame a]\ncolour = red\n", "t.ini:5: unknown key \"colour\" in [frame a]"},
+    {CAN_HEAD "[frame a]\nperiod_ms = sometimes\n", "t.ini:5: period_ms = 'sometimes'"},
+    {CAN_HEAD "[frame a]\nstale_policy = ignore\n", "t.ini:5: stale_policy = 'ignore': use stop or invalid"},
+    {CAN_HEAD "[frame a]\nsignal = q_actual[0] @0|16 intel\n", "t.ini:5: signal = 'q_actual[0] @0|16 intel': expected"},
+    {CAN_HEAD "[frame a]\nsignal = q_actual[6] @0|16 intel signed\n",
+     "t.ini:5: signal: q_actual has 6 elements: q_actual[6] is out of range (0..5)"},
+    {CAN_HEAD "[frame a]\nsignal = q_actual @0|16 intel signed\n",
+     "t.ini:5: signal: q_actual has 6 elements: write q_actual[0] .. q_actual[5]"},
+    {CAN_HEAD "[frame a]\nsignal = q_wrong[0] @0|16 intel signed\n", "t.ini:5: signal: no field 'q_wrong'"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|65 intel unsigned\n", "t.ini:5: signal: length 65: give 1..64 bits"},
+    {CAN_HEAD "[frame a]\nsignal = time @512|8 intel unsigned\n", "t.ini:5: signal: start bit 512"},
+    {CAN_HEAD "[frame a]\nsignal = time 0|8 intel unsigned\n", "t.ini:5: signal: '0|8': expected @START|LENGTH"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|16 intel float32\n", "t.ini:5: signal: float32 needs length 32, not 16"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 unsigned factor=1\n", "t.ini:5: signal: byte order missing"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel\n", "t.ini:5: signal = 'time @0|8 intel': expected"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned big\n", "t.ini:5: signal: unknown word 'big'"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel intel unsigned\n", "t.ini:5: signal: 'intel': byte order given twice"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned factor=0\n", "t.ini:5: signal: factor must not be 0"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned factor=x\n", "t.ini:5: signal: factor = 'x' is not a finite number"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned max=256\n",
+     "t.ini:5: signal: max=256 is above what the signal can carry (255)"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel signed min=-200\n",
+     "t.ini:5: signal: min=-200 is below what the signal can carry (-128)"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned min=10 max=5\n", "t.ini:5: signal: min=10 is above max=5"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned invalid=256\n", "t.ini:5: signal: invalid=256 does not fit 8 bits"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned invalid=-1\n", "t.ini:5: signal: invalid=-1 does not fit 8 unsigned bits"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|32 intel float32 invalid=0\n", "t.ini:5: signal: invalid= applies to integer signals"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned name=1x\n", "t.ini:5: signal: name '1x'"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned colour=red\n", "t.ini:5: signal: unknown option 'colour='"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned unit=\"a\n", "t.ini:5: signal: unbalanced quotes"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned\nsignal = time @8|8 intel unsigned\n",
+     "t.ini:6: signal name 'time' already used in [frame a] (line 5): add name=OTHER"},
+    {CAN_HEAD "[frame a]\nalive_counter = 99 big\n", "t.ini:5: alive_counter: byte order 'big'"},
+    /* Control characters would go raw into the DBC and the log (found by
+     * tests/gateway/config/fuzz_config.c). */
+    {CAN_HEAD "[frame a]\ncomment = Joint\x01" "positions\n",
+     "t.ini:5: comment: at most 127 characters, no '\"', '\\' or control characters"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned unit=r\x7f" "ad\n",
+     "t.ini:5: signal: unit 'r\\x7Fad': at most 24 characters, no '\"', '\\' or control characters"},
+    {"[can]\ninterface = log:/tmp/a\x1b[2J\n", "t.ini:2: interface = 'log:/tmp/a\\x1B[2J': no control characters"},
+    {CAN_HEAD "[frame a]\nvalidity_bit = 600\n", "t.ini:5: validity_bit = 600: give a bit number 0..511"},
+    /* Whole-file checks (can_map_finish). */
+    {"[frame a]\nid = 1\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:1: CAN frames need a [can] section"},
+    {"[can]\nheartbeat_id = 0x700\n[frame a]\nid = 1\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:1: [can] has no interface"},
+    {"[can]\ninterface = can0\n[frame a]\nid = 1\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:1: [can] has no heartbeat_id"},
+    {CAN_HEAD, "t.ini:1: [can] without any [frame NAME] section"},
+    {CAN_HEAD "[frame a]\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n", "t.ini:4: [frame a] has no id"},
+    {CAN_HEAD "[frame a]\nid = 0x800\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:5: [frame a] id 0x800 is past 0x7FF, the largest 11-bit id: set extended = yes"},
+    {CAN_HEAD "[frame a]\nid = 0x20000000\nextended = yes\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:5: [frame a] id 0x20000000 is past 0x1FFFFFFF, the largest 29-bit id"},
+    {CAN_HEAD "heartbeat_extended = no\n[frame a]\nid = 0x701\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:3: the heartbeat id 0x701 is already used by [frame a] (line 6)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n"
+              "[frame b]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:9: [frame b] id 0x100 is already used by [frame a] (line 5)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nlength = 12\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:6: [frame a] length 12: a classic CAN frame carries at most 8 bytes"},
+    {CAN_HEAD "fd = yes\n[frame a]\nid = 0x100\nfd = yes\nlength = 10\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:8: [frame a] length 10 is not a CAN FD length (0-8, 12, 16, 20, 24, 32, 48, 64): use 12"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nfd = yes\nlength = 12\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:6: [frame a] is a CAN FD frame but [can] fd is not yes"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|16 intel unsigned\n"
+              "signal = robot_mode @8|8 intel signed\n",
+     "t.ini:8: [frame a] signal 'robot_mode' overlaps signal 'time' (line 7)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|16 intel unsigned\nalive_counter = 12\n",
+     "t.ini:8: [frame a] signal 'alive_counter' overlaps signal 'time' (line 7)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nvalidity_bit = 7\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:8: [frame a] signal 'time' overlaps signal 'valid' (line 7)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nlength = 2\nperiod_ms = 10\nsignal = time @8|16 intel unsigned\n",
+     "t.ini:8: [frame a] signal 'time' (@8|16) reaches byte 2, past the frame's length 2"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nlength = 2\nperiod_ms = 10\nsignal = time @15|16 motorola unsigned\n",
+     "t.ini:8: [frame a] signal 'time' (@15|16) reaches byte 2, past the frame's length 2"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 5\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:6: [frame a] period_ms = 5 is faster than robot arm sends (every 8 ms, 125 Hz): use period_ms >= 8 or every"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nrobot = bob\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:6: [frame a]: unknown robot 'bob' (robots: arm)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:4: [frame a] has no period_ms"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\n", "t.ini:4: [frame a] has no signal"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nstale_policy = invalid\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:7: [frame a] stale_policy = invalid needs a validity_bit"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = every\nvalidity_bit = 63\nstale_policy = invalid\n"
+              "signal = time @0|8 intel unsigned\n",
+     "t.ini:8: [frame a]: a period_ms = every frame stops with the packets"},
+    {CAN_HEAD "data_bitrate = 2000000\n[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
+     "t.ini:4: data_bitrate is for CAN FD"},
+    {CAN_HEAD "max_bus_load = 5\n[frame a]\nid = 0x100\nperiod_ms = 1\nperiod_ms = 2\n", "t.ini:8: period_ms is set again (first at line 7)"},
+};
+
+static void test_config_rejections(void)
+{
+    size_t i;
+    for (i = 0; i < sizeof rejections / sizeof rejections[0]; i++) {
+        struct can_map map;
+        char err[4096] = "";
+        const struct can_map_robot robots[] = {{"arm", 8000}};
+        int rc = load(&map, rejections[i].config, robots, 1, err, sizeof err);
+        CHECK(rc == -1 && strncmp(err, rejections[i].expect, strlen(rejections[i].expect)) == 0,
+              "rejection %zu:\n  got:  %s\n  want: %s", i, err, rejections[i].expect);
+        unload(&map);
+    }
+}
+
+struct reported {
+    int count;
+    char first[512];
+    int first_line;
+};
+
+static void record_problem(void *ctx, const char *file, int line, const char *reason)
+{
+    struct reported *r = ctx;
+    if (r->count++ == 0) {
+        snprintf(r->first, sizeof r->first, "%s|%s", file, reason);
+        r->first_line = line;
+    }
+}
+
+/* A caller with its own error list (the loader) gets file, line and reason
+ * apart; a key's own error is the caller's to report. */
+static void test_reporter(void)
+{
+    struct can_map map;
+    struct reported r;
+    struct can_map_frame *f;
+    char why[CONF_WHY_MAX] = "";
+    memset(&r, 0, sizeof r);
+    can_map_init(&map);
+    can_map_set_reporter(&map, record_problem, &r);
+    f = can_map_frame_begin(&map, "a", (struct conf_at){"gw.ini", 11}, why, sizeof why);
+    CHECK(f != NULL, "frame: %s", why);
+    if (f == NULL) {
+        can_map_free(&map);
+        return;
+    }
+    CHECK(!can_map_set(&map, f, &can_map_frame_keys[CAN_MAP_FK_ID], "zz", (struct conf_at){"gw.ini", 12}, why,
+                       sizeof why),
+          "id zz accepted");
+    CHECK_EQ_STR(why, "id = 'zz' is not a number (0x181 or 385)");
+    CHECK(can_map_set(&map, f, &can_map_frame_keys[CAN_MAP_FK_SIGNAL], "time @0|8 intel unsigned",
+                      (struct conf_at){"gw.ini", 13}, why, sizeof why),
+          "signal: %s", why);
+    CHECK_EQ_INT(r.count, 0);
+    CHECK_EQ_INT(can_map_finish(&map, one_robot, 1, NULL, 0), -1);
+    /* No [can] section, and the frame has neither id nor period: three problems. */
+    CHECK(r.count == 3 && r.first_line == 11, "finish reported %d, first at %d: %s", r.count, r.first_line, r.first);
+    CHECK_EQ_STR(r.first, "gw.ini|CAN frames need a [can] section (interface, heartbeat_id, ...)");
+    can_map_free(&map);
+}
+
+static void test_config_robots(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    const struct can_map_robot two[] = {{"left", 2000}, {"right", 8000}};
+    const char *cfg = CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n";
+    int rc = load(&map, cfg, two, 2, err, sizeof err);
+    CHECK(rc == -1, "several robots need robot = NAME");
+    CHECK(strstr(err, "t.ini:1: heartbeat: the gateway has 2 robots (left, right): say which with heartbeat_robot = NAME") != NULL,
+          "heartbeat robot: %s", err);
+    CHECK(strstr(err, "t.ini:4: [frame a]: the gateway has 2 robots (left, right): say which with robot = NAME") != NULL,
+          "frame robot: %s", err);
+    unload(&map);
+    rc = load(&map,
+              CAN_HEAD "heartbeat_robot = right\n[frame a]\nid = 0x100\nrobot = left\nperiod_ms = 2\n"
+                       "signal = time @0|8 intel unsigned\n",
+              two, 2, err, sizeof err);
+    CHECK(rc == 0, "two robots: %s", err);
+    if (rc == 0) {
+        CHECK(map.frames[0].robot_index == 0 && map.hb_robot_index == 1, "robots resolved");
+    }
+    unload(&map);
+    /* Every error is reported, one per line. */
+    rc = load(&map,
+              CAN_HEAD "[frame a]\nid = 0x900\nperiod_ms = 10\nsignal = time @0|16 intel unsigned\n"
+                       "signal = robot_mode @8|8 intel signed\n",
+              one_robot, 1, err, sizeof err);
+    CHECK(rc == -1 && strstr(err, "t.ini:5: [frame a] id 0x900") == err &&
+              strstr(err, "\nt.ini:8: [frame a] signal 'robot_mode' overlaps") != NULL,
+          "two errors: %s", err);
+    unload(&map);
+}
+
+/* ---- can_map: bus load ---------------------------------------------------------------- */
+
+static void test_bus_load(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    int rc;
+    /* 500 kbit/s, 2 us per bit. 11-bit, 8 bytes: 135 bits = 270 us; every
+     * 10 ms is 2.7 %. The heartbeat (11-bit, 8 bytes, 100 ms) is 0.27 %. */
+    rc = load(&map, CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n", one_robot,
+              1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    CHECK(fabs(map.frames[0].load - 0.027) < 1e-12, "load %.6f", map.frames[0].load);
+    CHECK(fabs(map.load - 0.0297) < 1e-12, "total %.6f", map.load);
+    CHECK(fabs(can_map_frame_time_us(&map, 8, true, false) - 320.0) < 1e-9, "29-bit 8 bytes: 160 bits");
+    unload(&map);
+    /* every packet at 125 Hz: 270 us / 8 ms = 3.375 %; 29-bit 8 bytes at
+     * 250 kbit/s: 160 bits = 640 us, every 20 ms = 3.2 %; heartbeat at 1000
+     * ms on 250 kbit/s: 540 us / 1 s = 0.054 %. */
+    rc = load(&map,
+              CAN_HEAD "bitrate = 250000\nheartbeat_period_ms = 1000\n[frame a]\nid = 0x100\nperiod_ms = every\n"
+                       "signal = time @0|8 intel unsigned\n[frame b]\nid = 0x100\nextended = yes\nperiod_ms = 20\n"
+                       "signal = time @0|8 intel unsigned\n",
+              one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    CHECK(fabs(map.frames[0].load - 0.0675) < 1e-12, "every at 125 Hz, 250k: %.6f", map.frames[0].load);
+    CHECK(fabs(map.frames[1].load - 0.032) < 1e-12, "29-bit at 20 ms: %.6f", map.frames[1].load);
+    CHECK(fabs(map.hb_load - 0.00054) < 1e-12, "heartbeat: %.6f", map.hb_load);
+    unload(&map);
+    /* FD, 64 bytes, 500k/2M: 34 bits at 2 us + 679 bits at 0.5 us = 407.5 us;
+     * every 10 ms: 4.075 %. */
+    rc = load(&map,
+              CAN_HEAD "fd = yes\ndata_bitrate = 2000000\n[frame a]\nid = 0x100\nfd = yes\nlength = 64\n"
+                       "period_ms = 10\nsignal = time @0|8 intel unsigned\n",
+              one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    CHECK(fabs(map.frames[0].load - 0.04075) < 1e-12, "FD 64: %.6f", map.frames[0].load);
+    unload(&map);
+    /* Over the threshold: 10 frames every 1 ms... at 125 Hz the robot
+     * limits periods, so use an e-series robot: 2 ms. 4 frames of 270 us
+     * every 2 ms = 54 % + heartbeat 0.27 % = 54.27 % over 50 %. */
+    {
+        const struct can_map_robot fast[] = {{"arm", 2000}};
+        char cfg[2048];
+        int n = snprintf(cfg, sizeof cfg, "%s", CAN_HEAD);
+        int k;
+        for (k = 0; k < 4; k++) {
+            n += snprintf(cfg + n, sizeof cfg - (size_t)n,
+                          "[frame f%d]\nid = 0x%x\nperiod_ms = 2\nsignal = time @0|8 intel unsigned\n", k, 0x100 + k);
+        }
+        rc = load(&map, cfg, fast, 1, err, sizeof err);
+        CHECK(rc == -1 && strstr(err, "t.ini:1: worst-case bus load 54.3% at 500000 bit/s is over max_bus_load = 50% "
+                                      "(heaviest: f0 13.5%, f1 13.5%, f2 13.5%)") == err,
+              "bus load rejection: %s", err);
+        unload(&map);
+        /* The same at max_bus_load = 60 passes, and the message points at
+         * max_bus_load when it is given. */
+        snprintf(cfg + strlen(CAN_HEAD), sizeof cfg - strlen(CAN_HEAD), "max_bus_load = 54\n%s", "");
+        n = (int)strlen(cfg);
+        for (k = 0; k < 4; k++) {
+            n += snprintf(cfg + n, sizeof cfg - (size_t)n,
+                          "[frame f%d]\nid = 0x%x\nperiod_ms = 2\nsignal = time @0|8 intel unsigned\n", k, 0x100 + k);
+        }
+        rc = load(&map, cfg, fast, 1, err, sizeof err);
+        CHECK(rc == -1 && strncmp(err, "t.ini:4: worst-case bus load 54.3%", 34) == 0, "at max_bus_load: %s", err);
+        unload(&map);
+    }
+}
+
+/* ---- can_map: run time on a fake clock --------------------------------------------------- */
+
+#define MAX_SENT 4096
+struct sent {
+    uint64_t t;
+    urrt_can_frame f;
+};
+struct capture {
+    uint64_t now;
+    size_t n;
+    struct sent s[MAX_SENT];
+};
+
+static void capture_frame(void *ctx, const urrt_can_frame *f, uint64_t now_us)
+{
+    struct capture *c = ctx;
+    if (c->n < MAX_SENT) {
+        c->s[c->n].t = now_us;
+        c->s[c->n].f = *f;
+        c->n++;
+    }
+}
+
+static double hb_value(const urrt_can_frame *f, enum urrt_cantx_hb_signal k)
+{
+    double v = NAN;
+    urrt_can_unpack(&urrt_cantx_heartbeat_signals[k], f->data, f->len, &v);
+    return v;
+}
+
+static uint64_t bits_of(const urrt_can_frame *f, unsigned start, unsigned length)
+{
+    urrt_can_signal s = {0};
+    s.start = (uint16_t)start;
+    s.length = (uint8_t)length;
+    s.byte_order = URRT_CAN_INTEL;
+    s.type = URRT_CAN_UNSIGNED;
+    s.factor = 1;
+    uint64_t raw = 0;
+    urrt_can_get_raw(&s, f->data, f->len, &raw);
+    return raw;
+}
+
+static void packet(uint64_t t, double q0, double mode, bool with_q)
+{
+    urrt_state st;
+    urrt_state_clear(&st);
+    st.generation = URRT_GEN_3X;
+    st.time[0] = (double)t / 1e6;
+    st.robot_mode[0] = mode;
+    st.safety_mode[0] = 1;
+    st.q_actual[0] = q0;
+    st.present = (UINT64_C(1) << URRT_F_TIME) | (UINT64_C(1) << URRT_F_ROBOT_MODE) |
+                 (UINT64_C(1) << URRT_F_SAFETY_MODE) | (with_q ? UINT64_C(1) << URRT_F_Q_ACTUAL : 0);
+    urrt_cantx_on_packet(can_run_tx(loaded_run), 0, &st, t);
+}
+
+static const char *const sched_config =
+    "[can]\n"
+    "interface = log:-\n"
+    "heartbeat_id = 0x701\n"
+    "heartbeat_period_ms = 100\n"
+    "stale_after_ms = 50\n"
+    "[frame fast]\n"
+    "id = 0x181\n"
+    "period_ms = 10\n"
+    "alive_counter = 60\n"
+    "validity_bit = 59\n"
+    "stale_policy = invalid\n"
+    "signal = q_actual[0] @0|16 intel signed factor=0.001\n"
+    "[frame slow]\n"
+    "id = 0x281\n"
+    "period_ms = 20\n"
+    "stale_after_ms = 30\n"
+    "signal = robot_mode @0|8 intel signed\n"
+    "[frame each]\n"
+    "id = 0x381\n"
+    "period_ms = every\n"
+    "signal = time @0|32 intel unsigned factor=0.001\n";
+
+static struct capture cap;
+
+static void test_schedule(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    uint64_t t;
+    uint64_t last_packet = 0;
+    size_t i;
+    size_t fast = 0, slow = 0, each = 0, hb = 0;
+    int packets = 0;
+    bool ok_valid = true, ok_alive = true, ok_fast_t = true, ok_q = true, ok_each = true;
+    int rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "schedule config: %s", err);
+    if (rc != 0) {
+        return;
+    }
+    memset(&cap, 0, sizeof cap);
+    CHECK(urrt_cantx_deadline(can_run_tx(loaded_run)) == URRT_CANTX_NEVER, "no deadline before start");
+    can_run_start(loaded_run, 0);
+    /* Packets every 8 ms from 1 ms to 97 ms; due() every millisecond to 300 ms. */
+    for (t = 0; t < 300000; t += 1000) {
+        cap.now = t;
+        if (t % 8000 == 1000 && t < 100000) {
+            packet(t, 1.234, 7, true);
+            last_packet = t;
+            packets++;
+        }
+        can_run_due(loaded_run, t, NULL, capture_frame, &cap);
+        if (t == 50000) {
+            /* Next: fast at 60, slow at 61 (started at the first packet, 1 ms), heartbeat at 100. */
+            CHECK_EQ_INT(urrt_cantx_deadline(can_run_tx(loaded_run)), 60000);
+        }
+    }
+    (void)last_packet;
+    for (i = 0; i < cap.n; i++) {
+        const struct sent *s = &cap.s[i];
+        switch (s->f.id) {
+        case 0x181: {
+            bool has = s->t >= 1000;
+            uint64_t age = has ? s->t - (s->t >= 97000 ? 97000 : ((s->t - 1000) / 8000) * 8000 + 1000) : 0;
+            bool want_valid = has && age <= 50000;
+            ok_fast_t &= s->t == fast * 10000;
+            ok_alive &= bits_of(&s->f, 60, 4) == fast % 16;
+            ok_valid &= bits_of(&s->f, 59, 1) == (want_valid ? 1u : 0u);
+            /* Before data: NaN packs physical 0; after: 1.234 -> 1234. */
+            ok_q &= bits_of(&s->f, 0, 16) == (has ? 1234u : 0u);
+            fast++;
+            break;
+        }
+        case 0x281:
+            /* Started by the first packet at 1 ms; every 20 ms; stops once
+             * the data is older than 30 ms: the last packet is at 97 ms, so
+             * 121 (age 24) is sent and 141 (age 44) is not. */
+            CHECK(s->t == 1000 + slow * 20000, "slow frame %zu at %llu", slow, (unsigned long long)s->t);
+            CHECK(s->f.data[0] == 7 && s->f.len == 8, "slow frame carries robot mode 7");
+            slow++;
+            break;
+        case 0x381:
+            ok_each &= s->t % 8000 == 1000 && bits_of(&s->f, 0, 32) == s->t / 1000;
+            each++;
+            break;
+        case 0x701:
+            CHECK(s->t == hb * 100000, "heartbeat %zu at %llu", hb, (unsigned long long)s->t);
+            CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ALIVE), hb);
+            if (hb == 0) {
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_STARTING);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), URRT_CANTX_HB_ROBOT_MODE_NA);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), URRT_CANTX_HB_SAFETY_MODE_NA);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 65535);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_GENERATION), 0);
+            } else if (hb == 1) {
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_OK);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), 7);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), 1);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 3); /* last packet at 97 ms */
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_GENERATION), 3);
+            } else {
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_DATA_STALE);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 103);
+                /* Modes as old as the data are not current: not available. */
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), URRT_CANTX_HB_ROBOT_MODE_NA);
+                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), URRT_CANTX_HB_SAFETY_MODE_NA);
+            }
+            CHECK(s->f.len == 8 && !s->f.fd && !s->f.extended, "heartbeat frame shape");
+            hb++;
+            break;
+        default: CHECK(false, "unexpected id 0x%X", (unsigned)s->f.id);
+        }
+    }
+    CHECK_EQ_INT(fast, 30);
+    CHECK(ok_fast_t, "fast frames every 10 ms from 0");
+    CHECK(ok_alive, "alive counter 0..15, 0, ...");
+    CHECK(ok_valid, "validity bit follows data age (50 ms) and data presence");
+    CHECK(ok_q, "fast frame payload");
+    CHECK_EQ_INT(slow, 7); /* 1, 21, 41, 61, 81, 101, 121 */
+    CHECK_EQ_INT(each, packets);
+    CHECK(ok_each, "every-packet frames at the packets, with their time");
+    CHECK_EQ_INT(hb, 3);
+
+    /* Data comes back: the slow frame resumes at once, then every 20 ms. */
+    cap.n = 0;
+    for (t = 300000; t < 345000; t += 1000) {
+        cap.now = t;
+        if (t == 305000) {
+            packet(t, -1.0, 5, true);
+        }
+        can_run_due(loaded_run, t, NULL, capture_frame, &cap);
+    }
+    {
+        uint64_t slow_at[8];
+        size_t ns = 0;
+        for (i = 0; i < cap.n; i++) {
+            if (cap.s[i].f.id == 0x281 && ns < 8) {
+                slow_at[ns++] = cap.s[i].t;
+            }
+        }
+        CHECK(ns == 2 && slow_at[0] == 305000 && slow_at[1] == 325000, "slow resumes: %zu frames, first at %llu", ns,
+              ns ? (unsigned long long)slow_at[0] : 0ull);
+        /* 345: the 325 one was the last within 30 ms of data at 305 (age 20) */
+    }
+    /* A stalled loop: one frame per frame, not a burst of the missed slots. */
+    cap.n = 0;
+    cap.now = 1000000;
+    can_run_due(loaded_run, 1000000, NULL, capture_frame, &cap);
+    {
+        size_t nfast = 0, nhb = 0;
+        for (i = 0; i < cap.n; i++) {
+            nfast += cap.s[i].f.id == 0x181;
+            nhb += cap.s[i].f.id == 0x701;
+        }
+        CHECK(nfast == 1 && nhb == 1 && cap.n == 2, "after a stall: %zu fast, %zu heartbeats, %zu frames", nfast, nhb,
+              cap.n);
+        CHECK_EQ_INT(urrt_cantx_deadline(can_run_tx(loaded_run)), 1010000);
+    }
+    /* An every-packet frame left pending while the CAN link was down (the
+     * gateway calls no due() then) must not carry stale data out when the
+     * link comes back: it stops with the packets. */
+    packet(2000000, 1.234, 7, true);
+    for (t = 2200000; t <= 2300000; t += 100000) {
+        size_t neach = 0;
+        if (t == 2300000) {
+            packet(t, 1.234, 7, true);
+        }
+        cap.n = 0;
+        cap.now = t;
+        can_run_due(loaded_run, t, NULL, capture_frame, &cap);
+        for (i = 0; i < cap.n; i++) {
+            neach += cap.s[i].f.id == 0x381;
+        }
+        CHECK(neach == (t == 2300000 ? 1u : 0u), "every-packet frame at %llu ms, %s data: %zu sent",
+              (unsigned long long)(t / 1000), t == 2300000 ? "fresh" : "200 ms old", neach);
+    }
+    unload(&map);
+}
+
+/* Saturation, NaN and link statistics in the frames and the heartbeat. */
+static void test_validity_and_heartbeat(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    urrt_canlink_stats stats;
+    size_t i;
+    int rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    if (rc != 0) {
+        return;
+    }
+    memset(&stats, 0, sizeof stats);
+    memset(&cap, 0, sizeof cap);
+    can_run_start(loaded_run, 0);
+    /* In range: valid. */
+    packet(1000, 2.0, 7, true);
+    cap.now = 1000;
+    can_run_due(loaded_run, 1000, &stats, capture_frame, &cap);
+    /* 40.0 rad does not fit 16 signed bits at 0.001: saturated, invalid. */
+    packet(9000, 40.0, 7, true);
+    cap.now = 10000;
+    can_run_due(loaded_run, 10000, &stats, capture_frame, &cap);
+    /* q absent from the packet (NaN): invalid, payload carries physical 0. */
+    packet(17000, 0, 7, false);
+    cap.now = 20000;
+    can_run_due(loaded_run, 20000, &stats, capture_frame, &cap);
+    /* In range again: valid. */
+    packet(25000, -2.0, 7, true);
+    cap.now = 30000;
+    can_run_due(loaded_run, 30000, &stats, capture_frame, &cap);
+    {
+        int k = 0;
+        const uint64_t want_q[] = {2000, 32767, 0, (uint64_t)(65536 - 2000)};
+        const unsigned want_valid[] = {1, 0, 0, 1};
+        for (i = 0; i < cap.n; i++) {
+            if (cap.s[i].f.id != 0x181 || cap.s[i].t == 0) {
+                continue;
+            }
+            if (k < 4) {
+                CHECK(bits_of(&cap.s[i].f, 0, 16) == want_q[k] && bits_of(&cap.s[i].f, 59, 1) == want_valid[k],
+                      "frame %d: q raw %llu valid %llu", k, (unsigned long long)bits_of(&cap.s[i].f, 0, 16),
+                      (unsigned long long)bits_of(&cap.s[i].f, 59, 1));
+            }
+            k++;
+        }
+        CHECK_EQ_INT(k, 4);
+    }
+    /* Heartbeat flags say "since the previous heartbeat". */
+    stats.dropped = 70000;
+    stats.bus_off = 1;
+    cap.n = 0;
+    cap.now = 100000;
+    packet(99000, 1, 7, true);
+    can_run_due(loaded_run, 100000, &stats, capture_frame, &cap);
+    for (i = 0; i < cap.n && cap.s[i].f.id != 0x701; i++) {
+    }
+    CHECK(i < cap.n, "heartbeat at 100 ms");
+    if (i < cap.n) {
+        const urrt_can_frame *f = &cap.s[i].f;
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_DROPS), 70000 % 65536);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_TX_DROPPED), 1);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_BUS_OFF), 1);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_CAN_ERRORS), 0);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_CLAMPED), 1); /* 40 rad and NaN since start */
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_DATA_AGE), 1);
+    }
+    stats.error_frames = 3;
+    stats.down_events = 1;
+    stats.send_errors = 2;
+    cap.n = 0;
+    cap.now = 200000;
+    packet(199000, 1, 7, true);
+    can_run_due(loaded_run, 200000, &stats, capture_frame, &cap);
+    for (i = 0; i < cap.n && cap.s[i].f.id != 0x701; i++) {
+    }
+    if (i < cap.n) {
+        const urrt_can_frame *f = &cap.s[i].f;
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_DROPS), 70000 % 65536);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_TX_DROPPED), 0);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_BUS_OFF), 0);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_CAN_ERRORS), 1);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_CAN_DOWN), 1);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_SEND_ERRORS), 1);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_CLAMPED), 0);
+        CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_STATE), URRT_CANTX_OK);
+    } else {
+        CHECK(false, "heartbeat at 200 ms");
+    }
+    /* The link goes down: disconnected, whatever the age. */
+    urrt_cantx_robot_link(can_run_tx(loaded_run), 0, false);
+    CHECK_EQ_INT(can_run_state(loaded_run, 200500), URRT_CANTX_DISCONNECTED);
+    {
+        urrt_can_frame f;
+        can_run_heartbeat_frame(loaded_run, 200500, &stats, &f);
+        CHECK_EQ_INT(hb_value(&f, URRT_CANTX_HB_STATE), URRT_CANTX_DISCONNECTED);
+        CHECK(f.id == 0x701 && f.len == 8, "heartbeat_frame id and length");
+    }
+    /* Data age saturates at 65534 ms. */
+    CHECK_EQ_INT(can_run_state(loaded_run, 100000000), URRT_CANTX_DISCONNECTED);
+    {
+        urrt_can_frame f;
+        can_run_heartbeat_frame(loaded_run, 100000000, &stats, &f);
+        CHECK_EQ_INT(hb_value(&f, URRT_CANTX_HB_DATA_AGE), 65534);
+    }
+    unload(&map);
+
+    /* Starting: at most CAN_RUN_STARTUP_MS without data, then disconnected
+     * (link not up) or stale (link up but silent). */
+    rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
+    can_run_start(loaded_run, 1000);
+    CHECK_EQ_INT(can_run_state(loaded_run, 1000 + 4999000), URRT_CANTX_STARTING);
+    CHECK_EQ_INT(can_run_state(loaded_run, 1000 + 5000000), URRT_CANTX_DISCONNECTED);
+    urrt_cantx_robot_link(can_run_tx(loaded_run), 0, true);
+    CHECK_EQ_INT(can_run_state(loaded_run, 1000 + 5000000), URRT_CANTX_DATA_STALE);
+    unload(&map);
+}
+
+/* The heartbeat goes at least once a second, whatever the loop's rhythm. */
+static void test_heartbeat_rate(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    uint64_t t;
+    uint64_t prev = 0;
+    uint64_t worst_gap = 0;
+    size_t i;
+    int n = 0;
+    int rc = load(&map,
+                  CAN_HEAD "heartbeat_period_ms = 1000\n[frame a]\nid = 0x100\nperiod_ms = 500\n"
+                           "signal = time @0|8 intel unsigned\n",
+                  one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    memset(&cap, 0, sizeof cap);
+    /* The loop wakes at the map's deadline, a little late each time. */
+    t = 5000;
+    for (i = 0; i < 200 && t < 20000000; i++) {
+        uint64_t d;
+        cap.now = t;
+        can_run_due(loaded_run, t, NULL, capture_frame, &cap);
+        d = urrt_cantx_deadline(can_run_tx(loaded_run));
+        CHECK(d > t && d != URRT_CANTX_NEVER, "deadline %llu after %llu", (unsigned long long)d,
+              (unsigned long long)t);
+        t = d + 700; /* late by 0.7 ms */
+    }
+    for (i = 0; i < cap.n; i++) {
+        if (cap.s[i].f.id == 0x701) {
+            if (n > 0 && cap.s[i].t - prev > worst_gap) {
+                worst_gap = cap.s[i].t - prev;
+            }
+            prev = cap.s[i].t;
+            n++;
+        }
+    }
+    CHECK(n >= 19, "%d heartbeats in 20 s", n);
+    CHECK(worst_gap <= 1000700, "largest gap between heartbeats %llu us", (unsigned long long)worst_gap);
+    unload(&map);
+}
+
+/* Mangled configurations: never a crash (the sanitizer build watches), and
+ * either accepted or rejected with "t.ini:LINE: reason". Accepted ones
+ * write a DBC and run a few cycles. */
+static void test_config_mutations(void)
+{
+    static const char alphabet[] = "0123456789@|[]=x \"-.;#_abcfilmnorstuvFX\n";
+    char text[4096];
+    size_t base = strlen(sched_config);
+    int i;
+    int rejected = 0;
+    int accepted = 0;
+    int bad = 0;
+    for (i = 0; i < 3000; i++) {
+        struct can_map map;
+        char err[4096] = "";
+        int k;
+        int edits = 1 + (int)(test_rng() % 4);
+        size_t len = base;
+        memcpy(text, sched_config, base + 1);
+        for (k = 0; k < edits; k++) {
+            size_t at = (size_t)(test_rng() % len);
+            switch (test_rng() % 3) {
+            case 0: text[at] = alphabet[test_rng() % (sizeof alphabet - 1)]; break;
+            case 1: memmove(text + at, text + at + 1, len - at); len--; break;
+            default:
+                if (len + 1 < sizeof text) {
+                    memmove(text + at + 1, text + at, len - at + 1);
+                    text[at] = alphabet[test_rng() % (sizeof alphabet - 1)];
+                    len++;
+                }
+            }
+        }
+        if (load(&map, text, one_robot, 1, err, sizeof err) == 0) {
+            FILE *devnull = fopen("/dev/null", "w");
+            accepted++;
+            if (devnull != NULL) {
+                bad += dbc_write(devnull, &map, "t.ini") != 0;
+                fclose(devnull);
+            }
+            memset(&cap, 0, sizeof cap);
+            can_run_start(loaded_run, 0);
+            packet(1000, 1.0, 7, true);
+            can_run_due(loaded_run, 1000, NULL, capture_frame, &cap);
+            can_run_due(loaded_run, 200000, NULL, capture_frame, &cap);
+        } else {
+            rejected++;
+            if (strncmp(err, "t.ini:", 6) != 0) {
+                if (bad++ < 3) {
+                    fprintf(stderr, "mutation: error without a location: %s\n", err);
+                }
+            }
+        }
+        unload(&map);
+    }
+    CHECK(bad == 0, "%d mutated configurations misbehaved", bad);
+    CHECK(accepted > 50 && rejected > 1000, "mutations: %d accepted, %d rejected", accepted, rejected);
+}
+
+/* DBC text spot checks (the full comparison is check-can-dbc). */
+static void test_dbc_text(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    char *text = NULL;
+    size_t size = 0;
+    FILE *f;
+    char num[40];
+    int rc = load(&map, good_config, one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    f = open_memstream(&text, &size);
+    CHECK_EQ_INT(dbc_write(f, &map, "t.ini"), 0);
+    fclose(f);
+    CHECK(strstr(text, "BO_ 385 joints: 8 URRT_GATEWAY\n") != NULL, "joints BO_");
+    CHECK(strstr(text, " SG_ q_actual_0 : 0|16@1- (0.0001,0) [-3.2768|3.2767] \"rad\" Vector__XXX\n") != NULL,
+          "q_actual_0 SG_");
+    CHECK(strstr(text, " SG_ rx : 39|16@0- (0.0001,0) [-3.2768|3.2767] \"rad\" Vector__XXX\n") != NULL, "rx SG_");
+    CHECK(strstr(text, " SG_ alive_counter : 56|4@1+ (1,0) [0|15] \"\" Vector__XXX\n") != NULL, "alive SG_");
+    CHECK(strstr(text, "BO_ 2566848640 status: 4 URRT_GATEWAY\n") != NULL, "extended id flagged");
+    CHECK(strstr(text, "BA_ \"VFrameFormat\" BO_ 2566848640 1;\n") != NULL, "ExtendedCAN");
+    CHECK(strstr(text, "BA_ \"GenMsgCycleTime\" BO_ 385 10;\n") != NULL, "cycle time");
+    CHECK(strstr(text, "BA_ \"GenMsgCycleTime\" BO_ 2566848640 8;\n") != NULL, "every packet at 125 Hz: 8 ms");
+    CHECK(strstr(text, "VAL_ 2566848640 robot_mode -1 \"NO_CONTROLLER\" 0 \"DISCONNECTED\"") != NULL, "robot mode VAL_");
+    CHECK(strstr(text, "VAL_ 1793 state 0 \"STARTING\" 1 \"OK\" 2 \"DATA_STALE\" 3 \"ROBOT_DISCONNECTED\" ;") != NULL,
+          "heartbeat state VAL_");
+    CHECK(strstr(text, "VAL_ 1793 robot_mode -128 \"NOT_AVAILABLE\" -1 \"NO_CONTROLLER\"") != NULL, "hb robot mode");
+    free(text);
+    unload(&map);
+    CHECK_EQ_STR(dbc_number(0.1, num, sizeof num), "0.1");
+    CHECK_EQ_STR(dbc_number(-3276.8, num, sizeof num), "-3276.8");
+    CHECK_EQ_STR(dbc_number(1e-5, num, sizeof num), "1e-05");
+    CHECK_EQ_STR(dbc_number(3.4028234663852886e+38, num, sizeof num), "3.4028234663852886e+38");
+    CHECK(strtod(dbc_number(0.1 + 0.2, num, sizeof num), NULL) == 0.1 + 0.2, "shortest round trip %s", num);
+}
+
+int main(void)
+{
+    test_config_good();
+    test_config_rejections();
+    test_config_robots();
+    test_reporter();
+    test_bus_load();
+    test_schedule();
+    test_validity_and_heartbeat();
+    test_heartbeat_rate();
+    test_config_mutations();
+    test_dbc_text();
+    return check_report();
+}

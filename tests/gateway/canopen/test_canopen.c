@@ -1,0 +1,455 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The gateway's CANopen node (gateway/can/canopen_map.c, co_run.c, eds.c):
+ * configurations loaded through the gateway's own loader
+ * (gw_config_load_stream), each rejection of issue 18 section 4 with its
+ * file, line and reason; the description built for docs/examples/canopen.ini;
+ * its EDS read back against the node itself (every object the EDS names read
+ * by SDO, of the declared size); the DBC and C tables carrying the same TPDOs.
+ *
+ * docs/canopen.md's table of the example's object dictionary, row for row.
+ *
+ * Usage: test_canopen EXAMPLE.ini GENERATED_TABLES.c CANOPEN.md
+ *        test_canopen --table EXAMPLE.ini     (prints docs/canopen.md's table)
+ */
+#define _GNU_SOURCE
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "config.h"
+#include "dbc.h"
+#include "eds.h"
+
+/* ---- loading ---------------------------------------------------------------------- */
+
+/* Loads text as "t.ini"; returns the number of errors, their text in *messages (free it). */
+static int load(gw_config *cfg, const char *text, char **messages)
+{
+    size_t size = 0;
+    FILE *in = fmemopen((void *)text, strlen(text), "r");
+    FILE *err = open_memstream(messages, &size);
+    int errors = gw_config_load_stream(cfg, in, "t.ini", err);
+    fclose(in);
+    fclose(err);
+    return errors;
+}
+
+static const char robot_can[] = "[robot a]\nhost = h\n[can]\ninterface = log:-\n";   /* lines 1-4 */
+
+/* robot_can, then [canopen] with node_id (lines 5-6), then rest from line 7. */
+static void expect(const char *node_id, const char *rest, const char *want, const char *what)
+{
+    char text[2048];
+    char *messages = NULL;
+    gw_config cfg;
+    int errors;
+    snprintf(text, sizeof text, "%s[canopen]\nnode_id = %s\n%s", robot_can, node_id, rest);
+    errors = load(&cfg, text, &messages);
+    CHECK(errors > 0 && strstr(messages, want) != NULL, "%s: want \"%s\" in:\n%s", what, want, messages);
+    gw_config_free(&cfg);
+    free(messages);
+}
+
+static const char frame1[] = "[frame a]\nperiod_ms = 10\nsignal = q_actual[0] @0|16 intel signed\n"; /* 7-9 */
+
+static void test_rejections(void)
+{
+    char rest[1024];
+    expect("128", frame1, "t.ini:6: node_id = '128': give the CANopen node id, 1..127", "node id above 127");
+    expect("0", frame1, "t.ini:6: node_id = '0': give the CANopen node id, 1..127", "node id 0");
+    /* Two TPDOs on one COB-ID: an own id that is TPDO1's. */
+    snprintf(rest, sizeof rest, "%s[frame b]\nperiod_ms = 10\nid = 0x185\nown_id = yes\n"
+             "signal = q_actual[1] @0|16 intel signed\n", frame1);
+    expect("5", rest, "t.ini:12: [frame b] id 0x185 is already used by [frame a] (line 7)", "two TPDOs, one COB-ID");
+    snprintf(rest, sizeof rest, "%s[frame b]\ntpdo = 1\nperiod_ms = 10\nsignal = q_actual[1] @0|16 intel signed\n",
+             frame1);
+    expect("5", rest, "t.ini:11: [frame b] is TPDO1, as [frame a] (line 7) already is", "one TPDO number twice");
+    /* Signals a PDO cannot map. */
+    expect("5", "[frame a]\nperiod_ms = 10\nsignal = q_actual[0] @4|16 intel signed name=q\n",
+           "t.ini:9: [frame a] signal q starts at bit 4, inside a byte: a PDO maps whole bytes", "not byte-aligned");
+    expect("5", "[frame a]\nperiod_ms = 10\nsignal = q_actual[0] @7|16 motorola signed name=q\n",
+           "t.ini:9: [frame a] signal q is Motorola (big-endian): CANopen PDOs are little-endian", "Motorola");
+    expect("5", "[frame a]\nperiod_ms = 10\nsignal = q_actual[0] @0|64 intel float64 name=q\n",
+           "t.ini:9: [frame a] signal q has 64 bits: a PDO-mapped object holds at most 32 bits", "64 bits");
+    expect("5", "[frame a]\nperiod_ms = 10\nsignal = q_actual[0] @0|12 intel signed name=q\n",
+           "t.ini:9: [frame a] signal q is signed with 12 bits", "signed, not a whole object");
+    expect("5", "[frame a]\nperiod_ms = 10\nsignal = digital_input_bits @0|12 intel unsigned name=d\n"
+           "signal = robot_mode @16|8 intel signed\nalive_counter = 12\n",
+           "t.ini:11: [frame a] signal alive_counter starts at bit 12", "alive counter inside a byte");
+    expect("5", "[frame a]\nperiod_ms = 10\nsignal = digital_input_bits @0|18 intel unsigned name=d\n"
+           "signal = robot_mode @24|8 intel signed\n",
+           "t.ini:10: [frame a] signal robot_mode: its 1-byte object needs byte 3 that another signal uses",
+           "a byte shared by two objects");
+    expect("5", "[frame a]\nperiod_ms = 10\nextended = yes\nid = 0x185\nown_id = yes\n"
+           "signal = q_actual[0] @0|16 intel signed\n", "t.ini:7: [frame a] (TPDO1) is extended (29-bit)", "29-bit");
+    /* A frame id that does not follow from the node id, without saying so. */
+    expect("5", "[frame a]\nperiod_ms = 10\nid = 0x181\nsignal = q_actual[0] @0|16 intel signed\n",
+           "t.ini:9: [frame a] id = 0x181 is not TPDO1's COB-ID for node_id 5 (0x185): remove id (it follows from "
+           "node_id), or keep it and say own_id = yes", "id not from the node id");
+    expect("5", "[frame a]\nperiod_ms = 10\nid = 0x605\nown_id = yes\nsignal = q_actual[0] @0|16 intel signed\n",
+           "t.ini:9: [frame a] id = 0x605 is one CiA 301 keeps", "an own id CiA 301 reserves");
+    expect("5", "[frame a]\ntpdo = 5\nperiod_ms = 10\nsignal = q_actual[0] @0|16 intel signed\n",
+           "t.ini:8: [frame a] tpdo = 5: the 1 frames are TPDO1..1, numbered without a gap", "a gap");
+    expect("5", "[frame a]\nperiod_ms = 10\ntransmission = sync 241\nsignal = q_actual[0] @0|16 intel signed\n",
+           "t.ini:9: transmission = 'sync 241': use event", "SYNC count out of range");
+}
+
+static void test_causes_first(void)
+{
+    char *messages = NULL;
+    gw_config cfg;
+    char text[512];
+    /* The bad value (line 6) before what the file then lacks (the section, line 5). */
+    snprintf(text, sizeof text, "%s[canopen]\nnode_id = 200\n%s", robot_can, frame1);
+    CHECK(load(&cfg, text, &messages) == 2, "two errors: %s", messages);
+    char *value = strstr(messages, "t.ini:6:"), *lack = strstr(messages, "t.ini:5:");
+    CHECK(value != NULL && lack != NULL && value < lack, "cause first:\n%s", messages);
+    CHECK(strstr(messages, "has no id") == NULL, "no consequence for the frames:\n%s", messages);
+    gw_config_free(&cfg);
+    free(messages);
+    /* A CANopen key without [canopen]. */
+    snprintf(text, sizeof text, "%sheartbeat_id = 0x701\n[frame a]\nid = 0x181\nperiod_ms = 10\ntpdo = 1\n"
+             "signal = q_actual[0] @0|16 intel signed\n", robot_can);
+    CHECK(load(&cfg, text, &messages) == 1 && strstr(messages, "t.ini:9: [frame a] tpdo is a CANopen key: it needs a "
+                                                               "[canopen] section") != NULL, "%s", messages);
+    gw_config_free(&cfg);
+    free(messages);
+}
+
+/* ---- the example's description -------------------------------------------------------- */
+
+static void test_description(const gw_config *cfg)
+{
+    const urrt_co_desc *d = co_run_desc(cfg->co_run);
+    size_t rx_count;
+    const uint32_t *rx = co_run_rx_ids(cfg->co_run, &rx_count);
+    CHECK_EQ_INT(d->node_id, 5);
+    CHECK_EQ_INT(d->nmt_start, URRT_CO_START_OPERATIONAL);
+    CHECK_EQ_INT(d->heartbeat_ms, 1000);
+    CHECK_EQ_INT(d->tpdo_count, 5); /* TPDO1..4 and the status TPDO */
+    CHECK_EQ_INT(d->tpdos[0].cob_id, URRT_CO_COB_DEFAULT);
+    CHECK_EQ_INT(d->tpdos[3].transmission_type, 1);
+    CHECK_EQ_INT(d->tpdos[4].cob_id, 0x80000685u);
+    /* TPDO1: q0..q2 INTEGER16 at 0x2100 sub 1..3, the alive counter and validity bit a byte each. */
+    CHECK_EQ_INT(d->tpdos[0].mapping_count, 5);
+    CHECK_EQ_INT(d->tpdos[0].mapping[0], 0x21000110u);
+    CHECK_EQ_INT(d->tpdos[0].mapping[3], 0x21000408u);
+    CHECK_EQ_INT(d->tpdos[0].mapping[4], 0x21000508u);
+    /* Status: whole-byte values mapped (robot mode, safety mode, data age, drops), a dummy byte
+     * for each byte of bit fields. */
+    CHECK_EQ_INT(d->tpdos[4].mapping_count, 6);
+    CHECK_EQ_INT(d->tpdos[4].mapping[0], 0x00050008u);
+    CHECK_EQ_INT(d->tpdos[4].mapping[1], 0x20000308u);
+    CHECK_EQ_INT(d->tpdos[4].mapping[4], 0x20000C10u);
+    CHECK_EQ_INT(rx_count, 3);
+    CHECK(rx[0] == 0x000 && rx[1] == 0x080 && rx[2] == 0x605, "rx ids %X %X %X", rx[0], rx[1], rx[2]);
+    for (size_t i = 0; i < d->object_count; i++) {
+        if (d->objects[i].index == 0x2100 && d->objects[i].sub == 1) {
+            CHECK_EQ_INT(d->objects[i].type, URRT_CO_INTEGER16);
+        }
+    }
+}
+
+/* ---- the EDS against the node ----------------------------------------------------------- */
+
+/* The value of key in [section] of the EDS text, or NULL. */
+static const char *eds_get(const char *eds, const char *section, const char *key, char *buf, size_t size)
+{
+    char head[64];
+    const char *p;
+    snprintf(head, sizeof head, "\n[%s]\n", section);
+    p = strstr(eds, head);
+    if (p == NULL) {
+        return NULL;
+    }
+    for (p += strlen(head); *p != '\0' && *p != '\n' && *p != '['; p = strchr(p, '\n') + 1) {
+        size_t n = strlen(key);
+        if (strncmp(p, key, n) == 0 && p[n] == '=') {
+            size_t len = strcspn(p + n + 1, "\n");
+            snprintf(buf, size, "%.*s", (int)len, p + n + 1);
+            return buf;
+        }
+    }
+    return NULL;
+}
+
+struct sink {
+    urrt_can_frame last;
+    unsigned count;
+};
+
+static void sink_emit(void *ctx, const urrt_can_frame *frame, uint64_t now_us)
+{
+    struct sink *s = ctx;
+    (void)now_us;
+    s->last = *frame;
+    s->count++;
+}
+
+/* The size an SDO upload of index/sub reports, or -1 (abort: *abort). */
+static long sdo_size(urrt_co *node, unsigned index, unsigned sub, uint32_t *abort)
+{
+    struct sink s = {0};
+    uint8_t req[8] = {0x40, (uint8_t)index, (uint8_t)(index >> 8), (uint8_t)sub, 0, 0, 0, 0};
+    uint8_t cs;
+    urrt_co_on_frame(node, 0x605, 0, req, 8, 1000, sink_emit, &s);
+    cs = s.last.data[0];
+    *abort = 0;
+    if (s.count != 1 || s.last.id != 0x585) {
+        return -2;
+    }
+    if (cs == 0x80) {
+        *abort = (uint32_t)s.last.data[4] | (uint32_t)s.last.data[5] << 8 | (uint32_t)s.last.data[6] << 16 |
+                 (uint32_t)s.last.data[7] << 24;
+        return -1;
+    }
+    if (cs == 0x41) {
+        uint8_t abort_req[8] = {0x80, 0, 0, 0, 0, 0, 0, 0};
+        urrt_co_on_frame(node, 0x605, 0, abort_req, 8, 1000, sink_emit, &s); /* ends the segmented upload */
+        return (long)s.last.data[4] | (long)s.last.data[5] << 8;
+    }
+    return 4 - ((cs >> 2) & 3);
+}
+
+static long type_size(unsigned type)
+{
+    switch (type) {
+    case URRT_CO_INTEGER8: case URRT_CO_UNSIGNED8: return 1;
+    case URRT_CO_INTEGER16: case URRT_CO_UNSIGNED16: return 2;
+    case URRT_CO_VISIBLE_STRING: return 0;
+    default: return 4;
+    }
+}
+
+/* One VAR section of the EDS: read by SDO, of the size its DataType says. */
+static unsigned check_var(const char *eds, urrt_co *node, unsigned index, int sub)
+{
+    char name[32], buf[64];
+    uint32_t abort;
+    long size, want;
+    if (sub < 0) {
+        snprintf(name, sizeof name, "%04X", index);
+    } else {
+        snprintf(name, sizeof name, "%04Xsub%X", index, (unsigned)sub);
+    }
+    if (eds_get(eds, name, "DataType", buf, sizeof buf) == NULL) {
+        CHECK(0, "[%s] has no DataType", name);
+        return 0;
+    }
+    want = type_size((unsigned)strtoul(buf, NULL, 0));
+    size = sdo_size(node, index, sub < 0 ? 0u : (unsigned)sub, &abort);
+    if (index == 0x1003 && sub > 0) {
+        CHECK(size == -1 && abort == URRT_CO_ABORT_NO_DATA, "[%s]: no error recorded yet: 0x08000024", name);
+    } else {
+        CHECK(size >= 0 && (want == 0 || size == want), "[%s]: SDO size %ld (abort 0x%08X), EDS DataType %s", name,
+              size, abort, buf);
+    }
+    return 1;
+}
+
+/* Every object the three lists name, each sub-index of a record. */
+static unsigned check_listed(const char *eds, urrt_co *node, const char *list)
+{
+    char buf[64], key[16];
+    unsigned count = 0, vars = 0;
+    if (eds_get(eds, list, "SupportedObjects", buf, sizeof buf) == NULL) {
+        CHECK(0, "[%s] missing", list);
+        return 0;
+    }
+    count = (unsigned)strtoul(buf, NULL, 0);
+    for (unsigned i = 1; i <= count; i++) {
+        char name[16];
+        unsigned index;
+        snprintf(key, sizeof key, "%u", i);
+        index = (unsigned)strtoul(eds_get(eds, list, key, buf, sizeof buf) ? buf : "0", NULL, 0);
+        snprintf(name, sizeof name, "%04X", index);
+        if (eds_get(eds, name, "SubNumber", buf, sizeof buf) == NULL) {
+            vars += check_var(eds, node, index, -1);
+            continue;
+        }
+        for (unsigned sub = 0; sub < 256; sub++) {
+            char sname[24];
+            snprintf(sname, sizeof sname, "%04Xsub%X", index, sub);
+            if (eds_get(eds, sname, "DataType", buf, sizeof buf) != NULL) {
+                vars += check_var(eds, node, index, (int)sub);
+            }
+        }
+    }
+    return vars;
+}
+
+static void test_eds(gw_config *cfg)
+{
+    char *eds = NULL, buf[64];
+    size_t size = 0;
+    FILE *out = open_memstream(&eds, &size);
+    urrt_co *node = co_run_node(cfg->co_run);
+    struct sink s = {0};
+    unsigned vars;
+    CHECK_EQ_INT(eds_write(out, cfg->co_run, &cfg->co, &cfg->can, "canopen.ini"), 0);
+    fclose(out);
+    CHECK(strncmp(eds, "[FileInfo]\n", 11) == 0, "EDS begins with [FileInfo]");
+    CHECK(eds_get(eds, "DeviceInfo", "NrOfTXPDO", buf, sizeof buf) && strcmp(buf, "5") == 0, "NrOfTXPDO %s", buf);
+    CHECK(eds_get(eds, "DeviceInfo", "BaudRate_500", buf, sizeof buf) && strcmp(buf, "1") == 0, "BaudRate_500");
+    CHECK(eds_get(eds, "1800sub1", "DefaultValue", buf, sizeof buf) && strcmp(buf, "$NODEID+0x180") == 0, "%s", buf);
+    CHECK(eds_get(eds, "1014", "DefaultValue", buf, sizeof buf) && strcmp(buf, "$NODEID+0x80") == 0, "%s", buf);
+    CHECK(eds_get(eds, "1A00sub1", "DefaultValue", buf, sizeof buf) && strcmp(buf, "0x21000110") == 0, "%s", buf);
+    CHECK(eds_get(eds, "2100sub1", "ParameterName", buf, sizeof buf) &&
+          strstr(buf, "q0: q_actual[0], rad = raw x 0.0002") == buf, "scaling in the name: %s", buf);
+    urrt_co_start(node, 0, sink_emit, &s);
+    CHECK(s.count == 1 && s.last.id == 0x705 && s.last.len == 1 && s.last.data[0] == 0, "boot-up 0x705 [00]");
+    vars = check_listed(eds, node, "MandatoryObjects") + check_listed(eds, node, "OptionalObjects") +
+           check_listed(eds, node, "ManufacturerObjects");
+    CHECK(vars > 100, "%u objects and sub-indices read by SDO", vars);
+    free(eds);
+}
+
+/* ---- docs/canopen.md's table of the example's object dictionary --------------------------- */
+
+static const char *type_name(unsigned type)
+{
+    static const char *const names[] = {[URRT_CO_INTEGER8] = "INTEGER8", [URRT_CO_INTEGER16] = "INTEGER16",
+                                        [URRT_CO_INTEGER32] = "INTEGER32", [URRT_CO_UNSIGNED8] = "UNSIGNED8",
+                                        [URRT_CO_UNSIGNED16] = "UNSIGNED16", [URRT_CO_UNSIGNED32] = "UNSIGNED32",
+                                        [URRT_CO_REAL32] = "REAL32", [URRT_CO_VISIBLE_STRING] = "VISIBLE_STRING"};
+    return type < sizeof names / sizeof names[0] && names[type] ? names[type] : "?";
+}
+
+/* Calls row() with each VAR of the EDS as a markdown table row, in the EDS's order. */
+static unsigned table_rows(const char *eds, void (*row)(void *ctx, const char *line), void *ctx)
+{
+    unsigned rows = 0;
+    for (const char *p = strstr(eds, "\n["); p != NULL; p = strstr(p + 1, "\n[")) {
+        char section[32], name[200], type[16], access[8], def[64], pdo[4], line[400];
+        unsigned index = 0, sub = 0;
+        int sublen = 0;
+        if (sscanf(p + 1, "[%31[^]]]", section) != 1 || sscanf(section, "%4X%n", &index, &sublen) != 1 ||
+            sublen != 4 || eds_get(eds, section, "DataType", type, sizeof type) == NULL) {
+            continue;
+        }
+        if (strncmp(section + 4, "sub", 3) == 0) {
+            sub = (unsigned)strtoul(section + 7, NULL, 16);
+        }
+        eds_get(eds, section, "ParameterName", name, sizeof name);
+        eds_get(eds, section, "AccessType", access, sizeof access);
+        eds_get(eds, section, "DefaultValue", def, sizeof def);
+        eds_get(eds, section, "PDOMapping", pdo, sizeof pdo);
+        snprintf(line, sizeof line, "| 0x%04X | %u | %s | %s | %s | %s | %s |", index, sub, name,
+                 type_name((unsigned)strtoul(type, NULL, 0)), access, def[0] ? def : "\"\"",
+                 strcmp(pdo, "1") == 0 ? "yes" : "no");
+        row(ctx, line);
+        rows++;
+    }
+    return rows;
+}
+
+static void print_row(void *ctx, const char *line)
+{
+    (void)ctx;
+    puts(line);
+}
+
+static void find_row(void *ctx, const char *line)
+{
+    const char *doc = ctx;
+    char want[420];
+    snprintf(want, sizeof want, "\n%s\n", line);
+    CHECK(strstr(doc, want) != NULL, "docs/canopen.md lacks the row: %s", line);
+}
+
+static char *eds_text(gw_config *cfg)
+{
+    char *eds = NULL;
+    size_t size = 0;
+    FILE *out = open_memstream(&eds, &size);
+    eds_write(out, cfg->co_run, &cfg->co, &cfg->can, "canopen.ini");
+    fclose(out);
+    return eds;
+}
+
+/* Every row of the EDS in docs/canopen.md's table, and no other (the rows of that table counted). */
+static void test_doc_table(gw_config *cfg, const char *doc_path)
+{
+    static char doc[1 << 18];
+    FILE *in = fopen(doc_path, "r");
+    size_t n = in ? fread(doc, 1, sizeof doc - 1, in) : 0;
+    char *eds = eds_text(cfg);
+    const char *table = strstr(doc, "\n| 0x1000 | 0 |");
+    unsigned doc_rows = 0, rows;
+    doc[n] = '\0';
+    if (in) {
+        fclose(in);
+    }
+    rows = table_rows(eds, find_row, doc);
+    for (const char *p = table; p != NULL && strncmp(p, "\n| 0x", 5) == 0; p = strchr(p + 1, '\n')) {
+        doc_rows++;
+    }
+    CHECK(rows == doc_rows && rows > 100, "%s: %u rows, the EDS %u (regenerate with test_canopen --table)",
+          doc_path, doc_rows, rows);
+    free(eds);
+}
+
+/* ---- the DBC and the C tables ---------------------------------------------------------------- */
+
+static void test_dbc(gw_config *cfg)
+{
+    char *dbc = NULL;
+    size_t size = 0;
+    FILE *out = open_memstream(&dbc, &size);
+    CHECK_EQ_INT(dbc_write(out, &cfg->can, "canopen.ini"), 0);
+    fclose(out);
+    CHECK(strstr(dbc, "BO_ 389 tpdo1_joints_a: 8 URRT_GW") != NULL, "TPDO1 at 0x185");
+    CHECK(strstr(dbc, "BO_ 1157 tpdo4_status: 8 URRT_GW") != NULL, "TPDO4 at 0x485");
+    CHECK(strstr(dbc, " SG_ q0 : 0|16@1- (0.0002,0) [-6.3|6.3] \"rad\"") != NULL, "q0's scaling as the EDS says");
+    CHECK(strstr(dbc, "BO_ 1797 ") == NULL, "nothing at 0x705: the NMT heartbeat is not a DBC frame");
+    free(dbc);
+}
+
+static void test_c_tables(const char *path)
+{
+    FILE *in = fopen(path, "r");
+    static char text[1 << 18];
+    size_t n = in ? fread(text, 1, sizeof text - 1, in) : 0;
+    text[n] = '\0';
+    if (in) {
+        fclose(in);
+    }
+    CHECK(strstr(text, "const urrt_co_desc urrt_gateway_node = {\n    5, URRT_CO_START_OPERATIONAL, 1000,") != NULL,
+          "%s carries the node", path);
+    CHECK(strstr(text, "{urrt_gateway_tpdo5_mapping, UINT32_C(0x80000685), 4, 0, 254, 6}") != NULL, "status TPDO");
+    CHECK(strstr(text, "const uint32_t urrt_gateway_rx_ids[3] = {0x000, 0x080, 0x605};") != NULL, "rx ids");
+}
+
+int main(int argc, char **argv)
+{
+    gw_config cfg;
+    if (argc == 3 && strcmp(argv[1], "--table") == 0) {
+        /* docs/canopen.md's table, from the EDS of the configuration. */
+        if (gw_config_load(&cfg, argv[2], stderr) != 0 || cfg.co_run == NULL) {
+            return 2;
+        }
+        char *eds = eds_text(&cfg);
+        table_rows(eds, print_row, NULL);
+        free(eds);
+        gw_config_free(&cfg);
+        return 0;
+    }
+    if (argc != 4) {
+        fprintf(stderr, "usage: test_canopen EXAMPLE.ini TABLES.c CANOPEN.md | test_canopen --table EXAMPLE.ini\n");
+        return 2;
+    }
+    test_rejections();
+    test_causes_first();
+    CHECK(gw_config_load(&cfg, argv[1], stderr) == 0 && cfg.co_run != NULL, "%s loads, with its node", argv[1]);
+    if (cfg.co_run != NULL) {
+        test_description(&cfg);
+        test_eds(&cfg);
+        test_dbc(&cfg);
+        test_doc_table(&cfg, argv[3]);
+    }
+    gw_config_free(&cfg);
+    test_c_tables(argv[2]);
+    return check_report();
+}

@@ -1,0 +1,60 @@
+# SPDX-License-Identifier: MIT
+# tests/gateway/gateway.mk: urrt-gateway against urrt-sim, through LCM.
+#   check-gateway   values, decimation, two robots, restart/stall, mismatch,
+#                   zero allocations, publish errors, bad configurations, jar
+#   bench-gateway   latency robot -> subscriber and CPU per packet beside a
+#                   minimal relay (bench_relay.c), 1/10/50 robots, highest rate,
+#                   and the 500 Hz robots one core serves
+GWT := $(BUILD)/tests/gateway
+GWT_CFLAGS := $(PROG_WARN) $(OPT) $(CPPFLAGS) -I$(LCMGEN)
+
+CHECKS += check-freshness check-gateway
+BENCHES += bench-gateway
+.PHONY: check-freshness check-gateway bench-gateway
+
+# The age estimator on a fake clock (gateway/urrt-gateway/freshness.h).
+$(GWT)/test_freshness: tests/gateway/test_freshness.c tests/check.h gateway/urrt-gateway/freshness.c gateway/urrt-gateway/freshness.h
+	@mkdir -p $(@D)
+	$(CC) $(PROG_WARN) $(OPT) $(GATEWAY_INC) -Itests $< gateway/urrt-gateway/freshness.c -o $@
+
+check-freshness: $(GWT)/test_freshness
+	$(call suite,$@,$<)
+
+$(GWT)/lcm_sub: tests/gateway/lcm_sub.c $(LCMTYPES_OBJS) $(LCMTYPES_H) $(LIBURRT)
+	@mkdir -p $(@D)
+	$(CC) $(GWT_CFLAGS) -o $@ $< $(LCMTYPES_OBJS) $(LIBURRT) -llcm -lm
+
+$(GWT)/alloc_shim.so: tests/gateway/alloc_shim.c
+	@mkdir -p $(@D)
+	$(CC) -std=gnu11 $(OPT) -Wall -Wextra -Werror -fPIC -shared -o $@ $< -ldl
+
+$(GWT)/bench_gateway: tests/gateway/bench_gateway.c $(LIBURRT)
+	@mkdir -p $(@D)
+	$(CC) $(GWT_CFLAGS) -o $@ $< $(LIBURRT) -lm -lpthread
+
+$(GWT)/bench_relay: tests/gateway/bench_relay.c $(LIBURRT)
+	@mkdir -p $(@D)
+	$(CC) $(GWT_CFLAGS) -o $@ $< $(LIBURRT) -llcm
+
+check-gateway: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim $(GWT)/lcm_sub $(GWT)/alloc_shim.so $(LCMTYPES_JAR)
+	$(call suite,$@,$(PYTHON) tests/gateway/test_gateway.py --build $(BUILD))
+
+# The gateway beside the relay, every message at every packet, then the
+# focused messages at 50 Hz and no state; then one gateway against 1, 10 and
+# 50 robots at 500 Hz each, every message at every packet, and again with the
+# focused messages. Each CPU per packet also says how many robots one core serves.
+BENCH_GATEWAY_ROBOTS ?= 1 10 50
+bench-gateway: $(BUILD)/bin/urrt-gateway $(GWT)/bench_gateway $(GWT)/bench_relay
+	@echo "bench-gateway: *robots_per_core = 1 / (cpu_per_packet_us * 1e-6 * 500): the 500 Hz robots one core"
+	@echo "bench-gateway: serves at the subject's CPU per packet (its threads, from schedstat) measured there"
+	@echo "bench-gateway: all messages at every packet, gateway beside relay"
+	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --relay $(GWT)/bench_relay --max-rate
+	@echo "bench-gateway: focused messages at 50 Hz, no state, gateway beside relay"
+	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --relay $(GWT)/bench_relay --focused-hz 50 \
+	  | sed 's/^/decimated_/'
+	@echo "bench-gateway: one gateway, many robots at 500 Hz, every message at every packet"
+	@for n in $(BENCH_GATEWAY_ROBOTS); do \
+	  $(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --robots $$n || exit 1; done
+	@echo "bench-gateway: one gateway, many robots at 500 Hz, focused messages at 50 Hz, no state"
+	@for n in $(BENCH_GATEWAY_ROBOTS); do \
+	  $(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --robots $$n --focused-hz 50 || exit 1; done

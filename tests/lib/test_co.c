@@ -1,0 +1,825 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * check-co: lib/urrt_co.h, the CANopen node, on a fake clock. Every expected
+ * frame is written out byte by byte from CiA 301 (COB-IDs, command bytes,
+ * abort codes, heartbeat states), never computed by the code under test.
+ *
+ * The node is tests/lib/co_fixture.h's. The same file runs on the host and,
+ * without a C library, on the emulated Cortex-M4 and M0 (check-lib-m4:
+ * tests/check.h prints through tests/target/target_check.h there); check-lib-be
+ * runs it on big-endian Linux CPUs.
+ */
+#include "co_fixture.h"
+
+#include <stdint.h>
+
+#include "check.h"
+#include "testutil.h"
+#ifndef URRT_TARGET_CORTEX_M
+#include <string.h> /* the images' memcmp and memcpy: tests/target/target_check.h */
+#endif
+
+static urrt_co_desc desc;
+
+static urrt_cantx tx;
+static urrt_cantx_frame_state frame_states[2];
+static urrt_cantx_robot robots[1];
+static double values[8];
+static urrt_co co;
+static urrt_co_tpdo_state tpdo_states[2];
+static uint32_t vars[2];
+
+/* Frames kept of the latest call (no call sends more than 2 + 1 + URRT_CO_CONDITIONS + 2);
+ * out_count counts them all. Small: the Cortex-M0 has 16 KB of RAM. */
+#define MAX_OUT 16
+static urrt_can_frame out[MAX_OUT];
+static size_t out_count;
+
+static void capture(void *ctx, const urrt_can_frame *f, uint64_t now_us)
+{
+    (void)ctx;
+    (void)now_us;
+    if (out_count < MAX_OUT) {
+        out[out_count] = *f;
+    }
+    out_count++;
+}
+
+static void desc_defaults(void)
+{
+    co_fixture_desc(&desc);
+}
+
+/* CHECK_EQ_INT evaluates its arguments twice: these calls send frames. */
+static void eq_at(int line, long long got, long long want)
+{
+    CHECK(got == want, "line %d: %lld != %lld", line, got, want);
+}
+#define EQ(got, want) eq_at(__LINE__, (long long)(got), (long long)(want))
+
+/* A fresh node, started at time 0 (its boot-up captured). */
+static void setup(void)
+{
+    size_t bad = 0;
+    memset(frame_states, 0, sizeof frame_states);
+    EQ(urrt_cantx_init(&tx, &tables, frame_states, robots, values, 8, NULL, NULL), 0);
+    EQ(urrt_co_init(&co, &desc, &tx, tpdo_states, vars, 2, &bad), 0);
+    EQ(urrt_co_state(&co), URRT_CO_INITIALISING);
+    out_count = 0;
+    EQ(urrt_co_start(&co, 0, capture, NULL), 1);
+}
+
+static size_t rx(uint32_t id, const uint8_t *data, size_t len, uint64_t now_us)
+{
+    out_count = 0;
+    return urrt_co_on_frame(&co, id, 0, data, len, now_us, capture, NULL);
+}
+
+static size_t run(uint64_t now_us)
+{
+    out_count = 0;
+    return urrt_co_run(&co, now_us, capture, NULL);
+}
+
+static void nmt(uint8_t cs, uint8_t node, uint64_t now_us)
+{
+    const uint8_t d[2] = {cs, node};
+    rx(0x000, d, 2, now_us);
+}
+
+static void packet(uint64_t data_us, double q0, double mode)
+{
+    static urrt_state st; /* static: 1456 bytes, most of the Cortex-M0's 2 KB stack */
+    urrt_state_clear(&st);
+    st.generation = URRT_GEN_3X;
+    st.q_actual[0] = q0;
+    st.robot_mode[0] = mode;
+    st.present = (UINT64_C(1) << URRT_F_Q_ACTUAL) | (UINT64_C(1) << URRT_F_ROBOT_MODE);
+    urrt_cantx_on_packet(&tx, 0, &st, data_us);
+}
+
+static size_t count_id(uint32_t id)
+{
+    size_t n = 0;
+    size_t i;
+    for (i = 0; i < out_count && i < MAX_OUT; i++) {
+        n += out[i].id == id;
+    }
+    return n;
+}
+
+/* Up to 8 bytes as "0A 1B ", for messages (no snprintf without a C library). */
+static void hex_bytes(char text[3 * 8 + 1], const uint8_t *bytes, unsigned len)
+{
+    static const char digits[] = "0123456789ABCDEF";
+    unsigned k;
+    for (k = 0; k < len && k < 8u; k++) {
+        text[3 * k] = digits[bytes[k] >> 4];
+        text[3 * k + 1] = digits[bytes[k] & 15u];
+        text[3 * k + 2] = ' ';
+    }
+    text[3 * k] = '\0';
+}
+
+/* Frame i of the latest call: id, length and bytes. */
+static void expect_at(int line, size_t i, uint32_t id, const uint8_t *bytes, unsigned len)
+{
+    char got[3 * 8 + 1];
+    char want[3 * 8 + 1];
+    if (i >= out_count || i >= MAX_OUT) {
+        CHECK(i < out_count && i < MAX_OUT, "line %d: frame %zu missing (%zu sent, %d kept)", line, i, out_count,
+              MAX_OUT);
+        return;
+    }
+    hex_bytes(got, out[i].data, out[i].len);
+    hex_bytes(want, bytes, len);
+    CHECK(out[i].id == id && out[i].len == len && !out[i].extended && memcmp(out[i].data, bytes, len) == 0,
+          "line %d: frame %zu: got 0x%03X [%s], want 0x%03X [%s]", line, i, (unsigned)out[i].id, got, (unsigned)id,
+          want);
+}
+#define EXPECT(i, id, ...)                                                         \
+    do {                                                                           \
+        static const uint8_t want_[] = {__VA_ARGS__};                              \
+        expect_at(__LINE__, (i), (id), want_, (unsigned)sizeof want_);             \
+    } while (0)
+#define EXPECT_NONE(what) CHECK(out_count == 0, "%s: %zu frames sent", (what), out_count)
+
+/* An SDO request of 8 bytes: exactly one answer expected. */
+#define SDO(t, ...)                                                             \
+    do {                                                                        \
+        static const uint8_t req_[8] = {__VA_ARGS__};                           \
+        EQ(rx(0x600 + NODE, req_, 8, (t)), 1);                        \
+    } while (0)
+#define ANSWER(...) EXPECT(0, 0x580 + NODE, __VA_ARGS__)
+
+/* ---- init ------------------------------------------------------------------------ */
+
+static void expect_init(int want, size_t want_item, const char *what)
+{
+    size_t bad = 0;
+    int rc = urrt_co_init(&co, &desc, &tx, tpdo_states, vars, 2, &bad);
+    CHECK(rc == want && bad == want_item, "%s: got %d at %zu, want %d at %zu", what, rc, bad, want, want_item);
+    CHECK(urrt_co_strerror(rc)[0] != '\0', "a text for %d", rc);
+}
+
+static void test_init(void)
+{
+    static urrt_co_tpdo bad_tpdos[2];
+    static urrt_co_object bad_objects[4];
+    static const uint32_t long_map[1] = {0x20000140}; /* 64 bits in 5 bytes */
+    desc_defaults();
+    memset(frame_states, 0, sizeof frame_states);
+    EQ(urrt_cantx_init(&tx, &tables, frame_states, robots, values, 8, NULL, NULL), 0);
+    expect_init(0, SIZE_MAX, "the test's description");
+    desc.node_id = 0;
+    expect_init(URRT_CO_E_NODE_ID, SIZE_MAX, "node id 0");
+    desc.node_id = 128;
+    expect_init(URRT_CO_E_NODE_ID, SIZE_MAX, "node id 128");
+    desc_defaults();
+    memcpy(bad_tpdos, tpdos, sizeof tpdos);
+    desc.tpdos = bad_tpdos;
+    bad_tpdos[1].frame = 0;
+    expect_init(URRT_CO_E_TPDO, 1, "two TPDOs on one frame");
+    bad_tpdos[1].frame = 1;
+    bad_tpdos[1].transmission_type = 0;
+    expect_init(URRT_CO_E_TPDO, 1, "transmission type 0");
+    bad_tpdos[1].transmission_type = 241;
+    expect_init(URRT_CO_E_TPDO, 1, "transmission type 241");
+    bad_tpdos[1].transmission_type = 254;
+    bad_tpdos[1].cob_id = 0x601;
+    expect_init(URRT_CO_E_TPDO, 1, "a restricted COB-ID (SDO)");
+    bad_tpdos[1].cob_id = URRT_CO_COB_DEFAULT;
+    bad_tpdos[0].mapping = long_map;
+    bad_tpdos[0].mapping_count = 1;
+    expect_init(URRT_CO_E_TPDO, 0, "a mapping longer than the frame");
+    desc_defaults();
+    memcpy(bad_objects, objects, sizeof objects);
+    desc.objects = bad_objects;
+    bad_objects[1].sub = 1;
+    expect_init(URRT_CO_E_OBJECT, 1, "(index, sub) twice");
+    bad_objects[1].sub = 2;
+    bad_objects[1].index = 0x1FFF;
+    expect_init(URRT_CO_E_OBJECT, 1, "index below 0x2000");
+    bad_objects[1].index = 0x2000;
+    bad_objects[1].type = URRT_CO_INTEGER8;
+    bad_objects[0].type = URRT_CO_INTEGER8;
+    expect_init(URRT_CO_E_OBJECT, 0, "a 16-bit signal in an INTEGER8");
+    bad_objects[0].type = URRT_CO_INTEGER16;
+    bad_objects[2].def = 5;
+    expect_init(URRT_CO_E_OBJECT, 2, "default below the range");
+    bad_objects[2].def = 100;
+    bad_objects[3].item = 2;
+    expect_init(URRT_CO_E_OBJECT, 3, "var slot past vars[]");
+    desc_defaults();
+    EQ(urrt_co_init(&co, &desc, NULL, tpdo_states, vars, 2, NULL), URRT_CO_E_STORAGE);
+    EQ(urrt_co_on_frame(&co, 0, 0, (const uint8_t *)"\x01\x00", 2, 0, capture, NULL), 0);
+    EQ(urrt_co_deadline(&co), URRT_CANTX_NEVER);
+}
+
+/* ---- NMT ------------------------------------------------------------------------- */
+
+static void test_nmt(void)
+{
+    desc_defaults();
+    setup();
+    EXPECT(0, 0x70A, 0x00);
+    EQ(urrt_co_state(&co), URRT_CO_PRE_OPERATIONAL);
+    nmt(0x01, NODE, 1000);
+    EXPECT_NONE("start: no answer");
+    EQ(urrt_co_state(&co), URRT_CO_OPERATIONAL);
+    nmt(0x80, NODE, 2000);
+    EQ(urrt_co_state(&co), URRT_CO_PRE_OPERATIONAL);
+    nmt(0x01, 0x0B, 3000);
+    EQ(urrt_co_state(&co), URRT_CO_PRE_OPERATIONAL); /* node 11's command */
+    nmt(0x02, 0x00, 4000);
+    EQ(urrt_co_state(&co), URRT_CO_STOPPED); /* broadcast */
+    nmt(0x80, 0x00, 5000);
+    EQ(urrt_co_state(&co), URRT_CO_PRE_OPERATIONAL);
+    nmt(0x01, 0x00, 6000);
+    EQ(urrt_co_state(&co), URRT_CO_OPERATIONAL);
+    nmt(0x02, NODE, 7000);
+    EQ(urrt_co_state(&co), URRT_CO_STOPPED);
+    nmt(0x01, NODE, 8000);
+    EQ(urrt_co_state(&co), URRT_CO_OPERATIONAL); /* stopped -> operational */
+    nmt(0x03, NODE, 8500);
+    EQ(urrt_co_state(&co), URRT_CO_OPERATIONAL); /* unknown command */
+    {
+        const uint8_t three[3] = {0x02, NODE, 0};
+        rx(0x000, three, 3, 8600);
+        EQ(urrt_co_state(&co), URRT_CO_OPERATIONAL); /* NMT is 2 bytes */
+    }
+
+    nmt(0x81, NODE, 9000);
+    EQ(out_count, 1);
+    EXPECT(0, 0x70A, 0x00); /* boot-up after reset node */
+    EQ(urrt_co_state(&co), URRT_CO_PRE_OPERATIONAL);
+    nmt(0x01, NODE, 9500);
+    nmt(0x82, 0x00, 10000);
+    EQ(out_count, 1);
+    EXPECT(0, 0x70A, 0x00); /* boot-up after reset communication */
+    EQ(urrt_co_state(&co), URRT_CO_PRE_OPERATIONAL);
+    nmt(0x81, 0x0B, 11000);
+    EXPECT_NONE("reset of node 11");
+
+    /* Stopped: no SDO answer, only heartbeats. */
+    nmt(0x02, NODE, 12000);
+    {
+        const uint8_t req[8] = {0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0};
+        EQ(rx(0x60A, req, 8, 12000), 0);
+    }
+    EQ(run(110000), 1);
+    EXPECT(0, 0x70A, 0x04);
+
+    /* Self-starting: operational right after the boot-up. */
+    desc.nmt_start = URRT_CO_START_OPERATIONAL;
+    setup();
+    EXPECT(0, 0x70A, 0x00);
+    EQ(urrt_co_state(&co), URRT_CO_OPERATIONAL);
+    CHECK_EQ_STR(urrt_co_state_name(urrt_co_state(&co)), "OPERATIONAL");
+}
+
+/* ---- heartbeat -------------------------------------------------------------------- */
+
+static void test_heartbeat(void)
+{
+    desc_defaults();
+    setup();
+    EQ(urrt_co_deadline(&co), 0); /* urrt_cantx: TPDO1 due (closed) at start */
+    run(0);
+    EQ(urrt_co_deadline(&co), 10000);
+    EQ(run(99999), 0);
+    EQ(run(100000), 1);
+    EXPECT(0, 0x70A, 0x7F);
+    nmt(0x01, NODE, 150000);
+    EQ(run(200000), 2); /* the heartbeat and TPDO1 (no data: invalid) */
+    EXPECT(0, 0x70A, 0x05);
+    /* Off by SDO: 0x1017 = 0. */
+    SDO(210000, 0x2B, 0x17, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
+    ANSWER(0x60, 0x17, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
+    nmt(0x80, NODE, 210000);
+    EQ(run(300000), 0);
+    EQ(run(400000), 0);
+    /* On again: 250 ms from the write. */
+    SDO(500000, 0x2B, 0x17, 0x10, 0x00, 0xFA, 0x00, 0x00, 0x00);
+    ANSWER(0x60, 0x17, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
+    SDO(500000, 0x40, 0x17, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
+    ANSWER(0x4B, 0x17, 0x10, 0x00, 0xFA, 0x00, 0x00, 0x00);
+    EQ(run(749999), 0);
+    EQ(run(750000), 1);
+    EXPECT(0, 0x70A, 0x7F);
+    EQ(run(990000), 0);
+    EQ(run(1000000), 2); /* the heartbeat, and EMCY: no robot after the startup time */
+    EXPECT(0, 0x70A, 0x7F);
+}
+
+/* ---- SDO --------------------------------------------------------------------------- */
+
+static void test_sdo_upload(void)
+{
+    desc_defaults();
+    setup();
+    SDO(1000, 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x43, 0x00, 0x10, 0x00, 0x78, 0x56, 0x34, 0x12);
+    SDO(1000, 0x40, 0x01, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x01, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x03, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x03, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x05, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x43, 0x05, 0x10, 0x00, 0x80, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x14, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x43, 0x14, 0x10, 0x00, 0x8A, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x15, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x15, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x17, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x17, 0x10, 0x00, 0x64, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x09, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x47, 0x09, 0x10, 0x00, '1', '.', '0', 0x00); /* 3 bytes: expedited */
+    SDO(1000, 0x40, 0x18, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x18, 0x10, 0x00, 0x04, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x18, 0x10, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x18, 0x10, 0x01, 0x04, 0x03, 0x02, 0x01);
+    SDO(1000, 0x40, 0x18, 0x10, 0x02, 0, 0, 0, 0);
+    ANSWER(0x43, 0x18, 0x10, 0x02, 0xCD, 0xAB, 0x00, 0x00);
+    SDO(1000, 0x40, 0x18, 0x10, 0x03, 0, 0, 0, 0);
+    ANSWER(0x43, 0x18, 0x10, 0x03, 0x02, 0x00, 0x01, 0x00);
+    SDO(1000, 0x40, 0x18, 0x10, 0x04, 0, 0, 0, 0);
+    ANSWER(0x43, 0x18, 0x10, 0x04, 0x42, 0x00, 0x00, 0x00);
+    /* TPDO parameters and mapping. */
+    SDO(1000, 0x40, 0x00, 0x18, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x00, 0x18, 0x00, 0x05, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x00, 0x18, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x00, 0x18, 0x01, 0x8A, 0x01, 0x00, 0x00);
+    SDO(1000, 0x40, 0x01, 0x18, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x01, 0x18, 0x01, 0x8A, 0x02, 0x00, 0x00);
+    SDO(1000, 0x40, 0x00, 0x18, 0x02, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x00, 0x18, 0x02, 0xFE, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x00, 0x18, 0x03, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x00, 0x18, 0x03, 0x00, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x00, 0x18, 0x05, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x00, 0x18, 0x05, 0x0A, 0x00, 0x00, 0x00); /* the frame's 10 ms */
+    SDO(1000, 0x40, 0x00, 0x1A, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x00, 0x1A, 0x00, 0x04, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x00, 0x1A, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x00, 0x1A, 0x01, 0x10, 0x01, 0x00, 0x20);
+    /* Manufacturer objects: a record's count, a robot value as it goes out. */
+    packet(2000, -1.5, 7);
+    SDO(2000, 0x40, 0x00, 0x20, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x00, 0x20, 0x00, 0x02, 0x00, 0x00, 0x00);
+    SDO(2000, 0x40, 0x00, 0x20, 0x01, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x00, 0x20, 0x01, 0x24, 0xFA, 0x00, 0x00); /* -1500 */
+    SDO(2000, 0x40, 0x00, 0x20, 0x02, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x00, 0x20, 0x02, 0x07, 0x00, 0x00, 0x00);
+    SDO(2000, 0x40, 0x00, 0x21, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x00, 0x21, 0x00, 0x64, 0x00, 0x00, 0x00);
+}
+
+static void test_sdo_segmented(void)
+{
+    desc_defaults();
+    setup();
+    SDO(1000, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x41, 0x08, 0x10, 0x00, 0x14, 0x00, 0x00, 0x00); /* 20 bytes */
+    SDO(2000, 0x60, 0, 0, 0, 0, 0, 0, 0);
+    ANSWER(0x00, 'u', 'r', 'r', 't', ' ', 'C', 'A');
+    SDO(3000, 0x70, 0, 0, 0, 0, 0, 0, 0);
+    ANSWER(0x10, 'N', 'o', 'p', 'e', 'n', ' ', 'g');
+    SDO(4000, 0x60, 0, 0, 0, 0, 0, 0, 0);
+    ANSWER(0x03, 'a', 't', 'e', 'w', 'a', 'y', 0x00); /* 6 bytes (n = 1), last */
+    SDO(5000, 0x70, 0, 0, 0, 0, 0, 0, 0);
+    ANSWER(0x80, 0x00, 0x00, 0x00, 0x01, 0x00, 0x04, 0x05); /* no transfer: command unknown */
+    /* 0x100A, 5 bytes: one segment. */
+    SDO(6000, 0x40, 0x0A, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x41, 0x0A, 0x10, 0x00, 0x05, 0x00, 0x00, 0x00);
+    SDO(7000, 0x60, 0, 0, 0, 0, 0, 0, 0);
+    ANSWER(0x05, '0', '.', '9', '.', '0', 0x00, 0x00);
+    /* An empty string is segmented too: size 0, one empty last segment. */
+    desc.device_name = NULL;
+    SDO(8000, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x41, 0x08, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
+    SDO(9000, 0x60, 0, 0, 0, 0, 0, 0, 0);
+    ANSWER(0x0F, 0, 0, 0, 0, 0, 0, 0);
+}
+
+#define ABORT(t, code, ...)                                                                     \
+    do {                                                                                         \
+        static const uint8_t areq_[8] = {__VA_ARGS__};                                           \
+        EQ(rx(0x600 + NODE, areq_, 8, (t)), 1);                                        \
+        EXPECT(0, 0x580 + NODE, 0x80, areq_[1], areq_[2], areq_[3], (code) & 0xFF, (code) >> 8 & 0xFF, \
+               (code) >> 16 & 0xFF, (code) >> 24 & 0xFF);                                        \
+    } while (0)
+
+static void test_sdo_aborts(void)
+{
+    desc_defaults();
+    desc.heartbeat_ms = 0;
+    setup();
+    ABORT(0, 0x06090030, 0x23, 0x14, 0x10, 0x00, 0x8B, 0, 0, 0); /* EMCY id while valid */
+    SDO(0, 0x23, 0x14, 0x10, 0x00, 0x8A, 0x00, 0x00, 0x80);        /* no EMCY: SDO answers only */
+    ABORT(1000, 0x06020000, 0x40, 0x34, 0x12, 0x00, 0, 0, 0, 0);  /* no object 0x1234 */
+    ABORT(1000, 0x06020000, 0x40, 0x02, 0x18, 0x00, 0, 0, 0, 0);  /* no TPDO3 */
+    ABORT(1000, 0x06020000, 0x40, 0x00, 0x22, 0x00, 0, 0, 0, 0);  /* no 0x2200 */
+    ABORT(1000, 0x06090011, 0x40, 0x18, 0x10, 0x05, 0, 0, 0, 0);  /* 0x1018 sub 5 */
+    ABORT(1000, 0x06090011, 0x40, 0x00, 0x18, 0x04, 0, 0, 0, 0);  /* 0x1800 sub 4 is reserved */
+    ABORT(1000, 0x06090011, 0x40, 0x00, 0x1A, 0x05, 0, 0, 0, 0);  /* past the mapping */
+    ABORT(1000, 0x06090011, 0x40, 0x00, 0x10, 0x01, 0, 0, 0, 0);  /* a VAR has sub 0 only */
+    ABORT(1000, 0x06090011, 0x40, 0x03, 0x10, 0x09, 0, 0, 0, 0);  /* 0x1003 holds 8 */
+    ABORT(1000, 0x08000024, 0x40, 0x03, 0x10, 0x01, 0, 0, 0, 0);  /* 0x1003: no error recorded */
+    ABORT(1000, 0x06010002, 0x23, 0x00, 0x10, 0x00, 1, 2, 3, 4);  /* 0x1000 read-only */
+    ABORT(1000, 0x06010002, 0x23, 0x00, 0x1A, 0x01, 1, 2, 3, 4);  /* mapping static */
+    ABORT(1000, 0x06010002, 0x2B, 0x00, 0x20, 0x01, 1, 2, 0, 0);  /* a robot value */
+    ABORT(1000, 0x06010001, 0x40, 0x01, 0x21, 0x00, 0, 0, 0, 0);  /* write-only */
+    ABORT(1000, 0x06070012, 0x23, 0x17, 0x10, 0x00, 1, 0, 0, 0);  /* 4 bytes into UNSIGNED16 */
+    ABORT(1000, 0x06070013, 0x2B, 0x14, 0x10, 0x00, 0x8A, 0, 0, 0); /* 2 bytes into UNSIGNED32 */
+    ABORT(1000, 0x06070013, 0x2F, 0x00, 0x21, 0x00, 0x64, 0, 0, 0); /* 1 byte into UNSIGNED16 */
+    ABORT(1000, 0x06090030, 0x23, 0x00, 0x18, 0x01, 0x8B, 0x01, 0, 0); /* new id while valid */
+    ABORT(1000, 0x06090030, 0x2B, 0x00, 0x18, 0x03, 0x0A, 0x00, 0, 0); /* inhibit while valid */
+    ABORT(1000, 0x06090030, 0x2F, 0x03, 0x10, 0x00, 0x01, 0, 0, 0);    /* 0x1003 takes only 0 */
+    ABORT(1000, 0x06090030, 0x23, 0x05, 0x10, 0x00, 0x80, 0, 0, 0x40); /* SYNC producer */
+    ABORT(1000, 0x06090031, 0x2B, 0x00, 0x21, 0x00, 0xE9, 0x03, 0, 0); /* 1001 > 1000 */
+    ABORT(1000, 0x06090032, 0x2B, 0x00, 0x21, 0x00, 0x09, 0x00, 0, 0); /* 9 < 10 */
+    ABORT(1000, 0x06090031, 0x2F, 0x00, 0x18, 0x02, 0xFC, 0, 0, 0);    /* type 252: RTR only */
+    ABORT(1000, 0x06090032, 0x2F, 0x00, 0x18, 0x02, 0x00, 0, 0, 0);    /* type 0 */
+    ABORT(1000, 0x06090032, 0x2B, 0x00, 0x18, 0x05, 0x00, 0x00, 0, 0); /* invalid policy needs a period */
+    ABORT(1000, 0x05040001, 0xA0, 0x00, 0x10, 0x00, 0, 0, 0, 0);       /* block upload */
+    ABORT(1000, 0x05040001, 0xC0, 0x00, 0x10, 0x00, 0, 0, 0, 0);       /* block download */
+    ABORT(1000, 0x05040001, 0x21, 0x00, 0x21, 0x00, 2, 0, 0, 0);       /* segmented download */
+    ABORT(1000, 0x05040001, 0xE0, 0x00, 0x10, 0x00, 0, 0, 0, 0);       /* cs 7 */
+    /* The values behind the refused writes did not change. */
+    SDO(1000, 0x40, 0x00, 0x21, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x00, 0x21, 0x00, 0x64, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x00, 0x18, 0x02, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x00, 0x18, 0x02, 0xFE, 0x00, 0x00, 0x00);
+
+    /* Short frames: 0x06070010, with what index they carry. */
+    {
+        const uint8_t seven[7] = {0x40, 0x00, 0x10, 0x00, 0, 0, 0};
+        EQ(rx(0x60A, seven, 7, 1000), 1);
+        EXPECT(0, 0x58A, 0x80, 0x00, 0x10, 0x00, 0x10, 0x00, 0x07, 0x06);
+        EQ(rx(0x60A, NULL, 0, 1000), 1);
+        EXPECT(0, 0x58A, 0x80, 0x00, 0x00, 0x00, 0x10, 0x00, 0x07, 0x06);
+    }
+
+    /* Toggle error: the first segment request must have toggle 0. */
+    SDO(2000, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0);
+    ABORT(2000, 0x05030000, 0x70, 0x08, 0x10, 0x00, 0, 0, 0, 0); /* bytes 1-3: the transfer's, as written */
+    /* ... and twice the same toggle. */
+    SDO(2000, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0);
+    SDO(2000, 0x60, 0, 0, 0, 0, 0, 0, 0);
+    SDO(2000, 0x60, 0, 0, 0, 0, 0, 0, 0);
+    ANSWER(0x80, 0x08, 0x10, 0x00, 0x00, 0x00, 0x03, 0x05);
+
+    /* Timeout: the client leaves; 1 s after the last exchange the node aborts. */
+    SDO(10000, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0);
+    SDO(20000, 0x60, 0, 0, 0, 0, 0, 0, 0);
+    EQ(urrt_co_deadline(&co) <= 1020000, 1);
+    EQ(run(1019999), 0);
+    EQ(run(1020000), 1);
+    ANSWER(0x80, 0x08, 0x10, 0x00, 0x00, 0x00, 0x04, 0x05);
+    SDO(1030000, 0x70, 0, 0, 0, 0, 0, 0, 0);
+    ANSWER(0x80, 0x00, 0x00, 0x00, 0x01, 0x00, 0x04, 0x05); /* the transfer is over */
+
+    /* A new request in the middle: the old transfer is aborted, the request
+     * not served; the client's retry is. */
+    SDO(2000000, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0);
+    SDO(2000000, 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x80, 0x08, 0x10, 0x00, 0x01, 0x00, 0x04, 0x05);
+    SDO(2000000, 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x43, 0x00, 0x10, 0x00, 0x78, 0x56, 0x34, 0x12);
+    /* The client's abort ends the transfer, unanswered. */
+    SDO(3000000, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0);
+    {
+        const uint8_t client_abort[8] = {0x80, 0x08, 0x10, 0x00, 0x00, 0x00, 0x04, 0x05};
+        EQ(rx(0x60A, client_abort, 8, 3000000), 0);
+    }
+    run(5000000);
+    EQ(count_id(0x58A), 0); /* no timeout abort */
+}
+
+static void test_sdo_download(void)
+{
+    desc_defaults();
+    setup();
+    SDO(1000, 0x2B, 0x00, 0x21, 0x00, 0xF4, 0x01, 0x00, 0x00);
+    ANSWER(0x60, 0x00, 0x21, 0x00, 0x00, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x00, 0x21, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x00, 0x21, 0x00, 0xF4, 0x01, 0x00, 0x00);
+    SDO(1000, 0x22, 0x00, 0x21, 0x00, 0x0A, 0x00, 0xFF, 0xFF); /* size not indicated: the object's */
+    ANSWER(0x60, 0x00, 0x21, 0x00, 0x00, 0x00, 0x00, 0x00);
+    SDO(1000, 0x40, 0x00, 0x21, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x00, 0x21, 0x00, 0x0A, 0x00, 0x00, 0x00);
+    SDO(1000, 0x2F, 0x01, 0x21, 0x00, 0x01, 0, 0, 0);
+    ANSWER(0x60, 0x01, 0x21, 0x00, 0x00, 0x00, 0x00, 0x00);
+    EQ(vars[1], 1);
+    /* Reset node: variables back to their defaults; reset communication keeps them. */
+    nmt(0x82, NODE, 2000);
+    EQ(vars[0], 10);
+    nmt(0x81, NODE, 3000);
+    EQ(vars[0], 100);
+    EQ(vars[1], 0);
+}
+
+/* ---- TPDOs -------------------------------------------------------------------------- */
+
+static void test_tpdo_gating(void)
+{
+    desc_defaults();
+    desc.heartbeat_ms = 0;
+    setup();
+    packet(1000, 1.5, 7);
+    EQ(run(1000), 0); /* pre-operational: no PDO */
+    EQ(run(10000), 0);
+    nmt(0x01, NODE, 15000);
+    packet(15000, 1.5, 7);
+    EQ(run(15000), 1);
+    EXPECT(0, 0x28A, 0xDC, 0x05); /* TPDO2 with the packet */
+    EQ(run(20000), 1);
+    EXPECT(0, 0x18A, 0xDC, 0x05, 0x07, 0x00, 0x01); /* TPDO1 on its 10 ms cadence: alive 0, valid */
+    EQ(run(30000), 1);
+    EXPECT(0, 0x18A, 0xDC, 0x05, 0x07, 0x01, 0x01);
+    /* COB-ID: invalid, then a new id, then valid again. */
+    SDO(31000, 0x23, 0x00, 0x18, 0x01, 0x8A, 0x01, 0x00, 0x80);
+    ANSWER(0x60, 0x00, 0x18, 0x01, 0, 0, 0, 0);
+    EQ(run(40000), 0);
+    SDO(41000, 0x23, 0x00, 0x18, 0x01, 0x9A, 0x01, 0x00, 0x80);
+    ANSWER(0x60, 0x00, 0x18, 0x01, 0, 0, 0, 0);
+    SDO(41000, 0x2B, 0x00, 0x18, 0x03, 0x64, 0x00, 0, 0); /* inhibit 10 ms while invalid */
+    ANSWER(0x60, 0x00, 0x18, 0x03, 0, 0, 0, 0);
+    SDO(41000, 0x2B, 0x00, 0x18, 0x05, 0x14, 0x00, 0, 0); /* event timer 20 ms */
+    ANSWER(0x60, 0x00, 0x18, 0x05, 0, 0, 0, 0);
+    SDO(41000, 0x23, 0x00, 0x18, 0x01, 0x9A, 0x01, 0x00, 0x00);
+    ANSWER(0x60, 0x00, 0x18, 0x01, 0, 0, 0, 0);
+    packet(41000, 1.5, 7);
+    EQ(run(41000), 2);
+    EQ(count_id(0x19A), 1); /* at the new id, due at once after the change */
+    EQ(count_id(0x18A), 0);
+    EQ(run(51000), 0);
+    packet(60000, 1.5, 7);
+    EQ(run(61000), 2); /* 20 ms later, with TPDO2's packet */
+    EQ(count_id(0x19A), 1);
+    /* A valid id may not be taken twice. */
+    SDO(62000, 0x23, 0x01, 0x18, 0x01, 0x8A, 0x02, 0x00, 0x80);
+    SDO(62000, 0x23, 0x01, 0x18, 0x01, 0x9A, 0x01, 0x00, 0x80);
+    ABORT(62000, 0x06090030, 0x23, 0x01, 0x18, 0x01, 0x9A, 0x01, 0x00, 0x00);
+    /* Stopped and pre-operational: nothing. */
+    nmt(0x02, NODE, 70000);
+    packet(70000, 1.5, 7);
+    EQ(run(70000), 0);
+    EQ(run(81000), 0);
+    nmt(0x80, NODE, 90000);
+    EQ(run(101000), 0);
+}
+
+static void test_sync(void)
+{
+    const uint8_t counter[1] = {1};
+    desc_defaults();
+    desc.heartbeat_ms = 0;
+    setup();
+    SDO(1000, 0x2F, 0x01, 0x18, 0x02, 0x02, 0, 0, 0); /* TPDO2 on every 2nd SYNC */
+    ANSWER(0x60, 0x01, 0x18, 0x02, 0, 0, 0, 0);
+    packet(2000, 0.25, 7);
+    EQ(rx(0x080, NULL, 0, 2000), 0); /* pre-operational */
+    EQ(rx(0x080, NULL, 0, 2000), 0);
+    nmt(0x01, NODE, 3000);
+    run(3000);
+    EQ(count_id(0x28A), 0); /* TPDO2 no longer follows the packets */
+    EQ(rx(0x080, NULL, 0, 4000), 0);
+    EQ(rx(0x080, counter, 1, 5000), 1); /* with the optional counter byte */
+    EXPECT(0, 0x28A, 0xFA, 0x00);
+    EQ(rx(0x080, NULL, 0, 6000), 0);
+    EQ(rx(0x080, NULL, 0, 7000), 1);
+    EQ(rx(0x080, NULL, 0, 100000), 0);
+    EQ(rx(0x080, NULL, 0, 100000), 0); /* stale data: the stop policy holds */
+    {
+        const uint8_t two[2] = {1, 2};
+        packet(200000, 0.25, 7);
+        EQ(rx(0x080, two, 2, 200000), 0); /* not a SYNC: 2 bytes */
+    }
+    /* The SYNC id moves with 0x1005. */
+    SDO(200000, 0x23, 0x05, 0x10, 0x00, 0x81, 0x00, 0x00, 0x00);
+    ANSWER(0x60, 0x05, 0x10, 0x00, 0, 0, 0, 0);
+    EQ(rx(0x080, NULL, 0, 200000), 0);
+    EQ(rx(0x081, NULL, 0, 200000), 0);
+    EQ(rx(0x081, NULL, 0, 200000), 1);
+    /* Invalid PDO: counted, not sent. */
+    SDO(200000, 0x23, 0x01, 0x18, 0x01, 0x8A, 0x02, 0x00, 0x80);
+    EQ(rx(0x081, NULL, 0, 200000), 0);
+    EQ(rx(0x081, NULL, 0, 200000), 0);
+}
+
+/* ---- EMCY ------------------------------------------------------------------------- */
+
+static void read_errors(uint64_t t, uint8_t reg, uint8_t count)
+{
+    SDO(t, 0x40, 0x01, 0x10, 0x00, 0, 0, 0, 0);
+    CHECK(out[0].data[0] == 0x4F && out[0].data[4] == reg, "0x1001 = 0x%02X, want 0x%02X", out[0].data[4], reg);
+    SDO(t, 0x40, 0x03, 0x10, 0x00, 0, 0, 0, 0);
+    CHECK(out[0].data[0] == 0x4F && out[0].data[4] == count, "0x1003 sub 0 = %u, want %u", out[0].data[4], count);
+}
+
+static void test_emcy(void)
+{
+    static urrt_cantx_link link;
+    desc_defaults();
+    desc.heartbeat_ms = 0;
+    setup();
+    packet(1000, 0, 7);
+    EQ(run(1000), 0);
+    urrt_cantx_robot_link(&tx, 0, false);
+    EQ(run(2000), 1);
+    EXPECT(0, 0x08A, 0x01, 0xFF, 0x81, 0x00, 0x00, 0x00, 0x00, 0x00);
+    read_errors(2000, 0x81, 1);
+    SDO(2000, 0x40, 0x03, 0x10, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x03, 0x10, 0x01, 0x01, 0xFF, 0x00, 0x00);
+    EQ(run(3000), 0); /* told once */
+    packet(4000, 0, 7);
+    EQ(run(4000), 1);
+    EXPECT(0, 0x08A, 0x00, 0x00, 0x00, 0x01, 0xFF, 0x00, 0x00, 0x00); /* reset, naming 0xFF01 */
+    read_errors(4000, 0x00, 1);
+    /* Stale: 50 ms after the data, plus one microsecond. */
+    EQ(run(50000), 0);
+    EQ(urrt_co_deadline(&co), 54001); /* before urrt_cantx's next slot at 60 ms */
+    EQ(run(54000), 0);
+    EQ(run(54001), 1);
+    EXPECT(0, 0x08A, 0x02, 0xFF, 0x81, 0x00, 0x00, 0x00, 0x00, 0x00);
+    /* CAN overrun while stale: the register has both bits. */
+    link.dropped = 3;
+    urrt_cantx_set_link(&tx, &link);
+    EQ(run(60000), 1);
+    EXPECT(0, 0x08A, 0x10, 0x81, 0x91, 0x00, 0x00, 0x00, 0x00, 0x00);
+    read_errors(60000, 0x91, 3);
+    SDO(60000, 0x40, 0x03, 0x10, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x03, 0x10, 0x01, 0x10, 0x81, 0x00, 0x00); /* newest first */
+    SDO(60000, 0x40, 0x03, 0x10, 0x03, 0, 0, 0, 0);
+    ANSWER(0x43, 0x03, 0x10, 0x03, 0x01, 0xFF, 0x00, 0x00);
+    packet(70000, 0, 7);
+    EQ(run(70000), 1);
+    EXPECT(0, 0x08A, 0x00, 0x00, 0x11, 0x02, 0xFF, 0x00, 0x00, 0x00);
+    {
+        uint64_t t;
+        size_t sent = 0;
+        for (t = 100000; t < 1060000; t += 40000) {
+            packet(t, 0, 7);
+            sent += run(t);
+        }
+        EQ(sent, 0);
+    }
+    packet(1060000, 0, 7);
+    EQ(run(1060000), 1); /* the overrun held 1 s */
+    EXPECT(0, 0x08A, 0x00, 0x00, 0x00, 0x10, 0x81, 0x00, 0x00, 0x00);
+    /* Error passive and bus off, with an inhibit time of 5 ms (50 x 100 us). */
+    SDO(1060000, 0x2B, 0x15, 0x10, 0x00, 0x32, 0x00, 0, 0);
+    urrt_co_set_error_passive(&co, true);
+    link.bus_off = 1;
+    urrt_cantx_set_link(&tx, &link);
+    packet(1070000, 0, 7);
+    EQ(run(1070000), 1);
+    EXPECT(0, 0x08A, 0x20, 0x81, 0x11, 0x00, 0x00, 0x00, 0x00, 0x00);
+    EQ(urrt_co_deadline(&co), 1075000);
+    EQ(run(1074999), 0);
+    EQ(run(1075000), 1);
+    EXPECT(0, 0x08A, 0x40, 0x81, 0x11, 0x00, 0x00, 0x00, 0x00, 0x00);
+    /* 0x1003 sub 0 = 0 clears the history, not the register. */
+    SDO(1075000, 0x2F, 0x03, 0x10, 0x00, 0x00, 0, 0, 0);
+    ANSWER(0x60, 0x03, 0x10, 0x00, 0, 0, 0, 0);
+    read_errors(1075000, 0x11, 0);
+    /* EMCY switched off (bit 31): nothing sent, the register still kept. */
+    SDO(1075000, 0x23, 0x14, 0x10, 0x00, 0x8A, 0x00, 0x00, 0x80);
+    ANSWER(0x60, 0x14, 0x10, 0x00, 0, 0, 0, 0);
+    urrt_co_set_error_passive(&co, false);
+    packet(1080000, 0, 7);
+    EQ(run(1080000), 0);
+    read_errors(1080000, 0x11, 0);
+}
+
+/* ---- robustness ----------------------------------------------------------------------- */
+
+static bool state_known(void)
+{
+    urrt_co_nmt s = urrt_co_state(&co);
+    return s == URRT_CO_PRE_OPERATIONAL || s == URRT_CO_OPERATIONAL || s == URRT_CO_STOPPED;
+}
+
+static bool sdo_command_valid(uint8_t cmd)
+{
+    uint8_t cs = cmd >> 5;
+    return cmd == 0x80 || cmd == 0x60 || cmd == 0x41 || (cs == 2 && (cmd & 0x13) == 0x03) ||
+           (cs == 0 && (cmd & 0xE0) == 0);
+}
+
+/* Every frame out is one the node may send, at its ids. */
+static void check_outputs(const char *what)
+{
+    size_t i;
+    for (i = 0; i < out_count && i < MAX_OUT; i++) {
+        const urrt_can_frame *f = &out[i];
+        bool ok = f->len <= 8 && !f->extended && !f->fd;
+        if (f->id == 0x58A) {
+            ok = ok && f->len == 8 && sdo_command_valid(f->data[0]);
+        } else if (f->id == 0x70A) {
+            ok = ok && f->len == 1 && (f->data[0] == 0 || f->data[0] == 4 || f->data[0] == 5 || f->data[0] == 0x7F);
+        }
+        CHECK(ok, "%s: frame 0x%03X len %u byte0 0x%02X", what, (unsigned)f->id, f->len, f->data[0]);
+    }
+}
+
+static void test_lengths(void)
+{
+    static const uint32_t ids[] = {0x000, 0x080, 0x08A, 0x18A, 0x58A, 0x60A, 0x70A, 0x7FF};
+    uint8_t data[8];
+    size_t i;
+    unsigned len;
+    unsigned fill;
+    desc_defaults();
+    setup();
+    for (fill = 0; fill < 256; fill += 17) {
+        memset(data, (int)fill, sizeof data);
+        for (i = 0; i < sizeof ids / sizeof ids[0]; i++) {
+            for (len = 0; len <= 8; len++) {
+                size_t n = rx(ids[i], data, len, 1000 + fill);
+                CHECK(n <= 2 && n == out_count, "id 0x%03X len %u: %zu frames", (unsigned)ids[i], len, n);
+                check_outputs("lengths");
+                CHECK(state_known(), "state after id 0x%03X len %u", (unsigned)ids[i], len);
+                EQ(urrt_co_on_frame(&co, ids[i], URRT_CO_RX_RTR, data, len, 1000, capture, NULL), 0);
+            }
+            EQ(urrt_co_on_frame(&co, ids[i], 0, data, 9, 1000, capture, NULL), 0);
+        }
+        if (urrt_co_state(&co) == URRT_CO_STOPPED) {
+            nmt(0x80, 0, 1000);
+        }
+    }
+}
+
+/* 0..n-1 from tests/testutil.h's sequence, the one every test shares. */
+static unsigned pick(unsigned n)
+{
+    return (unsigned)(test_rng() % n);
+}
+
+/* Every core takes them all: the emulated Cortex-M0 (soft-float, no divide) in well under a second. */
+#define RANDOM_FRAMES 100000u
+
+static void test_random(void)
+{
+    static const uint32_t ids[] = {0x000, 0x080, 0x081, 0x60A, 0x60B, 0x18A};
+    uint64_t now = 0;
+    unsigned i;
+    unsigned bad = 0;
+    desc_defaults();
+    setup();
+    test_rng_seed(20261122);
+    for (i = 0; i < RANDOM_FRAMES; i++) {
+        uint8_t data[8];
+        unsigned k;
+        unsigned len = pick(9);
+        uint32_t id = ids[pick(6)];
+        size_t n;
+        for (k = 0; k < 8; k++) {
+            data[k] = (uint8_t)test_rng();
+        }
+        if (id == 0x60A && pick(2) == 0) {
+            /* Keep the SDO server on its interesting paths: objects that exist. */
+            static const uint8_t cmds[] = {0x40, 0x60, 0x70, 0x2B, 0x2F, 0x23, 0x80, 0x22};
+            static const uint16_t idx[] = {0x1008, 0x1800, 0x1801, 0x1017, 0x1003, 0x2100, 0x2000, 0x1A00};
+            uint16_t index = idx[pick(8)];
+            data[0] = cmds[pick(8)];
+            data[1] = (uint8_t)(index & 0xFF);
+            data[2] = (uint8_t)(index >> 8);
+            data[3] = (uint8_t)pick(7);
+            len = 8;
+        }
+        if (id == 0 && len == 2 && data[0] >= 0x81 && pick(4) != 0) {
+            data[0] = 0x01; /* resets less often: the node spends time in every state */
+        }
+        now += pick(20000);
+        if (pick(8) == 0) {
+            packet(now, (double)pick(3000) / 1000.0, 7);
+        }
+        n = rx(id, data, len, now);
+        bad += n > 2u;
+        check_outputs("random frame");
+        n = run(now);
+        bad += n > 2u + 1u + URRT_CO_CONDITIONS + 2u;
+        check_outputs("random run");
+        bad += !state_known();
+        bad += urrt_co_deadline(&co) <= now; /* a run leaves nothing due: no busy loop */
+    }
+    EQ(bad, 0);
+}
+
+int main(void)
+{
+    test_init();
+    test_nmt();
+    test_heartbeat();
+    test_sdo_upload();
+    test_sdo_segmented();
+    test_sdo_aborts();
+    test_sdo_download();
+    test_tpdo_gating();
+    test_sync();
+    test_emcy();
+    test_lengths();
+    test_random();
+    return check_report();
+}

@@ -1,8 +1,0 @@
-# SPDX-License-Identifier: MIT
-# tests/man.mk: check-man, the man pages against the programs' option tables.
-.PHONY: check-man
-check-man: $(MAN_PAGES) $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-dump $(BUILD)/bin/urrt-sim
-	@mkdir -p $(BUILD)/results
-	@$(PYTHON) tests/man/check_man.py $(BUILD)
-
-CHECKS += check-man

@@ -1,0 +1,955 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * can_link_test: black-box tests of the CAN link (port.h, port/posix/can.c).
+ *
+ *   can_link_test log DIR      the candump-log output (no CAN needed): writes
+ *                              DIR/log-fd.log, DIR/log-classic.log,
+ *                              DIR/log-stdout.log and DIR/log-expect.txt for
+ *                              an independent reader (python-can, canplayer)
+ *   can_link_test frames DIR   sends a known set of frames through SocketCAN
+ *                              links on vcan0 (FD MTU) and vcan1 (classic
+ *                              MTU), checks them with its own receiving
+ *                              sockets, and writes the same frames through
+ *                              log links to DIR/frames-vcan0.log and
+ *                              DIR/frames-vcan1.log, for a comparison with a
+ *                              candump -L capture
+ *   can_link_test socket       everything else on a real kernel: FD refused
+ *                              on a classic MTU, data frames not received,
+ *                              error frames, a full transmit queue (ENOBUFS
+ *                              with the plug qdisc; EAGAIN with a tiny socket
+ *                              buffer), interface down/up, removal and
+ *                              re-creation, MTU change
+ *
+ * The socket tests run in the VM of tests/vm/run.sh as root, with vcan0
+ * (MTU 72) and vcan1 (MTU 16) up, sch_plug loaded and iproute2's ip and tc
+ * in PATH. Each prints "N passed, N failed".
+ */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
+#include <inttypes.h>
+#include <net/if.h>
+#include <poll.h>
+#include <spawn.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <linux/can.h>
+#include <linux/can/error.h>
+#include <linux/can/raw.h>
+
+#include "port.h"
+#include "../check.h"
+
+extern char **environ;
+
+/* A call into the link must never block. Its duration cannot tell: a host
+ * that preempts the VM makes a non-blocking call take 120 ms (seen under
+ * TCG on a loaded 2-core host). The kernel can: a thread that sleeps in a
+ * call gives up the CPU voluntarily (ru_nvcsw), one that is preempted does
+ * not. So every call is bracketed by the thread's voluntary context switch
+ * count, and the longest call is printed for information only. */
+static long voluntary_switches(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_THREAD, &ru);
+    return ru.ru_nvcsw;
+}
+
+/* ---- captured log messages ----------------------------------------------------- */
+
+static char messages[16384];
+
+static void capture(void *ctx, urrt_log_level level, const char *message)
+{
+    (void)ctx;
+    size_t used = strlen(messages);
+    snprintf(messages + used, sizeof(messages) - used, "%s\n", message);
+    fprintf(stderr, "  [link %s] %s\n", urrt_log_level_name(level), message);
+}
+
+static void messages_clear(void)
+{
+    messages[0] = '\0';
+}
+
+/* ---- helpers ---------------------------------------------------------------------- */
+
+static uint64_t now_us(void)
+{
+    return urrt_port_monotonic_us();
+}
+
+/* Runs a program found in PATH (not through a shell: a busybox shell would
+ * pick its own ip and tc). Returns the exit status. */
+static int run(const char *first, ...)
+{
+    const char *argv[16];
+    int argc = 0;
+    va_list ap;
+    va_start(ap, first);
+    for (const char *a = first; a != NULL && argc < 15; a = va_arg(ap, const char *))
+        argv[argc++] = a;
+    va_end(ap);
+    argv[argc] = NULL;
+    pid_t pid;
+    if (posix_spawnp(&pid, argv[0], NULL, NULL, (char *const *)argv, environ) != 0) {
+        fprintf(stderr, "cannot run %s: %s\n", argv[0], strerror(errno));
+        return -1;
+    }
+    int status;
+    if (waitpid(pid, &status, 0) < 0)
+        return -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+#define RUN(...) CHECK(run(__VA_ARGS__, (const char *)NULL) == 0, "command failed")
+
+static urrt_can_frame make_frame(uint32_t id, bool ext, bool fd, uint8_t len, uint8_t seed)
+{
+    urrt_can_frame f;
+    memset(&f, 0, sizeof(f));
+    f.id = id;
+    f.extended = ext;
+    f.fd = fd;
+    f.len = len;
+    for (unsigned i = 0; i < len; i++)
+        f.data[i] = (uint8_t)(seed + i * 17u);
+    return f;
+}
+
+static urrt_canlink *open_link_hold(const char *ifname, bool fd, bool brs, uint32_t hold_max_ms)
+{
+    urrt_canlink_config cfg;
+    urrt_canlink_config_defaults(&cfg);
+    cfg.interface = ifname;
+    cfg.fd = fd;
+    cfg.fd_brs = brs;
+    cfg.reopen_interval_ms = 50;
+    cfg.retry_interval_ms = 5;
+    cfg.hold_max_ms = hold_max_ms;
+    return urrt_canlink_new(&cfg);
+}
+
+/* Held values stay fresh for 2 s: longer than any wait here, even on a
+ * loaded host under TCG, except where expiry is the point. */
+static urrt_canlink *open_link(const char *ifname, bool fd, bool brs)
+{
+    return open_link_hold(ifname, fd, brs, 2000);
+}
+
+/* The longest single call into the link, and the calls that slept, over
+ * the whole run. */
+static uint64_t max_call_us;
+static unsigned blocked_calls;
+
+static void call_ended(uint64_t t0, long switches0)
+{
+    uint64_t dt = now_us() - t0;
+    if (dt > max_call_us)
+        max_call_us = dt;
+    blocked_calls += voluntary_switches() != switches0;
+}
+
+static int timed_send(urrt_canlink *can, const urrt_can_frame *f)
+{
+    long switches0 = voluntary_switches();
+    uint64_t t0 = now_us();
+    int r = urrt_canlink_send(can, f, t0);
+    call_ended(t0, switches0);
+    return r;
+}
+
+/* Runs the link's share of a poll loop for ms milliseconds. Returns the
+ * poll events seen on its descriptor (ORed). */
+static short pump(urrt_canlink *can, unsigned ms)
+{
+    uint64_t end = now_us() + ms * 1000u;
+    short seen = 0;
+    for (uint64_t t = now_us(); t < end; t = now_us()) {
+        short events;
+        int fd = urrt_canlink_poll_fd(can, &events);
+        uint64_t deadline = urrt_canlink_deadline(can);
+        uint64_t until = deadline < end ? deadline : end;
+        int timeout_ms = until > t ? (int)((until - t + 999) / 1000) : 0;
+        struct pollfd p = { .fd = fd, .events = events };
+        int n = poll(&p, fd >= 0 ? 1 : 0, timeout_ms);
+        if (n > 0)
+            seen |= p.revents;
+        long switches0 = voluntary_switches();
+        uint64_t t0 = now_us();
+        urrt_canlink_service(can, t0);
+        call_ended(t0, switches0);
+    }
+    return seen;
+}
+
+/* Pumps until the link is in state (or nothing is held, for want_idle) or
+ * limit_ms pass: waits that depend on the host's speed end as soon as they
+ * can and still have a bound. */
+static short pump_until_state(urrt_canlink *can, urrt_canlink_state state, unsigned limit_ms)
+{
+    short seen = 0;
+    for (unsigned waited = 0; urrt_canlink_get_state(can) != state && waited < limit_ms; waited += 10)
+        seen |= pump(can, 10);
+    return seen;
+}
+
+static short pump_until_idle(urrt_canlink *can, unsigned limit_ms)
+{
+    short seen = 0;
+    for (unsigned waited = 0; urrt_canlink_get_stats(can)->pending != 0 && waited < limit_ms; waited += 10)
+        seen |= pump(can, 10);
+    return seen;
+}
+
+/* A receiving socket of our own: the kernel's view of what went out. */
+static int rx_open(const char *ifname)
+{
+    int s = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK, CAN_RAW);
+    int on = 1;
+    setsockopt(s, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof(on));
+    struct sockaddr_can addr = { .can_family = AF_CAN, .can_ifindex = (int)if_nametoindex(ifname) };
+    if (s < 0 || bind(s, (struct sockaddr *)&addr, sizeof(addr)) < 0) {
+        fprintf(stderr, "cannot open a receiver on %s: %s\n", ifname, strerror(errno));
+        if (s >= 0)
+            close(s);
+        return -1;
+    }
+    return s;
+}
+
+typedef struct rx_frame {
+    struct canfd_frame f;
+    bool fd;
+} rx_frame;
+
+/* Reads what arrived until quiet_ms pass without a frame. Errors queued on
+ * the socket (interface down) are read and skipped. */
+static size_t rx_collect(int s, rx_frame *out, size_t max, unsigned quiet_ms)
+{
+    size_t n = 0;
+    for (;;) {
+        struct pollfd p = { .fd = s, .events = POLLIN };
+        if (poll(&p, 1, (int)quiet_ms) <= 0)
+            return n;
+        struct canfd_frame f;
+        ssize_t r = recv(s, &f, sizeof(f), 0);
+        if (r < 0)
+            continue;
+        if (n < max) {
+            out[n].f = f;
+            out[n].fd = r == (ssize_t)CANFD_MTU;
+            n++;
+        }
+    }
+}
+
+static bool rx_matches(const rx_frame *r, const urrt_can_frame *f, bool brs)
+{
+    canid_t id = f->extended ? (f->id | CAN_EFF_FLAG) : f->id;
+    if (r->f.can_id != id || r->fd != f->fd || r->f.len != f->len)
+        return false;
+    if (f->fd && ((r->f.flags & CANFD_BRS) != 0) != brs)
+        return false;
+    return memcmp(r->f.data, f->data, f->len) == 0;
+}
+
+/* id as the kernel has it: CAN_EFF_FLAG set for a 29-bit ID. */
+static int count_id(const rx_frame *rx, size_t n, canid_t id)
+{
+    int c = 0;
+    for (size_t i = 0; i < n; i++)
+        if (rx[i].f.can_id == id)
+            c++;
+    return c;
+}
+
+static const rx_frame *last_of_id(const rx_frame *rx, size_t n, canid_t id)
+{
+    const rx_frame *last = NULL;
+    for (size_t i = 0; i < n; i++)
+        if (rx[i].f.can_id == id)
+            last = &rx[i];
+    return last;
+}
+
+static int count_substr(const char *text, const char *needle)
+{
+    int n = 0;
+    for (const char *p = strstr(text, needle); p != NULL; p = strstr(p + 1, needle))
+        n++;
+    return n;
+}
+
+static char *read_file(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (f == NULL)
+        return NULL;
+    static char buf[65536];
+    size_t n = fread(buf, 1, sizeof(buf) - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+    return buf;
+}
+
+/* ---- the frame sets ------------------------------------------------------------- */
+
+/* Chosen for the formats' edge cases: 3- and 8-digit IDs, the largest IDs,
+ * zero length, every FD length class, bytes that need two hex digits. */
+static const struct { uint32_t id; bool ext, fd; uint8_t len; } classic_set[] = {
+    { 0x123, false, false, 8 }, { 0x000, false, false, 0 }, { 0x7FF, false, false, 1 },
+    { 0x1ABCDEF0, true, false, 3 }, { 0x00000001, true, false, 8 }, { 0x1FFFFFFF, true, false, 0 },
+};
+static const struct { uint32_t id; bool ext, fd; uint8_t len; } fd_set_[] = {
+    { 0x100, false, true, 64 }, { 0x18FF1234, true, true, 12 }, { 0x101, false, true, 0 },
+    { 0x321, false, false, 2 }, { 0x102, false, true, 8 }, { 0x103, false, true, 48 },
+    { 0x0ABCDEF0, true, true, 20 },
+};
+
+/* ---- log: ------------------------------------------------------------------------ */
+
+static void expect_line(FILE *expect, const char *file, const urrt_can_frame *f, bool brs)
+{
+    fprintf(expect, "%s %" PRIX32 " %d %d %d ", file, f->id, f->extended, f->fd, f->fd && brs);
+    for (unsigned i = 0; i < f->len; i++)
+        fprintf(expect, "%02X", f->data[i]);
+    fputc('\n', expect);
+}
+
+/* "(SEC.USEC) " with a wall-clock time between lo and hi; returns what
+ * follows, or NULL. */
+static const char *strip_stamp(const char *line, uint64_t lo_us, uint64_t hi_us)
+{
+    unsigned long long sec, usec;
+    int n = 0;
+    if (strlen(line) < 20 || line[0] != '(' || line[11] != '.' || line[18] != ')' || line[19] != ' ')
+        return NULL;
+    if (sscanf(line, "(%10llu.%6llu) %n", &sec, &usec, &n) != 2 || n != 20)
+        return NULL;
+    uint64_t t = sec * 1000000u + usec;
+    if (t + 1000000u < lo_us || t > hi_us + 1000000u)
+        return NULL;
+    return line + 20;
+}
+
+/* Compares the file, line by line, with "IFNAME ID#..." strings. */
+static void check_log_file(const char *path, const char *const *want, size_t n_want, uint64_t lo_us, uint64_t hi_us)
+{
+    char *text = read_file(path);
+    CHECK(text != NULL, "cannot read %s", path);
+    if (text == NULL)
+        return;
+    size_t i = 0;
+    for (char *save = NULL, *line = strtok_r(text, "\n", &save); line != NULL; line = strtok_r(NULL, "\n", &save), i++) {
+        const char *rest = strip_stamp(line, lo_us, hi_us);
+        CHECK(rest != NULL, "%s line %zu: no (SEC.USEC) stamp of now: %s", path, i + 1, line);
+        if (rest != NULL && i < n_want)
+            CHECK(strcmp(rest, want[i]) == 0, "%s line %zu: \"%s\", want \"%s\"", path, i + 1, rest, want[i]);
+    }
+    CHECK_EQ_INT(i, n_want);
+}
+
+/* Frames with the line candump -l writes for each (can-utils lib.c: 3 or 8
+ * upper-case hex digits, '#', for FD a second '#' and the flags nibble, the
+ * data in upper-case hex). Written by hand, not by a formatter. */
+typedef struct log_case {
+    uint32_t id;
+    bool ext, fd;
+    uint8_t len;
+    const char *data;   /* hex; "ramp" is 00 01 02 ... */
+    const char *line;
+} log_case;
+
+static const log_case log_fd_cases[] = {
+    { 0x100, false, true, 64, "ramp",
+      "vcan0 100##5000102030405060708090A0B0C0D0E0F101112131415161718191A1B1C1D1E1F"
+      "202122232425262728292A2B2C2D2E2F303132333435363738393A3B3C3D3E3F" },
+    { 0x18FF1234, true, true, 12, "a1b2c3d4e5f60718293a4b5c", "vcan0 18FF1234##5A1B2C3D4E5F60718293A4B5C" },
+    { 0x101, false, true, 0, "", "vcan0 101##5" },
+    { 0x321, false, false, 2, "dead", "vcan0 321#DEAD" },
+    { 0x7FF, false, true, 8, "0001020304050607", "vcan0 7FF##50001020304050607" },
+    { 0x0ABCDEF0, true, true, 20, "ramp", "vcan0 0ABCDEF0##5000102030405060708090A0B0C0D0E0F10111213" },
+};
+static const log_case log_classic_cases[] = {
+    { 0x123, false, false, 8, "1122334455667788", "can0 123#1122334455667788" },
+    { 0x000, false, false, 0, "", "can0 000#" },
+    { 0x7FF, false, false, 1, "ff", "can0 7FF#FF" },
+    { 0x1ABCDEF0, true, false, 3, "abcdef", "can0 1ABCDEF0#ABCDEF" },
+    { 0x00000001, true, false, 1, "00", "can0 00000001#00" },
+    { 0x1FFFFFFF, true, false, 0, "", "can0 1FFFFFFF#" },
+};
+
+static urrt_can_frame case_frame(const log_case *c)
+{
+    urrt_can_frame f = make_frame(c->id, c->ext, c->fd, c->len, 0);
+    if (strcmp(c->data, "ramp") != 0)
+        for (unsigned i = 0; i < c->len; i++)
+            sscanf(c->data + 2 * i, "%2hhx", &f.data[i]);
+    else
+        for (unsigned i = 0; i < c->len; i++)
+            f.data[i] = (uint8_t)i;
+    return f;
+}
+
+static int test_log(const char *dir)
+{
+    char path_fd[512], path_cc[512], path_out[512], path_expect[512], spec[600];
+    snprintf(path_fd, sizeof(path_fd), "%s/log-fd.log", dir);
+    snprintf(path_cc, sizeof(path_cc), "%s/log-classic.log", dir);
+    snprintf(path_out, sizeof(path_out), "%s/log-stdout.log", dir);
+    snprintf(path_expect, sizeof(path_expect), "%s/log-expect.txt", dir);
+    FILE *expect = fopen(path_expect, "w");
+    CHECK(expect != NULL, "cannot create %s", path_expect);
+    if (expect == NULL)
+        return check_report();
+    uint64_t lo = urrt_port_realtime_us();
+
+    /* An FD link with the bit rate switch, interface column vcan0. */
+    snprintf(spec, sizeof(spec), "log:%s,ifname=vcan0", path_fd);
+    urrt_canlink *fd = open_link(spec, true, true);
+    CHECK(fd != NULL, "log link %s", spec);
+    /* A classic link with the default interface column. */
+    snprintf(spec, sizeof(spec), "log:%s", path_cc);
+    urrt_canlink *cc = open_link(spec, false, false);
+    CHECK(cc != NULL, "log link %s", spec);
+    if (fd == NULL || cc == NULL)
+        return check_report();
+
+    short events;
+    CHECK_EQ_INT(urrt_canlink_poll_fd(fd, &events), -1);
+    CHECK(urrt_canlink_deadline(fd) == UINT64_MAX, "a log link has nothing due");
+    CHECK_EQ_INT(urrt_canlink_get_state(fd), URRT_CANLINK_UP);
+
+    enum { N_FD = sizeof(log_fd_cases) / sizeof(log_fd_cases[0]),
+           N_CC = sizeof(log_classic_cases) / sizeof(log_classic_cases[0]) };
+    const char *want_fd[N_FD], *want_cc[N_CC];
+    for (size_t i = 0; i < N_FD; i++) {
+        urrt_can_frame f = case_frame(&log_fd_cases[i]);
+        CHECK_EQ_INT(timed_send(fd, &f), 1);
+        expect_line(expect, "log-fd.log", &f, true);
+        want_fd[i] = log_fd_cases[i].line;
+    }
+    for (size_t i = 0; i < N_CC; i++) {
+        urrt_can_frame f = case_frame(&log_classic_cases[i]);
+        CHECK_EQ_INT(timed_send(cc, &f), 1);
+        expect_line(expect, "log-classic.log", &f, false);
+        want_cc[i] = log_classic_cases[i].line;
+    }
+
+    /* Frames no link can send. */
+    urrt_can_frame bad = make_frame(0x100, false, true, 8, 0);
+    CHECK_EQ_INT(urrt_canlink_send(cc, &bad, now_us()), URRT_E_ARG); /* FD on a classic link */
+    bad = make_frame(0x100, false, false, 9, 0);
+    CHECK_EQ_INT(urrt_canlink_send(cc, &bad, now_us()), URRT_E_ARG);
+    bad = make_frame(0x100, false, true, 13, 0);
+    CHECK_EQ_INT(urrt_canlink_send(fd, &bad, now_us()), URRT_E_ARG);
+    bad = make_frame(0x100, false, true, 64, 0);
+    bad.len = 65;
+    CHECK_EQ_INT(urrt_canlink_send(fd, &bad, now_us()), URRT_E_ARG);
+    bad = make_frame(0x800, false, false, 1, 0);
+    CHECK_EQ_INT(urrt_canlink_send(cc, &bad, now_us()), URRT_E_ARG);
+    bad = make_frame(0x20000000, true, false, 1, 0);
+    CHECK_EQ_INT(urrt_canlink_send(cc, &bad, now_us()), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_canlink_send(cc, NULL, now_us()), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_canlink_get_stats(fd)->sent, N_FD);
+    CHECK_EQ_INT(urrt_canlink_get_stats(cc)->sent, N_CC);
+    CHECK_EQ_INT(urrt_canlink_get_stats(cc)->dropped, 0);
+    urrt_canlink_free(fd);
+    urrt_canlink_free(cc);
+
+    /* log:- writes to stdout: point stdout at a file for the moment. */
+    fflush(stdout);
+    int saved = dup(STDOUT_FILENO);
+    int out = open(path_out, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(out, STDOUT_FILENO);
+    close(out);
+    urrt_canlink *so = open_link("log:-,ifname=can1", false, false);
+    urrt_can_frame f = case_frame(&(log_case){ 0x5A5, false, false, 4, "c3d4e5f6", NULL });
+    int r = so ? urrt_canlink_send(so, &f, now_us()) : -99;
+    urrt_canlink_free(so);
+    int still_open = fcntl(STDOUT_FILENO, F_GETFD);
+    dup2(saved, STDOUT_FILENO);
+    close(saved);
+    CHECK(so != NULL, "log:- link");
+    CHECK_EQ_INT(r, 1);
+    CHECK(still_open >= 0, "stdout stays open after urrt_canlink_free");
+    expect_line(expect, "log-stdout.log", &f, false);
+    fclose(expect);
+
+    uint64_t hi = urrt_port_realtime_us();
+    static const char *const want_out[] = { "can1 5A5#C3D4E5F6" };
+    check_log_file(path_fd, want_fd, N_FD, lo, hi);
+    check_log_file(path_cc, want_cc, N_CC, lo, hi);
+    check_log_file(path_out, want_out, 1, lo, hi);
+
+    /* Unusable log specifications fail at creation, with a reason. */
+    messages_clear();
+    CHECK(open_link("log:", false, false) == NULL, "empty path");
+    CHECK(strstr(messages, "no path") != NULL, "reason: %s", messages);
+    messages_clear();
+    CHECK(open_link("log:/nonexistent-dir/x.log", false, false) == NULL, "uncreatable file");
+    CHECK(strstr(messages, "/nonexistent-dir/x.log") != NULL, "reason names the file: %s", messages);
+    messages_clear();
+    snprintf(spec, sizeof(spec), "log:%s/x.log,ifname=averyveryverylongname", dir);
+    CHECK(open_link(spec, false, false) == NULL, "long ifname");
+    CHECK(strstr(messages, "ifname") != NULL, "reason: %s", messages);
+    CHECK(blocked_calls == 0, "%u calls slept (longest call %" PRIu64 " us)", blocked_calls, max_call_us);
+    return check_report();
+}
+
+/* ---- frames: what goes on the wire ---------------------------------------------- */
+
+static int test_frames(const char *dir)
+{
+    char spec0[600], spec1[600];
+    snprintf(spec0, sizeof(spec0), "log:%s/frames-vcan0.log,ifname=vcan0", dir);
+    snprintf(spec1, sizeof(spec1), "log:%s/frames-vcan1.log,ifname=vcan1", dir);
+    int rx0 = rx_open("vcan0"), rx1 = rx_open("vcan1");
+    urrt_canlink *fd = open_link("vcan0", true, true);
+    urrt_canlink *fd_nobrs = open_link("vcan0", true, false);
+    urrt_canlink *cc = open_link("vcan1", false, false);
+    urrt_canlink *log_fd = open_link(spec0, true, true);
+    urrt_canlink *log_cc = open_link(spec1, false, false);
+    CHECK(rx0 >= 0 && rx1 >= 0, "receivers");
+    CHECK(fd && fd_nobrs && cc && log_fd && log_cc, "links");
+    if (!(rx0 >= 0 && rx1 >= 0 && fd && fd_nobrs && cc && log_fd && log_cc))
+        return check_report();
+    CHECK_EQ_INT(urrt_canlink_get_state(fd), URRT_CANLINK_UP);
+    CHECK_EQ_INT(urrt_canlink_get_stats(fd)->opens, 1);
+
+    enum { N_FD = sizeof(fd_set_) / sizeof(fd_set_[0]), N_CC = sizeof(classic_set) / sizeof(classic_set[0]) };
+    urrt_can_frame sent0[N_FD + 1], sent1[N_CC];
+    for (size_t i = 0; i < N_FD; i++) {
+        sent0[i] = make_frame(fd_set_[i].id, fd_set_[i].ext, fd_set_[i].fd, fd_set_[i].len, (uint8_t)(0x31 * i));
+        CHECK_EQ_INT(timed_send(fd, &sent0[i]), 1);
+        CHECK_EQ_INT(timed_send(log_fd, &sent0[i]), 1);
+    }
+    /* Without the bit rate switch: flags nibble 4 in the capture. */
+    sent0[N_FD] = make_frame(0x1F0, false, true, 16, 0x77);
+    CHECK_EQ_INT(timed_send(fd_nobrs, &sent0[N_FD]), 1);
+    for (size_t i = 0; i < N_CC; i++) {
+        sent1[i] = make_frame(classic_set[i].id, classic_set[i].ext, false, classic_set[i].len, (uint8_t)(0x13 * i + 1));
+        CHECK_EQ_INT(timed_send(cc, &sent1[i]), 1);
+        CHECK_EQ_INT(timed_send(log_cc, &sent1[i]), 1);
+    }
+    urrt_can_frame fd_on_cc = make_frame(0x100, false, true, 8, 0);
+    CHECK_EQ_INT(urrt_canlink_send(cc, &fd_on_cc, now_us()), URRT_E_ARG);
+
+    rx_frame rx[32];
+    size_t n = rx_collect(rx0, rx, 32, 100);
+    CHECK_EQ_INT(n, N_FD + 1);
+    for (size_t i = 0; i < n && i < N_FD + 1; i++)
+        CHECK(rx_matches(&rx[i], &sent0[i], i < N_FD), "vcan0 frame %zu: id %X len %u fd %d", i,
+              (unsigned)rx[i].f.can_id, rx[i].f.len, rx[i].fd);
+    n = rx_collect(rx1, rx, 32, 100);
+    CHECK_EQ_INT(n, N_CC);
+    for (size_t i = 0; i < n && i < N_CC; i++)
+        CHECK(rx_matches(&rx[i], &sent1[i], false), "vcan1 frame %zu: id %X len %u", i, (unsigned)rx[i].f.can_id,
+              rx[i].f.len);
+    CHECK_EQ_INT(urrt_canlink_get_stats(fd)->sent, N_FD);
+    CHECK_EQ_INT(urrt_canlink_get_stats(cc)->sent, N_CC);
+    CHECK_EQ_INT(urrt_canlink_get_stats(cc)->dropped, 0);
+
+    /* The frame without BRS goes to the log too, from a log link without BRS. */
+    urrt_canlink_free(log_fd);
+    snprintf(spec0, sizeof(spec0), "log:%s/frames-vcan0-nobrs.log,ifname=vcan0", dir);
+    log_fd = open_link(spec0, true, false);
+    CHECK(log_fd != NULL && timed_send(log_fd, &sent0[N_FD]) == 1, "log without BRS");
+
+    urrt_canlink_free(fd);
+    urrt_canlink_free(fd_nobrs);
+    urrt_canlink_free(cc);
+    urrt_canlink_free(log_fd);
+    urrt_canlink_free(log_cc);
+    close(rx0);
+    close(rx1);
+    CHECK(blocked_calls == 0, "%u calls slept (longest call %" PRIu64 " us)", blocked_calls, max_call_us);
+    return check_report();
+}
+
+/* ---- socket behaviour -------------------------------------------------------------- */
+
+static void test_refusals(void)
+{
+    messages_clear();
+    CHECK(open_link("vcan1", true, false) == NULL, "FD link on the classic-MTU vcan1");
+    CHECK(strstr(messages, "vcan1") != NULL && strstr(messages, "ip link set vcan1 mtu 72") != NULL,
+          "the reason names the interface and the fix: %s", messages);
+    messages_clear();
+    CHECK(open_link("vcan9", false, false) == NULL, "no such interface");
+    CHECK(strstr(messages, "vcan9") != NULL && strstr(messages, "no such interface") != NULL, "reason: %s",
+          messages);
+    messages_clear();
+    CHECK(open_link("lo", false, false) == NULL, "not a CAN interface");
+    CHECK(strstr(messages, "not a CAN interface") != NULL, "reason: %s", messages);
+    messages_clear();
+    CHECK(open_link("averyveryverylongname", false, false) == NULL, "name too long");
+    /* A classic link on an FD interface is fine. */
+    urrt_canlink *cc = open_link("vcan0", false, false);
+    CHECK(cc != NULL && urrt_canlink_get_state(cc) == URRT_CANLINK_UP, "classic link on vcan0");
+    urrt_canlink_free(cc);
+}
+
+static void test_no_data_frames(void)
+{
+    urrt_canlink *can = open_link("vcan0", true, false);
+    int tx = rx_open("vcan0");
+    CHECK(can != NULL && tx >= 0, "link and sender");
+    if (can == NULL || tx < 0)
+        return;
+    for (int i = 0; i < 20; i++) {
+        struct can_frame f = { .can_id = 0x123, .can_dlc = 8 };
+        CHECK(write(tx, &f, sizeof(f)) == (ssize_t)sizeof(f), "sender write: %s", strerror(errno));
+    }
+    short events;
+    int fd = urrt_canlink_poll_fd(can, &events);
+    CHECK(fd >= 0 && (events & POLLIN), "waits for POLLIN (error frames)");
+    struct pollfd p = { .fd = fd, .events = events };
+    CHECK_EQ_INT(poll(&p, 1, 200), 0); /* 20 data frames on the bus, none for the link */
+    pump(can, 20);
+    CHECK_EQ_INT(urrt_canlink_get_stats(can)->error_frames, 0);
+    close(tx);
+    urrt_canlink_free(can);
+}
+
+static void test_error_frames(void)
+{
+    urrt_canlink *can = open_link("vcan0", false, false);
+    int tx = rx_open("vcan0");
+    CHECK(can != NULL && tx >= 0, "link and injector");
+    if (can == NULL || tx < 0)
+        return;
+    /* vcan has no controller to report errors, but an error frame written to
+     * it reaches every socket subscribed to errors, as a driver's would. */
+    struct can_frame e[3];
+    memset(e, 0, sizeof(e));
+    e[0].can_id = CAN_ERR_FLAG | CAN_ERR_BUSOFF;
+    e[1].can_id = CAN_ERR_FLAG | CAN_ERR_RESTARTED;
+    e[2].can_id = CAN_ERR_FLAG | CAN_ERR_CRTL;
+    e[2].data[1] = CAN_ERR_CRTL_TX_WARNING;
+    for (int i = 0; i < 3; i++) {
+        e[i].can_dlc = CAN_ERR_DLC;
+        CHECK(write(tx, &e[i], sizeof(e[i])) == (ssize_t)sizeof(e[i]), "inject error frame: %s", strerror(errno));
+    }
+    messages_clear();
+    short seen = pump(can, 100);
+    CHECK(seen & POLLIN, "error frames wake the loop");
+    const urrt_canlink_stats *st = urrt_canlink_get_stats(can);
+    CHECK_EQ_INT(st->error_frames, 3);
+    CHECK_EQ_INT(st->bus_off, 1);
+    CHECK_EQ_INT(st->restarts, 1);
+    CHECK_EQ_INT(st->last_error_class, CAN_ERR_CRTL);
+    CHECK(strstr(messages, "bus-off") != NULL, "bus-off logged: %s", messages);
+    CHECK(strstr(messages, "restarted") != NULL, "restart logged: %s", messages);
+    CHECK(!st->error_passive, "a warning is not error passive");
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
+    /* Error passive holds from the controller's word until it says error active. */
+    static const uint8_t states[] = {CAN_ERR_CRTL_RX_PASSIVE, CAN_ERR_CRTL_TX_WARNING, CAN_ERR_CRTL_ACTIVE};
+    static const bool passive_after[] = {true, true, false};
+    for (int i = 0; i < 3; i++) {
+        struct can_frame f = {.can_id = CAN_ERR_FLAG | CAN_ERR_CRTL, .can_dlc = CAN_ERR_DLC};
+        f.data[1] = states[i];
+        CHECK(write(tx, &f, sizeof f) == (ssize_t)sizeof f, "inject error frame: %s", strerror(errno));
+        /* vcan delivers on write: the frame is queued; a bound, not a sleep. */
+        for (unsigned waited = 0; st->error_frames < (uint64_t)(4 + i) && waited < 1000; waited += 10)
+            pump(can, 10);
+        CHECK_EQ_INT(st->error_frames, 4 + i);
+        CHECK(st->error_passive == passive_after[i], "controller state 0x%02X: error passive %d", states[i],
+              (int)st->error_passive);
+    }
+    close(tx);
+    urrt_canlink_free(can);
+}
+
+/* ENOBUFS, as a controller that cannot get frames onto the bus causes it: the
+ * plug qdisc holds what it has taken and refuses the rest. */
+static void test_queue_full(void)
+{
+    RUN("tc", "qdisc", "add", "dev", "vcan1", "root", "plug", "limit", "160"); /* 10 classic frames */
+    urrt_canlink *can = open_link("vcan1", false, false);
+    int rx = rx_open("vcan1");
+    CHECK(can != NULL && rx >= 0, "link and receiver");
+    if (can == NULL || rx < 0)
+        return;
+    const urrt_canlink_stats *st = urrt_canlink_get_stats(can);
+    for (uint32_t i = 0; i < 10; i++) {
+        urrt_can_frame f = make_frame(0x200 + i, false, false, 8, (uint8_t)i);
+        CHECK_EQ_INT(timed_send(can, &f), 1);
+    }
+    messages_clear();
+    /* The queue is full: 0x20A and 0x20B are held, each newer value
+     * replacing the older one and counting a drop. */
+    urrt_can_frame last_a, last_b;
+    int not_held = 0;
+    for (int i = 0; i < 500; i++) {
+        last_a = make_frame(0x20A, false, false, 8, (uint8_t)(2 * i));
+        last_b = make_frame(0x20B, false, false, 2, (uint8_t)(2 * i + 1));
+        not_held += timed_send(can, &last_a) != 0;
+        not_held += timed_send(can, &last_b) != 0;
+        if (i % 50 == 0)
+            pump(can, 1);
+    }
+    CHECK(not_held == 0, "%d of 1000 sends into a full queue did not return 0 (held)", not_held);
+    CHECK_EQ_INT(st->sent, 10);
+    CHECK_EQ_INT(st->pending, 2);
+    CHECK_EQ_INT(st->dropped, 998);
+    CHECK(st->busy >= 1000, "busy %" PRIu64, st->busy);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
+    CHECK_EQ_INT(count_substr(messages, "transmit queue full"), 1);
+    /* 40 more IDs, one the 29-bit twin of 0x20A: each gets a slot of its own
+     * (and the slot table grows past its first allocation). */
+    urrt_can_frame twin = make_frame(0x20A, true, false, 1, 0x99);
+    not_held = timed_send(can, &twin) != 0;
+    for (uint32_t id = 0x210; id < 0x237; id++) {
+        urrt_can_frame f = make_frame(id, false, false, 1, (uint8_t)id);
+        not_held += timed_send(can, &f) != 0;
+    }
+    CHECK_EQ_INT(not_held, 0);
+    CHECK_EQ_INT(st->pending, 42);
+    CHECK_EQ_INT(st->dropped, 998);
+    short events;
+    urrt_canlink_poll_fd(can, &events);
+    CHECK(!(events & POLLOUT), "no POLLOUT wait on ENOBUFS: the socket would report writable at once");
+    CHECK(urrt_canlink_deadline(can) <= now_us() + 5000u + 1000u, "a retry is scheduled");
+
+    /* The queue drains: the held frames go out, the newest value of each,
+     * once. */
+    RUN("tc", "qdisc", "change", "dev", "vcan1", "root", "plug", "release_indefinite");
+    pump_until_idle(can, 2000);
+    CHECK_EQ_INT(st->pending, 0);
+    CHECK_EQ_INT(st->sent, 52);
+    CHECK(strstr(messages, "takes frames again") != NULL, "recovery logged: %s", messages);
+    rx_frame got[64];
+    size_t n = rx_collect(rx, got, 64, 100);
+    CHECK_EQ_INT(n, 52);
+    CHECK_EQ_INT(count_id(got, n, 0x20A), 1);
+    CHECK_EQ_INT(count_id(got, n, 0x20B), 1);
+    CHECK_EQ_INT(count_id(got, n, 0x20A | CAN_EFF_FLAG), 1);
+    /* Held frames leave in the order they were first held. */
+    bool order_ok = n == 52 && got[10].f.can_id == 0x20A && got[11].f.can_id == 0x20B &&
+                       got[12].f.can_id == (0x20A | CAN_EFF_FLAG);
+    for (size_t i = 13; order_ok && i < n; i++)
+        order_ok = got[i].f.can_id == 0x210 + (i - 13);
+    CHECK(order_ok, "held frames in the order first held");
+    const rx_frame *a = last_of_id(got, n, 0x20A), *b = last_of_id(got, n, 0x20B);
+    CHECK(a != NULL && rx_matches(a, &last_a, false), "0x20A carries the newest value");
+    CHECK(b != NULL && rx_matches(b, &last_b, false), "0x20B carries the newest value");
+
+    /* A value held longer than hold_max_ms is stale: dropped, never sent. */
+    urrt_canlink_free(can);
+    can = open_link_hold("vcan1", false, false, 200);
+    CHECK(can != NULL, "link with hold_max_ms 200");
+    if (can == NULL)
+        return;
+    st = urrt_canlink_get_stats(can);
+    RUN("tc", "qdisc", "del", "dev", "vcan1", "root");
+    RUN("tc", "qdisc", "add", "dev", "vcan1", "root", "plug", "limit", "16");
+    urrt_can_frame first = make_frame(0x300, false, false, 1, 1), stale = make_frame(0x301, false, false, 1, 2);
+    CHECK_EQ_INT(timed_send(can, &first), 1);
+    CHECK_EQ_INT(timed_send(can, &stale), 0);
+    uint64_t dropped = st->dropped;
+    CHECK(urrt_canlink_deadline(can) <= now_us() + 200000u + 1000u, "the held frame's expiry is a deadline");
+    pump(can, 350); /* hold_max_ms 200 */
+    CHECK_EQ_INT(st->pending, 0);
+    CHECK_EQ_INT(st->dropped, dropped + 1);
+    RUN("tc", "qdisc", "change", "dev", "vcan1", "root", "plug", "release_indefinite");
+    pump(can, 20);
+    n = rx_collect(rx, got, 64, 100);
+    CHECK_EQ_INT(count_id(got, n, 0x300), 1);
+    CHECK_EQ_INT(count_id(got, n, 0x301), 0);
+
+    RUN("tc", "qdisc", "del", "dev", "vcan1", "root");
+    close(rx);
+    urrt_canlink_free(can);
+}
+
+/* EAGAIN: the socket's own buffer is full (the kernel keeps charging a
+ * frame to it while a qdisc holds it). Here POLLOUT is the signal to retry. */
+static void test_socket_buffer_full(void)
+{
+    RUN("tc", "qdisc", "add", "dev", "vcan1", "root", "plug", "limit", "1000000");
+    urrt_canlink *can = open_link("vcan1", false, false);
+    int rx = rx_open("vcan1");
+    CHECK(can != NULL && rx >= 0, "link and receiver");
+    if (can == NULL || rx < 0)
+        return;
+    short events;
+    int fd = urrt_canlink_poll_fd(can, &events);
+    int tiny = 1; /* the kernel's minimum: a few frames */
+    CHECK(setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &tiny, sizeof(tiny)) == 0, "SO_SNDBUF");
+    const urrt_canlink_stats *st = urrt_canlink_get_stats(can);
+    uint64_t t0 = now_us();
+    urrt_can_frame last[4];
+    int refused = 0;
+    for (int i = 0; i < 2000; i++) {
+        last[i % 4] = make_frame(0x400 + (uint32_t)(i % 4), false, false, 8, (uint8_t)i);
+        refused += timed_send(can, &last[i % 4]) < 0;
+    }
+    CHECK(refused == 0, "%d valid frames refused", refused);
+    uint64_t flood_us = now_us() - t0;
+    CHECK(st->sent > 0 && st->sent < 100, "the buffer took %" PRIu64 " frames", st->sent);
+    CHECK_EQ_INT(st->pending, 4);
+    CHECK_EQ_INT(st->sent + st->dropped + st->pending, 2000);
+    CHECK(flood_us < 2000000u, "2000 sends took %" PRIu64 " us", flood_us);
+    fd = urrt_canlink_poll_fd(can, &events);
+    CHECK(events & POLLOUT, "waits for POLLOUT after EAGAIN");
+    struct pollfd p = { .fd = fd, .events = POLLOUT };
+    CHECK_EQ_INT(poll(&p, 1, 100), 0); /* still full: no spin */
+
+    uint64_t sent_before = st->sent;
+    RUN("tc", "qdisc", "change", "dev", "vcan1", "root", "plug", "release_indefinite");
+    short seen = pump_until_idle(can, 2000);
+    CHECK(seen & POLLOUT, "POLLOUT woke the loop");
+    CHECK_EQ_INT(st->pending, 0);
+    CHECK_EQ_INT(st->sent, sent_before + 4);
+    rx_frame got[128];
+    size_t n = rx_collect(rx, got, 128, 100);
+    CHECK_EQ_INT(n, st->sent);
+    for (uint32_t id = 0x400; id < 0x404; id++) {
+        const rx_frame *r = last_of_id(got, n, id);
+        CHECK(r != NULL && rx_matches(r, &last[id - 0x400], false), "0x%X ends with the newest value", id);
+    }
+    RUN("tc", "qdisc", "del", "dev", "vcan1", "root");
+    close(rx);
+    urrt_canlink_free(can);
+}
+
+static void test_down_up(void)
+{
+    urrt_canlink *can = open_link("vcan0", true, false);
+    int rx = rx_open("vcan0");
+    CHECK(can != NULL && rx >= 0, "link and receiver");
+    if (can == NULL || rx < 0)
+        return;
+    const urrt_canlink_stats *st = urrt_canlink_get_stats(can);
+    rx_frame got[64];
+
+    /* A frame held in the slot when the interface goes down is discarded. */
+    RUN("tc", "qdisc", "add", "dev", "vcan0", "root", "plug", "limit", "72");
+    urrt_can_frame f1 = make_frame(0x500, false, true, 64, 1), f2 = make_frame(0x501, false, true, 64, 2);
+    CHECK_EQ_INT(timed_send(can, &f1), 1);
+    CHECK_EQ_INT(timed_send(can, &f2), 0);
+    CHECK_EQ_INT(st->pending, 1);
+    messages_clear();
+    RUN("ip", "link", "set", "vcan0", "down");
+    short seen = pump_until_state(can, URRT_CANLINK_DOWN, 2000);
+    CHECK(seen & (POLLERR | POLLIN), "the down event wakes the loop");
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_DOWN);
+    CHECK_EQ_INT(st->down_events, 1);
+    CHECK_EQ_INT(st->pending, 0);
+    CHECK_EQ_INT(st->dropped, 1);
+    short events;
+    CHECK_EQ_INT(urrt_canlink_poll_fd(can, &events), -1);
+    CHECK(strstr(messages, "vcan0: down") != NULL, "down logged: %s", messages);
+    /* Sent while down: dropped and counted, never replayed. */
+    for (int i = 0; i < 5; i++) {
+        urrt_can_frame f = make_frame(0x502, false, true, 8, (uint8_t)i);
+        CHECK_EQ_INT(timed_send(can, &f), 0);
+    }
+    CHECK_EQ_INT(st->dropped, 6);
+    pump(can, 200); /* a few reopen attempts: logged once */
+    CHECK_EQ_INT(count_substr(messages, "vcan0: down"), 1); /* not once per reopen attempt */
+    CHECK_EQ_INT(count_substr(messages, "still down"), 0);
+    RUN("tc", "qdisc", "del", "dev", "vcan0", "root");
+    RUN("ip", "link", "set", "vcan0", "up");
+    rx_collect(rx, got, 64, 50); /* the receiver's own error and the plugged frame */
+    pump_until_state(can, URRT_CANLINK_UP, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
+    CHECK_EQ_INT(st->opens, 2);
+    CHECK(strstr(messages, "up again") != NULL, "recovery logged: %s", messages);
+    urrt_can_frame f3 = make_frame(0x503, false, true, 12, 3);
+    CHECK_EQ_INT(timed_send(can, &f3), 1);
+    size_t n = rx_collect(rx, got, 64, 100);
+    CHECK_EQ_INT(n, 1);
+    CHECK(n >= 1 && rx_matches(&got[0], &f3, false), "the first frame after the outage is the new one");
+
+    /* Removed and created again: a new ifindex, found by name. */
+    messages_clear();
+    RUN("ip", "link", "del", "vcan0");
+    pump_until_state(can, URRT_CANLINK_DOWN, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_DOWN);
+    CHECK_EQ_INT(st->down_events, 2);
+    CHECK(strstr(messages, "removed") != NULL, "removal logged: %s", messages);
+    RUN("ip", "link", "add", "dev", "vcan0", "type", "vcan");
+    RUN("ip", "link", "set", "vcan0", "mtu", "72");
+    RUN("ip", "link", "set", "vcan0", "up");
+    pump_until_state(can, URRT_CANLINK_UP, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
+    CHECK_EQ_INT(st->opens, 3);
+    close(rx);
+    rx = rx_open("vcan0");
+    CHECK_EQ_INT(timed_send(can, &f3), 1);
+    n = rx_collect(rx, got, 64, 100);
+    CHECK(n == 1 && rx_matches(&got[0], &f3, false), "frames flow on the new vcan0");
+
+    /* The MTU shrinks while down: an FD link stays down and says why. */
+    messages_clear();
+    RUN("ip", "link", "set", "vcan0", "down");
+    RUN("ip", "link", "set", "vcan0", "mtu", "16");
+    RUN("ip", "link", "set", "vcan0", "up");
+    for (int waited = 0; strstr(messages, "mtu 72") == NULL && waited < 2000; waited += 10)
+        pump(can, 10); /* until a reopen attempt has seen the interface up */
+    pump(can, 100);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_DOWN);
+    CHECK(strstr(messages, "mtu 72") != NULL, "MTU reason logged: %s", messages);
+    RUN("ip", "link", "set", "vcan0", "down");
+    RUN("ip", "link", "set", "vcan0", "mtu", "72");
+    RUN("ip", "link", "set", "vcan0", "up");
+    pump_until_state(can, URRT_CANLINK_UP, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
+    close(rx);
+    urrt_canlink_free(can);
+
+    /* Created while the interface is down: a link that opens later. */
+    RUN("ip", "link", "set", "vcan1", "down");
+    messages_clear();
+    can = open_link("vcan1", false, false);
+    CHECK(can != NULL, "a link on a down interface");
+    if (can == NULL)
+        return;
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_DOWN);
+    CHECK(strstr(messages, "vcan1: down (interface is down)") != NULL, "logged: %s", messages);
+    pump(can, 120);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_DOWN);
+    RUN("ip", "link", "set", "vcan1", "up");
+    pump_until_state(can, URRT_CANLINK_UP, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
+    CHECK_EQ_INT(urrt_canlink_get_stats(can)->opens, 1);
+    CHECK_EQ_INT(urrt_canlink_get_stats(can)->down_events, 0);
+    urrt_canlink_free(can);
+}
+
+static int test_socket(void)
+{
+    test_refusals();
+    test_no_data_frames();
+    test_error_frames();
+    test_queue_full();
+    test_socket_buffer_full();
+    test_down_up();
+    CHECK(blocked_calls == 0, "no call into the link slept (%u did)", blocked_calls);
+    printf("longest call into the link: %" PRIu64 " us\n", max_call_us);
+    return check_report();
+}
+
+int main(int argc, char **argv)
+{
+    urrt_log_init("can_link_test", URRT_LOG_DEBUG);
+    urrt_log_set_sink(capture, NULL);
+    if (argc == 3 && strcmp(argv[1], "log") == 0)
+        return test_log(argv[2]);
+    if (argc == 3 && strcmp(argv[1], "frames") == 0)
+        return test_frames(argv[2]);
+    if (argc == 2 && strcmp(argv[1], "socket") == 0)
+        return test_socket();
+    fprintf(stderr, "usage: %s log DIR | frames DIR | socket\n", argv[0]);
+    return 2;
+}

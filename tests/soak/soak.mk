@@ -1,0 +1,21 @@
+# SPDX-License-Identifier: MIT
+# tests/soak/soak.mk: make soak SOAK_MINUTES=N (default 10). urrt-sim cycles through
+# every fault mode against one long-running urrt-gateway with an LCM and a CAN
+# log output; an independent checker judges every message's and frame's data
+# age, and the gateway's RSS and descriptors. Not part of `make check`.
+SOAK_MINUTES ?= 10
+# Seconds per fault phase: 12 phases make one pass.
+SOAK_PHASE_SECONDS ?= 10
+SOAKT := $(BUILD)/tests/soak
+
+.PHONY: soak
+
+$(SOAKT)/soak_lcm: tests/soak/soak_lcm.c $(LCMTYPES_OBJS) $(LCMTYPES_H)
+	@mkdir -p $(@D)
+	$(CC) $(PROG_WARN) $(OPT) -I$(LCMGEN) -o $@ $< $(LCMTYPES_OBJS) -llcm -lm
+
+soak: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim $(SOAKT)/soak_lcm
+	@mkdir -p $(BUILD)/results
+	timeout --signal=TERM --kill-after=30 $$(( $(SOAK_MINUTES) * 60 + 300 )) \
+	  $(PYTHON) tests/soak/soak.py --build $(BUILD) --minutes $(SOAK_MINUTES) --phase-seconds $(SOAK_PHASE_SECONDS) \
+	  --result $(BUILD)/results/soak.result

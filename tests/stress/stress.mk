@@ -1,0 +1,10 @@
+# SPDX-License-Identifier: MIT
+# tests/stress/stress.mk: the flake gate (not part of make check).
+#   check-stress   every suite with processes, sockets or time, RUNS times,
+#                  half of them with the other core busy; prints a table of
+#                  runs and failures per suite and per check
+RUNS ?= 20
+STRESS_SUITES ?= check-gateway check-tools check-link check-can-log check-vm check-canopen
+.PHONY: check-stress
+check-stress: deps
+	@sh tests/stress/stress.sh $(BUILD) $(RUNS) $(STRESS_SUITES)
