@@ -387,14 +387,14 @@ static bool tpdo_id_taken(const urrt_co *co, size_t n, uint32_t id)
 static uint32_t tpdo_write(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
 {
     urrt_co_tpdo_state *t = &co->tpdos[n];
-    uint32_t abort = 0;
+    uint32_t abort_code = 0;
     switch (sub) {
     case 1:
-        abort = cob_check(t->cob_id, value, COB_RTR);
-        if (abort == 0u && cob_valid(value) && tpdo_id_taken(co, n, value & ID_MASK)) {
-            abort = URRT_CO_ABORT_VALUE;
+        abort_code = cob_check(t->cob_id, value, COB_RTR);
+        if (abort_code == 0u && cob_valid(value) && tpdo_id_taken(co, n, value & ID_MASK)) {
+            abort_code = URRT_CO_ABORT_VALUE;
         }
-        if (abort == 0u) {
+        if (abort_code == 0u) {
             t->cob_id = value;
             (void)urrt_cantx_set_id(co->tx, tpdo_desc(co, n)->frame, value & ID_MASK);
         }
@@ -416,7 +416,7 @@ static uint32_t tpdo_write(urrt_co *co, size_t n, uint8_t sub, uint32_t value, u
     default: return tpdo_timing(co, n, t->inhibit_100us, (uint16_t)value, now_us);
     }
     gates_apply(co);
-    return abort;
+    return abort_code;
 }
 
 /* ---- errors: 0x1001, 0x1003, EMCY ----------------------------------------------------- */
@@ -836,7 +836,7 @@ static uint32_t sync_write(urrt_co *co, uint32_t value)
 static uint32_t od_write(urrt_co *co, uint16_t index, uint8_t sub, const od_entry *e, uint32_t value,
                          uint64_t now_us)
 {
-    uint32_t abort = 0;
+    uint32_t abort_code = 0;
     if (e->object != NULL) {
         return var_write(co, e->object, value);
     }
@@ -846,14 +846,14 @@ static uint32_t od_write(urrt_co *co, uint16_t index, uint8_t sub, const od_entr
     switch (index) {
     case 0x1003:
         /* Only 0 clears the history (CiA 301). */
-        abort = value != 0u ? URRT_CO_ABORT_VALUE : 0u;
+        abort_code = value != 0u ? URRT_CO_ABORT_VALUE : 0u;
         co->error_count = value != 0u ? co->error_count : 0u;
-        return abort;
+        return abort_code;
     case 0x1005: return sync_write(co, value);
     case 0x1014:
-        abort = cob_check(co->emcy_cob_id, value, 0);
-        co->emcy_cob_id = abort != 0u ? co->emcy_cob_id : value;
-        return abort;
+        abort_code = cob_check(co->emcy_cob_id, value, 0);
+        co->emcy_cob_id = abort_code != 0u ? co->emcy_cob_id : value;
+        return abort_code;
     case 0x1015: co->emcy_inhibit_100us = (uint16_t)value; return 0;
     default: /* 0x1017 */
         co->heartbeat_ms = (uint16_t)value;
@@ -891,14 +891,14 @@ static uint64_t sdo_timeout_us(const urrt_co *co)
 static size_t upload(urrt_co *co, uint16_t index, uint8_t sub, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
 {
     od_entry e;
-    uint32_t abort = od_find(co, index, sub, now_us, &e);
+    uint32_t abort_code = od_find(co, index, sub, now_us, &e);
     uint8_t *data;
     uint32_t i;
-    if (abort == 0u && e.access == URRT_CO_WO) {
-        abort = URRT_CO_ABORT_WRITE_ONLY;
+    if (abort_code == 0u && e.access == URRT_CO_WO) {
+        abort_code = URRT_CO_ABORT_WRITE_ONLY;
     }
-    if (abort != 0u) {
-        return sdo_abort(co, index, sub, abort, now_us, emit, ctx);
+    if (abort_code != 0u) {
+        return sdo_abort(co, index, sub, abort_code, now_us, emit, ctx);
     }
     if (e.text != NULL && (e.size == 0u || e.size > 4u)) {
         data = sdo_begin(co, CS_UPLOAD << 5 | SDO_SIZE_SET, index, sub);
@@ -949,18 +949,18 @@ static size_t download(urrt_co *co, const uint8_t *req, uint64_t now_us, urrt_ca
     uint8_t sub = req[3];
     uint32_t bytes = (req[0] & SDO_SIZE_SET) != 0u ? 4u - (uint32_t)(req[0] >> 2 & 3u) : 0u;
     od_entry e;
-    uint32_t abort = (req[0] & SDO_EXPEDITED) == 0u ? URRT_CO_ABORT_COMMAND : od_find(co, index, sub, now_us, &e);
-    if (abort == 0u && (e.access & URRT_CO_WO) == 0u) {
-        abort = URRT_CO_ABORT_READ_ONLY;
+    uint32_t abort_code = (req[0] & SDO_EXPEDITED) == 0u ? URRT_CO_ABORT_COMMAND : od_find(co, index, sub, now_us, &e);
+    if (abort_code == 0u && (e.access & URRT_CO_WO) == 0u) {
+        abort_code = URRT_CO_ABORT_READ_ONLY;
     }
-    if (abort == 0u && bytes != 0u && bytes != e.size) {
-        abort = bytes > e.size ? URRT_CO_ABORT_TOO_LONG : URRT_CO_ABORT_TOO_SHORT;
+    if (abort_code == 0u && bytes != 0u && bytes != e.size) {
+        abort_code = bytes > e.size ? URRT_CO_ABORT_TOO_LONG : URRT_CO_ABORT_TOO_SHORT;
     }
-    if (abort == 0u) {
-        abort = od_write(co, index, sub, &e, get_le32(req + 4) & size_mask(e.size), now_us);
+    if (abort_code == 0u) {
+        abort_code = od_write(co, index, sub, &e, get_le32(req + 4) & size_mask(e.size), now_us);
     }
-    if (abort != 0u) {
-        return sdo_abort(co, index, sub, abort, now_us, emit, ctx);
+    if (abort_code != 0u) {
+        return sdo_abort(co, index, sub, abort_code, now_us, emit, ctx);
     }
     (void)sdo_begin(co, 0x60u, index, sub);
     return frame_send(co, now_us, emit, ctx);
