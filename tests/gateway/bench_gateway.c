@@ -419,51 +419,70 @@ static void summarize(session *s, result *res)
     res->late = s->late;
 }
 
-/* Serve sj->robots robots at 500 Hz for warm-up + seconds; false if the
- * subject did not connect. */
-static bool run(const subject *sj, result *res)
+#define INI_TEMPLATE "/tmp/bench-gateway-XXXXXX"
+
+/* A run's subject process and its connections. */
+typedef struct {
+    pid_t pid;
+    int sub_fd;                         /* the LCM subscriber's socket */
+    int lfd[MAX_ROBOTS], cfd[MAX_ROBOTS]; /* each robot's listener and its connection */
+    char ini[sizeof INI_TEMPLATE];      /* the gateway's configuration, mkstemp's template */
+} subject_run;
+
+/* Where the CPU and wall clocks stood when the measured packets began. */
+typedef struct {
+    uint64_t cpu, self, wall;
+} clocks;
+
+/* The session's arrays and channel prefix, for sj against n robots. */
+static void session_open(session *s, const subject *sj, int n)
 {
     static unsigned serial;
-    session s = {.robots = sj->robots, .raw = sj->relay};
-    uint16_t ports[MAX_ROBOTS];
-    int lfd[MAX_ROBOTS], cfd[MAX_ROBOTS];
-    char url[96], ini[] = "/tmp/bench-gateway-XXXXXX";
-    int n = sj->robots;
+    s->per_robot = WARMUP + (long)(sj->seconds * HZ);
+    s->sent_ns = calloc((size_t)n * (size_t)(s->per_robot + 1), sizeof *s->sent_ns);
+    for (int k = 0; k < KINDS; k++) s->lat_us[k] = calloc((size_t)n * (size_t)s->per_robot, sizeof(double));
+    snprintf(s->prefix, sizeof s->prefix, "b%d_%u", (int)getpid(), serial++);
+}
 
-    memset(res, 0, sizeof *res);
-    s.per_robot = WARMUP + (long)(sj->seconds * HZ);
-    s.sent_ns = calloc((size_t)n * (size_t)(s.per_robot + 1), sizeof *s.sent_ns);
-    for (int k = 0; k < KINDS; k++) s.lat_us[k] = calloc((size_t)n * (size_t)s.per_robot, sizeof(double));
-    snprintf(s.prefix, sizeof s.prefix, "b%d_%u", (int)getpid(), serial++);
+/* Subscribes, starts the subject and accepts its connection to each robot;
+ * false (the subject stopped) if one does not come within 5 s. */
+static bool subject_start(const subject *sj, const session *s, subject_run *sr)
+{
+    uint16_t ports[MAX_ROBOTS];
+    char url[96];
+    int n = sj->robots;
     uint16_t udp_port = free_udp_port();
     snprintf(url, sizeof url, "udpm://%s:%u?ttl=0", LCM_GROUP, udp_port);
-    int sub_fd = subscribe_udp(LCM_GROUP, udp_port);
-    for (int r = 0; r < n; r++) lfd[r] = listen_any(&ports[r]);
-    pid_t pid = sj->relay ? start_relay(sj, url, s.prefix, ports[0]) : start_gateway(sj, url, s.prefix, ports, ini);
+    sr->sub_fd = subscribe_udp(LCM_GROUP, udp_port);
+    for (int r = 0; r < n; r++) sr->lfd[r] = listen_any(&ports[r]);
+    sr->pid = sj->relay ? start_relay(sj, url, s->prefix, ports[0]) : start_gateway(sj, url, s->prefix, ports, sr->ini);
     for (int r = 0; r < n; r++) {
-        struct pollfd pl = {.fd = lfd[r], .events = POLLIN};
-        cfd[r] = poll(&pl, 1, 5000) == 1 ? accept(lfd[r], NULL, NULL) : -1;
-        if (cfd[r] < 0) {
+        struct pollfd pl = {.fd = sr->lfd[r], .events = POLLIN};
+        sr->cfd[r] = poll(&pl, 1, 5000) == 1 ? accept(sr->lfd[r], NULL, NULL) : -1;
+        if (sr->cfd[r] < 0) {
             fprintf(stderr, "bench_gateway: %s did not connect\n", sj->path);
-            kill(pid, SIGTERM);
-            waitpid(pid, NULL, 0);
+            kill(sr->pid, SIGTERM);
+            waitpid(sr->pid, NULL, 0);
             return false;
         }
         int one = 1;
-        setsockopt(cfd[r], IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+        setsockopt(sr->cfd[r], IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
     }
-    pthread_t th;
-    sub_arg sa = {sub_fd, &s};
-    pthread_create(&th, NULL, subscriber, &sa);
+    return true;
+}
 
+/* Every robot's packets at 500 Hz; the clocks as the measured ones begin. */
+static clocks send_packets(session *s, const subject_run *sr, int n)
+{
     uint8_t pkt[LENGTH];
-    uint64_t start = mono_ns(), cpu0 = 0, wall0 = 0, self0 = 0;
-    size_t row = (size_t)(s.per_robot + 1);
-    for (long index = 1; index <= s.per_robot; index++) {
+    clocks at = {0, 0, 0};
+    uint64_t start = mono_ns();
+    size_t row = (size_t)(s->per_robot + 1);
+    for (long index = 1; index <= s->per_robot; index++) {
         if (index == WARMUP + 1) {
-            cpu0 = cpu_ns(pid);
-            self0 = self_cpu_ns();
-            wall0 = mono_ns();
+            at.cpu = cpu_ns(sr->pid);
+            at.self = self_cpu_ns();
+            at.wall = mono_ns();
         }
         make_packet(pkt, index);
         for (int r = 0; r < n; r++) {
@@ -475,37 +494,68 @@ static bool run(const subject *sj, result *res)
                 struct timespec ts = {.tv_sec = 0, .tv_nsec = (long)(due - now)};
                 nanosleep(&ts, NULL);
             }
-            __atomic_store_n(&s.sent_ns[(size_t)r * row + (size_t)index], mono_ns(), __ATOMIC_RELEASE);
-            if (write(cfd[r], pkt, LENGTH) != LENGTH) {
+            __atomic_store_n(&s->sent_ns[(size_t)r * row + (size_t)index], mono_ns(), __ATOMIC_RELEASE);
+            if (write(sr->cfd[r], pkt, LENGTH) != LENGTH) {
                 fprintf(stderr, "bench_gateway: write: %s\n", strerror(errno));
                 exit(1);
             }
         }
     }
-    /* Every message is in once the subject's CPU stops moving and the
-     * subscriber has them all, or after a second at most. */
-    uint64_t cpu1 = cpu_ns(pid), self1 = self_cpu_ns(), wall1 = mono_ns();
-    res->packets = (long)(s.per_robot - WARMUP) * n;
-    uint64_t all = sj->focused_hz == NULL ? (uint64_t)s.per_robot * (uint64_t)n * KINDS : 0;
-    res->expected = sj->focused_hz == NULL ? (uint64_t)res->packets * KINDS : 0;
+    return at;
+}
+
+/* Waits until the subscriber has all messages (all 0: unknown) or a second has passed. */
+static void await_messages(session *s, uint64_t all)
+{
     for (uint64_t end = mono_ns() + 1000000000u; mono_ns() < end;) {
-        if (all != 0 && __atomic_load_n(&s.received, __ATOMIC_RELAXED) >= all) break;
+        if (all != 0 && __atomic_load_n(&s->received, __ATOMIC_RELAXED) >= all) break;
         struct timespec ts = {.tv_sec = 0, .tv_nsec = 1000000};
         nanosleep(&ts, NULL);
     }
-    kill(pid, SIGTERM);
-    waitpid(pid, NULL, 0);
-    for (int r = 0; r < n; r++) {
-        close(cfd[r]);
-        close(lfd[r]);
+}
+
+/* Stops the subject and the subscriber thread, closes every socket. */
+static void subject_stop(const subject *sj, session *s, subject_run *sr, pthread_t th)
+{
+    kill(sr->pid, SIGTERM);
+    waitpid(sr->pid, NULL, 0);
+    for (int r = 0; r < sj->robots; r++) {
+        close(sr->cfd[r]);
+        close(sr->lfd[r]);
     }
-    __atomic_store_n(&s.stop, 1, __ATOMIC_RELEASE);
+    __atomic_store_n(&s->stop, 1, __ATOMIC_RELEASE);
     pthread_join(th, NULL);
-    close(sub_fd);
-    if (!sj->relay) unlink(ini);
-    res->cpu_per_packet_us = (double)(cpu1 - cpu0) / 1000.0 / (double)res->packets;
-    res->cpu_percent = 100.0 * (double)(cpu1 - cpu0) / (double)(wall1 - wall0);
-    res->self_cpu_percent = 100.0 * (double)(self1 - self0) / (double)(wall1 - wall0);
+    close(sr->sub_fd);
+    if (!sj->relay) unlink(sr->ini);
+}
+
+/* Serve sj->robots robots at 500 Hz for warm-up + seconds; false if the
+ * subject did not connect. */
+static bool run(const subject *sj, result *res)
+{
+    session s = {.robots = sj->robots, .raw = sj->relay};
+    subject_run sr = {.ini = INI_TEMPLATE};
+    int n = sj->robots;
+
+    memset(res, 0, sizeof *res);
+    session_open(&s, sj, n);
+    if (!subject_start(sj, &s, &sr)) return false;
+    pthread_t th;
+    sub_arg sa = {sr.sub_fd, &s};
+    pthread_create(&th, NULL, subscriber, &sa);
+
+    clocks at = send_packets(&s, &sr, n);
+    /* Every message is in once the subject's CPU stops moving and the
+     * subscriber has them all, or after a second at most. */
+    uint64_t cpu1 = cpu_ns(sr.pid), self1 = self_cpu_ns(), wall1 = mono_ns();
+    res->packets = (long)(s.per_robot - WARMUP) * n;
+    uint64_t all = sj->focused_hz == NULL ? (uint64_t)s.per_robot * (uint64_t)n * KINDS : 0;
+    res->expected = sj->focused_hz == NULL ? (uint64_t)res->packets * KINDS : 0;
+    await_messages(&s, all);
+    subject_stop(sj, &s, &sr, th);
+    res->cpu_per_packet_us = (double)(cpu1 - at.cpu) / 1000.0 / (double)res->packets;
+    res->cpu_percent = 100.0 * (double)(cpu1 - at.cpu) / (double)(wall1 - at.wall);
+    res->self_cpu_percent = 100.0 * (double)(self1 - at.self) / (double)(wall1 - at.wall);
     summarize(&s, res);
     /* A connection's first packets may come as a burst, which the gateway
      * does not publish (their age cannot be judged): counted apart. */

@@ -52,3 +52,5 @@ check-fuzz-co: $(COT)/fuzz_co $(COT)/seeds/.made
 
 fuzz-co: $(COT)/fuzz_co $(COT)/seeds/.made
 	sh tests/lib/fuzz.sh $(COT)/fuzz_co $(COT)/seeds $(COT)/fuzz $(FUZZ_SECONDS)
+
+fuzz: fuzz-co

@@ -70,120 +70,299 @@ static void hex(const uint8_t *d, unsigned len, char *out)
 
 /* ---- lib: bit placement ------------------------------------------------------- */
 
-static void test_placement(void)
+/* The pictures in urrt_can.h: 0xABC as 12 bits at start 12. */
+static void placement_pictures(void)
 {
     uint8_t d[64];
     char h[130];
     uint64_t raw;
+    urrt_can_signal intel = sig_make(12, 12, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    urrt_can_signal moto = sig_make(12, 12, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+    const uint8_t want_intel[8] = {0x00, 0xC0, 0xAB, 0, 0, 0, 0, 0};
+    const uint8_t want_moto[8] = {0x00, 0x15, 0x78, 0, 0, 0, 0, 0};
+    unsigned lsb, msb, need;
+    memset(d, 0, sizeof d);
+    CHECK_EQ_INT(urrt_can_put_raw(&intel, 0xABC, d, 8), 0);
+    hex(d, 8, h);
+    CHECK(bytes_are(d, want_intel, 8), "intel 0xABC@12: %s", h);
+    memset(d, 0, sizeof d);
+    CHECK_EQ_INT(urrt_can_put_raw(&moto, 0xABC, d, 8), 0);
+    hex(d, 8, h);
+    CHECK(bytes_are(d, want_moto, 8), "motorola 0xABC@12: %s", h);
+    CHECK_EQ_INT(urrt_can_get_raw(&moto, d, 8, &raw), 0);
+    CHECK_EQ_INT(raw, 0xABC);
+    CHECK_EQ_INT(urrt_can_signal_span(&intel, &lsb, &msb, &need), 0);
+    CHECK(lsb == 12 && msb == 23 && need == 3, "intel span %u %u %u", lsb, msb, need);
+    CHECK_EQ_INT(urrt_can_signal_span(&moto, &lsb, &msb, &need), 0);
+    CHECK(lsb == 17 && msb == 12 && need == 3, "motorola span %u %u %u", lsb, msb, need);
+}
 
-    /* The pictures in urrt_can.h: 0xABC as 12 bits at start 12. */
-    {
-        urrt_can_signal intel = sig_make(12, 12, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
-        urrt_can_signal moto = sig_make(12, 12, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
-        const uint8_t want_intel[8] = {0x00, 0xC0, 0xAB, 0, 0, 0, 0, 0};
-        const uint8_t want_moto[8] = {0x00, 0x15, 0x78, 0, 0, 0, 0, 0};
-        unsigned lsb, msb, need;
-        memset(d, 0, sizeof d);
-        CHECK_EQ_INT(urrt_can_put_raw(&intel, 0xABC, d, 8), 0);
-        hex(d, 8, h);
-        CHECK(bytes_are(d, want_intel, 8), "intel 0xABC@12: %s", h);
-        memset(d, 0, sizeof d);
-        CHECK_EQ_INT(urrt_can_put_raw(&moto, 0xABC, d, 8), 0);
-        hex(d, 8, h);
-        CHECK(bytes_are(d, want_moto, 8), "motorola 0xABC@12: %s", h);
-        CHECK_EQ_INT(urrt_can_get_raw(&moto, d, 8, &raw), 0);
-        CHECK_EQ_INT(raw, 0xABC);
-        CHECK_EQ_INT(urrt_can_signal_span(&intel, &lsb, &msb, &need), 0);
-        CHECK(lsb == 12 && msb == 23 && need == 3, "intel span %u %u %u", lsb, msb, need);
-        CHECK_EQ_INT(urrt_can_signal_span(&moto, &lsb, &msb, &need), 0);
-        CHECK(lsb == 17 && msb == 12 && need == 3, "motorola span %u %u %u", lsb, msb, need);
-    }
-    /* Whole bytes: 16 bits in bytes 2-3, both orders. */
-    {
-        urrt_can_signal moto = sig_make(23, 16, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
-        urrt_can_signal intel = sig_make(16, 16, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
-        memset(d, 0, sizeof d);
-        urrt_can_put_raw(&moto, 0x1234, d, 8);
-        CHECK(d[2] == 0x12 && d[3] == 0x34 && d[1] == 0 && d[4] == 0, "motorola 16@23: %02X %02X", d[2], d[3]);
-        memset(d, 0, sizeof d);
-        urrt_can_put_raw(&intel, 0x1234, d, 8);
-        CHECK(d[2] == 0x34 && d[3] == 0x12 && d[1] == 0 && d[4] == 0, "intel 16@16: %02X %02X", d[2], d[3]);
-    }
-    /* 64 bits: the whole classic payload. */
-    {
-        urrt_can_signal moto = sig_make(7, 64, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
-        urrt_can_signal intel = sig_make(0, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
-        const uint8_t be[8] = {0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF};
-        const uint8_t le[8] = {0xEF, 0xCD, 0xAB, 0x89, 0x67, 0x45, 0x23, 0x01};
-        memset(d, 0, sizeof d);
-        urrt_can_put_raw(&moto, UINT64_C(0x0123456789ABCDEF), d, 8);
-        hex(d, 8, h);
-        CHECK(bytes_are(d, be, 8), "motorola 64@7: %s", h);
-        memset(d, 0, sizeof d);
-        urrt_can_put_raw(&intel, UINT64_C(0x0123456789ABCDEF), d, 8);
-        hex(d, 8, h);
-        CHECK(bytes_are(d, le, 8), "intel 64@0: %s", h);
-        CHECK_EQ_INT(urrt_can_get_raw(&intel, le, 8, &raw), 0);
-        CHECK(raw == UINT64_C(0x0123456789ABCDEF), "intel 64 read back %llX", (unsigned long long)raw);
-        /* 64 bits at the end of an FD frame, unaligned for Intel. */
-        urrt_can_signal tail = sig_make(8 * 56 + 0, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
-        CHECK_EQ_INT(urrt_can_signal_check(&tail, 64), 0);
-        CHECK_EQ_INT(urrt_can_signal_check(&tail, 48), URRT_CAN_E_PAST_END);
-        urrt_can_signal odd = sig_make(3, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
-        CHECK_EQ_INT(urrt_can_signal_check(&odd, 8), URRT_CAN_E_PAST_END);
-        CHECK_EQ_INT(urrt_can_signal_check(&odd, 9), 0);
-        memset(d, 0, sizeof d);
-        urrt_can_put_raw(&odd, ~UINT64_C(0), d, 9);
-        CHECK(d[0] == 0xF8 && d[7] == 0xFF && d[8] == 0x07, "intel 64@3: %02X..%02X %02X", d[0], d[7], d[8]);
-    }
-    /* Single bits and short Motorola runs across a byte boundary. */
-    {
-        urrt_can_signal bit63i = sig_make(63, 1, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
-        urrt_can_signal bit63m = sig_make(63, 1, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
-        urrt_can_signal m10 = sig_make(1, 10, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
-        urrt_can_signal m4 = sig_make(3, 4, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
-        memset(d, 0, sizeof d);
-        urrt_can_put_raw(&bit63i, 1, d, 8);
-        CHECK(d[7] == 0x80, "bit 63 intel: %02X", d[7]);
-        memset(d, 0, sizeof d);
-        urrt_can_put_raw(&bit63m, 1, d, 8);
-        CHECK(d[7] == 0x80, "bit 63 motorola: %02X", d[7]);
-        memset(d, 0, sizeof d);
-        urrt_can_put_raw(&m10, 0x2AA, d, 8); /* 10 1010 1010 */
-        CHECK(d[0] == 0x02 && d[1] == 0xAA, "motorola 10@1: %02X %02X", d[0], d[1]);
-        memset(d, 0, sizeof d);
-        urrt_can_put_raw(&m4, 0xF, d, 8);
-        CHECK(d[0] == 0x0F && d[1] == 0, "motorola 4@3: %02X", d[0]);
-    }
-    /* Bits outside the signal are left alone. */
-    {
-        urrt_can_signal moto = sig_make(12, 12, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
-        memset(d, 0xFF, sizeof d);
-        urrt_can_put_raw(&moto, 0, d, 8);
-        CHECK(d[0] == 0xFF && d[1] == 0xE0 && d[2] == 0x01 && d[3] == 0xFF, "clear motorola 12@12: %02X %02X %02X",
-              d[0], d[1], d[2]);
-    }
-    /* Signed read-back is sign-extended. */
-    {
-        urrt_can_signal s = sig_make(4, 12, URRT_CAN_INTEL, URRT_CAN_SIGNED, 0.5, 10);
-        double v;
-        memset(d, 0, sizeof d);
-        CHECK_EQ_INT(urrt_can_pack(&s, -10.0, d, 8), URRT_CAN_PACK_OK); /* raw -40 */
-        CHECK_EQ_INT(urrt_can_get_raw(&s, d, 8, &raw), 0);
-        CHECK(raw == 0xFD8, "raw -40 in 12 bits: %llX", (unsigned long long)raw);
-        CHECK_EQ_INT(urrt_can_unpack(&s, d, 8, &v), 0);
-        CHECK(v == -10.0, "unpack %g", v);
-        CHECK(urrt_can_from_raw(&s, 0x800) == -2048 * 0.5 + 10, "most negative %g", urrt_can_from_raw(&s, 0x800));
-    }
+/* Whole bytes: 16 bits in bytes 2-3, both orders. */
+static void placement_whole_bytes(void)
+{
+    uint8_t d[64];
+    urrt_can_signal moto = sig_make(23, 16, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+    urrt_can_signal intel = sig_make(16, 16, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    memset(d, 0, sizeof d);
+    urrt_can_put_raw(&moto, 0x1234, d, 8);
+    CHECK(d[2] == 0x12 && d[3] == 0x34 && d[1] == 0 && d[4] == 0, "motorola 16@23: %02X %02X", d[2], d[3]);
+    memset(d, 0, sizeof d);
+    urrt_can_put_raw(&intel, 0x1234, d, 8);
+    CHECK(d[2] == 0x34 && d[3] == 0x12 && d[1] == 0 && d[4] == 0, "intel 16@16: %02X %02X", d[2], d[3]);
+}
+
+/* 64 bits: the whole classic payload. */
+static void placement_64_bits(void)
+{
+    uint8_t d[64];
+    char h[130];
+    uint64_t raw;
+    urrt_can_signal moto = sig_make(7, 64, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+    urrt_can_signal intel = sig_make(0, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    const uint8_t be[8] = {0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF};
+    const uint8_t le[8] = {0xEF, 0xCD, 0xAB, 0x89, 0x67, 0x45, 0x23, 0x01};
+    memset(d, 0, sizeof d);
+    urrt_can_put_raw(&moto, UINT64_C(0x0123456789ABCDEF), d, 8);
+    hex(d, 8, h);
+    CHECK(bytes_are(d, be, 8), "motorola 64@7: %s", h);
+    memset(d, 0, sizeof d);
+    urrt_can_put_raw(&intel, UINT64_C(0x0123456789ABCDEF), d, 8);
+    hex(d, 8, h);
+    CHECK(bytes_are(d, le, 8), "intel 64@0: %s", h);
+    CHECK_EQ_INT(urrt_can_get_raw(&intel, le, 8, &raw), 0);
+    CHECK(raw == UINT64_C(0x0123456789ABCDEF), "intel 64 read back %llX", (unsigned long long)raw);
+    /* 64 bits at the end of an FD frame, unaligned for Intel. */
+    urrt_can_signal tail = sig_make(8 * 56 + 0, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    CHECK_EQ_INT(urrt_can_signal_check(&tail, 64), 0);
+    CHECK_EQ_INT(urrt_can_signal_check(&tail, 48), URRT_CAN_E_PAST_END);
+    urrt_can_signal odd = sig_make(3, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    CHECK_EQ_INT(urrt_can_signal_check(&odd, 8), URRT_CAN_E_PAST_END);
+    CHECK_EQ_INT(urrt_can_signal_check(&odd, 9), 0);
+    memset(d, 0, sizeof d);
+    urrt_can_put_raw(&odd, ~UINT64_C(0), d, 9);
+    CHECK(d[0] == 0xF8 && d[7] == 0xFF && d[8] == 0x07, "intel 64@3: %02X..%02X %02X", d[0], d[7], d[8]);
+}
+
+/* Single bits and short Motorola runs across a byte boundary. */
+static void placement_single_bits(void)
+{
+    uint8_t d[64];
+    urrt_can_signal bit63i = sig_make(63, 1, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    urrt_can_signal bit63m = sig_make(63, 1, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+    urrt_can_signal m10 = sig_make(1, 10, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+    urrt_can_signal m4 = sig_make(3, 4, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+    memset(d, 0, sizeof d);
+    urrt_can_put_raw(&bit63i, 1, d, 8);
+    CHECK(d[7] == 0x80, "bit 63 intel: %02X", d[7]);
+    memset(d, 0, sizeof d);
+    urrt_can_put_raw(&bit63m, 1, d, 8);
+    CHECK(d[7] == 0x80, "bit 63 motorola: %02X", d[7]);
+    memset(d, 0, sizeof d);
+    urrt_can_put_raw(&m10, 0x2AA, d, 8); /* 10 1010 1010 */
+    CHECK(d[0] == 0x02 && d[1] == 0xAA, "motorola 10@1: %02X %02X", d[0], d[1]);
+    memset(d, 0, sizeof d);
+    urrt_can_put_raw(&m4, 0xF, d, 8);
+    CHECK(d[0] == 0x0F && d[1] == 0, "motorola 4@3: %02X", d[0]);
+}
+
+/* Bits outside the signal are left alone. */
+static void placement_keeps_other_bits(void)
+{
+    uint8_t d[64];
+    urrt_can_signal moto = sig_make(12, 12, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 1, 0);
+    memset(d, 0xFF, sizeof d);
+    urrt_can_put_raw(&moto, 0, d, 8);
+    CHECK(d[0] == 0xFF && d[1] == 0xE0 && d[2] == 0x01 && d[3] == 0xFF, "clear motorola 12@12: %02X %02X %02X",
+          d[0], d[1], d[2]);
+}
+
+/* Signed read-back is sign-extended. */
+static void placement_signed_read_back(void)
+{
+    uint8_t d[64];
+    uint64_t raw;
+    urrt_can_signal s = sig_make(4, 12, URRT_CAN_INTEL, URRT_CAN_SIGNED, 0.5, 10);
+    double v;
+    memset(d, 0, sizeof d);
+    CHECK_EQ_INT(urrt_can_pack(&s, -10.0, d, 8), URRT_CAN_PACK_OK); /* raw -40 */
+    CHECK_EQ_INT(urrt_can_get_raw(&s, d, 8, &raw), 0);
+    CHECK(raw == 0xFD8, "raw -40 in 12 bits: %llX", (unsigned long long)raw);
+    CHECK_EQ_INT(urrt_can_unpack(&s, d, 8, &v), 0);
+    CHECK(v == -10.0, "unpack %g", v);
+    CHECK(urrt_can_from_raw(&s, 0x800) == -2048 * 0.5 + 10, "most negative %g", urrt_can_from_raw(&s, 0x800));
+}
+
+static void test_placement(void)
+{
+    placement_pictures();
+    placement_whole_bytes();
+    placement_64_bits();
+    placement_single_bits();
+    placement_keeps_other_bits();
+    placement_signed_read_back();
 }
 
 /* ---- lib: values ------------------------------------------------------------------ */
+
+/* The raw type's range applies even where min/max are wider than it
+ * (a descriptor built by hand, not by the configuration). */
+static void values_raw_type_range(urrt_can_signal u8)
+{
+    urrt_can_signal wide = u8;
+    wide.min = -1e9;
+    wide.max = 1e9;
+    CHECK_RAW(wide, 300, 255, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(wide, -3, 0, URRT_CAN_PACK_SATURATED);
+}
+
+/* Physical limits inside the raw range. */
+static void values_physical_limits(void)
+{
+    urrt_can_signal pct = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 0.5, 0);
+    pct.min = 0;
+    pct.max = 100;
+    CHECK_RAW(pct, 150, 200, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(pct, 99.74, 199, URRT_CAN_PACK_OK); /* 199.48 rounds to 199 */
+    CHECK_RAW(pct, 99.75, 200, URRT_CAN_PACK_OK); /* 199.5 rounds away from zero */
+}
+
+/* Scaling: factor 0.01, offset -40 (a temperature byte pair). */
+static void values_scaling(void)
+{
+    urrt_can_signal t = sig_make(0, 16, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 0.01, -40);
+    CHECK_RAW(t, 25.0, 6500, URRT_CAN_PACK_OK);
+    CHECK_RAW(t, -40.0, 0, URRT_CAN_PACK_OK);
+    CHECK_RAW(t, -41.0, 0, URRT_CAN_PACK_SATURATED);
+    CHECK(fabs(t.max - 615.35) < 1e-9, "max %.17g", t.max);
+}
+
+/* Negative factor: the range is ordered, the sign flips. */
+static void values_negative_factor(void)
+{
+    urrt_can_signal n = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_SIGNED, -0.5, 0);
+    CHECK(n.min == -63.5 && n.max == 64, "negative factor range %g %g", n.min, n.max);
+    CHECK_RAW(n, 10, 0xEC, URRT_CAN_PACK_OK); /* raw -20 */
+    CHECK_RAW(n, 64, 0x80, URRT_CAN_PACK_OK);
+}
+
+/* NaN: outcome NAN; integers carry physical 0 clamped into [min, max],
+ * or the configured invalid raw. */
+static void values_nan(void)
+{
+    urrt_can_signal t = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, -40);
+    CHECK_RAW(t, NAN, 40, URRT_CAN_PACK_NAN);
+    t.min = 10;
+    CHECK_RAW(t, NAN, 50, URRT_CAN_PACK_NAN);
+    t.flags = URRT_CAN_SIG_INVALID_RAW;
+    t.invalid_raw = 0xFF;
+    CHECK_RAW(t, NAN, 0xFF, URRT_CAN_PACK_NAN);
+    CHECK_RAW(t, -NAN, 0xFF, URRT_CAN_PACK_NAN);
+    t.invalid_raw = 0x1FF; /* does not fit 8 bits */
+    CHECK_EQ_INT(urrt_can_to_raw(&t, 1, &(uint64_t){0}), URRT_CAN_E_SIGNAL);
+}
+
+/* 64-bit integers at the edges of what a double holds. */
+static void values_64_bit_edges(void)
+{
+    urrt_can_signal u64 = sig_make(0, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    urrt_can_signal s64 = sig_make(0, 64, URRT_CAN_INTEL, URRT_CAN_SIGNED, 1, 0);
+    CHECK_RAW(u64, 18446744073709549568.0, UINT64_C(0xFFFFFFFFFFFFF800), URRT_CAN_PACK_OK);
+    CHECK_RAW(u64, 18446744073709551616.0, UINT64_MAX, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(u64, 1e19 * 10, UINT64_MAX, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(s64, -9223372036854775808.0, UINT64_C(0x8000000000000000), URRT_CAN_PACK_OK);
+    CHECK_RAW(s64, 9223372036854775808.0, UINT64_C(0x7FFFFFFFFFFFFFFF), URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(s64, -9223372036854777856.0, UINT64_C(0x8000000000000000), URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(s64, -1.0, UINT64_MAX, URRT_CAN_PACK_OK);
+    CHECK(urrt_can_from_raw(&s64, UINT64_C(0x8000000000000000)) == -9223372036854775808.0, "s64 min");
+    CHECK(urrt_can_from_raw(&s64, UINT64_MAX) == -1.0, "s64 -1");
+    CHECK(urrt_can_from_raw(&u64, UINT64_MAX) == 18446744073709551616.0, "u64 max");
+}
+
+/* Tiny factors: the scaled value overflows to infinity, which saturates. */
+static void values_tiny_factor(void)
+{
+    urrt_can_signal tiny = sig_make(0, 32, URRT_CAN_INTEL, URRT_CAN_SIGNED, 1e-300, 0);
+    tiny.min = -DBL_MAX;
+    tiny.max = DBL_MAX;
+    CHECK_RAW(tiny, 1e300, 0x7FFFFFFF, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(tiny, -1e300, 0x80000000, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(tiny, 5e-300, 5, URRT_CAN_PACK_OK);
+}
+
+/* float32: IEEE bits, out of range clamped to FLT_MAX (never an
+ * undefined double-to-float conversion), NaN stays NaN. */
+static void values_float32(void)
+{
+    urrt_can_signal f = sig_make(0, 32, URRT_CAN_INTEL, URRT_CAN_FLOAT32, 1, 0);
+    urrt_can_signal g = sig_make(0, 32, URRT_CAN_INTEL, URRT_CAN_FLOAT32, 2, 1);
+    CHECK(f.max == (double)FLT_MAX && f.min == -(double)FLT_MAX, "float32 range %g", f.max);
+    CHECK_RAW(f, 1.5, 0x3FC00000, URRT_CAN_PACK_OK);
+    CHECK_RAW(f, -2.0, 0xC0000000, URRT_CAN_PACK_OK);
+    CHECK_RAW(f, 1e39, 0x7F7FFFFF, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(f, -INFINITY, 0xFF7FFFFF, URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(f, NAN, 0x7FC00000, URRT_CAN_PACK_NAN);
+    CHECK_RAW(f, 1e-50, 0, URRT_CAN_PACK_OK); /* underflows to +0 */
+    CHECK_RAW(g, 4.0, 0x3FC00000, URRT_CAN_PACK_OK);
+    CHECK(urrt_can_from_raw(&g, 0x3FC00000) == 4.0, "float32 scaled read-back");
+    f.max = 10;
+    CHECK_RAW(f, 11, 0x41200000, URRT_CAN_PACK_SATURATED);
+}
+
+/* float64, Motorola: the big-endian double. */
+static void values_float64(void)
+{
+    urrt_can_signal d = sig_make(0, 64, URRT_CAN_MOTOROLA, URRT_CAN_FLOAT64, 1, 0);
+    uint8_t buf[8] = {0};
+    const uint8_t want[8] = {0x3F, 0xF8, 0, 0, 0, 0, 0, 0};
+    d.start = 7;
+    CHECK_RAW(d, 1.5, UINT64_C(0x3FF8000000000000), URRT_CAN_PACK_OK);
+    CHECK_RAW(d, INFINITY, UINT64_C(0x7FEFFFFFFFFFFFFF), URRT_CAN_PACK_SATURATED);
+    CHECK_RAW(d, NAN, UINT64_C(0x7FF8000000000000), URRT_CAN_PACK_NAN);
+    CHECK_EQ_INT(urrt_can_pack(&d, 1.5, buf, 8), URRT_CAN_PACK_OK);
+    CHECK(bytes_are(buf, want, 8), "float64 motorola is the big-endian double");
+}
+
+/* Descriptors out of their domain. */
+static void values_bad_descriptors(urrt_can_signal u8)
+{
+    int outcome;
+    urrt_can_signal bad = u8;
+    uint64_t r;
+    bad.factor = 0;
+    CHECK_EQ_INT(urrt_can_to_raw(&bad, 1, &r), URRT_CAN_E_SIGNAL);
+    bad = u8;
+    bad.factor = NAN;
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+    bad = u8;
+    bad.min = 5;
+    bad.max = 4;
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+    bad = u8;
+    bad.length = 0;
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+    bad.length = 65;
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 64), URRT_CAN_E_SIGNAL);
+    bad = sig_make(0, 16, URRT_CAN_INTEL, URRT_CAN_FLOAT32, 1, 0);
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+    bad = u8;
+    bad.type = 9;
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+    bad = u8;
+    bad.start = 600;
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 64), URRT_CAN_E_PAST_END);
+    CHECK_EQ_INT(urrt_can_pack(NULL, 1, (uint8_t[8]){0}, 8), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_can_pack(&u8, 1, NULL, 8), URRT_E_ARG);
+    CHECK_EQ_STR(urrt_can_strerror(URRT_CAN_E_OVERLAP), "signals overlap");
+    CHECK_EQ_STR(urrt_can_strerror(URRT_E_ARG), "invalid argument");
+    CHECK(isnan(urrt_can_from_raw(NULL, 0)), "from_raw(NULL) is NaN");
+    outcome = urrt_can_pack(&bad, 1, (uint8_t[64]){0}, 64);
+    CHECK_EQ_INT(outcome, URRT_CAN_E_PAST_END);
+}
 
 static void test_values(void)
 {
     urrt_can_signal u8 = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
     urrt_can_signal s8 = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_SIGNED, 1, 0);
-    int outcome;
 
     CHECK(u8.min == 0 && u8.max == 255, "u8 range %g %g", u8.min, u8.max);
     CHECK(s8.min == -128 && s8.max == 127, "s8 range %g %g", s8.min, s8.max);
@@ -205,139 +384,16 @@ static void test_values(void)
     CHECK_RAW(s8, 128.0, 0x7F, URRT_CAN_PACK_SATURATED);
     CHECK_RAW(s8, -128.6, 0x80, URRT_CAN_PACK_SATURATED);
     CHECK_RAW(s8, -1e308, 0x80, URRT_CAN_PACK_SATURATED);
-    /* The raw type's range applies even where min/max are wider than it
-     * (a descriptor built by hand, not by the configuration). */
-    {
-        urrt_can_signal wide = u8;
-        wide.min = -1e9;
-        wide.max = 1e9;
-        CHECK_RAW(wide, 300, 255, URRT_CAN_PACK_SATURATED);
-        CHECK_RAW(wide, -3, 0, URRT_CAN_PACK_SATURATED);
-    }
-    /* Physical limits inside the raw range. */
-    {
-        urrt_can_signal pct = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 0.5, 0);
-        pct.min = 0;
-        pct.max = 100;
-        CHECK_RAW(pct, 150, 200, URRT_CAN_PACK_SATURATED);
-        CHECK_RAW(pct, 99.74, 199, URRT_CAN_PACK_OK); /* 199.48 rounds to 199 */
-        CHECK_RAW(pct, 99.75, 200, URRT_CAN_PACK_OK); /* 199.5 rounds away from zero */
-    }
-    /* Scaling: factor 0.01, offset -40 (a temperature byte pair). */
-    {
-        urrt_can_signal t = sig_make(0, 16, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 0.01, -40);
-        CHECK_RAW(t, 25.0, 6500, URRT_CAN_PACK_OK);
-        CHECK_RAW(t, -40.0, 0, URRT_CAN_PACK_OK);
-        CHECK_RAW(t, -41.0, 0, URRT_CAN_PACK_SATURATED);
-        CHECK(fabs(t.max - 615.35) < 1e-9, "max %.17g", t.max);
-    }
-    /* Negative factor: the range is ordered, the sign flips. */
-    {
-        urrt_can_signal n = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_SIGNED, -0.5, 0);
-        CHECK(n.min == -63.5 && n.max == 64, "negative factor range %g %g", n.min, n.max);
-        CHECK_RAW(n, 10, 0xEC, URRT_CAN_PACK_OK); /* raw -20 */
-        CHECK_RAW(n, 64, 0x80, URRT_CAN_PACK_OK);
-    }
-    /* NaN: outcome NAN; integers carry physical 0 clamped into [min, max],
-     * or the configured invalid raw. */
-    {
-        urrt_can_signal t = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, -40);
-        CHECK_RAW(t, NAN, 40, URRT_CAN_PACK_NAN);
-        t.min = 10;
-        CHECK_RAW(t, NAN, 50, URRT_CAN_PACK_NAN);
-        t.flags = URRT_CAN_SIG_INVALID_RAW;
-        t.invalid_raw = 0xFF;
-        CHECK_RAW(t, NAN, 0xFF, URRT_CAN_PACK_NAN);
-        CHECK_RAW(t, -NAN, 0xFF, URRT_CAN_PACK_NAN);
-        t.invalid_raw = 0x1FF; /* does not fit 8 bits */
-        CHECK_EQ_INT(urrt_can_to_raw(&t, 1, &(uint64_t){0}), URRT_CAN_E_SIGNAL);
-    }
-    /* 64-bit integers at the edges of what a double holds. */
-    {
-        urrt_can_signal u64 = sig_make(0, 64, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
-        urrt_can_signal s64 = sig_make(0, 64, URRT_CAN_INTEL, URRT_CAN_SIGNED, 1, 0);
-        CHECK_RAW(u64, 18446744073709549568.0, UINT64_C(0xFFFFFFFFFFFFF800), URRT_CAN_PACK_OK);
-        CHECK_RAW(u64, 18446744073709551616.0, UINT64_MAX, URRT_CAN_PACK_SATURATED);
-        CHECK_RAW(u64, 1e19 * 10, UINT64_MAX, URRT_CAN_PACK_SATURATED);
-        CHECK_RAW(s64, -9223372036854775808.0, UINT64_C(0x8000000000000000), URRT_CAN_PACK_OK);
-        CHECK_RAW(s64, 9223372036854775808.0, UINT64_C(0x7FFFFFFFFFFFFFFF), URRT_CAN_PACK_SATURATED);
-        CHECK_RAW(s64, -9223372036854777856.0, UINT64_C(0x8000000000000000), URRT_CAN_PACK_SATURATED);
-        CHECK_RAW(s64, -1.0, UINT64_MAX, URRT_CAN_PACK_OK);
-        CHECK(urrt_can_from_raw(&s64, UINT64_C(0x8000000000000000)) == -9223372036854775808.0, "s64 min");
-        CHECK(urrt_can_from_raw(&s64, UINT64_MAX) == -1.0, "s64 -1");
-        CHECK(urrt_can_from_raw(&u64, UINT64_MAX) == 18446744073709551616.0, "u64 max");
-    }
-    /* Tiny factors: the scaled value overflows to infinity, which saturates. */
-    {
-        urrt_can_signal tiny = sig_make(0, 32, URRT_CAN_INTEL, URRT_CAN_SIGNED, 1e-300, 0);
-        tiny.min = -DBL_MAX;
-        tiny.max = DBL_MAX;
-        CHECK_RAW(tiny, 1e300, 0x7FFFFFFF, URRT_CAN_PACK_SATURATED);
-        CHECK_RAW(tiny, -1e300, 0x80000000, URRT_CAN_PACK_SATURATED);
-        CHECK_RAW(tiny, 5e-300, 5, URRT_CAN_PACK_OK);
-    }
-    /* float32: IEEE bits, out of range clamped to FLT_MAX (never an
-     * undefined double-to-float conversion), NaN stays NaN. */
-    {
-        urrt_can_signal f = sig_make(0, 32, URRT_CAN_INTEL, URRT_CAN_FLOAT32, 1, 0);
-        urrt_can_signal g = sig_make(0, 32, URRT_CAN_INTEL, URRT_CAN_FLOAT32, 2, 1);
-        CHECK(f.max == (double)FLT_MAX && f.min == -(double)FLT_MAX, "float32 range %g", f.max);
-        CHECK_RAW(f, 1.5, 0x3FC00000, URRT_CAN_PACK_OK);
-        CHECK_RAW(f, -2.0, 0xC0000000, URRT_CAN_PACK_OK);
-        CHECK_RAW(f, 1e39, 0x7F7FFFFF, URRT_CAN_PACK_SATURATED);
-        CHECK_RAW(f, -INFINITY, 0xFF7FFFFF, URRT_CAN_PACK_SATURATED);
-        CHECK_RAW(f, NAN, 0x7FC00000, URRT_CAN_PACK_NAN);
-        CHECK_RAW(f, 1e-50, 0, URRT_CAN_PACK_OK); /* underflows to +0 */
-        CHECK_RAW(g, 4.0, 0x3FC00000, URRT_CAN_PACK_OK);
-        CHECK(urrt_can_from_raw(&g, 0x3FC00000) == 4.0, "float32 scaled read-back");
-        f.max = 10;
-        CHECK_RAW(f, 11, 0x41200000, URRT_CAN_PACK_SATURATED);
-    }
-    {
-        urrt_can_signal d = sig_make(0, 64, URRT_CAN_MOTOROLA, URRT_CAN_FLOAT64, 1, 0);
-        uint8_t buf[8] = {0};
-        const uint8_t want[8] = {0x3F, 0xF8, 0, 0, 0, 0, 0, 0};
-        d.start = 7;
-        CHECK_RAW(d, 1.5, UINT64_C(0x3FF8000000000000), URRT_CAN_PACK_OK);
-        CHECK_RAW(d, INFINITY, UINT64_C(0x7FEFFFFFFFFFFFFF), URRT_CAN_PACK_SATURATED);
-        CHECK_RAW(d, NAN, UINT64_C(0x7FF8000000000000), URRT_CAN_PACK_NAN);
-        CHECK_EQ_INT(urrt_can_pack(&d, 1.5, buf, 8), URRT_CAN_PACK_OK);
-        CHECK(bytes_are(buf, want, 8), "float64 motorola is the big-endian double");
-    }
-    /* Descriptors out of their domain. */
-    {
-        urrt_can_signal bad = u8;
-        uint64_t r;
-        bad.factor = 0;
-        CHECK_EQ_INT(urrt_can_to_raw(&bad, 1, &r), URRT_CAN_E_SIGNAL);
-        bad = u8;
-        bad.factor = NAN;
-        CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
-        bad = u8;
-        bad.min = 5;
-        bad.max = 4;
-        CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
-        bad = u8;
-        bad.length = 0;
-        CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
-        bad.length = 65;
-        CHECK_EQ_INT(urrt_can_signal_check(&bad, 64), URRT_CAN_E_SIGNAL);
-        bad = sig_make(0, 16, URRT_CAN_INTEL, URRT_CAN_FLOAT32, 1, 0);
-        CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
-        bad = u8;
-        bad.type = 9;
-        CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
-        bad = u8;
-        bad.start = 600;
-        CHECK_EQ_INT(urrt_can_signal_check(&bad, 64), URRT_CAN_E_PAST_END);
-        CHECK_EQ_INT(urrt_can_pack(NULL, 1, (uint8_t[8]){0}, 8), URRT_E_ARG);
-        CHECK_EQ_INT(urrt_can_pack(&u8, 1, NULL, 8), URRT_E_ARG);
-        CHECK_EQ_STR(urrt_can_strerror(URRT_CAN_E_OVERLAP), "signals overlap");
-        CHECK_EQ_STR(urrt_can_strerror(URRT_E_ARG), "invalid argument");
-        CHECK(isnan(urrt_can_from_raw(NULL, 0)), "from_raw(NULL) is NaN");
-        outcome = urrt_can_pack(&bad, 1, (uint8_t[64]){0}, 64);
-        CHECK_EQ_INT(outcome, URRT_CAN_E_PAST_END);
-    }
+    values_raw_type_range(u8);
+    values_physical_limits();
+    values_scaling();
+    values_negative_factor();
+    values_nan();
+    values_64_bit_edges();
+    values_tiny_factor();
+    values_float32();
+    values_float64();
+    values_bad_descriptors(u8);
 }
 
 /* Random descriptors: pack, unpack, compare within half a raw step; every

@@ -408,11 +408,9 @@ static void test_sdo_segmented(void)
                (code) >> 16 & 0xFF, (code) >> 24 & 0xFF);                                        \
     } while (0)
 
-static void test_sdo_aborts(void)
+/* Requests the node refuses, each answered with its abort code. */
+static void sdo_refused_requests(void)
 {
-    desc_defaults();
-    desc.heartbeat_ms = 0;
-    setup();
     ABORT(0, 0x06090030, 0x23, 0x14, 0x10, 0x00, 0x8B, 0, 0, 0); /* EMCY id while valid */
     SDO(0, 0x23, 0x14, 0x10, 0x00, 0x8A, 0x00, 0x00, 0x80);        /* no EMCY: SDO answers only */
     ABORT(1000, 0x06020000, 0x40, 0x34, 0x12, 0x00, 0, 0, 0, 0);  /* no object 0x1234 */
@@ -449,17 +447,21 @@ static void test_sdo_aborts(void)
     ANSWER(0x4B, 0x00, 0x21, 0x00, 0x64, 0x00, 0x00, 0x00);
     SDO(1000, 0x40, 0x00, 0x18, 0x02, 0, 0, 0, 0);
     ANSWER(0x4F, 0x00, 0x18, 0x02, 0xFE, 0x00, 0x00, 0x00);
+}
 
-    /* Short frames: 0x06070010, with what index they carry. */
-    {
-        const uint8_t seven[7] = {0x40, 0x00, 0x10, 0x00, 0, 0, 0};
-        EQ(rx(0x60A, seven, 7, 1000), 1);
-        EXPECT(0, 0x58A, 0x80, 0x00, 0x10, 0x00, 0x10, 0x00, 0x07, 0x06);
-        EQ(rx(0x60A, NULL, 0, 1000), 1);
-        EXPECT(0, 0x58A, 0x80, 0x00, 0x00, 0x00, 0x10, 0x00, 0x07, 0x06);
-    }
+/* Short frames: 0x06070010, with what index they carry. */
+static void sdo_short_frames(void)
+{
+    const uint8_t seven[7] = {0x40, 0x00, 0x10, 0x00, 0, 0, 0};
+    EQ(rx(0x60A, seven, 7, 1000), 1);
+    EXPECT(0, 0x58A, 0x80, 0x00, 0x10, 0x00, 0x10, 0x00, 0x07, 0x06);
+    EQ(rx(0x60A, NULL, 0, 1000), 1);
+    EXPECT(0, 0x58A, 0x80, 0x00, 0x00, 0x00, 0x10, 0x00, 0x07, 0x06);
+}
 
-    /* Toggle error: the first segment request must have toggle 0. */
+/* Toggle error: the first segment request must have toggle 0. */
+static void sdo_toggle_errors(void)
+{
     SDO(2000, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0);
     ABORT(2000, 0x05030000, 0x70, 0x08, 0x10, 0x00, 0, 0, 0, 0); /* bytes 1-3: the transfer's, as written */
     /* ... and twice the same toggle. */
@@ -467,8 +469,11 @@ static void test_sdo_aborts(void)
     SDO(2000, 0x60, 0, 0, 0, 0, 0, 0, 0);
     SDO(2000, 0x60, 0, 0, 0, 0, 0, 0, 0);
     ANSWER(0x80, 0x08, 0x10, 0x00, 0x00, 0x00, 0x03, 0x05);
+}
 
-    /* Timeout: the client leaves; 1 s after the last exchange the node aborts. */
+/* Timeout: the client leaves; 1 s after the last exchange the node aborts. */
+static void sdo_timeout(void)
+{
     SDO(10000, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0);
     SDO(20000, 0x60, 0, 0, 0, 0, 0, 0, 0);
     EQ(urrt_co_deadline(&co) <= 1020000, 1);
@@ -477,9 +482,12 @@ static void test_sdo_aborts(void)
     ANSWER(0x80, 0x08, 0x10, 0x00, 0x00, 0x00, 0x04, 0x05);
     SDO(1030000, 0x70, 0, 0, 0, 0, 0, 0, 0);
     ANSWER(0x80, 0x00, 0x00, 0x00, 0x01, 0x00, 0x04, 0x05); /* the transfer is over */
+}
 
-    /* A new request in the middle: the old transfer is aborted, the request
-     * not served; the client's retry is. */
+/* A new request in the middle: the old transfer is aborted, the request
+ * not served; the client's retry is. */
+static void sdo_interrupted_transfers(void)
+{
     SDO(2000000, 0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0);
     SDO(2000000, 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0);
     ANSWER(0x80, 0x08, 0x10, 0x00, 0x01, 0x00, 0x04, 0x05);
@@ -493,6 +501,20 @@ static void test_sdo_aborts(void)
     }
     run(5000000);
     EQ(count_id(0x58A), 0); /* no timeout abort */
+}
+
+/* Every abort of the server, on one node: each step continues from the state the one
+ * before left. */
+static void test_sdo_aborts(void)
+{
+    desc_defaults();
+    desc.heartbeat_ms = 0;
+    setup();
+    sdo_refused_requests();
+    sdo_short_frames();
+    sdo_toggle_errors();
+    sdo_timeout();
+    sdo_interrupted_transfers();
 }
 
 static void test_sdo_download(void)

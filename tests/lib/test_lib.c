@@ -75,12 +75,212 @@ static const vector *find_vector(const char *name)
     exit(2);
 }
 
-static void check_vector(const vector *v, expected_field *e)
+/* What the decoded state says of the packet as a whole. */
+static void check_vector_header(const vector *v, const urrt_state *st)
+{
+    CHECK(st->length == v->length, "%s: length %u", v->name, st->length);
+    CHECK(st->doubles == v->doubles, "%s: doubles %u", v->name, st->doubles);
+    CHECK((int)st->generation == v->generation, "%s: generation %d", v->name, (int)st->generation);
+    CHECK((int)urrt_generation_of(v->length) == v->generation, "%s: generation_of", v->name);
+    CHECK(st->extra_columns == v->extra, "%s: extra columns %u, expected %u", v->name, st->extra_columns, v->extra);
+    {
+        const char *vs = urrt_versions_of(v->length);
+        if (strcmp(v->versions, "-") == 0) {
+            CHECK(vs == NULL, "%s: versions \"%s\" for an unknown length", v->name, vs);
+        } else {
+            CHECK(vs != NULL && strcmp(vs, v->versions) == 0, "%s: versions \"%s\", expected \"%s\"", v->name,
+                  vs ? vs : "(null)", v->versions);
+        }
+    }
+}
+
+/* A field the reference says is absent: NaN in the state, URRT_E_ABSENT to urrt_read. */
+static void check_absent_field(const vector *v, urrt_state *st, int id)
+{
+    const urrt_field_info *f = urrt_field((urrt_field_id)id);
+    double *val = state_slot(st, id);
+    double d;
+    CHECK(!urrt_has(st, id), "%s: %s present, reference says absent", v->name, f->name);
+    for (unsigned i = 0; i < f->count; i++) {
+        CHECK(isnan(val[i]), "%s: absent %s[%u] is not NaN", v->name, f->name, i);
+    }
+    CHECK_EQ_INT(urrt_read(v->packet, v->length, (urrt_field_id)id, 0, &d), URRT_E_ABSENT);
+}
+
+/* A present field's elements, bit for bit, by every way of reading them. */
+static void check_field_elements(const vector *v, const expected_field *e, urrt_state *st, int id)
+{
+    const urrt_field_info *f = urrt_field((urrt_field_id)id);
+    urrt_generation gen = (urrt_generation)v->generation;
+    double *val = state_slot(st, id);
+    int r;
+    for (unsigned i = 0; i < f->count && (int)i < e[id].elements; i++) {
+        double d = 0;
+        uint64_t raw = 0;
+        unsigned column = urrt_field_column((urrt_field_id)id, gen) + i;
+        CHECK(bits_of(val[i]) == e[id].bits[i], "%s: decode %s[%u] = %016" PRIx64 ", expected %016" PRIx64,
+              v->name, f->name, i, bits_of(val[i]), e[id].bits[i]);
+        r = urrt_read(v->packet, v->length, (urrt_field_id)id, i, &d);
+        CHECK(r == URRT_OK && bits_of(d) == e[id].bits[i], "%s: read %s[%u] = %d, %016" PRIx64, v->name,
+              f->name, i, r, bits_of(d));
+        r = urrt_read_column(v->packet, v->length, column, &d);
+        CHECK(r == URRT_OK && bits_of(d) == e[id].bits[i], "%s: read_column %u (%s[%u]) = %d, %016" PRIx64,
+              v->name, column, f->name, i, r, bits_of(d));
+        r = urrt_read_column_bits(v->packet, v->length, column, &raw);
+        CHECK(r == URRT_OK && raw == e[id].bits[i], "%s: read_column_bits %u", v->name, column);
+        if (e[id].has_enum[i]) {
+            const char *name = urrt_enum_name(urrt_field_enum((urrt_field_id)id, gen), val[i]);
+            CHECK(strcmp(name, e[id].enum_name[i]) == 0, "%s: %s[%u] = %g is %s, expected %s", v->name,
+                  f->name, i, val[i], name, e[id].enum_name[i]);
+        }
+    }
+}
+
+/* The bit mask of a field the reference reads as one (or says is none). */
+static void check_field_mask(const vector *v, const expected_field *e, urrt_state *st, int id)
+{
+    const urrt_field_info *f = urrt_field((urrt_field_id)id);
+    double *val = state_slot(st, id);
+    uint64_t mask = 0;
+    int r = urrt_bitmask(val[0], &mask);
+    if (e[id].mask_ok) {
+        CHECK(r == URRT_OK && mask == e[id].mask, "%s: %s mask %d %" PRIx64 ", expected %" PRIx64, v->name,
+              f->name, r, mask, e[id].mask);
+    } else {
+        CHECK(r == URRT_E_NOT_BITMASK, "%s: %s (%016" PRIx64 ") gave %d, expected NOT_BITMASK", v->name,
+              f->name, bits_of(val[0]), r);
+    }
+}
+
+/* Every field against the reference, present or absent. */
+static void check_vector_fields(const vector *v, const expected_field *e, urrt_state *st)
+{
+    for (int id = 0; id < URRT_FIELD_COUNT; id++) {
+        const urrt_field_info *f = urrt_field((urrt_field_id)id);
+        CHECK(e[id].seen, "%s: the reference does not know field %s", v->name, f->name);
+        if (!e[id].seen) {
+            continue;
+        }
+        if (e[id].absent) {
+            check_absent_field(v, st, id);
+            continue;
+        }
+        CHECK(urrt_has(st, id), "%s: %s absent, reference says present", v->name, f->name);
+        CHECK(e[id].elements == f->count, "%s: %s has %d elements in the reference, %u in lib", v->name, f->name,
+              e[id].elements, f->count);
+        check_field_elements(v, e, st, id);
+        if (e[id].has_mask) {
+            check_field_mask(v, e, st, id);
+        }
+    }
+}
+
+/* Columns past the known layout are readable, one past the end is not. */
+static void check_vector_extra_columns(const vector *v)
+{
+    for (unsigned c = URRT_WIRE_COLUMNS + 1; c <= v->doubles; c++) {
+        uint64_t raw = 0;
+        CHECK(urrt_read_column_bits(v->packet, v->length, c, &raw) == URRT_OK &&
+                  raw == get_be64(v->packet + 4 + 8 * (c - 1)),
+              "%s: extra column %u", v->name, c);
+    }
+    {
+        double d;
+        CHECK_EQ_INT(urrt_read_column(v->packet, v->length, v->doubles + 1, &d), URRT_E_RANGE);
+        CHECK_EQ_INT(urrt_read_column(v->packet, v->length, 0, &d), URRT_E_RANGE);
+    }
+}
+
+/* Bytes past the packet are left alone; one byte short is truncated. st2 is
+ * the caller's, so that the round trip after decodes into the same state. */
+static void check_vector_trailing_bytes(const vector *v, const urrt_state *st, urrt_state *st2)
+{
+    static uint8_t padded[URRT_PACKET_MAX + 16];
+    memcpy(padded, v->packet, v->length);
+    memset(padded + v->length, 0x5A, 16);
+    CHECK_EQ_INT(urrt_decode(padded, v->length + 16, st2), v->length);
+    CHECK(st2->present == st->present && st2->length == st->length && st2->extra_columns == st->extra_columns &&
+              memcmp(st2->time, st->time, 8u * (URRT_WIRE_COLUMNS)) == 0,
+          "%s: decode with trailing bytes differs", v->name);
+    CHECK_EQ_INT(urrt_decode(v->packet, v->length - 1, st2), URRT_E_TRUNCATED);
+    CHECK(st2->present == 0, "%s: a failed decode left fields present", v->name);
+}
+
+/* Where present fields cover every column, the bytes come back whole
+ * (3.x up to column 152; 1.x from 1.7 on at the whole-field cuts). */
+static void check_encode_coverage(const vector *v, const urrt_state *st, const uint8_t *out)
+{
+    urrt_generation gen = (urrt_generation)v->generation;
+    unsigned char covered[URRT_MAX_DOUBLES + 1] = {0};
+    unsigned all = 1;
+    for (int id = 0; id < URRT_FIELD_COUNT; id++) {
+        unsigned column = urrt_field_column((urrt_field_id)id, gen);
+        for (unsigned i = 0; urrt_has(st, id) && i < urrt_field((urrt_field_id)id)->count; i++) {
+            covered[column + i] = 1;
+        }
+    }
+    for (unsigned c = 1; c <= v->doubles && c <= URRT_WIRE_COLUMNS; c++) {
+        all &= covered[c];
+    }
+    if (all && v->doubles <= URRT_WIRE_COLUMNS) {
+        CHECK(memcmp(out, v->packet, v->length) == 0, "%s: encode(decode(p)) != p", v->name);
+    }
+    if (strcmp(v->name, "v3_10_1116") == 0 || strcmp(v->name, "v5_10_1220") == 0 ||
+        strcmp(v->name, "v1_8_812") == 0 || strcmp(v->name, "v1_7_764") == 0) {
+        CHECK(all, "%s: not every column is covered by a present field", v->name);
+    }
+}
+
+/* The encoded packet decoded again: the same fields, bit for bit. */
+static void check_encode_round_trip(const vector *v, urrt_state *st, urrt_state *st2, const uint8_t *out)
+{
+    urrt_generation gen = (urrt_generation)v->generation;
+    int r;
+    for (unsigned c = URRT_WIRE_COLUMNS + 1; gen == URRT_GEN_3X && c <= v->doubles; c++) {
+        CHECK(get_be64(out + 4 + 8 * (c - 1)) == 0, "%s: extra column %u not encoded as 0.0", v->name, c);
+    }
+    CHECK(out[v->length] == 0xEE, "%s: encode wrote past the length", v->name);
+    r = urrt_decode(out, v->length, st2);
+    CHECK(r == (int)v->length && st2->present == st->present && st2->generation == st->generation,
+          "%s: decode(encode(st)) differs in presence", v->name);
+    for (int id = 0; id < URRT_FIELD_COUNT; id++) {
+        if (urrt_has(st, id)) {
+            CHECK(memcmp(state_slot(st, id), state_slot(st2, id), 8u * urrt_field((urrt_field_id)id)->count) == 0,
+                  "%s: %s changed in a round trip", v->name, urrt_field((urrt_field_id)id)->name);
+        }
+    }
+}
+
+/* Encoder round trip: every present field comes back bit-exact, and the
+ * bytes are the reference's wherever a present field covers them. */
+static void check_vector_encode(const vector *v, urrt_state *st, urrt_state *st2)
 {
     static uint8_t out[URRT_PACKET_MAX + 16];
-    static uint8_t padded[URRT_PACKET_MAX + 16];
-    urrt_state st, st2;
     urrt_generation gen = (urrt_generation)v->generation;
+    int r;
+    memset(out, 0xEE, sizeof out);
+    r = urrt_encode(st, v->length, out, sizeof out);
+    CHECK(r == (int)v->length, "%s: encode returned %d", v->name, r);
+    if (r != (int)v->length) {
+        return;
+    }
+    CHECK(memcmp(out, v->packet, 4) == 0, "%s: encoded header", v->name);
+    for (int id = 0; id < URRT_FIELD_COUNT; id++) {
+        unsigned column = urrt_field_column((urrt_field_id)id, gen);
+        const urrt_field_info *f = urrt_field((urrt_field_id)id);
+        if (!urrt_has(st, id)) {
+            continue;
+        }
+        CHECK(memcmp(out + 4 + 8 * (column - 1), v->packet + 4 + 8 * (column - 1), 8u * f->count) == 0,
+              "%s: encoded %s differs from the reference bytes", v->name, f->name);
+    }
+    check_encode_coverage(v, st, out);
+    check_encode_round_trip(v, st, st2, out);
+}
+
+static void check_vector(const vector *v, expected_field *e)
+{
+    urrt_state st, st2;
     int r;
 
     if (v->length > URRT_PACKET_MAX) {
@@ -97,148 +297,11 @@ static void check_vector(const vector *v, expected_field *e)
     if (r < 0) {
         return;
     }
-    CHECK(st.length == v->length, "%s: length %u", v->name, st.length);
-    CHECK(st.doubles == v->doubles, "%s: doubles %u", v->name, st.doubles);
-    CHECK((int)st.generation == v->generation, "%s: generation %d", v->name, (int)st.generation);
-    CHECK((int)urrt_generation_of(v->length) == v->generation, "%s: generation_of", v->name);
-    CHECK(st.extra_columns == v->extra, "%s: extra columns %u, expected %u", v->name, st.extra_columns, v->extra);
-    {
-        const char *vs = urrt_versions_of(v->length);
-        if (strcmp(v->versions, "-") == 0) {
-            CHECK(vs == NULL, "%s: versions \"%s\" for an unknown length", v->name, vs);
-        } else {
-            CHECK(vs != NULL && strcmp(vs, v->versions) == 0, "%s: versions \"%s\", expected \"%s\"", v->name,
-                  vs ? vs : "(null)", v->versions);
-        }
-    }
-
-    for (int id = 0; id < URRT_FIELD_COUNT; id++) {
-        const urrt_field_info *f = urrt_field((urrt_field_id)id);
-        double *val = state_slot(&st, id);
-        CHECK(e[id].seen, "%s: the reference does not know field %s", v->name, f->name);
-        if (!e[id].seen) {
-            continue;
-        }
-        if (e[id].absent) {
-            double d;
-            CHECK(!urrt_has(&st, id), "%s: %s present, reference says absent", v->name, f->name);
-            for (unsigned i = 0; i < f->count; i++) {
-                CHECK(isnan(val[i]), "%s: absent %s[%u] is not NaN", v->name, f->name, i);
-            }
-            CHECK_EQ_INT(urrt_read(v->packet, v->length, (urrt_field_id)id, 0, &d), URRT_E_ABSENT);
-            continue;
-        }
-        CHECK(urrt_has(&st, id), "%s: %s absent, reference says present", v->name, f->name);
-        CHECK(e[id].elements == f->count, "%s: %s has %d elements in the reference, %u in lib", v->name, f->name,
-              e[id].elements, f->count);
-        for (unsigned i = 0; i < f->count && (int)i < e[id].elements; i++) {
-            double d = 0;
-            uint64_t raw = 0;
-            unsigned column = urrt_field_column((urrt_field_id)id, gen) + i;
-            CHECK(bits_of(val[i]) == e[id].bits[i], "%s: decode %s[%u] = %016" PRIx64 ", expected %016" PRIx64,
-                  v->name, f->name, i, bits_of(val[i]), e[id].bits[i]);
-            r = urrt_read(v->packet, v->length, (urrt_field_id)id, i, &d);
-            CHECK(r == URRT_OK && bits_of(d) == e[id].bits[i], "%s: read %s[%u] = %d, %016" PRIx64, v->name,
-                  f->name, i, r, bits_of(d));
-            r = urrt_read_column(v->packet, v->length, column, &d);
-            CHECK(r == URRT_OK && bits_of(d) == e[id].bits[i], "%s: read_column %u (%s[%u]) = %d, %016" PRIx64,
-                  v->name, column, f->name, i, r, bits_of(d));
-            r = urrt_read_column_bits(v->packet, v->length, column, &raw);
-            CHECK(r == URRT_OK && raw == e[id].bits[i], "%s: read_column_bits %u", v->name, column);
-            if (e[id].has_enum[i]) {
-                const char *name = urrt_enum_name(urrt_field_enum((urrt_field_id)id, gen), val[i]);
-                CHECK(strcmp(name, e[id].enum_name[i]) == 0, "%s: %s[%u] = %g is %s, expected %s", v->name,
-                      f->name, i, val[i], name, e[id].enum_name[i]);
-            }
-        }
-        if (e[id].has_mask) {
-            uint64_t mask = 0;
-            r = urrt_bitmask(val[0], &mask);
-            if (e[id].mask_ok) {
-                CHECK(r == URRT_OK && mask == e[id].mask, "%s: %s mask %d %" PRIx64 ", expected %" PRIx64, v->name,
-                      f->name, r, mask, e[id].mask);
-            } else {
-                CHECK(r == URRT_E_NOT_BITMASK, "%s: %s (%016" PRIx64 ") gave %d, expected NOT_BITMASK", v->name,
-                      f->name, bits_of(val[0]), r);
-            }
-        }
-    }
-    /* Columns past the known layout are readable, one past the end is not. */
-    for (unsigned c = URRT_WIRE_COLUMNS + 1; c <= v->doubles; c++) {
-        uint64_t raw = 0;
-        CHECK(urrt_read_column_bits(v->packet, v->length, c, &raw) == URRT_OK &&
-                  raw == get_be64(v->packet + 4 + 8 * (c - 1)),
-              "%s: extra column %u", v->name, c);
-    }
-    {
-        double d;
-        CHECK_EQ_INT(urrt_read_column(v->packet, v->length, v->doubles + 1, &d), URRT_E_RANGE);
-        CHECK_EQ_INT(urrt_read_column(v->packet, v->length, 0, &d), URRT_E_RANGE);
-    }
-
-    /* Bytes past the packet are left alone; one byte short is truncated. */
-    memcpy(padded, v->packet, v->length);
-    memset(padded + v->length, 0x5A, 16);
-    CHECK_EQ_INT(urrt_decode(padded, v->length + 16, &st2), v->length);
-    CHECK(st2.present == st.present && st2.length == st.length && st2.extra_columns == st.extra_columns &&
-              memcmp(st2.time, st.time, 8u * (URRT_WIRE_COLUMNS)) == 0,
-          "%s: decode with trailing bytes differs", v->name);
-    CHECK_EQ_INT(urrt_decode(v->packet, v->length - 1, &st2), URRT_E_TRUNCATED);
-    CHECK(st2.present == 0, "%s: a failed decode left fields present", v->name);
-
-    /* Encoder round trip: every present field comes back bit-exact, and the
-     * bytes are the reference's wherever a present field covers them. */
-    memset(out, 0xEE, sizeof out);
-    r = urrt_encode(&st, v->length, out, sizeof out);
-    CHECK(r == (int)v->length, "%s: encode returned %d", v->name, r);
-    if (r != (int)v->length) {
-        return;
-    }
-    CHECK(memcmp(out, v->packet, 4) == 0, "%s: encoded header", v->name);
-    for (int id = 0; id < URRT_FIELD_COUNT; id++) {
-        unsigned column = urrt_field_column((urrt_field_id)id, gen);
-        const urrt_field_info *f = urrt_field((urrt_field_id)id);
-        if (!urrt_has(&st, id)) {
-            continue;
-        }
-        CHECK(memcmp(out + 4 + 8 * (column - 1), v->packet + 4 + 8 * (column - 1), 8u * f->count) == 0,
-              "%s: encoded %s differs from the reference bytes", v->name, f->name);
-    }
-    {
-        /* Where present fields cover every column, the bytes come back whole
-         * (3.x up to column 152; 1.x from 1.7 on at the whole-field cuts). */
-        unsigned char covered[URRT_MAX_DOUBLES + 1] = {0};
-        unsigned all = 1;
-        for (int id = 0; id < URRT_FIELD_COUNT; id++) {
-            unsigned column = urrt_field_column((urrt_field_id)id, gen);
-            for (unsigned i = 0; urrt_has(&st, id) && i < urrt_field((urrt_field_id)id)->count; i++) {
-                covered[column + i] = 1;
-            }
-        }
-        for (unsigned c = 1; c <= v->doubles && c <= URRT_WIRE_COLUMNS; c++) {
-            all &= covered[c];
-        }
-        if (all && v->doubles <= URRT_WIRE_COLUMNS) {
-            CHECK(memcmp(out, v->packet, v->length) == 0, "%s: encode(decode(p)) != p", v->name);
-        }
-        if (strcmp(v->name, "v3_10_1116") == 0 || strcmp(v->name, "v5_10_1220") == 0 ||
-            strcmp(v->name, "v1_8_812") == 0 || strcmp(v->name, "v1_7_764") == 0) {
-            CHECK(all, "%s: not every column is covered by a present field", v->name);
-        }
-    }
-    for (unsigned c = URRT_WIRE_COLUMNS + 1; gen == URRT_GEN_3X && c <= v->doubles; c++) {
-        CHECK(get_be64(out + 4 + 8 * (c - 1)) == 0, "%s: extra column %u not encoded as 0.0", v->name, c);
-    }
-    CHECK(out[v->length] == 0xEE, "%s: encode wrote past the length", v->name);
-    r = urrt_decode(out, v->length, &st2);
-    CHECK(r == (int)v->length && st2.present == st.present && st2.generation == st.generation,
-          "%s: decode(encode(st)) differs in presence", v->name);
-    for (int id = 0; id < URRT_FIELD_COUNT; id++) {
-        if (urrt_has(&st, id)) {
-            CHECK(memcmp(state_slot(&st, id), state_slot(&st2, id), 8u * urrt_field((urrt_field_id)id)->count) == 0,
-                  "%s: %s changed in a round trip", v->name, urrt_field((urrt_field_id)id)->name);
-        }
-    }
+    check_vector_header(v, &st);
+    check_vector_fields(v, e, &st);
+    check_vector_extra_columns(v);
+    check_vector_trailing_bytes(v, &st, &st2);
+    check_vector_encode(v, &st, &st2);
 }
 
 static int hexval(int c)
@@ -246,6 +309,78 @@ static int hexval(int c)
     if (c >= '0' && c <= '9') return c - '0';
     if (c >= 'a' && c <= 'f') return c - 'a' + 10;
     return -1;
+}
+
+/* A "vector NAME LENGTH GENERATION DOUBLES EXTRA VERSIONS" line: the next vector. */
+static vector *start_vector(const char *line)
+{
+    vector *v;
+    int consumed = 0;
+    if (vector_count == MAX_VECTORS) {
+        fprintf(stderr, "test_lib: too many vectors\n");
+        exit(2);
+    }
+    v = &vectors[vector_count++];
+    if (sscanf(line, "vector %63s %" SCNu32 " %d %u %u %n", v->name, &v->length, &v->generation, &v->doubles,
+               &v->extra, &consumed) != 5 || consumed == 0) {
+        fprintf(stderr, "test_lib: bad line: %.80s\n", line);
+        exit(2);
+    }
+    snprintf(v->versions, sizeof v->versions, "%s", line + consumed);
+    return v;
+}
+
+/* A "hex" line: the vector's packet. */
+static void read_packet(vector *v, const char *line)
+{
+    size_t n = strlen(line + 4) / 2;
+    CHECK(n == v->length, "%s: hex holds %zu bytes", v->name, n);
+    v->packet = malloc(n + 1);
+    for (size_t i = 0; i < n; i++) {
+        v->packet[i] = (uint8_t)(hexval(line[4 + 2 * i]) << 4 | hexval(line[5 + 2 * i]));
+    }
+}
+
+/* A "field", "absent", "enum" or "bits" line into expected; 0 for any other line. */
+static int read_expectation(const vector *v, const char *line, expected_field *expected)
+{
+    char name[64], word[64];
+    unsigned elem;
+    int id;
+    if (sscanf(line, "field %63s %u %63s", name, &elem, word) == 3) {
+        id = urrt_field_find(name, strlen(name));
+        CHECK(id >= 0, "%s: lib has no field %s", v->name, name);
+        if (id >= 0 && elem < URRT_FIELD_COUNT_MAX) {
+            expected[id].seen = 1;
+            expected[id].bits[elem] = strtoull(word, NULL, 16);
+            if ((int)elem + 1 > expected[id].elements) {
+                expected[id].elements = (int)elem + 1;
+            }
+        }
+    } else if (sscanf(line, "absent %63s", name) == 1) {
+        id = urrt_field_find(name, strlen(name));
+        CHECK(id >= 0, "%s: lib has no field %s", v->name, name);
+        if (id >= 0) {
+            expected[id].seen = 1;
+            expected[id].absent = 1;
+        }
+    } else if (sscanf(line, "enum %63s %u %63s", name, &elem, word) == 3) {
+        id = urrt_field_find(name, strlen(name));
+        if (id >= 0 && elem < URRT_FIELD_COUNT_MAX) {
+            expected[id].has_enum[elem] = 1;
+            snprintf(expected[id].enum_name[elem], sizeof expected[id].enum_name[elem], "%s", word);
+        }
+    } else if (sscanf(line, "bits %63s %63s", name, word) == 2) {
+        id = urrt_field_find(name, strlen(name));
+        if (id >= 0) {
+            expected[id].has_mask = 1;
+            expected[id].mask_ok = strcmp(word, "NOT_BITMASK") != 0;
+            expected[id].mask = expected[id].mask_ok ? strtoull(word, NULL, 16) : 0;
+        }
+    } else {
+        return 0;
+    }
+    return 1;
 }
 
 static void load_vectors(const char *path)
@@ -261,26 +396,12 @@ static void load_vectors(const char *path)
         exit(2);
     }
     while (fgets(line, sizeof line, f) != NULL) {
-        char name[64], word[64];
-        unsigned elem;
-        int id;
         line[strcspn(line, "\n")] = '\0';
         if (line[0] == '#' || line[0] == '\0') {
             continue;
         }
         if (strncmp(line, "vector ", 7) == 0) {
-            int consumed = 0;
-            if (vector_count == MAX_VECTORS) {
-                fprintf(stderr, "test_lib: too many vectors\n");
-                exit(2);
-            }
-            v = &vectors[vector_count++];
-            if (sscanf(line, "vector %63s %" SCNu32 " %d %u %u %n", v->name, &v->length, &v->generation, &v->doubles,
-                       &v->extra, &consumed) != 5 || consumed == 0) {
-                fprintf(stderr, "test_lib: bad line: %.80s\n", line);
-                exit(2);
-            }
-            snprintf(v->versions, sizeof v->versions, "%s", line + consumed);
+            v = start_vector(line);
             memset(expected, 0, sizeof expected);
             continue;
         }
@@ -289,48 +410,13 @@ static void load_vectors(const char *path)
             exit(2);
         }
         if (strncmp(line, "hex ", 4) == 0) {
-            size_t n = strlen(line + 4) / 2;
-            CHECK(n == v->length, "%s: hex holds %zu bytes", v->name, n);
-            v->packet = malloc(n + 1);
-            for (size_t i = 0; i < n; i++) {
-                v->packet[i] = (uint8_t)(hexval(line[4 + 2 * i]) << 4 | hexval(line[5 + 2 * i]));
-            }
-        } else if (sscanf(line, "field %63s %u %63s", name, &elem, word) == 3) {
-            id = urrt_field_find(name, strlen(name));
-            CHECK(id >= 0, "%s: lib has no field %s", v->name, name);
-            if (id >= 0 && elem < URRT_FIELD_COUNT_MAX) {
-                expected[id].seen = 1;
-                expected[id].bits[elem] = strtoull(word, NULL, 16);
-                if ((int)elem + 1 > expected[id].elements) {
-                    expected[id].elements = (int)elem + 1;
-                }
-            }
-        } else if (sscanf(line, "absent %63s", name) == 1) {
-            id = urrt_field_find(name, strlen(name));
-            CHECK(id >= 0, "%s: lib has no field %s", v->name, name);
-            if (id >= 0) {
-                expected[id].seen = 1;
-                expected[id].absent = 1;
-            }
-        } else if (sscanf(line, "enum %63s %u %63s", name, &elem, word) == 3) {
-            id = urrt_field_find(name, strlen(name));
-            if (id >= 0 && elem < URRT_FIELD_COUNT_MAX) {
-                expected[id].has_enum[elem] = 1;
-                snprintf(expected[id].enum_name[elem], sizeof expected[id].enum_name[elem], "%s", word);
-            }
-        } else if (sscanf(line, "bits %63s %63s", name, word) == 2) {
-            id = urrt_field_find(name, strlen(name));
-            if (id >= 0) {
-                expected[id].has_mask = 1;
-                expected[id].mask_ok = strcmp(word, "NOT_BITMASK") != 0;
-                expected[id].mask = expected[id].mask_ok ? strtoull(word, NULL, 16) : 0;
-            }
+            read_packet(v, line);
         } else if (strcmp(line, "end") == 0) {
             if (v->packet != NULL) {
                 check_vector(v, expected);
                 checked++;
             }
-        } else {
+        } else if (!read_expectation(v, line, expected)) {
             fprintf(stderr, "test_lib: bad line: %.80s\n", line);
             exit(2);
         }
@@ -557,105 +643,128 @@ static void test_real_capture(void)
     CHECK(st.time[0] == 951.600, "next time %.17g", st.time[0]);
 }
 
-static void test_framer_garbage(void)
-{
-    static uint8_t stream[16384];
-    static run_result rr;
-    const vector *p1 = find_vector("v3_10_1116"), *p2 = find_vector("len_1116"), *p3 = find_vector("v5_10_1220");
-    const uint8_t text[] = "GET / HTTP/1.0\r\n\r\n"; /* not a plausible header at any offset */
-    uint8_t ff[37];
-    size_t n;
-    memset(ff, 0xFF, sizeof ff);
+/* The garbage test_framer_garbage puts around packets: text that is not a
+ * plausible header at any offset, and 0xFF bytes (filled there). */
+static const uint8_t garbage_text[] = "GET / HTTP/1.0\r\n\r\n";
+static uint8_t garbage_ff[37];
 
-    /* Before the first packet. */
-    n = concat(stream, 0, ff, sizeof ff);
+/* The stream of a, the garbage text, b, ff bytes of 0xFF and c; its length. */
+static size_t garbage_between_packets(uint8_t *stream, const vector *a, const vector *b, size_t ff, const vector *c)
+{
+    size_t n = concat(stream, 0, a->packet, a->length);
+    n = concat(stream, n, garbage_text, sizeof garbage_text - 1);
+    n = concat(stream, n, b->packet, b->length);
+    n = concat(stream, n, garbage_ff, ff);
+    return concat(stream, n, c->packet, c->length);
+}
+
+/* Before the first packet. */
+static void garbage_before(uint8_t *stream, run_result *rr)
+{
+    const vector *p1 = find_vector("v3_10_1116"), *p2 = find_vector("len_1116");
+    size_t n = concat(stream, 0, garbage_ff, sizeof garbage_ff);
     n = concat(stream, n, p1->packet, p1->length);
     n = concat(stream, n, p2->packet, p2->length);
-    run_framer(stream, n, NULL, 0, &rr);
+    run_framer(stream, n, NULL, 0, rr);
     {
         const uint8_t *pk[2] = {p1->packet, p2->packet};
         size_t ln[2] = {p1->length, p2->length};
-        expect_packets("garbage before", &rr, pk, ln, 2);
-        CHECK(rr.stats.skipped == sizeof ff && rr.stats.resyncs == 1, "garbage before: skipped %" PRIu64 ", %" PRIu64
-              " resyncs", rr.stats.skipped, rr.stats.resyncs);
+        expect_packets("garbage before", rr, pk, ln, 2);
+        CHECK(rr->stats.skipped == sizeof garbage_ff && rr->stats.resyncs == 1, "garbage before: skipped %" PRIu64
+              ", %" PRIu64 " resyncs", rr->stats.skipped, rr->stats.resyncs);
     }
     check_every_split("garbage before", stream, n, 0);
+}
 
-    /* Between packets, and between packets of different known lengths. */
-    n = concat(stream, 0, p1->packet, p1->length);
-    n = concat(stream, n, text, sizeof text - 1);
-    n = concat(stream, n, p2->packet, p2->length);
-    n = concat(stream, n, ff, 5);
-    n = concat(stream, n, p3->packet, p3->length);
-    run_framer(stream, n, NULL, 0, &rr);
+/* Between packets, and between packets of different known lengths. */
+static void garbage_between(uint8_t *stream, run_result *rr)
+{
+    const vector *p1 = find_vector("v3_10_1116"), *p2 = find_vector("len_1116"), *p3 = find_vector("v5_10_1220");
+    size_t n = garbage_between_packets(stream, p1, p2, 5, p3);
+    run_framer(stream, n, NULL, 0, rr);
     {
         const uint8_t *pk[3] = {p1->packet, p2->packet, p3->packet};
         size_t ln[3] = {p1->length, p2->length, p3->length};
-        expect_packets("garbage between", &rr, pk, ln, 3);
-        CHECK(rr.stats.skipped == sizeof text - 1 + 5 && rr.stats.resyncs == 2, "garbage between: skipped %" PRIu64,
-              rr.stats.skipped);
+        expect_packets("garbage between", rr, pk, ln, 3);
+        CHECK(rr->stats.skipped == sizeof garbage_text - 1 + 5 && rr->stats.resyncs == 2,
+              "garbage between: skipped %" PRIu64, rr->stats.skipped);
     }
     check_every_split("garbage between", stream, n, 0);
+}
 
-    /* Regression: a fresh framer scanning leading garbage took any plausible
-     * size it met (here 00 00 02 14, 532 bytes) as a packet, so noise came
-     * out as values. Only known lengths lock once it has had to scan. */
-    {
-        const vector *v = find_vector("len_1116");
-        static const uint8_t noise[] = {0xAB, 0x00, 0x00, 0x02, 0x14, 0x99, 0x42};
-        const uint8_t *pk[1] = {v->packet};
-        size_t ln[1] = {v->length};
-        n = concat(stream, 0, noise, sizeof noise);
-        for (size_t pad = sizeof noise; pad < 600; pad++) {
-            stream[n++] = 0x55; /* enough bytes for a 532-byte "packet" */
-        }
-        n = concat(stream, n, v->packet, v->length);
-        run_framer(stream, n, NULL, 0, &rr);
-        expect_packets("regression_fresh_scan_unknown_size", &rr, pk, ln, 1);
-        CHECK(rr.stats.skipped == 600 && rr.stats.resyncs == 1,
-              "regression_fresh_scan_unknown_size: skipped %" PRIu64, rr.stats.skipped);
+/* Regression: a fresh framer scanning leading garbage took any plausible
+ * size it met (here 00 00 02 14, 532 bytes) as a packet, so noise came
+ * out as values. Only known lengths lock once it has had to scan. */
+static void regression_fresh_scan_unknown_size(uint8_t *stream, run_result *rr)
+{
+    const vector *v = find_vector("len_1116");
+    static const uint8_t noise[] = {0xAB, 0x00, 0x00, 0x02, 0x14, 0x99, 0x42};
+    const uint8_t *pk[1] = {v->packet};
+    size_t ln[1] = {v->length};
+    size_t n = concat(stream, 0, noise, sizeof noise);
+    for (size_t pad = sizeof noise; pad < 600; pad++) {
+        stream[n++] = 0x55; /* enough bytes for a 532-byte "packet" */
     }
-    /* A length no controller is known to send (a newer one, 1236 bytes):
-     * after garbage the framer finds it again because it equals the last
-     * accepted length. Likewise a 1.8 stream. */
-    {
-        const char *names[2] = {"capture_1_8", "future_1236"};
-        for (int k = 0; k < (URRT_MAX_DOUBLES >= 154 ? 2 : 1); k++) {
-            const vector *f = find_vector(names[k]);
-            const uint8_t *pk[3] = {f->packet, f->packet, f->packet};
-            size_t ln[3] = {f->length, f->length, f->length};
-            n = concat(stream, 0, f->packet, f->length);
-            n = concat(stream, n, text, sizeof text - 1);
-            n = concat(stream, n, f->packet, f->length);
-            n = concat(stream, n, ff, 3);
-            n = concat(stream, n, f->packet, f->length);
-            run_framer(stream, n, NULL, 0, &rr);
-            expect_packets(names[k], &rr, pk, ln, 3);
-            CHECK(rr.stats.skipped == sizeof text - 1 + 3 && rr.stats.resyncs == 2, "%s: skipped %" PRIu64, names[k],
-                  rr.stats.skipped);
-        }
-    }
+    n = concat(stream, n, v->packet, v->length);
+    run_framer(stream, n, NULL, 0, rr);
+    expect_packets("regression_fresh_scan_unknown_size", rr, pk, ln, 1);
+    CHECK(rr->stats.skipped == 600 && rr->stats.resyncs == 1,
+          "regression_fresh_scan_unknown_size: skipped %" PRIu64, rr->stats.skipped);
+}
 
-    /* Inside a packet: the first 500 bytes of one, then whole packets. With
-     * no checksum on the wire the cut packet swallows the start of the next
-     * (a packet of the declared size is yielded), then the framer must find
-     * its way back to the packet after. */
-    n = concat(stream, 0, p1->packet, p1->length);
+/* A length no controller is known to send (a newer one, 1236 bytes):
+ * after garbage the framer finds it again because it equals the last
+ * accepted length. Likewise a 1.8 stream. */
+static void garbage_around_unlisted_lengths(uint8_t *stream, run_result *rr)
+{
+    const char *names[2] = {"capture_1_8", "future_1236"};
+    for (int k = 0; k < (URRT_MAX_DOUBLES >= 154 ? 2 : 1); k++) {
+        const vector *f = find_vector(names[k]);
+        const uint8_t *pk[3] = {f->packet, f->packet, f->packet};
+        size_t ln[3] = {f->length, f->length, f->length};
+        size_t n = garbage_between_packets(stream, f, f, 3, f);
+        run_framer(stream, n, NULL, 0, rr);
+        expect_packets(names[k], rr, pk, ln, 3);
+        CHECK(rr->stats.skipped == sizeof garbage_text - 1 + 3 && rr->stats.resyncs == 2, "%s: skipped %" PRIu64,
+              names[k], rr->stats.skipped);
+    }
+}
+
+/* Inside a packet: the first 500 bytes of one, then whole packets. With
+ * no checksum on the wire the cut packet swallows the start of the next
+ * (a packet of the declared size is yielded), then the framer must find
+ * its way back to the packet after. */
+static void garbage_inside(uint8_t *stream, run_result *rr)
+{
+    const vector *p1 = find_vector("v3_10_1116"), *p2 = find_vector("len_1116");
+    size_t n = concat(stream, 0, p1->packet, p1->length);
     n = concat(stream, n, p2->packet, 500);
     n = concat(stream, n, p1->packet, p1->length);
     n = concat(stream, n, p2->packet, p2->length);
     n = concat(stream, n, p1->packet, p1->length);
-    run_framer(stream, n, NULL, 0, &rr);
-    CHECK_EQ_INT(rr.out.packets, 4);
-    if (rr.out.packets == 4) {
-        CHECK(memcmp(rr.out.data, p1->packet, 1116) == 0, "inside: first packet");
-        CHECK(memcmp(rr.out.data + 1116, p2->packet, 500) == 0 && memcmp(rr.out.data + 1616, p1->packet, 616) == 0,
+    run_framer(stream, n, NULL, 0, rr);
+    CHECK_EQ_INT(rr->out.packets, 4);
+    if (rr->out.packets == 4) {
+        CHECK(memcmp(rr->out.data, p1->packet, 1116) == 0, "inside: first packet");
+        CHECK(memcmp(rr->out.data + 1116, p2->packet, 500) == 0 && memcmp(rr->out.data + 1616, p1->packet, 616) == 0,
               "inside: the cut packet");
-        CHECK(memcmp(rr.out.data + 2232, p2->packet, 1116) == 0, "inside: recovered packet");
-        CHECK(memcmp(rr.out.data + 3348, p1->packet, 1116) == 0, "inside: last packet");
+        CHECK(memcmp(rr->out.data + 2232, p2->packet, 1116) == 0, "inside: recovered packet");
+        CHECK(memcmp(rr->out.data + 3348, p1->packet, 1116) == 0, "inside: last packet");
     }
-    CHECK(rr.stats.skipped == 500 && rr.stats.resyncs == 1, "inside: skipped %" PRIu64, rr.stats.skipped);
+    CHECK(rr->stats.skipped == 500 && rr->stats.resyncs == 1, "inside: skipped %" PRIu64, rr->stats.skipped);
     check_every_split("garbage inside", stream, n, 0);
+}
+
+static void test_framer_garbage(void)
+{
+    static uint8_t stream[16384];
+    static run_result rr;
+    memset(garbage_ff, 0xFF, sizeof garbage_ff);
+    garbage_before(stream, &rr);
+    garbage_between(stream, &rr);
+    regression_fresh_scan_unknown_size(stream, &rr);
+    garbage_around_unlisted_lengths(stream, &rr);
+    garbage_inside(stream, &rr);
 }
 
 /* A stream that goes on mid-packet, at every double boundary: the framer

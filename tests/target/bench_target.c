@@ -127,13 +127,10 @@ static int pack_tpdo1(const double *values, uint8_t *frame)
     return worst;
 }
 
-int main(void)
+/* SysTick started, the cost of reading it and the ticks per 1000 instructions. */
+static void calibrate(void)
 {
-    uint32_t ticks, i;
-    int sink = 0;
-    uint8_t *pkt = (uint8_t *)packet_words;
-    const tv_vector *v1116 = vector(1116), *v1220 = vector(1220);
-
+    uint32_t ticks;
     target_systick_start();
     TIMED(overhead_ticks, (void)0);
     TIMED(ticks, known_loop(10000));
@@ -142,70 +139,100 @@ int main(void)
     target_puts("bench: systick_ticks_per_1000_instructions ");
     target_put_uint(ticks_per_kinsn);
     target_puts("\n");
+}
 
-    for (i = 0; i < v1116->length; i++) {
-        pkt[i] = v1116->packet[i];
+/* v's packet, copied into packet_words: decoded, and the floor of a byte-swapping copy. */
+static int bench_decode(const tv_vector *v, const char *decode_name, const char *copy_name)
+{
+    uint32_t ticks, i;
+    int sink = 0;
+    uint8_t *pkt = (uint8_t *)packet_words;
+    for (i = 0; i < v->length; i++) {
+        pkt[i] = v->packet[i];
     }
-    TIMED(ticks, sink += urrt_decode(pkt, v1116->length, &st));
-    report("decode_1116", ticks);
-    TIMED(ticks, swap_copy(copy_words, pkt + 4, (v1116->length - 4u) / 8u));
-    report("swap_copy_1116", ticks);
-    {
-        double values[10];
-        TIMED(ticks, for (i = 0; i < 10; i++) sink += urrt_read(pkt, v1116->length, read_fields[i], i % 3u,
-                                                               &values[i]));
-        report("read10_1116", ticks);
-    }
-    for (i = 0; i < v1220->length; i++) {
-        pkt[i] = v1220->packet[i];
-    }
-    TIMED(ticks, sink += urrt_decode(pkt, v1220->length, &st));
-    report("decode_1220", ticks);
-    TIMED(ticks, swap_copy(copy_words, pkt + 4, (v1220->length - 4u) / 8u));
-    report("swap_copy_1220", ticks);
+    TIMED(ticks, sink += urrt_decode(pkt, v->length, &st));
+    report(decode_name, ticks);
+    TIMED(ticks, swap_copy(copy_words, pkt + 4, (v->length - 4u) / 8u));
+    report(copy_name, ticks);
+    return sink;
+}
 
-    /* The framer in steady state: a stream of 1116-byte packets arriving as
-     * 1460-byte TCP segments; the figure is the mean over the whole segments. */
+/* Ten fields read at random from the packet in packet_words. */
+static int bench_read10(const tv_vector *v1116)
+{
+    uint32_t ticks, i;
+    int sink = 0;
+    uint8_t *pkt = (uint8_t *)packet_words;
+    double values[10];
+    TIMED(ticks, for (i = 0; i < 10; i++) sink += urrt_read(pkt, v1116->length, read_fields[i], i % 3u,
+                                                           &values[i]));
+    report("read10_1116", ticks);
+    return sink;
+}
+
+/* The framer in steady state: a stream of 1116-byte packets arriving as
+ * 1460-byte TCP segments; the figure is the mean over the whole segments. */
+static int bench_framer(const tv_vector *v1116)
+{
+    uint32_t ticks, i;
+    int sink = 0;
+    uint32_t total = 0, segments = 0, pos;
     for (i = 0; i < sizeof stream; i++) {
         stream[i] = v1116->packet[i % 1116u];
     }
     urrt_framer_init(&framer);
-    {
-        uint32_t total = 0, segments = 0, pos;
-        for (pos = 0; pos + 1460u <= sizeof stream; pos += 1460u) {
-            TIMED(ticks, {
-                const uint8_t *p = stream + pos;
-                size_t n = 1460, used;
-                while (n > 0) {
-                    sink += urrt_framer_feed(&framer, p, n, &used);
-                    p += used;
-                    n -= used;
-                }
-            });
-            total += ticks - overhead_ticks;
-            segments++;
-        }
-        report("framer_feed_1460", total / segments + overhead_ticks);
+    for (pos = 0; pos + 1460u <= sizeof stream; pos += 1460u) {
+        TIMED(ticks, {
+            const uint8_t *p = stream + pos;
+            size_t n = 1460, used;
+            while (n > 0) {
+                sink += urrt_framer_feed(&framer, p, n, &used);
+                p += used;
+                n -= used;
+            }
+        });
+        total += ticks - overhead_ticks;
+        segments++;
     }
+    report("framer_feed_1460", total / segments + overhead_ticks);
+    return sink;
+}
 
+/* TPDO1 packed from the decoded packet, signal by signal and as a frame. */
+static int bench_can_pack(const tv_vector *v1116)
+{
+    uint32_t ticks;
+    int sink = 0;
+    double values[5];
     tpdo1_signal(0, 0, 16, URRT_CAN_SIGNED, 0.0002);
     tpdo1_signal(1, 16, 16, URRT_CAN_SIGNED, 0.0002);
     tpdo1_signal(2, 32, 16, URRT_CAN_SIGNED, 0.0002);
     tpdo1_signal(3, 56, 4, URRT_CAN_UNSIGNED, 1.0);
     tpdo1_signal(4, 63, 1, URRT_CAN_UNSIGNED, 1.0);
-    {
-        double values[5];
-        urrt_decode(v1116->packet, v1116->length, &st);
-        values[0] = st.q_actual[0];
-        values[1] = st.q_actual[1];
-        values[2] = st.q_actual[2];
-        values[3] = 5;
-        values[4] = 1;
-        TIMED(ticks, sink += pack_tpdo1(values, payload));
-        report("can_pack_tpdo1", ticks);
-        TIMED(ticks, sink += urrt_can_pack_frame(tpdo1, values, 5, payload, 8, NULL));
-        report("can_pack_frame_tpdo1", ticks);
-    }
+    urrt_decode(v1116->packet, v1116->length, &st);
+    values[0] = st.q_actual[0];
+    values[1] = st.q_actual[1];
+    values[2] = st.q_actual[2];
+    values[3] = 5;
+    values[4] = 1;
+    TIMED(ticks, sink += pack_tpdo1(values, payload));
+    report("can_pack_tpdo1", ticks);
+    TIMED(ticks, sink += urrt_can_pack_frame(tpdo1, values, 5, payload, 8, NULL));
+    report("can_pack_frame_tpdo1", ticks);
+    return sink;
+}
+
+int main(void)
+{
+    int sink = 0;
+    const tv_vector *v1116 = vector(1116), *v1220 = vector(1220);
+
+    calibrate();
+    sink += bench_decode(v1116, "decode_1116", "swap_copy_1116");
+    sink += bench_read10(v1116);
+    sink += bench_decode(v1220, "decode_1220", "swap_copy_1220");
+    sink += bench_framer(v1116);
+    sink += bench_can_pack(v1116);
     target_puts("bench: sink ");
     target_put_uint((uint32_t)sink);
     target_puts("\n");

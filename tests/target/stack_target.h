@@ -215,30 +215,9 @@ static void stack_co(void)
           urrt_co_error_register(&co));
 }
 
-static void test_stack(void)
+/* Eight CAN signals of every byte order and type, over one 64-byte FD frame. */
+static void stack_can_signals(urrt_can_signal *sigs)
 {
-    static const char name[] = "stack";
-    static urrt_can_signal sigs[8];
-    static const double values[8] = {1.5, -2.25, 1e30, -1e30, 0.0, 3.75, 100.0, -7.0};
-    static uint8_t outcomes[8];
-    static urrt_can_scale scale;
-    uint8_t frame[64];
-    double d, lo, hi;
-    uint64_t raw;
-    unsigned u1, u2, u3, i;
-    size_t used, len, z1, z2;
-    const tv_vector *v1 = &tv_vectors[0], *v3 = &tv_vectors[0];
-    const urrt_controller *found[2];
-    uint32_t u32;
-    int64_t i64;
-
-    for (i = 0; i < tv_vector_count; i++) {
-        if (tv_vectors[i].generation == URRT_GEN_1X) {
-            v1 = &tv_vectors[i];
-        } else if (tv_vectors[i].generation == URRT_GEN_3X && tv_vectors[i].extra > 0) {
-            v3 = &tv_vectors[i];
-        }
-    }
     can_sig(&sigs[0], 0, 16, URRT_CAN_INTEL, URRT_CAN_SIGNED, 0.0002);
     can_sig(&sigs[1], 23, 16, URRT_CAN_MOTOROLA, URRT_CAN_UNSIGNED, 0.01);
     can_sig(&sigs[2], 32, 32, URRT_CAN_INTEL, URRT_CAN_FLOAT32, 1.0);
@@ -247,7 +226,18 @@ static void test_stack(void)
     can_sig(&sigs[5], 192, 63, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 3.0);
     can_sig(&sigs[6], 256, 1, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1.0);
     can_sig(&sigs[7], 300, 12, URRT_CAN_MOTOROLA, URRT_CAN_SIGNED, -0.5);
+}
 
+/* The field tables, controllers, decode, random access, encoder and enums, on
+ * a 1.x packet (v1) and a 3.x one with extra columns (v3). */
+static void stack_decode(const tv_vector *v1, const tv_vector *v3)
+{
+    double d;
+    uint64_t raw;
+    size_t len;
+    const urrt_controller *found[2];
+    uint32_t u32;
+    int64_t i64;
     STACK(urrt_strerror, (URRT_E_RANGE));
     STACK(urrt_field, (URRT_F_Q_ACTUAL));
     STACK(urrt_field_find, ("payload_inertia", 15));
@@ -279,6 +269,12 @@ static void test_stack(void)
     STACK(urrt_enum_name, (URRT_ENUM_JOINT_MODE, 255.0));
     STACK(urrt_enum_name, (URRT_ENUM_ROBOT_MODE, -1.0));
     STACK(urrt_field_enum, (URRT_F_ROBOT_MODE, URRT_GEN_1X));
+}
+
+/* The framer: a packet in pieces, whole, a new length, and garbage. */
+static void stack_framer(const tv_vector *v1, const tv_vector *v3)
+{
+    size_t used, len;
     STACK(urrt_framer_init, (&framer));
     STACK(urrt_framer_reset, (&framer));
     STACK(urrt_framer_feed, (&framer, v3->packet, 3, &used));
@@ -289,7 +285,19 @@ static void test_stack(void)
     STACK(urrt_framer_feed, (&framer, v1->packet, v1->length, &used)); /* a new length: looked up */
     STACK(urrt_framer_feed, (&framer, (const uint8_t *)"\1\2\3\4\5\6\7", 7, &used));
     STACK(urrt_framer_finish, (&framer));
+}
 
+/* lib/urrt_can: every call on each of the signals, and on all of them as a frame. */
+static void stack_can(const char *name, const urrt_can_signal *sigs)
+{
+    static const double values[8] = {1.5, -2.25, 1e30, -1e30, 0.0, 3.75, 100.0, -7.0};
+    static uint8_t outcomes[8];
+    static urrt_can_scale scale;
+    uint8_t frame[64];
+    double d, lo, hi;
+    uint64_t raw;
+    unsigned u1, u2, u3, i;
+    size_t z1, z2;
     STACK(urrt_can_strerror, (URRT_CAN_E_OVERLAP));
     STACK(urrt_can_length_valid, (48, true));
     STACK(urrt_can_len_to_dlc, (48));
@@ -320,6 +328,26 @@ static void test_stack(void)
     STACK(urrt_can_layout_check, (sigs, 8, 64, &z1, &z2));
     STACK(urrt_can_pack_frame, (sigs, values, 8, frame, 64, outcomes));
     CHECK(urrt_can_layout_check(sigs, 8, 64, &z1, &z2) == 0, "CAN layout of the stack test", name, z1, z2);
+}
+
+static void test_stack(void)
+{
+    static const char name[] = "stack";
+    static urrt_can_signal sigs[8];
+    unsigned i;
+    const tv_vector *v1 = &tv_vectors[0], *v3 = &tv_vectors[0];
+
+    for (i = 0; i < tv_vector_count; i++) {
+        if (tv_vectors[i].generation == URRT_GEN_1X) {
+            v1 = &tv_vectors[i];
+        } else if (tv_vectors[i].generation == URRT_GEN_3X && tv_vectors[i].extra > 0) {
+            v3 = &tv_vectors[i];
+        }
+    }
+    stack_can_signals(sigs);
+    stack_decode(v1, v3);
+    stack_framer(v1, v3);
+    stack_can(name, sigs);
     urrt_decode(v3->packet, v3->length, &st);
     stack_cantx(sigs);
     stack_co();

@@ -517,25 +517,20 @@ static const char *const sched_config =
 
 static struct capture cap;
 
-static void test_schedule(void)
+/* What test_schedule's first 300 ms sent: frames per id, and whether every
+ * fast and every-packet frame was as expected. */
+struct sched_tally {
+    size_t fast, slow, each, hb;
+    bool ok_valid, ok_alive, ok_fast_t, ok_q, ok_each;
+};
+
+/* Packets every 8 ms from 1 ms to 97 ms; due() every millisecond to 300 ms.
+ * Returns the number of packets. */
+static int schedule_first_300ms(void)
 {
-    struct can_map map;
-    char err[4096] = "";
     uint64_t t;
     uint64_t last_packet = 0;
-    size_t i;
-    size_t fast = 0, slow = 0, each = 0, hb = 0;
     int packets = 0;
-    bool ok_valid = true, ok_alive = true, ok_fast_t = true, ok_q = true, ok_each = true;
-    int rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
-    CHECK(rc == 0, "schedule config: %s", err);
-    if (rc != 0) {
-        return;
-    }
-    memset(&cap, 0, sizeof cap);
-    CHECK(urrt_cantx_deadline(can_run_tx(loaded_run)) == URRT_CANTX_NEVER, "no deadline before start");
-    can_run_start(loaded_run, 0);
-    /* Packets every 8 ms from 1 ms to 97 ms; due() every millisecond to 300 ms. */
     for (t = 0; t < 300000; t += 1000) {
         cap.now = t;
         if (t % 8000 == 1000 && t < 100000) {
@@ -550,72 +545,93 @@ static void test_schedule(void)
         }
     }
     (void)last_packet;
+    return packets;
+}
+
+static void tally_fast_frame(struct sched_tally *k, const struct sent *s)
+{
+    bool has = s->t >= 1000;
+    uint64_t age = has ? s->t - (s->t >= 97000 ? 97000 : ((s->t - 1000) / 8000) * 8000 + 1000) : 0;
+    bool want_valid = has && age <= 50000;
+    k->ok_fast_t &= s->t == k->fast * 10000;
+    k->ok_alive &= bits_of(&s->f, 60, 4) == k->fast % 16;
+    k->ok_valid &= bits_of(&s->f, 59, 1) == (want_valid ? 1u : 0u);
+    /* Before data: NaN packs physical 0; after: 1.234 -> 1234. */
+    k->ok_q &= bits_of(&s->f, 0, 16) == (has ? 1234u : 0u);
+    k->fast++;
+}
+
+/* Heartbeat number hb: starting, then OK on the packets' data, then stale. */
+static void check_schedule_heartbeat(const struct sent *s, size_t hb)
+{
+    CHECK(s->t == hb * 100000, "heartbeat %zu at %llu", hb, (unsigned long long)s->t);
+    CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ALIVE), hb);
+    if (hb == 0) {
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_STARTING);
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), URRT_CANTX_HB_ROBOT_MODE_NA);
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), URRT_CANTX_HB_SAFETY_MODE_NA);
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 65535);
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_GENERATION), 0);
+    } else if (hb == 1) {
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_OK);
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), 7);
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), 1);
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 3); /* last packet at 97 ms */
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_GENERATION), 3);
+    } else {
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_DATA_STALE);
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 103);
+        /* Modes as old as the data are not current: not available. */
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), URRT_CANTX_HB_ROBOT_MODE_NA);
+        CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), URRT_CANTX_HB_SAFETY_MODE_NA);
+    }
+    CHECK(s->f.len == 8 && !s->f.fd && !s->f.extended, "heartbeat frame shape");
+}
+
+/* The frames of schedule_first_300ms, in the order they were sent. */
+static void check_schedule_frames(int packets)
+{
+    struct sched_tally k = {0, 0, 0, 0, true, true, true, true, true};
+    size_t i;
     for (i = 0; i < cap.n; i++) {
         const struct sent *s = &cap.s[i];
         switch (s->f.id) {
-        case 0x181: {
-            bool has = s->t >= 1000;
-            uint64_t age = has ? s->t - (s->t >= 97000 ? 97000 : ((s->t - 1000) / 8000) * 8000 + 1000) : 0;
-            bool want_valid = has && age <= 50000;
-            ok_fast_t &= s->t == fast * 10000;
-            ok_alive &= bits_of(&s->f, 60, 4) == fast % 16;
-            ok_valid &= bits_of(&s->f, 59, 1) == (want_valid ? 1u : 0u);
-            /* Before data: NaN packs physical 0; after: 1.234 -> 1234. */
-            ok_q &= bits_of(&s->f, 0, 16) == (has ? 1234u : 0u);
-            fast++;
-            break;
-        }
+        case 0x181: tally_fast_frame(&k, s); break;
         case 0x281:
             /* Started by the first packet at 1 ms; every 20 ms; stops once
              * the data is older than 30 ms: the last packet is at 97 ms, so
              * 121 (age 24) is sent and 141 (age 44) is not. */
-            CHECK(s->t == 1000 + slow * 20000, "slow frame %zu at %llu", slow, (unsigned long long)s->t);
+            CHECK(s->t == 1000 + k.slow * 20000, "slow frame %zu at %llu", k.slow, (unsigned long long)s->t);
             CHECK(s->f.data[0] == 7 && s->f.len == 8, "slow frame carries robot mode 7");
-            slow++;
+            k.slow++;
             break;
         case 0x381:
-            ok_each &= s->t % 8000 == 1000 && bits_of(&s->f, 0, 32) == s->t / 1000;
-            each++;
+            k.ok_each &= s->t % 8000 == 1000 && bits_of(&s->f, 0, 32) == s->t / 1000;
+            k.each++;
             break;
         case 0x701:
-            CHECK(s->t == hb * 100000, "heartbeat %zu at %llu", hb, (unsigned long long)s->t);
-            CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ALIVE), hb);
-            if (hb == 0) {
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_STARTING);
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), URRT_CANTX_HB_ROBOT_MODE_NA);
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), URRT_CANTX_HB_SAFETY_MODE_NA);
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 65535);
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_GENERATION), 0);
-            } else if (hb == 1) {
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_OK);
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), 7);
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), 1);
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 3); /* last packet at 97 ms */
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_GENERATION), 3);
-            } else {
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_STATE), URRT_CANTX_DATA_STALE);
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_DATA_AGE), 103);
-                /* Modes as old as the data are not current: not available. */
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_ROBOT_MODE), URRT_CANTX_HB_ROBOT_MODE_NA);
-                CHECK_EQ_INT(hb_value(&s->f, URRT_CANTX_HB_SAFETY_MODE), URRT_CANTX_HB_SAFETY_MODE_NA);
-            }
-            CHECK(s->f.len == 8 && !s->f.fd && !s->f.extended, "heartbeat frame shape");
-            hb++;
+            check_schedule_heartbeat(s, k.hb);
+            k.hb++;
             break;
         default: CHECK(false, "unexpected id 0x%X", (unsigned)s->f.id);
         }
     }
-    CHECK_EQ_INT(fast, 30);
-    CHECK(ok_fast_t, "fast frames every 10 ms from 0");
-    CHECK(ok_alive, "alive counter 0..15, 0, ...");
-    CHECK(ok_valid, "validity bit follows data age (50 ms) and data presence");
-    CHECK(ok_q, "fast frame payload");
-    CHECK_EQ_INT(slow, 7); /* 1, 21, 41, 61, 81, 101, 121 */
-    CHECK_EQ_INT(each, packets);
-    CHECK(ok_each, "every-packet frames at the packets, with their time");
-    CHECK_EQ_INT(hb, 3);
+    CHECK_EQ_INT(k.fast, 30);
+    CHECK(k.ok_fast_t, "fast frames every 10 ms from 0");
+    CHECK(k.ok_alive, "alive counter 0..15, 0, ...");
+    CHECK(k.ok_valid, "validity bit follows data age (50 ms) and data presence");
+    CHECK(k.ok_q, "fast frame payload");
+    CHECK_EQ_INT(k.slow, 7); /* 1, 21, 41, 61, 81, 101, 121 */
+    CHECK_EQ_INT(k.each, packets);
+    CHECK(k.ok_each, "every-packet frames at the packets, with their time");
+    CHECK_EQ_INT(k.hb, 3);
+}
 
-    /* Data comes back: the slow frame resumes at once, then every 20 ms. */
+/* Data comes back: the slow frame resumes at once, then every 20 ms. */
+static void schedule_data_returns(void)
+{
+    uint64_t t;
+    size_t i;
     cap.n = 0;
     for (t = 300000; t < 345000; t += 1000) {
         cap.now = t;
@@ -636,7 +652,12 @@ static void test_schedule(void)
               ns ? (unsigned long long)slow_at[0] : 0ull);
         /* 345: the 325 one was the last within 30 ms of data at 305 (age 20) */
     }
-    /* A stalled loop: one frame per frame, not a burst of the missed slots. */
+}
+
+/* A stalled loop: one frame per frame, not a burst of the missed slots. */
+static void schedule_after_stall(void)
+{
+    size_t i;
     cap.n = 0;
     cap.now = 1000000;
     can_run_due(loaded_run, 1000000, NULL, capture_frame, &cap);
@@ -650,9 +671,15 @@ static void test_schedule(void)
               cap.n);
         CHECK_EQ_INT(urrt_cantx_deadline(can_run_tx(loaded_run)), 1010000);
     }
-    /* An every-packet frame left pending while the CAN link was down (the
-     * gateway calls no due() then) must not carry stale data out when the
-     * link comes back: it stops with the packets. */
+}
+
+/* An every-packet frame left pending while the CAN link was down (the
+ * gateway calls no due() then) must not carry stale data out when the
+ * link comes back: it stops with the packets. */
+static void schedule_every_packet_after_link_down(void)
+{
+    uint64_t t;
+    size_t i;
     packet(2000000, 1.234, 7, true);
     for (t = 2200000; t <= 2300000; t += 100000) {
         size_t neach = 0;
@@ -668,40 +695,51 @@ static void test_schedule(void)
         CHECK(neach == (t == 2300000 ? 1u : 0u), "every-packet frame at %llu ms, %s data: %zu sent",
               (unsigned long long)(t / 1000), t == 2300000 ? "fresh" : "200 ms old", neach);
     }
-    unload(&map);
 }
 
-/* Saturation, NaN and link statistics in the frames and the heartbeat. */
-static void test_validity_and_heartbeat(void)
+/* One map through time: each step goes on from the state the one before left. */
+static void test_schedule(void)
 {
     struct can_map map;
     char err[4096] = "";
-    urrt_canlink_stats stats;
-    size_t i;
+    int packets;
     int rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
-    CHECK(rc == 0, "%s", err);
+    CHECK(rc == 0, "schedule config: %s", err);
     if (rc != 0) {
         return;
     }
-    memset(&stats, 0, sizeof stats);
     memset(&cap, 0, sizeof cap);
+    CHECK(urrt_cantx_deadline(can_run_tx(loaded_run)) == URRT_CANTX_NEVER, "no deadline before start");
     can_run_start(loaded_run, 0);
+    packets = schedule_first_300ms();
+    check_schedule_frames(packets);
+    schedule_data_returns();
+    schedule_after_stall();
+    schedule_every_packet_after_link_down();
+    unload(&map);
+}
+
+/* The fast frame through data in range, saturated, absent and in range again:
+ * its payload and validity bit. */
+static void validity_of_fast_frames(urrt_canlink_stats *stats)
+{
+    size_t i;
     /* In range: valid. */
     packet(1000, 2.0, 7, true);
     cap.now = 1000;
-    can_run_due(loaded_run, 1000, &stats, capture_frame, &cap);
+    can_run_due(loaded_run, 1000, stats, capture_frame, &cap);
     /* 40.0 rad does not fit 16 signed bits at 0.001: saturated, invalid. */
     packet(9000, 40.0, 7, true);
     cap.now = 10000;
-    can_run_due(loaded_run, 10000, &stats, capture_frame, &cap);
+    can_run_due(loaded_run, 10000, stats, capture_frame, &cap);
     /* q absent from the packet (NaN): invalid, payload carries physical 0. */
     packet(17000, 0, 7, false);
     cap.now = 20000;
-    can_run_due(loaded_run, 20000, &stats, capture_frame, &cap);
+    can_run_due(loaded_run, 20000, stats, capture_frame, &cap);
     /* In range again: valid. */
     packet(25000, -2.0, 7, true);
     cap.now = 30000;
-    can_run_due(loaded_run, 30000, &stats, capture_frame, &cap);
+    can_run_due(loaded_run, 30000, stats, capture_frame, &cap);
     {
         int k = 0;
         const uint64_t want_q[] = {2000, 32767, 0, (uint64_t)(65536 - 2000)};
@@ -719,13 +757,18 @@ static void test_validity_and_heartbeat(void)
         }
         CHECK_EQ_INT(k, 4);
     }
-    /* Heartbeat flags say "since the previous heartbeat". */
-    stats.dropped = 70000;
-    stats.bus_off = 1;
+}
+
+/* Heartbeat flags say "since the previous heartbeat": the one at 100 ms. */
+static void heartbeat_flags_at_100ms(urrt_canlink_stats *stats)
+{
+    size_t i;
+    stats->dropped = 70000;
+    stats->bus_off = 1;
     cap.n = 0;
     cap.now = 100000;
     packet(99000, 1, 7, true);
-    can_run_due(loaded_run, 100000, &stats, capture_frame, &cap);
+    can_run_due(loaded_run, 100000, stats, capture_frame, &cap);
     for (i = 0; i < cap.n && cap.s[i].f.id != 0x701; i++) {
     }
     CHECK(i < cap.n, "heartbeat at 100 ms");
@@ -738,13 +781,19 @@ static void test_validity_and_heartbeat(void)
         CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_CLAMPED), 1); /* 40 rad and NaN since start */
         CHECK_EQ_INT(hb_value(f, URRT_CANTX_HB_DATA_AGE), 1);
     }
-    stats.error_frames = 3;
-    stats.down_events = 1;
-    stats.send_errors = 2;
+}
+
+/* ... and the one at 200 ms, after other link events. */
+static void heartbeat_flags_at_200ms(urrt_canlink_stats *stats)
+{
+    size_t i;
+    stats->error_frames = 3;
+    stats->down_events = 1;
+    stats->send_errors = 2;
     cap.n = 0;
     cap.now = 200000;
     packet(199000, 1, 7, true);
-    can_run_due(loaded_run, 200000, &stats, capture_frame, &cap);
+    can_run_due(loaded_run, 200000, stats, capture_frame, &cap);
     for (i = 0; i < cap.n && cap.s[i].f.id != 0x701; i++) {
     }
     if (i < cap.n) {
@@ -760,12 +809,16 @@ static void test_validity_and_heartbeat(void)
     } else {
         CHECK(false, "heartbeat at 200 ms");
     }
-    /* The link goes down: disconnected, whatever the age. */
+}
+
+/* The link goes down: disconnected, whatever the age. */
+static void heartbeat_link_down(urrt_canlink_stats *stats)
+{
     urrt_cantx_robot_link(can_run_tx(loaded_run), 0, false);
     CHECK_EQ_INT(can_run_state(loaded_run, 200500), URRT_CANTX_DISCONNECTED);
     {
         urrt_can_frame f;
-        can_run_heartbeat_frame(loaded_run, 200500, &stats, &f);
+        can_run_heartbeat_frame(loaded_run, 200500, stats, &f);
         CHECK_EQ_INT(hb_value(&f, URRT_CANTX_HB_STATE), URRT_CANTX_DISCONNECTED);
         CHECK(f.id == 0x701 && f.len == 8, "heartbeat_frame id and length");
     }
@@ -773,20 +826,48 @@ static void test_validity_and_heartbeat(void)
     CHECK_EQ_INT(can_run_state(loaded_run, 100000000), URRT_CANTX_DISCONNECTED);
     {
         urrt_can_frame f;
-        can_run_heartbeat_frame(loaded_run, 100000000, &stats, &f);
+        can_run_heartbeat_frame(loaded_run, 100000000, stats, &f);
         CHECK_EQ_INT(hb_value(&f, URRT_CANTX_HB_DATA_AGE), 65534);
     }
-    unload(&map);
+}
 
-    /* Starting: at most CAN_RUN_STARTUP_MS without data, then disconnected
-     * (link not up) or stale (link up but silent). */
-    rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
+/* Starting: at most CAN_RUN_STARTUP_MS without data, then disconnected
+ * (link not up) or stale (link up but silent). */
+static void startup_without_data(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    /* The configuration test_validity_and_heartbeat loaded and checked. */
+    load(&map, sched_config, one_robot, 1, err, sizeof err);
     can_run_start(loaded_run, 1000);
     CHECK_EQ_INT(can_run_state(loaded_run, 1000 + 4999000), URRT_CANTX_STARTING);
     CHECK_EQ_INT(can_run_state(loaded_run, 1000 + 5000000), URRT_CANTX_DISCONNECTED);
     urrt_cantx_robot_link(can_run_tx(loaded_run), 0, true);
     CHECK_EQ_INT(can_run_state(loaded_run, 1000 + 5000000), URRT_CANTX_DATA_STALE);
     unload(&map);
+}
+
+/* Saturation, NaN and link statistics in the frames and the heartbeat, on one
+ * map: each step goes on from the state the one before left. */
+static void test_validity_and_heartbeat(void)
+{
+    struct can_map map;
+    char err[4096] = "";
+    urrt_canlink_stats stats;
+    int rc = load(&map, sched_config, one_robot, 1, err, sizeof err);
+    CHECK(rc == 0, "%s", err);
+    if (rc != 0) {
+        return;
+    }
+    memset(&stats, 0, sizeof stats);
+    memset(&cap, 0, sizeof cap);
+    can_run_start(loaded_run, 0);
+    validity_of_fast_frames(&stats);
+    heartbeat_flags_at_100ms(&stats);
+    heartbeat_flags_at_200ms(&stats);
+    heartbeat_link_down(&stats);
+    unload(&map);
+    startup_without_data();
 }
 
 /* The heartbeat goes at least once a second, whatever the loop's rhythm. */
