@@ -595,8 +595,12 @@ def t_backlog(args):
         stopped = time.time() * 1e6
         gw.send_signal(signal.SIGSTOP)
         time.sleep(1)  # the stimulus: how long the gateway is stopped
-        gw.send_signal(signal.SIGCONT)
+        # Taken before SIGCONT: the resumed gateway may read and publish
+        # fresh packets before this process reads the clock again (on a
+        # loaded machine it did, ten milliseconds' worth), so only a time
+        # taken before the signal bounds what was read before the stop.
         resumed = time.time() * 1e6
+        gw.send_signal(signal.SIGCONT)
         r.wait(lambda: len([m for m in r.channel("STATE") if m["utime"] > resumed]) >= 500 and
                any(g["utime"] > resumed and counter(g, "late_packets") > 0 for g in r.channel("GATEWAY")),
                "backlog: state flows after the stop")
