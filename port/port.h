@@ -282,7 +282,9 @@ typedef struct urrt_canlink urrt_canlink;
 urrt_canlink *urrt_canlink_new(const urrt_canlink_config *cfg);
 void urrt_canlink_free(urrt_canlink *can);
 
-/* Sends a frame now, never blocking. 1: the driver (or the log) took it;
+/* Sends a frame now, never waiting for the bus (a log: link writes a file
+ * with write(2), which the kernel may make wait briefly on the
+ * filesystem). 1: the driver (or the log) took it;
  * 0: held for a retry, or dropped and counted because the link is down;
  * URRT_E_ARG for a frame the link can never send (FD frame on a classic
  * link, a length FD does not have, an ID out of range). */

@@ -144,26 +144,46 @@ static urrt_canlink *open_link(const char *ifname, bool fd, bool brs)
     return open_link_hold(ifname, fd, brs, 2000);
 }
 
-/* The longest single call into the link, and the calls that slept, over
- * the whole run. */
+/* The longest single call into the link, and the calls into a socket link
+ * that slept, over the whole run. A log: link writes a regular file, and
+ * write(2) to a file may wait on the filesystem (its journal, the inode's
+ * lock) whatever the caller does: check-stress saw one such wait of 121 us
+ * on a loaded host. Those calls are counted apart, not held to "never
+ * sleeps", which is the promise of the socket links. */
 static uint64_t max_call_us;
-static unsigned blocked_calls;
+static unsigned blocked_calls, file_waits;
 
-static void call_ended(uint64_t t0, long switches0)
+static void call_ended(uint64_t t0, long switches0, bool file)
 {
     uint64_t dt = now_us() - t0;
     if (dt > max_call_us)
         max_call_us = dt;
-    blocked_calls += voluntary_switches() != switches0;
+    if (voluntary_switches() != switches0) {
+        if (file)
+            file_waits++;
+        else
+            blocked_calls++;
+    }
 }
 
-static int timed_send(urrt_canlink *can, const urrt_can_frame *f)
+static int send_measured(urrt_canlink *can, const urrt_can_frame *f, bool file)
 {
     long switches0 = voluntary_switches();
     uint64_t t0 = now_us();
     int r = urrt_canlink_send(can, f, t0);
-    call_ended(t0, switches0);
+    call_ended(t0, switches0, file);
     return r;
+}
+
+static int timed_send(urrt_canlink *can, const urrt_can_frame *f)
+{
+    return send_measured(can, f, false);
+}
+
+/* A send to a log: link (a file). */
+static int timed_log_send(urrt_canlink *can, const urrt_can_frame *f)
+{
+    return send_measured(can, f, true);
 }
 
 /* Runs the link's share of a poll loop for ms milliseconds. Returns the
@@ -185,7 +205,7 @@ static short pump(urrt_canlink *can, unsigned ms)
         long switches0 = voluntary_switches();
         uint64_t t0 = now_us();
         urrt_canlink_service(can, t0);
-        call_ended(t0, switches0);
+        call_ended(t0, switches0, false);
     }
     return seen;
 }
@@ -433,13 +453,13 @@ static int test_log(const char *dir)
     const char *want_fd[N_FD], *want_cc[N_CC];
     for (size_t i = 0; i < N_FD; i++) {
         urrt_can_frame f = case_frame(&log_fd_cases[i]);
-        CHECK_EQ_INT(timed_send(fd, &f), 1);
+        CHECK_EQ_INT(timed_log_send(fd, &f), 1);
         expect_line(expect, "log-fd.log", &f, true);
         want_fd[i] = log_fd_cases[i].line;
     }
     for (size_t i = 0; i < N_CC; i++) {
         urrt_can_frame f = case_frame(&log_classic_cases[i]);
-        CHECK_EQ_INT(timed_send(cc, &f), 1);
+        CHECK_EQ_INT(timed_log_send(cc, &f), 1);
         expect_line(expect, "log-classic.log", &f, false);
         want_cc[i] = log_classic_cases[i].line;
     }
@@ -501,7 +521,8 @@ static int test_log(const char *dir)
     snprintf(spec, sizeof(spec), "log:%s/x.log,ifname=averyveryverylongname", dir);
     CHECK(open_link(spec, false, false) == NULL, "long ifname");
     CHECK(strstr(messages, "ifname") != NULL, "reason: %s", messages);
-    CHECK(blocked_calls == 0, "%u calls slept (longest call %" PRIu64 " us)", blocked_calls, max_call_us);
+    /* Only files were written here: said, not held to "never sleeps" (see call_ended). */
+    printf("log writes that waited on the filesystem: %u (longest call %" PRIu64 " us)\n", file_waits, max_call_us);
     return check_report();
 }
 
@@ -530,7 +551,7 @@ static int test_frames(const char *dir)
     for (size_t i = 0; i < N_FD; i++) {
         sent0[i] = make_frame(fd_set_[i].id, fd_set_[i].ext, fd_set_[i].fd, fd_set_[i].len, (uint8_t)(0x31 * i));
         CHECK_EQ_INT(timed_send(fd, &sent0[i]), 1);
-        CHECK_EQ_INT(timed_send(log_fd, &sent0[i]), 1);
+        CHECK_EQ_INT(timed_log_send(log_fd, &sent0[i]), 1);
     }
     /* Without the bit rate switch: flags nibble 4 in the capture. */
     sent0[N_FD] = make_frame(0x1F0, false, true, 16, 0x77);
@@ -538,7 +559,7 @@ static int test_frames(const char *dir)
     for (size_t i = 0; i < N_CC; i++) {
         sent1[i] = make_frame(classic_set[i].id, classic_set[i].ext, false, classic_set[i].len, (uint8_t)(0x13 * i + 1));
         CHECK_EQ_INT(timed_send(cc, &sent1[i]), 1);
-        CHECK_EQ_INT(timed_send(log_cc, &sent1[i]), 1);
+        CHECK_EQ_INT(timed_log_send(log_cc, &sent1[i]), 1);
     }
     urrt_can_frame fd_on_cc = make_frame(0x100, false, true, 8, 0);
     CHECK_EQ_INT(urrt_canlink_send(cc, &fd_on_cc, now_us()), URRT_E_ARG);
@@ -562,7 +583,7 @@ static int test_frames(const char *dir)
     urrt_canlink_free(log_fd);
     snprintf(spec0, sizeof(spec0), "log:%s/frames-vcan0-nobrs.log,ifname=vcan0", dir);
     log_fd = open_link(spec0, true, false);
-    CHECK(log_fd != NULL && timed_send(log_fd, &sent0[N_FD]) == 1, "log without BRS");
+    CHECK(log_fd != NULL && timed_log_send(log_fd, &sent0[N_FD]) == 1, "log without BRS");
 
     urrt_canlink_free(fd);
     urrt_canlink_free(fd_nobrs);
@@ -571,7 +592,9 @@ static int test_frames(const char *dir)
     urrt_canlink_free(log_cc);
     close(rx0);
     close(rx1);
-    CHECK(blocked_calls == 0, "%u calls slept (longest call %" PRIu64 " us)", blocked_calls, max_call_us);
+    CHECK(blocked_calls == 0, "%u calls into socket links slept (longest call %" PRIu64 " us)", blocked_calls,
+          max_call_us);
+    printf("log writes that waited on the filesystem: %u\n", file_waits);
     return check_report();
 }
 
