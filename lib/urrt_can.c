@@ -19,6 +19,7 @@ URRT_CAN_STATIC_ASSERT(errors_apart_from_urrt, (int)URRT_CAN_E_SIGNAL < (int)URR
 #define INFINITY_BITS UINT64_C(0x7FF0000000000000)
 #define FRACTION_BITS UINT64_C(0x000FFFFFFFFFFFFF)
 #define HIDDEN_BIT UINT64_C(0x0010000000000000)
+#define ONE_BITS UINT64_C(0x3FF0000000000000)
 #define FLOAT32_QUIET_NAN UINT64_C(0x7FC00000)
 #define FLOAT64_QUIET_NAN UINT64_C(0x7FF8000000000000)
 
@@ -141,6 +142,14 @@ static int64_t order_key(uint64_t bits)
     return (bits & SIGN_BIT) != 0u ? -magnitude : magnitude;
 }
 
+/* A bit mask: unsigned, factor exactly 1, offset +-0, its bits inside the
+ * 64 of a mask. */
+static bool mask_valid(const urrt_can_signal *sig)
+{
+    return sig->type == (uint8_t)URRT_CAN_UNSIGNED && bits_of(sig->factor) == ONE_BITS &&
+           (bits_of(sig->offset) & ABS_BITS) == 0u && URRT_CAN_SIG_MASK_FIRST(sig->flags) + sig->length <= 64u;
+}
+
 static bool descriptor_valid(const urrt_can_signal *sig)
 {
     if (sig->length < 1u || sig->length > 64u || sig->byte_order > (uint8_t)URRT_CAN_MOTOROLA) {
@@ -161,11 +170,14 @@ static bool descriptor_valid(const urrt_can_signal *sig)
         break;
     default: return false;
     }
-    if (!is_finite(sig->factor) || (bits_of(sig->factor) & ABS_BITS) == 0u || !is_finite(sig->offset) ||
-        !is_finite(sig->min) || !is_finite(sig->max) || order_key(bits_of(sig->min)) > order_key(bits_of(sig->max))) {
+    /* The flags before the numbers: a mask's factor and offset are done with
+     * before the limits are loaded (fewer registers live on a 32-bit core). */
+    if ((sig->flags & URRT_CAN_SIG_BITMASK) != 0u ? !mask_valid(sig)
+                                                  : (sig->flags & ~URRT_CAN_SIG_INVALID_RAW) != 0u) {
         return false;
     }
-    if ((sig->flags & ~URRT_CAN_SIG_INVALID_RAW) != 0u) {
+    if (!is_finite(sig->factor) || (bits_of(sig->factor) & ABS_BITS) == 0u || !is_finite(sig->offset) ||
+        !is_finite(sig->min) || !is_finite(sig->max) || order_key(bits_of(sig->min)) > order_key(bits_of(sig->max))) {
         return false;
     }
     if ((sig->flags & URRT_CAN_SIG_INVALID_RAW) != 0u && (sig->invalid_raw & ~low_mask(sig->length)) != 0u) {
@@ -902,6 +914,47 @@ static int float_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
     return outcome > raw_outcome ? outcome : raw_outcome;
 }
 
+/*
+ * The mask a double holds, by urrt_bitmask's rule (urrt.h): sign and
+ * exponent bits all zero is a raw int64 read as a double, whose bits are
+ * the mask; anything else must be a non-negative integer up to 2^53.
+ * Written again here, on the bits in hand, because calling urrt_bitmask
+ * made packing a mask 40 bytes deeper on a Cortex-M4 than scaling a number
+ * (docs/footprint.md, "Stack"); tests/lib/test_can.c holds the two to the
+ * same answers.
+ */
+static bool mask_of(uint64_t bits, uint64_t *mask)
+{
+    unsigned biased = (unsigned)(bits >> 52); /* with the sign: 0x800 and up is negative */
+    uint64_t mantissa = (bits & FRACTION_BITS) | HIDDEN_BIT;
+    if (biased == 0u || bits == SIGN_BIT) {
+        *mask = biased == 0u ? bits : 0u; /* a raw int64, or -0 */
+        return true;
+    }
+    if (biased < 1023u || biased > 1076u) {
+        return false; /* a fraction below 1, negative, 2^54 or more, infinite or NaN */
+    }
+    if (biased == 1076u) {
+        *mask = mantissa << 1; /* [2^53, 2^54): 2^53 alone is a mask */
+        return mantissa == HIDDEN_BIT;
+    }
+    *mask = mantissa >> (1075u - biased);
+    return (mantissa & low_mask(1075u - biased)) == 0u; /* no fraction */
+}
+
+/* A bit mask: the bits the signal carries, never clamped; a value that is
+ * no mask goes as NaN does. */
+static int mask_to_raw(const urrt_can_signal *sig, double value, uint64_t *raw)
+{
+    uint64_t mask;
+    if (!mask_of(bits_of(value), &mask)) {
+        *raw = (sig->flags & URRT_CAN_SIG_INVALID_RAW) != 0u ? sig->invalid_raw : 0u;
+        return URRT_CAN_PACK_NAN;
+    }
+    *raw = (mask >> URRT_CAN_SIG_MASK_FIRST(sig->flags)) & low_mask(sig->length);
+    return URRT_CAN_PACK_OK;
+}
+
 static bool is_float(const urrt_can_signal *sig)
 {
     return sig->type == (uint8_t)URRT_CAN_FLOAT32 || sig->type == (uint8_t)URRT_CAN_FLOAT64;
@@ -909,6 +962,9 @@ static bool is_float(const urrt_can_signal *sig)
 
 static int prepared_to_raw(const urrt_can_signal *sig, const urrt_can_scale *scale, double value, uint64_t *raw)
 {
+    if ((sig->flags & URRT_CAN_SIG_BITMASK) != 0u) {
+        return mask_to_raw(sig, value, raw);
+    }
     return is_float(sig) ? float_to_raw(sig, value, raw) : scaled_to_raw(sig, scale, value, raw);
 }
 

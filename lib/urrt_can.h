@@ -65,11 +65,33 @@
  *   URRT_CAN_PACK_OK         the value fit (after rounding half away from zero)
  *   URRT_CAN_PACK_SATURATED  it was out of [min, max] or of the raw type's
  *                            range (infinities included) and was clamped
- *   URRT_CAN_PACK_NAN        it was NaN: the signal carries invalid_raw if
- *                            the descriptor sets URRT_CAN_SIG_INVALID_RAW,
- *                            else a quiet NaN (float types) or the raw value
+ *   URRT_CAN_PACK_NAN        it was NaN (or, for a bit mask, no mask): the
+ *                            signal carries invalid_raw if the descriptor
+ *                            sets URRT_CAN_SIG_INVALID_RAW, else a quiet NaN
+ *                            (float types), 0 (a bit mask) or the raw value
  *                            of physical 0 clamped into [min, max]
  * so that a caller can clear a validity bit on anything but OK.
+ *
+ * ---- Bit masks ----------------------------------------------------------------
+ *
+ * A signal with URRT_CAN_SIG_BITMASK carries a set of independent bits
+ * (digital inputs and outputs, status bits), not a quantity: it is never
+ * scaled and never saturated. Its value is a mask as UR sends one, by
+ * urrt_bitmask's rule (urrt.h): a double holding the integer, or a raw int64
+ * read as a double. The signal carries the mask's bits first .. first + length - 1
+ * (URRT_CAN_SIG_MASK(first); first 0 by default): raw = (mask >> first)
+ * in `length` bits. Bits it does not carry are left out, and the outcome
+ * is URRT_CAN_PACK_OK for every mask, whatever bits are set.
+ *
+ * A value that is no mask (negative, fractional, NaN, infinite, or above
+ * 2^53, where a double no longer holds every integer and the low bits may
+ * have been rounded away) is URRT_CAN_PACK_NAN, never a guess: the signal
+ * carries invalid_raw with URRT_CAN_SIG_INVALID_RAW, else 0 (no bit set),
+ * and a caller clears the validity bit as for any NaN.
+ *
+ * A mask descriptor is unsigned, with factor 1 and offset 0; min and max
+ * are not used (urrt_can_signal_range gives 0 .. 2^length - 1, what a DBC
+ * states for it). Packing it is integer work on the double's bits only.
  */
 #ifndef URRT_CAN_H
 #define URRT_CAN_H
@@ -165,7 +187,17 @@ typedef enum urrt_can_value_type {
 } urrt_can_value_type;
 
 /* Flags of a signal descriptor. */
-#define URRT_CAN_SIG_INVALID_RAW 0x01u /* send invalid_raw for NaN */
+#define URRT_CAN_SIG_INVALID_RAW 0x01u /* send invalid_raw for NaN (and, for a bit mask, for no mask) */
+#define URRT_CAN_SIG_BITMASK 0x02u     /* the value is a bit mask (see "Bit masks" above) */
+/*
+ * The flags of a bit mask signal that carries the mask's bits from `first`
+ * (0..63) up: URRT_CAN_SIG_BITMASK, and `first` in the flags' upper six
+ * bits. Kept in the flags so that the descriptor's layout stays as it was:
+ * tables written for it, positional initializers included, still compile.
+ * Without URRT_CAN_SIG_BITMASK those six bits are 0.
+ */
+#define URRT_CAN_SIG_MASK(first) (URRT_CAN_SIG_BITMASK | (unsigned)(first) << 2)
+#define URRT_CAN_SIG_MASK_FIRST(flags) ((unsigned)(flags) >> 2)
 
 /*
  * One signal: where it sits and how it is scaled. A frame is an array of
@@ -174,7 +206,8 @@ typedef enum urrt_can_value_type {
  *
  * min and max are physical limits; packing clamps to them before scaling,
  * and again to the raw type's range after. Use urrt_can_signal_range() for
- * the widest limits a raw type can carry.
+ * the widest limits a raw type can carry. A bit mask (URRT_CAN_SIG_BITMASK)
+ * is never clamped: unsigned, factor 1, offset 0, first + length <= 64.
  */
 typedef struct urrt_can_signal {
     double factor;        /* finite and non-zero (negative allowed) */
@@ -186,7 +219,7 @@ typedef struct urrt_can_signal {
     uint8_t length;       /* bits, 1..64 */
     uint8_t byte_order;   /* urrt_can_byte_order */
     uint8_t type;         /* urrt_can_value_type */
-    uint8_t flags;        /* URRT_CAN_SIG_* */
+    uint8_t flags;        /* URRT_CAN_SIG_*, URRT_CAN_SIG_MASK(first) for a bit mask */
 } urrt_can_signal;
 
 /*

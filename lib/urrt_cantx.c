@@ -69,8 +69,10 @@ static int check_sources(const urrt_cantx_frame *f, size_t *bad_signal)
         switch ((urrt_cantx_kind)src->kind) {
         case URRT_CANTX_FIELD:
         case URRT_CANTX_FIELD_MASK: {
+            /* The kind and the descriptor agree: a mask is never scaled. */
             const urrt_field_info *info = urrt_field((urrt_field_id)src->field);
-            ok = info != NULL && src->elem < info->count;
+            bool mask = (sig->flags & URRT_CAN_SIG_BITMASK) != 0u;
+            ok = info != NULL && src->elem < info->count && mask == (src->kind == (uint8_t)URRT_CANTX_FIELD_MASK);
             break;
         }
         case URRT_CANTX_ALIVE:
@@ -274,7 +276,8 @@ static const uint16_t field_slots[URRT_FIELD_COUNT] = {
 
 /* A packet costs these loads only: the values are packed once, when the
  * frame next goes out (or a heartbeat reports clamping); a bit mask is
- * read as one then too. No state: every field NaN. */
+ * read as one then too (urrt_can's URRT_CAN_SIG_BITMASK). No state: every
+ * field NaN. */
 static void take_fields(urrt_cantx *tx, size_t index, const urrt_state *st)
 {
     const urrt_cantx_source *sources = tx->tables->frames[index].sources;
@@ -291,12 +294,6 @@ static void take_fields(urrt_cantx *tx, size_t index, const urrt_state *st)
         }
     }
     fs->unpacked = true;
-}
-
-static double mask_value(double v)
-{
-    uint64_t mask;
-    return urrt_bitmask(v, &mask) < 0 ? nan_value() : (double)mask;
 }
 
 /* One signal into the frame, with its prepared scale when the caller keeps
@@ -326,9 +323,7 @@ static void pack_fields(urrt_cantx *tx, size_t index)
         if (!takes_field(kind)) {
             continue;
         }
-        outcome = pack_signal(tx, fs->first_value + i, &f->signals[i],
-                              kind == (uint8_t)URRT_CANTX_FIELD_MASK ? mask_value(values[i]) : values[i],
-                              fs->frame.data);
+        outcome = pack_signal(tx, fs->first_value + i, &f->signals[i], values[i], fs->frame.data);
         if (outcome != URRT_CAN_PACK_OK) {
             tx->clamped++;
             worst = outcome > worst ? outcome : worst;

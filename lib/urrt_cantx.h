@@ -52,7 +52,8 @@ extern "C" {
  * layout, frame length and id errors come from there). */
 enum urrt_cantx_result {
     URRT_CANTX_E_SOURCE = -40,   /* a signal's source: unknown kind, field or element out of
-                                    range, an alive counter or validity bit of the wrong type or
+                                    range, a mask field without a bit mask descriptor (or a
+                                    field with one), an alive counter or validity bit of the wrong type or
                                     length or twice in a frame, a filled value in a frame
                                     without a fill function */
     URRT_CANTX_E_ROBOT = -41,    /* robot index out of range */
@@ -67,7 +68,10 @@ const char *urrt_cantx_strerror(int result);
 /* Where a signal's value comes from. */
 typedef enum urrt_cantx_kind {
     URRT_CANTX_FIELD = 0,     /* element elem of robot field `field` */
-    URRT_CANTX_FIELD_MASK,    /* the same field read as a bit mask (digital I/O, urrt_bitmask) */
+    URRT_CANTX_FIELD_MASK,    /* the same field read as a bit mask (digital I/O, urrt_bitmask):
+                                 its signal is a URRT_CAN_SIG_BITMASK descriptor, which
+                                 carries the mask's bits and is never clamped (a FIELD's
+                                 signal is not one) */
     URRT_CANTX_ALIVE,         /* the frame's alive counter: 0, 1, ... with each frame sent,
                                  modulo 2^length (unsigned, length 1..8; one per frame) */
     URRT_CANTX_VALID,         /* the frame's validity bit (unsigned, length 1; one per frame):
@@ -322,7 +326,7 @@ enum urrt_cantx_hb_signal {
     URRT_CANTX_HB_CAN_DOWN,
     URRT_CANTX_HB_SEND_ERRORS,
     URRT_CANTX_HB_TX_DROPPED,
-    URRT_CANTX_HB_CLAMPED,         /* a value saturated or was NaN */
+    URRT_CANTX_HB_CLAMPED,         /* a value saturated or was NaN (or, for a bit mask, no mask) */
     URRT_CANTX_HB_DATA_AGE,        /* ms, 16 bits, saturated at 65534; URRT_CANTX_HB_AGE_NA: no data */
     URRT_CANTX_HB_DROPS,           /* link's dropped frames modulo 65536 */
     URRT_CANTX_HB_COUNT

@@ -33,6 +33,18 @@ static void put_field_id(FILE *out, unsigned field)
     }
 }
 
+/* A descriptor's flags as urrt_can.h's macros: a bit mask's first bit by name. */
+static void put_flags(FILE *out, uint8_t flags)
+{
+    bool invalid = (flags & URRT_CAN_SIG_INVALID_RAW) != 0u;
+    if ((flags & URRT_CAN_SIG_BITMASK) != 0u) {
+        fprintf(out, "URRT_CAN_SIG_MASK(%u)%s", URRT_CAN_SIG_MASK_FIRST(flags),
+                invalid ? " | URRT_CAN_SIG_INVALID_RAW" : "");
+    } else {
+        fputs(invalid ? "URRT_CAN_SIG_INVALID_RAW" : "0", out);
+    }
+}
+
 static void put_signal(FILE *out, const urrt_can_signal *s, const char *name)
 {
     fputs("    {", out);
@@ -43,13 +55,14 @@ static void put_signal(FILE *out, const urrt_can_signal *s, const char *name)
     put_double(out, s->min);
     fputs(", ", out);
     put_double(out, s->max);
-    fprintf(out, ", UINT64_C(0x%" PRIX64 "), %u, %u, %s, %s, %s}, /* %s */\n", s->invalid_raw, s->start, s->length,
+    fprintf(out, ", UINT64_C(0x%" PRIX64 "), %u, %u, %s, %s, ", s->invalid_raw, s->start, s->length,
             s->byte_order == URRT_CAN_MOTOROLA ? "URRT_CAN_MOTOROLA" : "URRT_CAN_INTEL",
             s->type == URRT_CAN_SIGNED    ? "URRT_CAN_SIGNED"
             : s->type == URRT_CAN_FLOAT32 ? "URRT_CAN_FLOAT32"
             : s->type == URRT_CAN_FLOAT64 ? "URRT_CAN_FLOAT64"
-                                          : "URRT_CAN_UNSIGNED",
-            s->flags & URRT_CAN_SIG_INVALID_RAW ? "URRT_CAN_SIG_INVALID_RAW" : "0", name);
+                                          : "URRT_CAN_UNSIGNED");
+    put_flags(out, s->flags);
+    fprintf(out, "}, /* %s */\n", name);
 }
 
 static void put_source(FILE *out, const urrt_cantx_source *src)

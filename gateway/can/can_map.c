@@ -97,6 +97,10 @@ void can_map_free(struct can_map *map)
         free(map->files[i]);
     }
     free(map->files);
+    for (i = 0; i < map->notice_count; i++) {
+        free(map->notices[i]);
+    }
+    free(map->notices);
     memset(map, 0, sizeof *map);
 }
 
@@ -420,13 +424,15 @@ struct signal_parse {
     const urrt_field_info *info;
     int order;              /* URRT_CAN_INTEL/MOTOROLA, -1: not given */
     int type;               /* URRT_CAN_UNSIGNED..., -1: not given */
-    bool have_min, have_max, have_name, have_unit, have_invalid;
+    bool have_min, have_max, have_name, have_unit, have_invalid, have_factor, have_offset, have_bits;
     int64_t invalid;
+    uint32_t length;        /* as written, checked once the frame and signal can be named */
+    uint32_t first_bit, last_bit; /* bits=FIRST-LAST of a bit mask */
 };
 
 #define SIGNAL_GRAMMAR \
     "signal = FIELD[ELEM] @START|LENGTH intel|motorola unsigned|signed|float32|float64 " \
-    "[factor=F] [offset=O] [min=A] [max=B] [unit=U] [name=N] [invalid=RAW]"
+    "[factor=F] [offset=O] [min=A] [max=B] [unit=U] [name=N] [invalid=RAW] [bits=FIRST-LAST]"
 
 /* FIELD or FIELD[ELEM] */
 static bool signal_field(struct signal_parse *s, const char *word, char *why, size_t n)
@@ -484,14 +490,12 @@ static bool signal_place(struct signal_parse *s, const char *word, char *why, si
     if (!conf_u32(buf, 0, UINT32_MAX, &start, NULL, 0) || !conf_u32(bar + 1, 0, UINT32_MAX, &length, NULL, 0)) {
         return conf_fail(why, n, "signal: '%s': expected @START|LENGTH, e.g. @0|16 (decimal bit numbers)", word);
     }
-    if (length < 1 || length > 64) {
-        return conf_fail(why, n, "signal: length %u: give 1..64 bits", (unsigned)length);
-    }
     if (start >= 8 * URRT_CAN_MAX_LEN) {
         return conf_fail(why, n, "signal: start bit %u: give 0..511", (unsigned)start);
     }
     s->sig.start = (uint16_t)start;
-    s->sig.length = (uint8_t)length;
+    s->length = length;
+    s->sig.length = length <= 64 ? (uint8_t)length : 0;
     return true;
 }
 
@@ -514,7 +518,7 @@ static bool signal_word(struct signal_parse *s, const char *w, char *why, size_t
         }
     }
     return conf_fail(why, n, "signal: unknown word '%s': expected intel|motorola, unsigned|signed|float32|float64 "
-               "or factor=, offset=, min=, max=, unit=, name=, invalid=", w);
+               "or factor=, offset=, min=, max=, unit=, name=, invalid=, bits=", w);
 }
 
 /* factor=, offset=, min=, max= */
@@ -529,8 +533,10 @@ static bool signal_number(struct signal_parse *s, const char *k, const char *v, 
             return conf_fail(why, n, "signal: factor must not be 0");
         }
         s->sig.factor = d;
+        s->have_factor = true;
     } else if (strcmp(k, "offset") == 0) {
         s->sig.offset = d;
+        s->have_offset = true;
     } else if (strcmp(k, "min") == 0) {
         s->sig.min = d;
         s->have_min = true;
@@ -538,6 +544,25 @@ static bool signal_number(struct signal_parse *s, const char *k, const char *v, 
         s->sig.max = d;
         s->have_max = true;
     }
+    return true;
+}
+
+/* bits=FIRST-LAST or bits=BIT: which bits of a bit mask the signal carries. */
+static bool signal_bits(struct signal_parse *s, const char *v, char *why, size_t n)
+{
+    char first[16];
+    const char *dash = strchr(v, '-');
+    size_t len = dash != NULL ? (size_t)(dash - v) : strlen(v);
+    if (len == 0 || len >= sizeof first) {
+        return conf_fail(why, n, "signal: bits = '%s': give the mask's bits as FIRST-LAST (16-17) or one BIT", v);
+    }
+    snprintf(first, sizeof first, "%.*s", (int)len, v);
+    if (!conf_u32(first, 0, 63, &s->first_bit, NULL, 0) ||
+        !conf_u32(dash != NULL ? dash + 1 : first, s->first_bit, 63, &s->last_bit, NULL, 0)) {
+        return conf_fail(why, n,
+                         "signal: bits = '%s': give FIRST-LAST with 0 <= FIRST <= LAST <= 63 (16-17), or one BIT", v);
+    }
+    s->have_bits = true;
     return true;
 }
 
@@ -565,6 +590,9 @@ static bool signal_option(struct signal_parse *s, char *w, char *eq, char *why, 
         s->have_name = true;
         return true;
     }
+    if (strcmp(k, "bits") == 0) {
+        return signal_bits(s, v, why, n);
+    }
     if (strcmp(k, "invalid") == 0) {
         s->have_invalid = true;
         if (!conf_int(v, INT64_MIN, INT64_MAX, &s->invalid, reason, sizeof reason)) {
@@ -572,8 +600,8 @@ static bool signal_option(struct signal_parse *s, char *w, char *eq, char *why, 
         }
         return true;
     }
-    return conf_fail(why, n, "signal: unknown option '%s=': expected factor=, offset=, min=, max=, unit=, name=, invalid=",
-               k);
+    return conf_fail(why, n, "signal: unknown option '%s=': expected factor=, offset=, min=, max=, unit=, name=, "
+               "invalid=, bits=", k);
 }
 
 /* min=, max= against what the type and scaling can carry. */
@@ -625,7 +653,38 @@ static bool signal_invalid(struct signal_parse *s, char *why, size_t n)
         return conf_fail(why, n, "signal: invalid=%lld does not fit %u bits", (long long)s->invalid, length);
     }
     s->sig.invalid_raw = (uint64_t)s->invalid & mask;
-    s->sig.flags = URRT_CAN_SIG_INVALID_RAW;
+    s->sig.flags |= URRT_CAN_SIG_INVALID_RAW;
+    return true;
+}
+
+/* A field whose unit is "bits" is a bit mask, whatever its name: its bits go
+ * out as they are (lib/urrt_can.h, "Bit masks"), so nothing may scale or
+ * limit them. bits= picks which of them the signal carries. */
+static bool signal_mask(struct signal_parse *s, char *why, size_t n)
+{
+    static const char *const types[] = {"unsigned", "signed", "float32", "float64"};
+    const char *field = s->info->name;
+    unsigned first = s->have_bits ? s->first_bit : 0;
+    if (!s->meta.bitmask) {
+        return !s->have_bits ||
+               conf_fail(why, n, "signal: bits= is for bit masks (fields of unit bits, such as digital_input_bits), "
+                         "not %s", field);
+    }
+    if (s->have_factor || s->have_offset || s->have_min || s->have_max) {
+        const char *key = s->have_factor ? "factor=" : s->have_offset ? "offset=" : s->have_min ? "min=" : "max=";
+        return conf_fail(why, n, "signal: %s is a bit mask, sent bit for bit: remove %s (bits=FIRST-LAST picks "
+                         "which bits)", field, key);
+    }
+    if (s->type != URRT_CAN_UNSIGNED) {
+        return conf_fail(why, n, "signal: %s is a bit mask: its type is unsigned, not %s", field, types[s->type]);
+    }
+    if (s->have_bits && s->last_bit - s->first_bit + 1 != s->sig.length) {
+        unsigned count = (unsigned)(s->last_bit - s->first_bit + 1);
+        return conf_fail(why, n, "signal: bits=%u-%u %s %u bit%s, but the signal has %u: make them agree",
+                         (unsigned)s->first_bit, (unsigned)s->last_bit, count == 1 ? "is" : "are", count,
+                         count == 1 ? "" : "s", (unsigned)s->sig.length);
+    }
+    s->sig.flags |= (uint8_t)URRT_CAN_SIG_MASK(first);
     return true;
 }
 
@@ -646,6 +705,9 @@ static bool signal_rest(struct signal_parse *s, char **words, int nwords, char *
     }
     s->sig.byte_order = (uint8_t)s->order;
     s->sig.type = (uint8_t)s->type;
+    if (!signal_mask(s, why, n)) {
+        return false;
+    }
     if ((s->type == URRT_CAN_FLOAT32 && s->sig.length != 32) || (s->type == URRT_CAN_FLOAT64 && s->sig.length != 64)) {
         return conf_fail(why, n, "signal: %s needs length %d, not %u", s->type == URRT_CAN_FLOAT32 ? "float32" : "float64",
                    s->type == URRT_CAN_FLOAT32 ? 32 : 64, (unsigned)s->sig.length);
@@ -679,8 +741,14 @@ static bool frame_signal(void *obj, const struct conf_key *key, const char *valu
     s.meta.role = CAN_MAP_ROLE_FIELD;
     s.meta.loc.file = at.file;
     s.meta.loc.line = at.line;
-    if (!signal_field(&s, words[0], why, n) || !signal_place(&s, words[1], why, n) ||
-        !signal_rest(&s, words, nwords, why, n)) {
+    if (!signal_field(&s, words[0], why, n) || !signal_place(&s, words[1], why, n)) {
+        return false;
+    }
+    if (s.length < 1 || s.length > 64) {
+        return conf_fail(why, n, "[frame %s] signal '%s': length %u: give 1..64 bits", f->name, words[0],
+                         (unsigned)s.length);
+    }
+    if (!signal_rest(&s, words, nwords, why, n)) {
         return false;
     }
     if (!s.have_unit) {
@@ -1206,6 +1274,135 @@ static void check_load(struct finish *fin, struct can_map_loc can_loc)
             map->load * 100.0, (unsigned)map->bitrate, map->max_load_percent, top);
 }
 
+/* ---- notices: bits of a mask that no signal carries ---------------------------------- */
+
+/*
+ * What the bits of each bit-mask field mean: the one place the gateway keeps
+ * them (docs/protocol.md; the RealTime interface and RTDE give digital inputs
+ * and outputs the same layout). A mask field without rows here has no defined
+ * bits to miss. RTDE's masks (robot_status_bits, safety_status_bits, the bit
+ * registers) add their rows when they join lib's field table.
+ */
+static const struct mask_group {
+    urrt_field_id field;
+    unsigned first, last;
+    const char *meaning;
+} mask_groups[] = {
+    {URRT_F_DIGITAL_INPUT_BITS, 0, 7, "standard inputs"},
+    {URRT_F_DIGITAL_INPUT_BITS, 8, 15, "configurable inputs"},
+    {URRT_F_DIGITAL_INPUT_BITS, 16, 17, "tool inputs"},
+    {URRT_F_DIGITAL_OUTPUTS, 0, 7, "standard outputs"},
+    {URRT_F_DIGITAL_OUTPUTS, 8, 15, "configurable outputs"},
+    {URRT_F_DIGITAL_OUTPUTS, 16, 17, "tool outputs"},
+};
+
+size_t can_map_notice_count(const struct can_map *map)
+{
+    return map->notice_count;
+}
+
+const char *can_map_notice(const struct can_map *map, size_t i)
+{
+    return i < map->notice_count ? map->notices[i] : NULL;
+}
+
+static void add_notice(struct can_map *map, struct can_map_loc loc, const char *text)
+{
+    char **grown = realloc(map->notices, (map->notice_count + 1) * sizeof *grown);
+    char line[512];
+    if (grown == NULL) {
+        return; /* a notice is advice: without memory, none */
+    }
+    map->notices = grown;
+    snprintf(line, sizeof line, "%s:%d: %s", loc.file ? loc.file : "?", loc.line, text);
+    map->notices[map->notice_count] = strdup(line);
+    map->notice_count += map->notices[map->notice_count] != NULL;
+}
+
+/* The bits of `field` that robot `robot`'s signals carry, and the place of
+ * the first such signal (line 0: none). */
+static uint64_t carried_bits(const struct can_map *map, size_t robot, int field, struct can_map_loc *first)
+{
+    uint64_t carried = 0;
+    first->line = 0;
+    for (size_t i = 0; i < map->frame_count; i++) {
+        const struct can_map_frame *f = &map->frames[i];
+        for (size_t k = 0; k < f->count && f->robot_index == robot; k++) {
+            unsigned from = URRT_CAN_SIG_MASK_FIRST(f->sigs[k].flags);
+            unsigned len = f->sigs[k].length;
+            if (f->meta[k].role != CAN_MAP_ROLE_FIELD || f->meta[k].field != field || !f->meta[k].bitmask) {
+                continue;
+            }
+            carried |= (len >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << len) - 1) << from;
+            *first = first->line == 0 ? f->meta[k].loc : *first;
+        }
+    }
+    return carried;
+}
+
+/* "bits 16-17 (tool inputs)" for each run of group bits not carried; the
+ * number of runs. */
+static int missing_runs(int field, uint64_t carried, char *out, size_t size, unsigned *run_first, unsigned *run_last)
+{
+    size_t used = 0;
+    int runs = 0;
+    out[0] = '\0';
+    for (size_t g = 0; g < sizeof mask_groups / sizeof mask_groups[0]; g++) {
+        const struct mask_group *m = &mask_groups[g];
+        for (unsigned b = m->first; m->field == (urrt_field_id)field && b <= m->last; b++) {
+            unsigned e = b;
+            int w;
+            if ((carried >> b & 1u) != 0) {
+                continue;
+            }
+            while (e < m->last && (carried >> (e + 1) & 1u) == 0) {
+                e++;
+            }
+            w = e > b ? snprintf(out + used, size - used, "%sbits %u-%u (%s)", runs ? ", " : "", b, e, m->meaning)
+                      : snprintf(out + used, size - used, "%sbit %u (%s)", runs ? ", " : "", b, m->meaning);
+            used += w > 0 && (size_t)w < size - used ? (size_t)w : 0;
+            *run_first = runs == 0 ? b : *run_first;
+            *run_last = e;
+            runs++;
+            b = e;
+        }
+    }
+    return runs;
+}
+
+/* For each robot and mask field it sends: the defined bits no signal carries. */
+static void notice_dropped_bits(struct can_map *map)
+{
+    for (size_t i = 0; i < map->notice_count; i++) {
+        free(map->notices[i]);
+    }
+    map->notice_count = 0;
+    for (size_t r = 0; r < map->robot_count; r++) {
+        for (int field = 0; field < URRT_FIELD_COUNT; field++) {
+            struct can_map_loc at;
+            uint64_t carried = carried_bits(map, r, field, &at);
+            char runs[256], text[400];
+            unsigned first = 0, last = 0;
+            int n;
+            if (at.line == 0 || (n = missing_runs(field, carried, runs, sizeof runs, &first, &last)) == 0) {
+                continue;
+            }
+            int used = snprintf(text, sizeof text, "%s%s%s: %s %s not carried", urrt_field((urrt_field_id)field)->name,
+                                map->robot_count > 1 ? " of robot " : "",
+                                map->robot_count > 1 ? map->robots[r].name : "", runs,
+                                n > 1 || last > first ? "are" : "is");
+            if (n == 1 && used > 0 && (size_t)used < sizeof text) {
+                /* One run: the bits= that would carry it. */
+                char bits[24];
+                snprintf(bits, sizeof bits, last > first ? "%u-%u" : "%u", first, last);
+                snprintf(text + used, sizeof text - (size_t)used, " (bits=%s in a signal would carry %s)", bits,
+                         last > first ? "them" : "it");
+            }
+            add_notice(map, at, text);
+        }
+    }
+}
+
 int can_map_finish(struct can_map *map, const struct can_map_robot *robots, size_t robot_count, char *err,
                    size_t errlen)
 {
@@ -1240,5 +1437,6 @@ int can_map_finish(struct can_map *map, const struct can_map_robot *robots, size
         map->finished = false;
         return -1;
     }
+    notice_dropped_bits(map);
     return 0;
 }

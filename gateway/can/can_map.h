@@ -61,7 +61,8 @@ struct can_map_signal {
     enum can_map_role role;
     int field;               /* urrt_field_id for CAN_MAP_ROLE_FIELD */
     unsigned elem;
-    bool bitmask;            /* field coded as a bit mask (unit "bits"): sent as the integer mask */
+    bool bitmask;            /* field coded as a bit mask (unit "bits"): its bits sent as they are,
+                                never scaled or clamped (sigs[i] has URRT_CAN_SIG_MASK(first)) */
     struct can_map_loc loc;
 };
 
@@ -184,6 +185,9 @@ struct can_map {
     /* File names seen, each stored once (struct can_map_loc points here). */
     char **files;
     size_t file_count;
+    /* What can_map_finish noticed in a valid map, as "FILE:LINE: text". */
+    char **notices;
+    size_t notice_count;
 };
 
 /* An empty map with the keys' defaults (can_map_can_keys' def). */
@@ -218,6 +222,18 @@ int can_map_finish(struct can_map *map, const struct can_map_robot *robots, size
                    size_t errlen);
 
 bool can_map_enabled(const struct can_map *map);
+
+/*
+ * Notices of a finished map: what a valid configuration does that its
+ * author may not mean, for --check-config and the log at start (level
+ * notice). Today: the bits of a bit-mask field that UR defines and no
+ * signal of a robot carries, with their meaning, e.g. "t.ini:9:
+ * digital_input_bits: bits 16-17 (tool inputs) are not carried (bits=16-17
+ * in a signal would carry them)". Each is "FILE:LINE: text"; i below
+ * can_map_notice_count().
+ */
+size_t can_map_notice_count(const struct can_map *map);
+const char *can_map_notice(const struct can_map *map, size_t i);
 
 /* The CAN link's configuration from [can]: interface, fd, and fd_brs (FD
  * frames switch to data_bitrate when it is above bitrate). cfg must hold

@@ -64,6 +64,14 @@ static void put_text(FILE *out, const char *text)
     }
 }
 
+/*
+ * A bit mask (URRT_CAN_SIG_BITMASK) has factor 1, offset 0 and its whole
+ * unsigned range, [0|2^length-1], as its limits (can_map gives it no other):
+ * read as written, that limits nothing, in every tool. [0|0] means "no
+ * range" only by a convention some tools keep; canmatrix takes it as
+ * written (it computes limits only where the file gives none), min 0 and
+ * max 0, and so would any importer that checks values against it.
+ */
 static void put_signal(FILE *out, const char *name, const urrt_can_signal *sig, const char *unit,
                        const char *receiver)
 {
@@ -137,7 +145,8 @@ static unsigned cycle_ms(const struct can_map *map, const struct can_map_frame *
     return DBC_UNKNOWN_ROBOT_CYCLE_MS;
 }
 
-static void put_field_comment(FILE *out, unsigned long id, const struct can_map *map, const struct can_map_signal *m)
+static void put_field_comment(FILE *out, unsigned long id, const struct can_map *map, const struct can_map_signal *m,
+                              const urrt_can_signal *sig)
 {
     const urrt_field_info *info = urrt_field((urrt_field_id)m->field);
     urrt_enum_kind kind = urrt_field_enum((urrt_field_id)m->field, map->generation);
@@ -165,7 +174,8 @@ static void put_field_comment(FILE *out, unsigned long id, const struct can_map 
     }
     fprintf(out, " (%s)", column);
     if (m->bitmask) {
-        fprintf(out, "; the bit mask as an integer, bit 0 = input/output 0");
+        fprintf(out, "; a bit mask, sent bit for bit (never scaled or saturated): bit n of this signal is bit %u+n "
+                     "of the field, whose bit 0 is input/output 0", URRT_CAN_SIG_MASK_FIRST(sig->flags));
     }
     if (kind != URRT_ENUM_NONE && m->field == URRT_F_ROBOT_MODE) {
         fprintf(out, "; value table for %s numbering ([can] robot_generation)",
@@ -247,7 +257,7 @@ static void put_frame_comment(FILE *out, const struct can_map *map, const struct
     for (size_t k = 0; k < f->count; k++) {
         const struct can_map_signal *m = &f->meta[k];
         switch (m->role) {
-        case CAN_MAP_ROLE_FIELD: put_field_comment(out, id, map, m); break;
+        case CAN_MAP_ROLE_FIELD: put_field_comment(out, id, map, m, &f->sigs[k]); break;
         case CAN_MAP_ROLE_ALIVE:
             fprintf(out, "CM_ SG_ %lu %s \"Alive counter: +1 modulo 16 with every frame sent\";\n", id, m->name);
             break;

@@ -471,6 +471,221 @@ static void test_round_trip(void)
     CHECK(bad_checked == 0, "%d of 40000 word-wide writes differ from urrt_can_pack / urrt_can_put_raw", bad_checked);
 }
 
+/* ---- lib: bit masks ------------------------------------------------------------------ */
+
+/* A bit mask signal of `length` bits carrying the mask's bits from `first`. */
+static urrt_can_signal mask_make(unsigned start, unsigned length, unsigned first, urrt_can_byte_order order)
+{
+    urrt_can_signal s = sig_make(start, length, order, URRT_CAN_UNSIGNED, 1, 0);
+    s.flags = (uint8_t)URRT_CAN_SIG_MASK(first);
+    return s;
+}
+
+/* What a signal carrying bits first .. first + length - 1 of mask holds,
+ * worked out here bit by bit (not as urrt_can shifts and masks). */
+static uint64_t mask_bits(uint64_t mask, unsigned first, unsigned length)
+{
+    uint64_t out = 0;
+    unsigned i;
+    for (i = 0; i < length && first + i < 64; i++) {
+        out |= ((mask >> (first + i)) & 1u) << i;
+    }
+    return out;
+}
+
+static double double_with_bits(uint64_t bits)
+{
+    double d;
+    memcpy(&d, &bits, sizeof d);
+    return d;
+}
+
+/* Every pattern of the 18 bits UR defines for the digital inputs and
+ * outputs (8 standard, 8 configurable, 2 tool) through every width 1..64
+ * from bit 0, and through the tool bits (16-17), the configurable ones
+ * (8-15) and bits 4-20: the signal holds exactly its bits, whatever else is
+ * set, never saturated. The widths' expected values come from mask_bits'
+ * loop, once per pattern. */
+static void masks_every_pattern(void)
+{
+    static const unsigned ranges[][2] = {{16, 2}, {8, 8}, {4, 17}, {17, 1}};
+    urrt_can_signal widths[64 + 4];
+    urrt_can_scale scales[64 + 4];
+    unsigned k;
+    uint64_t p;
+    long bad = 0;
+    for (k = 0; k < 64; k++) {
+        widths[k] = mask_make(0, k + 1, 0, URRT_CAN_INTEL);
+    }
+    for (k = 0; k < 4; k++) {
+        widths[64 + k] = mask_make(0, ranges[k][1], ranges[k][0], URRT_CAN_INTEL);
+    }
+    for (k = 0; k < 64 + 4; k++) {
+        CHECK_EQ_INT(urrt_can_scale_prepare(&widths[k], &scales[k]), 0);
+    }
+    for (p = 0; p < (UINT64_C(1) << 18); p++) {
+        for (k = 0; k < 64 + 4; k++) {
+            unsigned first = k < 64 ? 0 : ranges[k - 64][0];
+            uint64_t want = mask_bits(p, first, widths[k].length);
+            uint64_t raw = ~UINT64_C(0);
+            int outcome = urrt_can_to_raw_scaled(&widths[k], &scales[k], (double)p, &raw);
+            if ((raw != want || outcome != URRT_CAN_PACK_OK) && bad++ < 5) {
+                fprintf(stderr, "mask 0x%05llX, bits %u..%u: raw 0x%llX outcome %d, want 0x%llX\n",
+                        (unsigned long long)p, first, first + widths[k].length - 1, (unsigned long long)raw, outcome,
+                        (unsigned long long)want);
+            }
+        }
+    }
+    CHECK(bad == 0, "%ld of 2^18 x 68 masks packed wrong", bad);
+}
+
+/* Random masks over the 53 bits a double holds exactly, as UR's doubles
+ * and as raw int64s read as doubles (below 2^52: subnormal), through
+ * random widths and first bits, Intel and Motorola, read back from the
+ * payload bit by bit here; bits outside the signal keep their value. */
+static void masks_random(void)
+{
+    long bad = 0;
+    int n;
+    for (n = 0; n < 20000; n++) {
+        unsigned length = (unsigned)(test_rng() % 64) + 1;
+        unsigned first = (unsigned)(test_rng() % (65 - length));
+        urrt_can_byte_order order = test_rng() % 2 ? URRT_CAN_MOTOROLA : URRT_CAN_INTEL;
+        urrt_can_signal s = mask_make(0, length, first, order);
+        uint64_t mask = test_rng() >> (11 + test_rng() % 53); /* 0 .. 2^53 - 1, all bit lengths */
+        bool raw_int64 = n % 4 == 0 && mask < (UINT64_C(1) << 52);
+        uint64_t want = mask_bits(mask, first, length);
+        uint8_t data[64];
+        uint8_t before[64];
+        unsigned lsb;
+        unsigned i;
+        uint64_t got = 0;
+        int outcome;
+        bool outside_kept = true;
+        do {
+            s.start = (uint16_t)(test_rng() % 512);
+        } while (urrt_can_signal_check(&s, 64) != 0);
+        for (i = 0; i < 64; i++) {
+            before[i] = data[i] = (uint8_t)test_rng();
+        }
+        outcome = urrt_can_pack_checked(&s, raw_int64 ? double_with_bits(mask) : (double)mask, data);
+        urrt_can_signal_span(&s, &lsb, NULL, NULL);
+        /* The signal's bits in payload order (docs: Intel up from lsb; Motorola
+         * up from lsb within a byte, then on at bit 0 of the byte before). */
+        for (i = 0; i < length; i++) {
+            unsigned up = lsb % 8u + i; /* Motorola: bits up from lsb's, then the byte before */
+            unsigned at = order == URRT_CAN_INTEL ? lsb + i : (lsb / 8u - up / 8u) * 8u + up % 8u;
+            got |= (uint64_t)((data[at / 8u] >> (at % 8u)) & 1u) << i;
+            before[at / 8u] = (uint8_t)(before[at / 8u] & ~(1u << (at % 8u)));
+            data[at / 8u] = (uint8_t)(data[at / 8u] & ~(1u << (at % 8u)));
+        }
+        outside_kept = memcmp(before, data, sizeof data) == 0;
+        if ((got != want || outcome != URRT_CAN_PACK_OK || !outside_kept) && bad++ < 5) {
+            fprintf(stderr, "mask 0x%llX%s, bits %u..%u @%u %s: 0x%llX outcome %d, want 0x%llX%s\n",
+                    (unsigned long long)mask, raw_int64 ? " (raw int64)" : "", first, first + length - 1, s.start,
+                    order == URRT_CAN_INTEL ? "intel" : "motorola", (unsigned long long)got, outcome,
+                    (unsigned long long)want, outside_kept ? "" : ", other bits changed");
+        }
+    }
+    CHECK(bad == 0, "%ld of 20000 random masks packed wrong", bad);
+}
+
+/* A value that is no mask is NaN's case: 0, or invalid_raw, outcome NAN. */
+static void masks_not_a_mask(void)
+{
+    urrt_can_signal m = mask_make(0, 16, 0, URRT_CAN_INTEL);
+    CHECK_RAW(m, 65552.0, 0x0010, URRT_CAN_PACK_OK); /* the issue: input 4 and tool input 0 */
+    CHECK_RAW(m, 65535.0, 0xFFFF, URRT_CAN_PACK_OK);
+    CHECK_RAW(m, -0.0, 0, URRT_CAN_PACK_OK);
+    CHECK_RAW(m, 9007199254740992.0, 0, URRT_CAN_PACK_OK);          /* 2^53: bit 53 only */
+    CHECK_RAW(m, double_with_bits(0x10005), 5, URRT_CAN_PACK_OK); /* a raw int64 read as a double */
+    CHECK_RAW(m, 9007199254740994.0, 0, URRT_CAN_PACK_NAN);         /* past 2^53 */
+    CHECK_RAW(m, 18446744073709551616.0, 0, URRT_CAN_PACK_NAN);
+    CHECK_RAW(m, -1.0, 0, URRT_CAN_PACK_NAN);
+    CHECK_RAW(m, 0.5, 0, URRT_CAN_PACK_NAN);
+    CHECK_RAW(m, 65552.5, 0, URRT_CAN_PACK_NAN);
+    CHECK_RAW(m, NAN, 0, URRT_CAN_PACK_NAN);
+    CHECK_RAW(m, INFINITY, 0, URRT_CAN_PACK_NAN);
+    CHECK_RAW(m, -INFINITY, 0, URRT_CAN_PACK_NAN);
+    m.flags |= URRT_CAN_SIG_INVALID_RAW;
+    m.invalid_raw = 0xFFFF;
+    CHECK_RAW(m, -1.0, 0xFFFF, URRT_CAN_PACK_NAN);
+    CHECK_RAW(m, NAN, 0xFFFF, URRT_CAN_PACK_NAN);
+    CHECK_RAW(m, 3.0, 3, URRT_CAN_PACK_OK);
+}
+
+/* A mask is unsigned, factor 1, offset 0, inside 64 bits; no other flag
+ * bits. Its range is the raw type's. */
+static void masks_descriptors(void)
+{
+    urrt_can_signal m = mask_make(0, 8, 56, URRT_CAN_INTEL);
+    urrt_can_signal bad;
+    double lo;
+    double hi;
+    CHECK_EQ_INT(urrt_can_signal_check(&m, 8), 0);
+    CHECK_EQ_INT(URRT_CAN_SIG_MASK_FIRST(m.flags), 56);
+    CHECK_EQ_INT(urrt_can_signal_range(&m, &lo, &hi), 0);
+    CHECK(lo == 0 && hi == 255, "mask range %g..%g", lo, hi);
+    bad = mask_make(0, 8, 57, URRT_CAN_INTEL);
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+    bad = m;
+    bad.factor = 2;
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+    bad = m;
+    bad.offset = 1;
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+    bad = m;
+    bad.offset = -0.0;
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), 0);
+    bad = m;
+    bad.type = URRT_CAN_SIGNED;
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+    bad = sig_make(0, 8, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 1, 0);
+    bad.flags = (uint8_t)(URRT_CAN_SIG_MASK(1) & ~URRT_CAN_SIG_BITMASK); /* a first bit without the flag */
+    CHECK_EQ_INT(urrt_can_signal_check(&bad, 8), URRT_CAN_E_SIGNAL);
+    /* min and max are not a mask's: narrow ones clamp nothing. */
+    m = mask_make(0, 16, 0, URRT_CAN_INTEL);
+    m.max = 1;
+    CHECK_RAW(m, 65552.0, 0x0010, URRT_CAN_PACK_OK);
+}
+
+/* urrt_can reads a mask by urrt_bitmask's rule, written again on the bits:
+ * the two agree on every exponent (both signs, fractions, the edges at 1,
+ * 2^52, 2^53, 2^54, subnormals, infinities, NaNs) and random mantissas. */
+static void masks_as_urrt_bitmask(void)
+{
+    urrt_can_signal m = mask_make(0, 64, 0, URRT_CAN_INTEL);
+    long bad = 0;
+    unsigned exponent;
+    int n;
+    for (exponent = 0; exponent < 4096; exponent++) {
+        for (n = 0; n < 64; n++) {
+            uint64_t fraction = n < 3 ? (uint64_t)n : (test_rng() >> 12) >> (test_rng() % 52) << (test_rng() % 52);
+            uint64_t bits = (uint64_t)exponent << 52 | (fraction & UINT64_C(0xFFFFFFFFFFFFF));
+            uint64_t want = 0;
+            uint64_t raw = 0;
+            int ok = urrt_bitmask(double_with_bits(bits), &want) == URRT_OK;
+            int outcome = urrt_can_to_raw(&m, double_with_bits(bits), &raw);
+            if ((ok ? outcome != URRT_CAN_PACK_OK || raw != want : outcome != URRT_CAN_PACK_NAN || raw != 0) &&
+                bad++ < 5) {
+                fprintf(stderr, "mask of %016llX: raw 0x%llX outcome %d; urrt_bitmask %s 0x%llX\n",
+                        (unsigned long long)bits, (unsigned long long)raw, outcome, ok ? "gives" : "refuses",
+                        (unsigned long long)want);
+            }
+        }
+    }
+    CHECK(bad == 0, "%ld of 4096 x 64 doubles read as masks unlike urrt_bitmask", bad);
+}
+
+static void test_masks(void)
+{
+    masks_descriptors();
+    masks_as_urrt_bitmask();
+    masks_not_a_mask();
+    masks_every_pattern();
+    masks_random();
+}
+
 /* ---- lib: layout, lengths, ids, bits on the wire --------------------------------- */
 
 static void test_layout(void)
@@ -545,6 +760,7 @@ int main(void)
     test_placement();
     test_values();
     test_round_trip();
+    test_masks();
     test_layout();
     test_frame_bits();
     return check_report();

@@ -188,7 +188,35 @@ static const struct rejection rejections[] = {
     {CAN_HEAD "[frame a]\nsignal = q_actual @0|16 intel signed\n",
      "t.ini:5: signal: q_actual has 6 elements: write q_actual[0] .. q_actual[5]"},
     {CAN_HEAD "[frame a]\nsignal = q_wrong[0] @0|16 intel signed\n", "t.ini:5: signal: no field 'q_wrong'"},
-    {CAN_HEAD "[frame a]\nsignal = time @0|65 intel unsigned\n", "t.ini:5: signal: length 65: give 1..64 bits"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|65 intel unsigned\n",
+     "t.ini:5: [frame a] signal 'time': length 65: give 1..64 bits"},
+    {CAN_HEAD "[frame a]\nsignal = q_actual[2] @0|0 intel signed name=q2\n",
+     "t.ini:5: [frame a] signal 'q_actual[2]': length 0: give 1..64 bits"},
+    /* Bit masks (fields of unit "bits") are sent bit for bit. */
+    {CAN_HEAD "[frame a]\nsignal = digital_input_bits @0|16 intel unsigned factor=2\n",
+     "t.ini:5: signal: digital_input_bits is a bit mask, sent bit for bit: remove factor= (bits=FIRST-LAST picks"},
+    {CAN_HEAD "[frame a]\nsignal = digital_outputs @0|16 intel unsigned offset=1\n",
+     "t.ini:5: signal: digital_outputs is a bit mask, sent bit for bit: remove offset="},
+    {CAN_HEAD "[frame a]\nsignal = digital_outputs @0|16 intel unsigned min=0\n",
+     "t.ini:5: signal: digital_outputs is a bit mask, sent bit for bit: remove min="},
+    {CAN_HEAD "[frame a]\nsignal = digital_input_bits @0|16 intel unsigned max=65535\n",
+     "t.ini:5: signal: digital_input_bits is a bit mask, sent bit for bit: remove max="},
+    {CAN_HEAD "[frame a]\nsignal = digital_input_bits @0|16 intel signed\n",
+     "t.ini:5: signal: digital_input_bits is a bit mask: its type is unsigned, not signed"},
+    {CAN_HEAD "[frame a]\nsignal = digital_outputs @0|32 intel float32\n",
+     "t.ini:5: signal: digital_outputs is a bit mask: its type is unsigned, not float32"},
+    {CAN_HEAD "[frame a]\nsignal = digital_input_bits @0|4 intel unsigned bits=16-17\n",
+     "t.ini:5: signal: bits=16-17 are 2 bits, but the signal has 4: make them agree"},
+    {CAN_HEAD "[frame a]\nsignal = digital_input_bits @0|2 intel unsigned bits=17\n",
+     "t.ini:5: signal: bits=17-17 is 1 bit, but the signal has 2: make them agree"},
+    {CAN_HEAD "[frame a]\nsignal = digital_input_bits @0|1 intel unsigned bits=17-16\n",
+     "t.ini:5: signal: bits = '17-16': give FIRST-LAST with 0 <= FIRST <= LAST <= 63"},
+    {CAN_HEAD "[frame a]\nsignal = digital_input_bits @0|1 intel unsigned bits=64\n",
+     "t.ini:5: signal: bits = '64': give FIRST-LAST with 0 <= FIRST <= LAST <= 63"},
+    {CAN_HEAD "[frame a]\nsignal = digital_input_bits @0|1 intel unsigned bits=-3\n",
+     "t.ini:5: signal: bits = '-3': give the mask's bits as FIRST-LAST (16-17) or one BIT"},
+    {CAN_HEAD "[frame a]\nsignal = time @0|8 intel unsigned bits=0-7\n",
+     "t.ini:5: signal: bits= is for bit masks (fields of unit bits, such as digital_input_bits), not time"},
     {CAN_HEAD "[frame a]\nsignal = time @512|8 intel unsigned\n", "t.ini:5: signal: start bit 512"},
     {CAN_HEAD "[frame a]\nsignal = time 0|8 intel unsigned\n", "t.ini:5: signal: '0|8': expected @START|LENGTH"},
     {CAN_HEAD "[frame a]\nsignal = time @0|16 intel float32\n", "t.ini:5: signal: float32 needs length 32, not 16"},
@@ -969,6 +997,143 @@ static void test_config_mutations(void)
     CHECK(accepted > 50 && rejected > 1000, "mutations: %d accepted, %d rejected", accepted, rejected);
 }
 
+/* ---- bit masks -------------------------------------------------------------------------- */
+
+/* A bit-mask field's signals: the mask kind whatever the field's name (its
+ * unit is "bits"), the bits= range, the notices of bits no signal carries. */
+static const struct {
+    const char *signals; /* [frame a]'s signal lines */
+    const char *notices; /* every notice, '|'-separated */
+} mask_cases[] = {
+    {"signal = digital_input_bits @0|18 intel unsigned\n", ""},
+    {"signal = digital_input_bits @0|16 intel unsigned\n",
+     "t.ini:8: digital_input_bits: bits 16-17 (tool inputs) are not carried (bits=16-17 in a signal would carry "
+     "them)"},
+    {"signal = digital_input_bits @0|16 intel unsigned name=din\n"
+     "signal = digital_input_bits @16|2 intel unsigned bits=16-17 name=tool\n", ""},
+    {"signal = digital_input_bits @0|14 intel unsigned bits=4-17\n",
+     "t.ini:8: digital_input_bits: bits 0-3 (standard inputs) are not carried (bits=0-3 in a signal would carry "
+     "them)"},
+    {"signal = digital_outputs @0|4 motorola unsigned\nsignal = digital_outputs @8|1 intel unsigned bits=16 name=t\n",
+     "t.ini:8: digital_outputs: bits 4-7 (standard outputs), bits 8-15 (configurable outputs), bit 17 (tool "
+     "outputs) are not carried"},
+    {"signal = robot_mode @0|8 intel signed\nsignal = digital_outputs @8|17 intel unsigned\n"
+     "signal = digital_input_bits @32|8 intel unsigned bits=10-17\n",
+     "t.ini:10: digital_input_bits: bits 0-7 (standard inputs), bits 8-9 (configurable inputs) are not carried|"
+     "t.ini:9: digital_outputs: bit 17 (tool outputs) is not carried (bits=17 in a signal would carry it)"},
+};
+
+static void masks_notices(void)
+{
+    for (size_t i = 0; i < sizeof mask_cases / sizeof mask_cases[0]; i++) {
+        struct can_map map;
+        char err[2048] = "", text[1024], all[1024] = "";
+        snprintf(text, sizeof text, CAN_HEAD "\n[frame a]\nid = 0x100\nperiod_ms = 10\n%s", mask_cases[i].signals);
+        CHECK(load(&map, text, one_robot, 1, err, sizeof err) == 0, "mask case %zu: %s", i, err);
+        for (size_t k = 0; k < can_map_notice_count(&map); k++) {
+            snprintf(all + strlen(all), sizeof all - strlen(all), "%s%s", k ? "|" : "", can_map_notice(&map, k));
+        }
+        CHECK(strcmp(all, mask_cases[i].notices) == 0, "mask case %zu notices:\n  got:  %s\n  want: %s", i, all,
+              mask_cases[i].notices);
+        for (size_t k = 0; map.frame_count == 1 && k < map.frames[0].count; k++) {
+            const struct can_map_signal *m = &map.frames[0].meta[k];
+            const urrt_can_signal *sig = &map.frames[0].sigs[k];
+            bool mask = m->field == URRT_F_DIGITAL_INPUT_BITS || m->field == URRT_F_DIGITAL_OUTPUTS;
+            CHECK(m->bitmask == mask && ((sig->flags & URRT_CAN_SIG_BITMASK) != 0) == mask,
+                  "mask case %zu signal %zu: a mask exactly when the field's unit is bits", i, k);
+            CHECK(!mask || (sig->factor == 1 && sig->offset == 0 && sig->min == 0 &&
+                            sig->max == ldexp(1, sig->length) - 1),
+                  "mask case %zu signal %zu: factor 1, offset 0, the whole unsigned range", i, k);
+        }
+        unload(&map);
+    }
+}
+
+/* The 1-based number of the first line of path that starts with prefix (0: none). */
+static int line_of(const char *path, const char *prefix)
+{
+    char line[512];
+    int n = 0;
+    FILE *f = fopen(path, "r");
+    while (f != NULL && fgets(line, sizeof line, f) != NULL) {
+        n++;
+        if (strncmp(line, prefix, strlen(prefix)) == 0) {
+            fclose(f);
+            return n;
+        }
+    }
+    if (f != NULL) {
+        fclose(f);
+    }
+    return 0;
+}
+
+/* The issue's case, through docs/examples/canopen.ini as the gateway loads
+ * it: digital inputs 65552 (input 4 and tool input 0) in TPDO4's 16-bit
+ * signal at bytes 3-4 are 0x0010, not 65535 ("all sixteen on"), and not
+ * counted as clamped; the notice says the tool bits are not carried. */
+static void masks_canopen_example(void)
+{
+    char want[512];
+    gw_config cfg;
+    urrt_state st;
+    char *messages = NULL;
+    size_t size = 0;
+    FILE *out = open_memstream(&messages, &size);
+    int errors = gw_config_load(&cfg, "docs/examples/canopen.ini", out);
+    bool found = false;
+    fclose(out);
+    CHECK(errors == 0, "canopen.ini loads: %s", messages);
+    free(messages);
+    if (errors != 0) {
+        gw_config_free(&cfg);
+        return;
+    }
+    snprintf(want, sizeof want, "docs/examples/canopen.ini:%d: digital_input_bits: bits 16-17 (tool inputs) are not "
+             "carried (bits=16-17 in a signal would carry them)", line_of("docs/examples/canopen.ini",
+                                                                          "signal = digital_input_bits "));
+    CHECK_EQ_INT(can_map_notice_count(&cfg.can), 2);
+    CHECK_EQ_STR(can_map_notice(&cfg.can, 0), want);
+    memset(&cap, 0, sizeof cap);
+    can_run_start(cfg.can_run, 0);
+    urrt_state_clear(&st);
+    st.generation = URRT_GEN_3X;
+    for (int k = 0; k < 6; k++) {
+        st.q_actual[k] = 0.5;
+        st.tool_vector_actual[k] = 0.25;
+    }
+    st.speed_scaling[0] = 1;
+    st.robot_mode[0] = 7;
+    st.safety_mode[0] = 1;
+    st.program_state[0] = 2;
+    st.digital_input_bits[0] = 65552.0;
+    st.digital_outputs[0] = 131071.0; /* 0x1FFFF: tool output 0 and all sixteen */
+    st.present = (UINT64_C(1) << URRT_F_DIGITAL_INPUT_BITS) | (UINT64_C(1) << URRT_F_DIGITAL_OUTPUTS) |
+                 (UINT64_C(1) << URRT_F_Q_ACTUAL) | (UINT64_C(1) << URRT_F_TOOL_VECTOR_ACTUAL) |
+                 (UINT64_C(1) << URRT_F_SPEED_SCALING) | (UINT64_C(1) << URRT_F_ROBOT_MODE) |
+                 (UINT64_C(1) << URRT_F_SAFETY_MODE) | (UINT64_C(1) << URRT_F_PROGRAM_STATE);
+    urrt_cantx_on_packet(can_run_tx(cfg.can_run), 0, &st, 1000);
+    can_run_due(cfg.can_run, 1000, NULL, capture_frame, &cap);
+    for (size_t i = 0; i < cap.n; i++) {
+        if (cap.s[i].f.id == 0x485) {
+            found = true;
+            CHECK(bits_of(&cap.s[i].f, 24, 16) == 0x0010, "TPDO4 din: 0x%04llX, want 0x0010",
+                  (unsigned long long)bits_of(&cap.s[i].f, 24, 16));
+            CHECK(bits_of(&cap.s[i].f, 40, 16) == 0xFFFF, "TPDO4 dout: 0x%04llX, want 0xFFFF",
+                  (unsigned long long)bits_of(&cap.s[i].f, 40, 16));
+        }
+    }
+    CHECK(found, "TPDO4 (0x485) sent");
+    CHECK_EQ_INT(can_run_clamped(cfg.can_run), 0);
+    gw_config_free(&cfg);
+}
+
+static void test_masks(void)
+{
+    masks_notices();
+    masks_canopen_example();
+}
+
 /* DBC text spot checks (the full comparison is check-can-dbc). */
 static void test_dbc_text(void)
 {
@@ -1016,6 +1181,7 @@ int main(void)
     test_validity_and_heartbeat();
     test_heartbeat_rate();
     test_config_mutations();
+    test_masks();
     test_dbc_text();
     return check_report();
 }

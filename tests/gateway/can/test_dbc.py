@@ -143,6 +143,10 @@ def parse_signal(value):
     sig['max'] = float(explicit['max']) if 'max' in explicit else hi
     if 'invalid' in explicit:
         sig['invalid'] = int(explicit['invalid'], 0) & ((1 << length) - 1)
+    # A field of unit "bits" is a bit mask: bits=FIRST-LAST (or one BIT) says
+    # which of its bits the signal carries, from bit 0 by default.
+    sig['mask'] = FIELDS[field]['unit'] == 'bits'
+    sig['first'] = int(explicit.get('bits', '0').split('-')[0])
     if FIELDS[field]['count'] > 1:
         sig['name'] = explicit.get('name', '%s_%d' % (field, elem))
     else:
@@ -248,11 +252,29 @@ def round_half_away(x):
     return n if f >= 0 else -n
 
 
+def mask_of(v):
+    """The bit mask a double holds, as UR sends one (docs/protocol.md), or None:
+    a non-negative integer up to 2^53, or a raw int64 read as a double (sign
+    and exponent bits all zero: a subnormal, or zero)."""
+    bits = struct.unpack('<Q', struct.pack('<d', v))[0]
+    if bits >> 52 == 0:
+        return bits
+    if math.isfinite(v) and v >= 0 and v == int(v) and v <= 2 ** 53:
+        return int(v)
+    return None
+
+
 def ref_to_raw(sig, v):
     """(raw value as canmatrix takes it: signed int or float, raw bits, outcome)."""
     n = sig['length']
     mask = (1 << n) - 1
     t = sig['type']
+    if sig.get('mask'):
+        m = mask_of(v)
+        if m is None:  # no mask: as NaN, the invalid raw or no bit set
+            bits = sig['invalid'] if sig['invalid'] is not None else 0
+            return bits, bits, 2
+        return (m >> sig['first']) & mask, (m >> sig['first']) & mask, 0
     if math.isnan(v):
         if sig['invalid'] is not None:
             bits = sig['invalid']
@@ -428,6 +450,8 @@ def random_signal(rng, frame_bits, taken, index):
         if any(p < 0 or p >= frame_bits for p in pos) or taken.intersection(pos):
             continue
         taken.update(pos)
+        if t == 'unsigned' and rng.random() < 0.3:
+            return random_mask_signal(rng, sig, index)
         if t in ('float32', 'float64') or n > 48:
             factor, offset = (1.0, 0.0) if n > 48 and t not in ('float32', 'float64') else \
                 (rng.choice([1.0, 2.0, 0.5]), rng.choice([0.0, 1.0]))
@@ -449,6 +473,19 @@ def random_signal(rng, frame_bits, taken, index):
             words.append('invalid=%d' % rng.randrange(1 << n))
         return ' '.join(words)
     return None
+
+
+def random_mask_signal(rng, sig, index):
+    """A bit-mask field in the place chosen: its bits from a random first one."""
+    n = sig['length']
+    first = rng.randrange(65 - n)
+    words = [rng.choice(['digital_input_bits', 'digital_outputs']), '@%d|%d' % (sig['start'], n), sig['order'],
+             'unsigned', 'name=s%d' % index]
+    if first > 0 or rng.random() < 0.3:
+        words.append('bits=%d-%d' % (first, first + n - 1) if n > 1 or rng.random() < 0.5 else 'bits=%d' % first)
+    if rng.random() < 0.3:
+        words.append('invalid=%d' % rng.randrange(1 << n))
+    return ' '.join(words)
 
 
 def random_config(rng, path, nframes):
@@ -484,10 +521,22 @@ def at_period(path, work, period_us):
     return out
 
 
+def mask_values(rng):
+    """Masks of the digital I/O's 18 bits and of up to 53, as doubles and as raw
+    int64s read as doubles; values that are no mask."""
+    out = [float(rng.randrange(1 << 18)) for _ in range(4)]
+    out += [float(rng.randrange(1 << rng.randrange(1, 54))) for _ in range(4)]
+    out += [struct.unpack('<d', struct.pack('<Q', rng.randrange(1 << 52)))[0], 2.0 ** 53, 65552.0]
+    out += [-1.0, 0.5, 2.0 ** 53 + 2, 2.0 ** 64, -0.0, math.nan, math.inf, -math.inf]
+    return out
+
+
 def values_for(rng, sig):
     """Physical values a packer must handle: raw-exact, random, out of range, specials."""
     lo, hi = raw_range(sig)
     t = sig['type']
+    if sig.get('mask'):
+        return mask_values(rng)
     out = []
     for _ in range(6):
         if t in ('float32', 'float64'):
@@ -611,8 +660,8 @@ def test_canopen_run(tool, work):
             v = {'q_actual[%d]' % j: rng.uniform(-6.2, 6.2) for j in range(6)}
             v.update({'tool_vector_actual[%d]' % j: rng.uniform(-1.3, 1.3) for j in range(3)})
             v.update({'speed_scaling': rng.uniform(0, 1), 'robot_mode': 7.0, 'safety_mode': 1.0,
-                      'program_state': 2.0, 'digital_input_bits': float(rng.randrange(1 << 16)),
-                      'digital_outputs': float(rng.randrange(1 << 16))})
+                      'program_state': 2.0, 'digital_input_bits': float(rng.randrange(1 << 18)),
+                      'digital_outputs': float(rng.randrange(1 << 18))})
             packets.append((t, v))
             script.append('packet %d arm1 %s' % (t, ' '.join('%s=%r' % kv for kv in v.items())))
         elif t == 300000:
@@ -666,7 +715,10 @@ def test_canopen_run(tool, work):
                 key = '%s[%d]' % (s['field'], s['elem']) if FIELDS[s['field']]['count'] > 1 else s['field']
                 want = p[1][key]
                 got = float(dec[s['name']].phys_value)
-                values_ok &= abs(got - want) <= abs(step[s['name']]['factor']) / 2 + 1e-9
+                if s['mask']:  # the bits it carries, exactly, whatever else is set
+                    values_ok &= got == (int(want) >> s['first']) & ((1 << s['length']) - 1)
+                else:
+                    values_ok &= abs(got - want) <= abs(step[s['name']]['factor']) / 2 + 1e-9
         label = 'canopen %s' % f['name']
         check(len(sent) >= 2, '%s: sent' % label, len(sent))
         check(all(b - a == f['period'] * 1000 for a, b in zip(times, times[1:])
