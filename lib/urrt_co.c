@@ -8,7 +8,7 @@
 #define MAX_NODE_ID 127u
 #define MAX_TPDOS 512u
 #define ID_MASK 0x7FFu
-#define COB_RTR UINT32_C(0x40000000)   /* TPDO COB-ID bit 30: no RTR allowed (stored, never served) */
+#define COB_NO_RTR UINT32_C(0x40000000) /* TPDO COB-ID bit 30: no RTR allowed (the node serves none) */
 #define SYNC_DEFAULT 0x080u
 #define EMCY_BASE 0x080u
 #define SDO_RX_BASE 0x600u
@@ -141,18 +141,23 @@ static bool id_restricted(uint32_t id)
            (id >= 0x601u && id <= 0x67Fu) || (id >= 0x6E0u && id <= 0x6FFu) || id >= 0x701u;
 }
 
-/* A COB-ID with a "not valid" bit 31 (EMCY, TPDO): 11-bit ids only, the
- * id changes only while the old value is invalid (CiA 301: set bit 31,
- * write the new id, clear bit 31), and a valid id is not a restricted one. */
+/* A COB-ID with a "not valid" bit 31 (EMCY, TPDO): 11-bit ids only, and a
+ * valid one not restricted. The id may change in a write that leaves or
+ * makes the object invalid (CiA 301; python-canopen's PdoMap.save disables
+ * and moves a PDO in one write): only a new id while staying valid is
+ * refused, as CANopenNode does. */
 static uint32_t cob_check(uint32_t old, uint32_t value, uint32_t also_allowed)
 {
     if ((value & ~(URRT_CO_COB_INVALID | also_allowed | ID_MASK)) != 0u) {
         return URRT_CO_ABORT_VALUE;
     }
+    if (!cob_valid(value)) {
+        return 0;
+    }
     if (cob_valid(old) && ((old ^ value) & ID_MASK) != 0u) {
         return URRT_CO_ABORT_VALUE;
     }
-    return cob_valid(value) && id_restricted(value & ID_MASK) ? URRT_CO_ABORT_VALUE : 0u;
+    return id_restricted(value & ID_MASK) ? URRT_CO_ABORT_VALUE : 0u;
 }
 
 /* ---- checks, once --------------------------------------------------------------- */
@@ -188,7 +193,7 @@ static int check_tpdo(const urrt_co_desc *d, const urrt_cantx *tx, size_t n)
     if (p->transmission_type == 0u || (p->transmission_type > SYNC_MAX_N && p->transmission_type < TYPE_EVENT_MFR)) {
         return URRT_CO_E_TPDO;
     }
-    return p->cob_id != URRT_CO_COB_DEFAULT && cob_check(URRT_CO_COB_INVALID, p->cob_id, COB_RTR) != 0u
+    return p->cob_id != URRT_CO_COB_DEFAULT && cob_check(URRT_CO_COB_INVALID, p->cob_id, COB_NO_RTR) != 0u
                ? URRT_CO_E_TPDO
                : 0;
 }
@@ -316,6 +321,26 @@ static const urrt_co_tpdo *tpdo_desc(const urrt_co *co, size_t n)
     return &co->desc->tpdos[n];
 }
 
+static bool tpdo_event_driven(const urrt_co_tpdo_state *t)
+{
+    return t->type >= TYPE_EVENT_MFR;
+}
+
+/* Event timer 0 on a frame whose stale policy needs a period (invalid,
+ * ignore): urrt_cantx cannot send it per packet, so the node does, on each
+ * new robot data (tpdo_events); its own schedule stays closed. */
+static bool tpdo_on_packets(const urrt_co *co, size_t n)
+{
+    const urrt_cantx_frame *f = &co->tx->tables->frames[tpdo_desc(co, n)->frame];
+    return co->tpdos[n].event_ms == 0u && f->stale != (uint8_t)URRT_CANTX_STALE_STOP;
+}
+
+/* Whether the node may send TPDO n at all now. */
+static bool tpdo_live(const urrt_co *co, size_t n)
+{
+    return co->state == (uint8_t)URRT_CO_OPERATIONAL && cob_valid(co->tpdos[n].cob_id);
+}
+
 static void gates_apply(urrt_co *co)
 {
     bool operational = co->state == (uint8_t)URRT_CO_OPERATIONAL;
@@ -326,34 +351,31 @@ static void gates_apply(urrt_co *co)
     for (i = 0; i < co->desc->tpdo_count; i++) {
         const urrt_co_tpdo_state *t = &co->tpdos[i];
         urrt_cantx_gate(co->tx, tpdo_desc(co, i)->frame,
-                        operational && cob_valid(t->cob_id) && t->type >= TYPE_EVENT_MFR);
+                        tpdo_live(co, i) && tpdo_event_driven(t) && !t->inhibited && !tpdo_on_packets(co, i));
     }
 }
 
-/* The frame's period from the event timer and the inhibit time: the later
- * of the two (0: with every packet). Refused when the frame's stale policy
- * needs a period. */
-static uint32_t tpdo_timing(urrt_co *co, size_t n, uint16_t inhibit_100us, uint16_t event_ms, uint64_t now_us)
+/* The event timer (ms) as the frame's period; 0: no timer, the frame goes
+ * with each robot packet (by urrt_cantx, or by the node: tpdo_on_packets). */
+static void tpdo_event_timer(urrt_co *co, size_t n, uint16_t event_ms, uint64_t now_us)
 {
-    uint32_t event_us = (uint32_t)event_ms * 1000u;
-    uint32_t inhibit_us = (uint32_t)inhibit_100us * 100u;
     urrt_co_tpdo_state *t = &co->tpdos[n];
-    if (urrt_cantx_set_period(co->tx, tpdo_desc(co, n)->frame, event_us > inhibit_us ? event_us : inhibit_us,
-                              now_us) < 0) {
-        return URRT_CO_ABORT_TOO_LOW;
-    }
-    t->inhibit_100us = inhibit_100us;
+    size_t frame = tpdo_desc(co, n)->frame;
+    const urrt_cantx_robot *r = &co->tx->robots[co->tx->tables->frames[frame].robot];
     t->event_ms = event_ms;
-    return 0;
+    t->packet_us = r->has_data ? r->data_us : URRT_CANTX_NEVER; /* only data that comes from now on counts */
+    if (!tpdo_on_packets(co, n)) {
+        (void)urrt_cantx_set_period(co->tx, frame, (uint32_t)event_ms * 1000u, now_us);
+    }
 }
 
-static uint32_t tpdo_cob_default(const urrt_co *co, size_t n)
+uint32_t urrt_co_tpdo_cob_default(const urrt_co *co, size_t n)
 {
     const urrt_co_tpdo *p = tpdo_desc(co, n);
     if (p->cob_id != URRT_CO_COB_DEFAULT) {
-        return p->cob_id;
+        return p->cob_id | COB_NO_RTR;
     }
-    return n < 4u ? 0x180u + 0x100u * (uint32_t)n + co->desc->node_id : URRT_CO_COB_INVALID;
+    return COB_NO_RTR | (n < 4u ? 0x180u + 0x100u * (uint32_t)n + co->desc->node_id : URRT_CO_COB_INVALID);
 }
 
 static void tpdo_defaults(urrt_co *co, uint64_t now_us)
@@ -362,14 +384,89 @@ static void tpdo_defaults(urrt_co *co, uint64_t now_us)
     for (n = 0; n < co->desc->tpdo_count; n++) {
         const urrt_co_tpdo *p = tpdo_desc(co, n);
         urrt_co_tpdo_state *t = &co->tpdos[n];
-        /* A 32-bit division, at a reset only; urrt_co_init saw it fits. */
-        uint16_t event_ms = (uint16_t)(co->tx->tables->frames[p->frame].period_us / 1000u);
-        t->cob_id = tpdo_cob_default(co, n);
+        t->cob_id = urrt_co_tpdo_cob_default(co, n);
         t->type = p->transmission_type;
         t->syncs = 0;
+        t->inhibit_100us = p->inhibit_100us;
+        t->inhibited = false;
+        t->held = false;
+        t->sent_seen = (uint32_t)co->tx->frames[p->frame].sent;
         (void)urrt_cantx_set_id(co->tx, p->frame, t->cob_id & ID_MASK);
-        (void)tpdo_timing(co, n, p->inhibit_100us, event_ms, now_us);
+        /* A 32-bit division, at a reset only; urrt_co_init saw it fits. */
+        tpdo_event_timer(co, n, (uint16_t)(co->tx->tables->frames[p->frame].period_us / 1000u), now_us);
     }
+}
+
+/* After frames went out: an event-driven TPDO just sent opens its inhibit gap. */
+static void tpdo_sent(urrt_co *co, uint64_t now_us)
+{
+    bool changed = false;
+    size_t n;
+    for (n = 0; n < co->desc->tpdo_count; n++) {
+        urrt_co_tpdo_state *t = &co->tpdos[n];
+        uint32_t sent = (uint32_t)co->tx->frames[tpdo_desc(co, n)->frame].sent;
+        if (sent != t->sent_seen && t->inhibit_100us != 0u && tpdo_event_driven(t)) {
+            t->inhibited = true;
+            t->inhibit_end_us = now_us + (uint64_t)t->inhibit_100us * 100u;
+            changed = true;
+        }
+        t->sent_seen = sent;
+    }
+    if (changed) {
+        gates_apply(co);
+    }
+}
+
+/* Before urrt_cantx_run: what became due for each event-driven TPDO. A
+ * send due inside its inhibit gap is held; at the gap's end a held send
+ * goes out with the newest data (urrt_cantx_trigger). */
+static size_t tpdo_events(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    size_t sent = 0;
+    bool reopened = false;
+    size_t n;
+    for (n = 0; n < co->desc->tpdo_count; n++) {
+        urrt_co_tpdo_state *t = &co->tpdos[n];
+        size_t frame = tpdo_desc(co, n)->frame;
+        const urrt_cantx_frame_state *fs = &co->tx->frames[frame];
+        const urrt_cantx_robot *r = &co->tx->robots[co->tx->tables->frames[frame].robot];
+        if (!tpdo_event_driven(t)) {
+            continue;
+        }
+        if (tpdo_on_packets(co, n)) {
+            t->held = t->held || (r->has_data && r->data_us != t->packet_us);
+            t->packet_us = r->has_data ? r->data_us : t->packet_us;
+        } else if (t->inhibited && now_us < t->inhibit_end_us) {
+            /* urrt_cantx's send, due now: its closed gate lets it pass */
+            t->held = t->held || fs->pending || fs->next_due_us <= now_us;
+        }
+        if (t->inhibited && now_us < t->inhibit_end_us) {
+            continue;
+        }
+        reopened = reopened || t->inhibited;
+        t->inhibited = false;
+        if (t->held && tpdo_live(co, n)) {
+            sent += urrt_cantx_trigger(co->tx, frame, now_us, emit, ctx);
+        }
+        t->held = false;
+    }
+    tpdo_sent(co, now_us); /* so that urrt_cantx_run does not send them again at once */
+    if (reopened) {
+        gates_apply(co);
+    }
+    return sent;
+}
+
+/* When a held send is due: the earliest gap's end. */
+static uint64_t tpdo_deadline(const urrt_co *co)
+{
+    uint64_t next = URRT_CANTX_NEVER;
+    size_t n;
+    for (n = 0; n < co->desc->tpdo_count; n++) {
+        const urrt_co_tpdo_state *t = &co->tpdos[n];
+        next = t->held && t->inhibited ? min64(next, t->inhibit_end_us) : next;
+    }
+    return next;
 }
 
 /* No two valid TPDOs on one id. */
@@ -384,39 +481,41 @@ static bool tpdo_id_taken(const urrt_co *co, size_t n, uint32_t id)
     return false;
 }
 
+/* 0x1800+n sub 1, 2, 3, 5 (urrt_co_comm_table). */
 static uint32_t tpdo_write(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
 {
     urrt_co_tpdo_state *t = &co->tpdos[n];
-    uint32_t abort_code = 0;
     switch (sub) {
     case 1:
-        abort_code = cob_check(t->cob_id, value, COB_RTR);
-        if (abort_code == 0u && cob_valid(value) && tpdo_id_taken(co, n, value & ID_MASK)) {
-            abort_code = URRT_CO_ABORT_VALUE;
+        if (cob_check(t->cob_id, value, COB_NO_RTR) != 0u ||
+            (cob_valid(value) && tpdo_id_taken(co, n, value & ID_MASK))) {
+            return URRT_CO_ABORT_VALUE;
         }
-        if (abort_code == 0u) {
-            t->cob_id = value;
-            (void)urrt_cantx_set_id(co->tx, tpdo_desc(co, n)->frame, value & ID_MASK);
-        }
+        t->cob_id = value;
+        (void)urrt_cantx_set_id(co->tx, tpdo_desc(co, n)->frame, value & ID_MASK);
         break;
     case 2:
-        if (value == 0u) {
-            return URRT_CO_ABORT_TOO_LOW; /* acyclic synchronous: not supported */
-        }
         if (value > SYNC_MAX_N && value < TYPE_EVENT_MFR) {
             return URRT_CO_ABORT_TOO_HIGH; /* reserved, or RTR only: not supported */
         }
         t->type = (uint8_t)value;
         t->syncs = 0;
+        t->held = false;
+        t->inhibited = false;
         break;
     case 3:
         /* CiA 301: the inhibit time changes only while the PDO is not valid. */
-        return cob_valid(t->cob_id) ? URRT_CO_ABORT_VALUE
-                                    : tpdo_timing(co, n, (uint16_t)value, t->event_ms, now_us);
-    default: return tpdo_timing(co, n, t->inhibit_100us, (uint16_t)value, now_us);
+        if (cob_valid(t->cob_id)) {
+            return URRT_CO_ABORT_VALUE;
+        }
+        t->inhibit_100us = (uint16_t)value;
+        t->inhibited = false;
+        t->held = false;
+        break;
+    default: tpdo_event_timer(co, n, (uint16_t)value, now_us); break;
     }
     gates_apply(co);
-    return abort_code;
+    return 0;
 }
 
 /* ---- errors: 0x1001, 0x1003, EMCY ----------------------------------------------------- */
@@ -563,6 +662,21 @@ const char *urrt_co_state_name(urrt_co_nmt state)
     }
 }
 
+static size_t heartbeat(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    uint64_t period_us = (uint64_t)co->heartbeat_ms * 1000u;
+    if (co->heartbeat_due_us == URRT_CANTX_NEVER || now_us < co->heartbeat_due_us) {
+        return 0;
+    }
+    frame_begin(co, NMT_EC_BASE + co->desc->node_id, 1)[0] = co->state;
+    /* The cadence holds; after a stall the missed beats are skipped. */
+    co->heartbeat_due_us += period_us;
+    if (co->heartbeat_due_us <= now_us) {
+        co->heartbeat_due_us = now_us + period_us;
+    }
+    return frame_send(co, now_us, emit, ctx);
+}
+
 static void nmt_enter(urrt_co *co, urrt_co_nmt state)
 {
     size_t n;
@@ -576,6 +690,21 @@ static void nmt_enter(urrt_co *co, urrt_co_nmt state)
     }
     co->state = (uint8_t)state;
     gates_apply(co);
+}
+
+/* An NMT command's new state: a heartbeat tells it at once and the cadence
+ * restarts from it (as CANopenNode and the common stacks do). */
+static size_t nmt_change(urrt_co *co, urrt_co_nmt state, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    if (co->state == (uint8_t)state) {
+        return 0;
+    }
+    nmt_enter(co, state);
+    if (co->heartbeat_ms == 0u) {
+        return 0;
+    }
+    co->heartbeat_due_us = now_us;
+    return heartbeat(co, now_us, emit, ctx);
 }
 
 static void heartbeat_restart(urrt_co *co, uint64_t now_us)
@@ -624,9 +753,9 @@ static size_t nmt_command(urrt_co *co, const uint8_t *data, uint64_t now_us, urr
         return 0;
     }
     switch (data[0]) {
-    case URRT_CO_NMT_START: nmt_enter(co, URRT_CO_OPERATIONAL); return 0;
-    case URRT_CO_NMT_STOP: nmt_enter(co, URRT_CO_STOPPED); return 0;
-    case URRT_CO_NMT_PRE_OPERATIONAL: nmt_enter(co, URRT_CO_PRE_OPERATIONAL); return 0;
+    case URRT_CO_NMT_START: return nmt_change(co, URRT_CO_OPERATIONAL, now_us, emit, ctx);
+    case URRT_CO_NMT_STOP: return nmt_change(co, URRT_CO_STOPPED, now_us, emit, ctx);
+    case URRT_CO_NMT_PRE_OPERATIONAL: return nmt_change(co, URRT_CO_PRE_OPERATIONAL, now_us, emit, ctx);
     case URRT_CO_NMT_RESET_NODE: return boot(co, now_us, true, emit, ctx);
     case URRT_CO_NMT_RESET_COMM: return boot(co, now_us, false, emit, ctx);
     default: return 0;
@@ -654,105 +783,272 @@ static size_t sync_received(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emi
     return sent;
 }
 
-/* ---- the object dictionary ------------------------------------------------------------- */
+/* ---- the object dictionary: the communication objects' table ---------------------------- */
 
-typedef struct od_entry {
-    uint32_t value;
-    const char *text;               /* a string: its bytes, `size` of them */
-    const urrt_co_object *object;   /* a manufacturer object */
-    uint32_t size;
-    uint8_t access;
-} od_entry;
-
-static uint32_t od_value(od_entry *e, uint32_t value, uint32_t size, uint8_t access)
+/* A number: its size is its row's type's (urrt_co_comm_read). */
+static uint32_t value_of(urrt_co_value *v, uint32_t value)
 {
-    e->value = value;
-    e->size = size;
-    e->access = access;
+    v->value = value;
+    v->text = NULL;
     return 0;
 }
 
-static uint32_t od_var(od_entry *e, uint8_t sub, uint32_t value, uint32_t size, uint8_t access)
+static uint32_t text_of(urrt_co_value *v, const char *text)
 {
-    return sub != 0u ? URRT_CO_ABORT_NO_SUB : od_value(e, value, size, access);
+    v->value = 0;
+    v->text = text != NULL ? text : "";
+    v->size = text_len(text);
+    return 0;
 }
 
-static uint32_t od_text(od_entry *e, uint8_t sub, const char *text)
+static uint32_t read_device_type(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
 {
-    if (sub != 0u) {
-        return URRT_CO_ABORT_NO_SUB;
-    }
-    e->text = text != NULL ? text : "";
-    return od_value(e, 0, text_len(text), URRT_CO_RO);
+    (void)n;
+    (void)sub;
+    return value_of(v, co->desc->device_type);
 }
 
-static uint32_t od_identity(const urrt_co_desc *d, od_entry *e, uint8_t sub)
+static uint32_t read_error_register(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
 {
-    switch (sub) {
-    case 0: return od_value(e, IDENTITY_SUBS, 1, URRT_CO_RO);
-    case 1: return od_value(e, d->vendor_id, 4, URRT_CO_RO);
-    case 2: return od_value(e, d->product_code, 4, URRT_CO_RO);
-    case 3: return od_value(e, d->revision, 4, URRT_CO_RO);
-    case 4: return od_value(e, d->serial, 4, URRT_CO_RO);
-    default: return URRT_CO_ABORT_NO_SUB;
-    }
+    (void)n;
+    (void)sub;
+    return value_of(v, urrt_co_error_register(co));
 }
 
-static uint32_t od_errors(const urrt_co *co, od_entry *e, uint8_t sub)
+/* 0x1003: sub 0 the count, sub 1.. the codes, newest first. */
+static uint32_t read_errors(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
 {
+    (void)n;
     if (sub == 0u) {
-        return od_value(e, co->error_count, 1, URRT_CO_RW);
+        return value_of(v, co->error_count);
     }
-    if (sub > URRT_CO_HISTORY) {
-        return URRT_CO_ABORT_NO_SUB;
-    }
-    return sub > co->error_count ? URRT_CO_ABORT_NO_DATA : od_value(e, co->errors[sub - 1u], 4, URRT_CO_RO);
+    return sub > co->error_count ? URRT_CO_ABORT_NO_DATA : value_of(v, co->errors[sub - 1u]);
 }
 
-/* 0x1000-0x1018. */
-static uint32_t od_comm(const urrt_co *co, uint16_t index, uint8_t sub, od_entry *e)
+/* Only 0 clears the history (CiA 301). */
+static uint32_t write_errors(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
+{
+    (void)n;
+    (void)sub;
+    (void)now_us;
+    if (value != 0u) {
+        return URRT_CO_ABORT_VALUE;
+    }
+    co->error_count = 0;
+    return 0;
+}
+
+static uint32_t read_sync(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    (void)n;
+    (void)sub;
+    return value_of(v, co->sync_cob_id);
+}
+
+/* SYNC consumer only: bit 30 (generate) and 29-bit ids are refused. */
+static uint32_t write_sync(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
+{
+    (void)n;
+    (void)sub;
+    (void)now_us;
+    if ((value & ~(URRT_CO_COB_INVALID | ID_MASK)) != 0u || id_restricted(value & ID_MASK)) {
+        return URRT_CO_ABORT_VALUE;
+    }
+    co->sync_cob_id = value;
+    return 0;
+}
+
+static uint32_t read_device_name(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    (void)n;
+    (void)sub;
+    return text_of(v, co->desc->device_name);
+}
+
+static uint32_t read_hardware_version(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    (void)n;
+    (void)sub;
+    return text_of(v, co->desc->hardware_version);
+}
+
+static uint32_t read_software_version(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    (void)n;
+    (void)sub;
+    return text_of(v, co->desc->software_version);
+}
+
+static uint32_t read_emcy(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    (void)n;
+    (void)sub;
+    return value_of(v, co->emcy_cob_id);
+}
+
+static uint32_t write_emcy(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
+{
+    uint32_t abort_code = cob_check(co->emcy_cob_id, value, 0);
+    (void)n;
+    (void)sub;
+    (void)now_us;
+    co->emcy_cob_id = abort_code != 0u ? co->emcy_cob_id : value;
+    return abort_code;
+}
+
+static uint32_t read_emcy_inhibit(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    (void)n;
+    (void)sub;
+    return value_of(v, co->emcy_inhibit_100us);
+}
+
+static uint32_t write_emcy_inhibit(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
+{
+    (void)n;
+    (void)sub;
+    (void)now_us;
+    co->emcy_inhibit_100us = (uint16_t)value;
+    return 0;
+}
+
+static uint32_t read_heartbeat(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    (void)n;
+    (void)sub;
+    return value_of(v, co->heartbeat_ms);
+}
+
+static uint32_t write_heartbeat(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
+{
+    (void)n;
+    (void)sub;
+    co->heartbeat_ms = (uint16_t)value;
+    heartbeat_restart(co, now_us);
+    return 0;
+}
+
+static uint32_t read_identity(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
 {
     const urrt_co_desc *d = co->desc;
-    switch (index) {
-    case 0x1000: return od_var(e, sub, d->device_type, 4, URRT_CO_RO);
-    case 0x1001: return od_var(e, sub, urrt_co_error_register(co), 1, URRT_CO_RO);
-    case 0x1003: return od_errors(co, e, sub);
-    case 0x1005: return od_var(e, sub, co->sync_cob_id, 4, URRT_CO_RW);
-    case 0x1008: return od_text(e, sub, d->device_name);
-    case 0x1009: return od_text(e, sub, d->hardware_version);
-    case 0x100A: return od_text(e, sub, d->software_version);
-    case 0x1014: return od_var(e, sub, co->emcy_cob_id, 4, URRT_CO_RW);
-    case 0x1015: return od_var(e, sub, co->emcy_inhibit_100us, 2, URRT_CO_RW);
-    case 0x1017: return od_var(e, sub, co->heartbeat_ms, 2, URRT_CO_RW);
-    case 0x1018: return od_identity(d, e, sub);
-    default: return URRT_CO_ABORT_NO_OBJECT;
+    const uint32_t ids[IDENTITY_SUBS] = {d->vendor_id, d->product_code, d->revision, d->serial};
+    (void)n;
+    return value_of(v, sub == 0u ? IDENTITY_SUBS : ids[sub - 1u]);
+}
+
+/* 0x1800+n: sub 0 the highest sub-index (4 is reserved, 6 unsupported). */
+static uint32_t read_tpdo_comm(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    const urrt_co_tpdo_state *t = &co->tpdos[n];
+    switch (sub) {
+    case 0: return value_of(v, TPDO_COMM_SUBS);
+    case 1: return value_of(v, t->cob_id);
+    case 2: return value_of(v, t->type);
+    case 3: return value_of(v, t->inhibit_100us);
+    default: return value_of(v, t->event_ms);
     }
 }
 
-/* 0x1800+n and 0x1A00+n. */
-static uint32_t od_pdo(const urrt_co *co, uint16_t index, uint8_t sub, od_entry *e)
+/* 0x1A00+n: the description's mapping, read-only. */
+static uint32_t read_tpdo_map(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
 {
-    size_t n = (size_t)(index - (index >= TPDO_MAP ? TPDO_MAP : TPDO_COMM));
-    const urrt_co_tpdo_state *t;
-    if (n >= co->desc->tpdo_count) {
-        return URRT_CO_ABORT_NO_OBJECT;
+    const urrt_co_tpdo *p = tpdo_desc(co, n);
+    if (sub == 0u) {
+        return value_of(v, p->mapping_count);
     }
-    t = &co->tpdos[n];
-    if (index >= TPDO_MAP) {
-        const urrt_co_tpdo *p = tpdo_desc(co, n);
-        if (sub == 0u) {
-            return od_value(e, p->mapping_count, 1, URRT_CO_RO);
+    return sub > p->mapping_count ? URRT_CO_ABORT_NO_SUB : value_of(v, p->mapping[sub - 1u]);
+}
+
+#define U8 URRT_CO_UNSIGNED8
+#define U16 URRT_CO_UNSIGNED16
+#define U32 URRT_CO_UNSIGNED32
+#define TEXT URRT_CO_VISIBLE_STRING
+#define VAR URRT_CO_OBJ_VAR
+#define SUB URRT_CO_OBJ_SUB
+#define HEADER(index_, object_, name_, flags_) {(name_), NULL, NULL, 0, 0, (index_), 0, 0, (object_), 0, (flags_)}
+#define ROW(index_, sub_, subs_, object_, type_, name_, read_, write_, flags_) \
+    {(name_), (read_), (write_), 0, 0, (index_), (sub_), (subs_), (object_), (type_), (flags_)}
+
+const urrt_co_comm urrt_co_comm_table[] = {
+    ROW(0x1000, 0, 1, VAR, U32, "Device type", read_device_type, NULL, 0),
+    ROW(0x1001, 0, 1, VAR, U8, "Error register", read_error_register, NULL, 0),
+    HEADER(0x1003, URRT_CO_OBJ_ARRAY, "Pre-defined error field", 0),
+    ROW(0x1003, 0, 1, SUB, U8, "Number of errors", read_errors, write_errors, 0),
+    ROW(0x1003, 1, URRT_CO_HISTORY, SUB, U32, "Standard error field", read_errors, NULL, 0),
+    ROW(0x1005, 0, 1, VAR, U32, "COB-ID SYNC", read_sync, write_sync, 0),
+    ROW(0x1008, 0, 1, VAR, TEXT, "Manufacturer device name", read_device_name, NULL, 0),
+    ROW(0x1009, 0, 1, VAR, TEXT, "Manufacturer hardware version", read_hardware_version, NULL, 0),
+    ROW(0x100A, 0, 1, VAR, TEXT, "Manufacturer software version", read_software_version, NULL, 0),
+    ROW(0x1014, 0, 1, VAR, U32, "COB-ID EMCY", read_emcy, write_emcy, URRT_CO_NODE_ID),
+    ROW(0x1015, 0, 1, VAR, U16, "Inhibit time EMCY", read_emcy_inhibit, write_emcy_inhibit, 0),
+    ROW(0x1017, 0, 1, VAR, U16, "Producer heartbeat time", read_heartbeat, write_heartbeat, 0),
+    HEADER(0x1018, URRT_CO_OBJ_RECORD, "Identity object", 0),
+    ROW(0x1018, 0, 1, SUB, U8, "Highest sub-index supported", read_identity, NULL, 0),
+    ROW(0x1018, 1, 1, SUB, U32, "Vendor-ID", read_identity, NULL, 0),
+    ROW(0x1018, 2, 1, SUB, U32, "Product code", read_identity, NULL, 0),
+    ROW(0x1018, 3, 1, SUB, U32, "Revision number", read_identity, NULL, 0),
+    ROW(0x1018, 4, 1, SUB, U32, "Serial number", read_identity, NULL, 0),
+    HEADER(TPDO_COMM, URRT_CO_OBJ_RECORD, "TPDO communication parameter", URRT_CO_PER_TPDO),
+    ROW(TPDO_COMM, 0, 1, SUB, U8, "Highest sub-index supported", read_tpdo_comm, NULL, URRT_CO_PER_TPDO),
+    ROW(TPDO_COMM, 1, 1, SUB, U32, "COB-ID used by TPDO", read_tpdo_comm, tpdo_write,
+        URRT_CO_PER_TPDO | URRT_CO_NODE_ID),
+    /* 1..240 (every nth SYNC), 254, 255; 241..253 are refused by tpdo_write */
+    {"Transmission type", read_tpdo_comm, tpdo_write, 1, 0xFF, TPDO_COMM, 2, 1, SUB, U8,
+     URRT_CO_PER_TPDO | URRT_CO_LIMITS},
+    ROW(TPDO_COMM, 3, 1, SUB, U16, "Inhibit time", read_tpdo_comm, tpdo_write, URRT_CO_PER_TPDO),
+    ROW(TPDO_COMM, 5, 1, SUB, U16, "Event timer", read_tpdo_comm, tpdo_write, URRT_CO_PER_TPDO),
+    HEADER(TPDO_MAP, URRT_CO_OBJ_RECORD, "TPDO mapping parameter", URRT_CO_PER_TPDO),
+    ROW(TPDO_MAP, 0, 1, SUB, U8, "Number of mapped objects", read_tpdo_map, NULL, URRT_CO_PER_TPDO),
+    ROW(TPDO_MAP, 1, URRT_CO_MAX_MAPPED, SUB, U32, "Mapped object", read_tpdo_map, NULL, URRT_CO_PER_TPDO),
+};
+const size_t urrt_co_comm_count = sizeof urrt_co_comm_table / sizeof urrt_co_comm_table[0];
+
+size_t urrt_co_comm_instances(const urrt_co *co, const urrt_co_comm *row)
+{
+    return (row->flags & URRT_CO_PER_TPDO) != 0u ? co->desc->tpdo_count : 1u;
+}
+
+uint32_t urrt_co_comm_read(const urrt_co *co, const urrt_co_comm *row, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    uint32_t abort_code;
+    v->text = NULL;
+    if (row->read == NULL || sub < row->sub || sub - row->sub >= row->subs || n >= urrt_co_comm_instances(co, row)) {
+        return URRT_CO_ABORT_NO_SUB;
+    }
+    abort_code = row->read(co, n, sub, v);
+    v->size = v->text != NULL ? v->size : type_size(row->type);
+    return abort_code;
+}
+
+/* What a request names: a row of the table or a manufacturer object. */
+typedef struct od_entry {
+    urrt_co_value v;
+    const urrt_co_comm *row;
+    size_t n;                       /* the row's instance */
+    const urrt_co_object *object;   /* a manufacturer object */
+    uint8_t access;
+} od_entry;
+
+/* The row holding (index, sub), or NULL with the abort code. */
+static uint32_t comm_find(const urrt_co *co, uint16_t index, uint8_t sub, od_entry *e)
+{
+    bool known = false;
+    size_t i;
+    for (i = 0; i < urrt_co_comm_count; i++) {
+        const urrt_co_comm *row = &urrt_co_comm_table[i];
+        size_t n = (size_t)(index - row->index);
+        if (index < row->index || n >= urrt_co_comm_instances(co, row)) {
+            continue;
         }
-        return sub > p->mapping_count ? URRT_CO_ABORT_NO_SUB : od_value(e, p->mapping[sub - 1u], 4, URRT_CO_RO);
+        known = true;
+        if (row->subs != 0u && sub >= row->sub && sub - row->sub < row->subs) {
+            e->row = row;
+            e->n = n;
+            e->access = row->write != NULL ? URRT_CO_RW : URRT_CO_RO;
+            return urrt_co_comm_read(co, row, n, sub, &e->v);
+        }
     }
-    switch (sub) {
-    case 0: return od_value(e, TPDO_COMM_SUBS, 1, URRT_CO_RO);
-    case 1: return od_value(e, t->cob_id, 4, URRT_CO_RW);
-    case 2: return od_value(e, t->type, 1, URRT_CO_RW);
-    case 3: return od_value(e, t->inhibit_100us, 2, URRT_CO_RW);
-    case 5: return od_value(e, t->event_ms, 2, URRT_CO_RW);
-    default: return URRT_CO_ABORT_NO_SUB;
-    }
+    return known ? URRT_CO_ABORT_NO_SUB : URRT_CO_ABORT_NO_OBJECT;
 }
 
 /* A signal's raw bits as its frame would go out now, sign-extended for INTEGERn. */
@@ -786,80 +1082,59 @@ static uint32_t od_mfr(urrt_co *co, uint16_t index, uint8_t sub, uint64_t now_us
         highest = o->sub > highest ? o->sub : highest;
         if (o->sub == sub) {
             e->object = o;
-            return od_value(e, o->kind == URRT_CO_VAR ? co->vars[o->item] : signal_value(co, o, now_us),
-                            type_size(o->type), o->access);
+            e->access = o->access;
+            e->v.size = type_size(o->type);
+            return value_of(&e->v, o->kind == URRT_CO_VAR ? co->vars[o->item] : signal_value(co, o, now_us));
         }
     }
     if (known && sub == 0u) {
-        return od_value(e, highest, 1, URRT_CO_RO);
+        e->access = URRT_CO_RO;
+        e->v.size = 1;
+        return value_of(&e->v, highest);
     }
     return known ? URRT_CO_ABORT_NO_SUB : URRT_CO_ABORT_NO_OBJECT;
 }
 
+/* The entry and its value: 0, or why it cannot be read (e->access is set
+ * whenever the object exists: a NO_DATA read still has an access). */
 static uint32_t od_find(urrt_co *co, uint16_t index, uint8_t sub, uint64_t now_us, od_entry *e)
 {
-    e->text = NULL;
+    e->row = NULL;
     e->object = NULL;
-    if (index >= TPDO_COMM && index < TPDO_MAP + MAX_TPDOS) {
-        return od_pdo(co, index, sub, e);
-    }
+    e->access = 0;
     if (index >= MFR_FIRST && index <= MFR_LAST) {
         return od_mfr(co, index, sub, now_us, e);
     }
-    return od_comm(co, index, sub, e);
+    return comm_find(co, index, sub, e);
 }
 
-static uint32_t var_write(urrt_co *co, const urrt_co_object *o, uint32_t value)
+static bool od_missing(uint32_t abort_code)
 {
-    uint32_t key = order_key(value, o->type);
-    if (key < order_key(o->min, o->type)) {
+    return abort_code == URRT_CO_ABORT_NO_OBJECT || abort_code == URRT_CO_ABORT_NO_SUB;
+}
+
+/* A value in range of a manufacturer variable, or of a row with limits. */
+static uint32_t range_check(uint32_t value, uint8_t type, uint32_t low, uint32_t high)
+{
+    uint32_t key = order_key(value, type);
+    if (key < order_key(low, type)) {
         return URRT_CO_ABORT_TOO_LOW;
     }
-    if (key > order_key(o->max, o->type)) {
-        return URRT_CO_ABORT_TOO_HIGH;
-    }
-    co->vars[o->item] = value;
-    return 0;
-}
-
-/* SYNC consumer only: bit 30 (generate) and 29-bit ids are refused. */
-static uint32_t sync_write(urrt_co *co, uint32_t value)
-{
-    if ((value & ~(URRT_CO_COB_INVALID | ID_MASK)) != 0u || id_restricted(value & ID_MASK)) {
-        return URRT_CO_ABORT_VALUE;
-    }
-    co->sync_cob_id = value;
-    return 0;
+    return key > order_key(high, type) ? URRT_CO_ABORT_TOO_HIGH : 0u;
 }
 
 /* A write the entry's access and size allow: its value's rules. */
-static uint32_t od_write(urrt_co *co, uint16_t index, uint8_t sub, const od_entry *e, uint32_t value,
-                         uint64_t now_us)
+static uint32_t od_write(urrt_co *co, uint8_t sub, const od_entry *e, uint32_t value, uint64_t now_us)
 {
-    uint32_t abort_code = 0;
+    const urrt_co_comm *row = e->row;
+    uint32_t abort_code;
     if (e->object != NULL) {
-        return var_write(co, e->object, value);
-    }
-    if (index >= TPDO_COMM && index < TPDO_MAP) {
-        return tpdo_write(co, (size_t)(index - TPDO_COMM), sub, value, now_us);
-    }
-    switch (index) {
-    case 0x1003:
-        /* Only 0 clears the history (CiA 301). */
-        abort_code = value != 0u ? URRT_CO_ABORT_VALUE : 0u;
-        co->error_count = value != 0u ? co->error_count : 0u;
+        abort_code = range_check(value, e->object->type, e->object->min, e->object->max);
+        co->vars[e->object->item] = abort_code != 0u ? co->vars[e->object->item] : value;
         return abort_code;
-    case 0x1005: return sync_write(co, value);
-    case 0x1014:
-        abort_code = cob_check(co->emcy_cob_id, value, 0);
-        co->emcy_cob_id = abort_code != 0u ? co->emcy_cob_id : value;
-        return abort_code;
-    case 0x1015: co->emcy_inhibit_100us = (uint16_t)value; return 0;
-    default: /* 0x1017 */
-        co->heartbeat_ms = (uint16_t)value;
-        heartbeat_restart(co, now_us);
-        return 0;
     }
+    abort_code = (row->flags & URRT_CO_LIMITS) != 0u ? range_check(value, row->type, row->low, row->high) : 0u;
+    return abort_code != 0u ? abort_code : row->write(co, e->n, sub, value, now_us);
 }
 
 /* ---- the SDO server ------------------------------------------------------------------ */
@@ -887,25 +1162,26 @@ static uint64_t sdo_timeout_us(const urrt_co *co)
     return (uint64_t)(ms != 0u ? ms : URRT_CO_SDO_TIMEOUT_MS) * 1000u;
 }
 
-/* Up to 4 bytes in the answer itself; a longer (or empty) string segmented. */
+/* Up to 4 bytes in the answer itself; a longer (or empty) string segmented.
+ * Checked in order: exists, access, then what the value's read says. */
 static size_t upload(urrt_co *co, uint16_t index, uint8_t sub, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
 {
     od_entry e;
     uint32_t abort_code = od_find(co, index, sub, now_us, &e);
     uint8_t *data;
     uint32_t i;
-    if (abort_code == 0u && e.access == URRT_CO_WO) {
+    if (!od_missing(abort_code) && e.access == URRT_CO_WO) {
         abort_code = URRT_CO_ABORT_WRITE_ONLY;
     }
     if (abort_code != 0u) {
         return sdo_abort(co, index, sub, abort_code, now_us, emit, ctx);
     }
-    if (e.text != NULL && (e.size == 0u || e.size > 4u)) {
+    if (e.v.text != NULL && (e.v.size == 0u || e.v.size > 4u)) {
         data = sdo_begin(co, CS_UPLOAD << 5 | SDO_SIZE_SET, index, sub);
-        put_le(data + 4, e.size, 4);
+        put_le(data + 4, e.v.size, 4);
         co->sdo_busy = true;
-        co->sdo_text = e.text;
-        co->sdo_size = e.size;
+        co->sdo_text = e.v.text;
+        co->sdo_size = e.v.size;
         co->sdo_offset = 0;
         co->sdo_toggle = 0;
         co->sdo_index = index;
@@ -913,9 +1189,10 @@ static size_t upload(urrt_co *co, uint16_t index, uint8_t sub, uint64_t now_us, 
         co->sdo_deadline_us = now_us + sdo_timeout_us(co);
         return frame_send(co, now_us, emit, ctx);
     }
-    data = sdo_begin(co, (uint8_t)(CS_UPLOAD << 5 | (4u - e.size) << 2 | SDO_EXPEDITED | SDO_SIZE_SET), index, sub);
-    for (i = 0; i < e.size; i++) {
-        data[4 + i] = (uint8_t)(e.text != NULL ? (unsigned char)e.text[i] : e.value >> (8u * i));
+    data = sdo_begin(co, (uint8_t)(CS_UPLOAD << 5 | (4u - e.v.size) << 2 | SDO_EXPEDITED | SDO_SIZE_SET), index,
+                     sub);
+    for (i = 0; i < e.v.size; i++) {
+        data[4 + i] = (uint8_t)(e.v.text != NULL ? (unsigned char)e.v.text[i] : e.v.value >> (8u * i));
     }
     return frame_send(co, now_us, emit, ctx);
 }
@@ -942,27 +1219,41 @@ static size_t upload_segment(urrt_co *co, uint8_t command, uint64_t now_us, urrt
     return frame_send(co, now_us, emit, ctx);
 }
 
-/* Expedited only: a segmented download is an unknown command here. */
-static size_t download(urrt_co *co, const uint8_t *req, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+/* Why a download is refused, checked in one order for every object (CiA
+ * 301): exists, access, size, value. A value the object cannot be read at
+ * now (0x1003 past the errors recorded) is no reason: it exists. */
+static uint32_t download_check(urrt_co *co, const uint8_t *req, uint64_t now_us, od_entry *e)
 {
     uint16_t index = (uint16_t)(req[1] | req[2] << 8);
     uint8_t sub = req[3];
     uint32_t bytes = (req[0] & SDO_SIZE_SET) != 0u ? 4u - (uint32_t)(req[0] >> 2 & 3u) : 0u;
+    uint32_t abort_code;
+    if ((req[0] & SDO_EXPEDITED) == 0u) {
+        return URRT_CO_ABORT_COMMAND;
+    }
+    abort_code = od_find(co, index, sub, now_us, e);
+    if (od_missing(abort_code)) {
+        return abort_code;
+    }
+    if ((e->access & URRT_CO_WO) == 0u) {
+        return URRT_CO_ABORT_READ_ONLY;
+    }
+    if (bytes != 0u && bytes != e->v.size) {
+        return bytes > e->v.size ? URRT_CO_ABORT_TOO_LONG : URRT_CO_ABORT_TOO_SHORT;
+    }
+    return od_write(co, sub, e, get_le32(req + 4) & size_mask(e->v.size), now_us);
+}
+
+/* Expedited only: a segmented download is an unknown command here. */
+static size_t download(urrt_co *co, const uint8_t *req, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
+{
+    uint16_t index = (uint16_t)(req[1] | req[2] << 8);
     od_entry e;
-    uint32_t abort_code = (req[0] & SDO_EXPEDITED) == 0u ? URRT_CO_ABORT_COMMAND : od_find(co, index, sub, now_us, &e);
-    if (abort_code == 0u && (e.access & URRT_CO_WO) == 0u) {
-        abort_code = URRT_CO_ABORT_READ_ONLY;
-    }
-    if (abort_code == 0u && bytes != 0u && bytes != e.size) {
-        abort_code = bytes > e.size ? URRT_CO_ABORT_TOO_LONG : URRT_CO_ABORT_TOO_SHORT;
-    }
-    if (abort_code == 0u) {
-        abort_code = od_write(co, index, sub, &e, get_le32(req + 4) & size_mask(e.size), now_us);
-    }
+    uint32_t abort_code = download_check(co, req, now_us, &e);
     if (abort_code != 0u) {
-        return sdo_abort(co, index, sub, abort_code, now_us, emit, ctx);
+        return sdo_abort(co, index, req[3], abort_code, now_us, emit, ctx);
     }
-    (void)sdo_begin(co, 0x60u, index, sub);
+    (void)sdo_begin(co, 0x60u, index, req[3]);
     return frame_send(co, now_us, emit, ctx);
 }
 
@@ -1023,21 +1314,6 @@ size_t urrt_co_on_frame(urrt_co *co, uint32_t id, unsigned flags, const uint8_t 
     return 0;
 }
 
-static size_t heartbeat(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
-{
-    uint64_t period_us = (uint64_t)co->heartbeat_ms * 1000u;
-    if (co->heartbeat_due_us == URRT_CANTX_NEVER || now_us < co->heartbeat_due_us) {
-        return 0;
-    }
-    frame_begin(co, NMT_EC_BASE + co->desc->node_id, 1)[0] = co->state;
-    /* The cadence holds; after a stall the missed beats are skipped. */
-    co->heartbeat_due_us += period_us;
-    if (co->heartbeat_due_us <= now_us) {
-        co->heartbeat_due_us = now_us + period_us;
-    }
-    return frame_send(co, now_us, emit, ctx);
-}
-
 size_t urrt_co_run(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
 {
     size_t sent;
@@ -1050,7 +1326,10 @@ size_t urrt_co_run(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *
     }
     conditions_update(co, now_us);
     sent += emcy_send(co, now_us, emit, ctx);
-    return sent + urrt_cantx_run(co->tx, now_us, emit, ctx);
+    sent += tpdo_events(co, now_us, emit, ctx);
+    sent += urrt_cantx_run(co->tx, now_us, emit, ctx);
+    tpdo_sent(co, now_us);
+    return sent;
 }
 
 /* When a condition may change without a call: a robot's data turning
@@ -1080,5 +1359,6 @@ uint64_t urrt_co_deadline(const urrt_co *co)
     next = min64(urrt_cantx_deadline(co->tx), co->heartbeat_due_us);
     next = co->sdo_busy ? min64(next, co->sdo_deadline_us) : next;
     next = emcy_may_send(co) ? min64(next, emcy_due(co)) : next;
+    next = min64(next, tpdo_deadline(co));
     return min64(next, conditions_deadline(co));
 }

@@ -26,9 +26,12 @@
  * The node owns the urrt_cantx it is given: call urrt_co_start and
  * urrt_co_run instead of urrt_cantx_start and urrt_cantx_run. Every frame of
  * the cantx tables goes out only in OPERATIONAL; a TPDO's frame besides only
- * while its COB-ID is valid, with the id of 0x1800+n sub 1 and the period of
- * its event timer (transmission type 254/255), or on every nth SYNC (type
- * n = 1..240). Its mapping (0x1A00+n) is the description's, read-only.
+ * while its COB-ID is valid, with the id of 0x1800+n sub 1: at the period of
+ * its event timer (transmission type 254/255; 0: with every robot packet),
+ * never twice within its inhibit time (a send due inside waits for the gap's
+ * end and carries the newest data), or on every nth SYNC (type n = 1..240).
+ * Its mapping (0x1A00+n) is the description's, read-only. An NMT command that
+ * changes the state sends a heartbeat at once.
  *
  * Manufacturer objects (0x2000-0x5FFF) are the description's too: a signal
  * of a cantx frame (a robot value, or one of the gateway's heartbeat values)
@@ -180,13 +183,22 @@ typedef struct urrt_co_desc {
     size_t object_count;
 } urrt_co_desc;
 
-/* Run-time values of TPDO n's communication parameters (0x1800+n). */
+/* Run-time values of TPDO n's communication parameters (0x1800+n), and
+ * its inhibit time's gap (event-driven types 254/255 only: after a send,
+ * nothing goes out until inhibit_end_us; a send that falls inside waits for
+ * the gap's end and then carries the newest data). */
 typedef struct urrt_co_tpdo_state {
+    uint64_t inhibit_end_us;  /* the gap after the latest send ends */
+    uint64_t packet_us;       /* event timer 0 on a frame with the invalid or ignore policy: the robot
+                                 data (urrt_cantx_robot.data_us) it was last sent for */
     uint32_t cob_id;          /* sub 1 */
+    uint32_t sent_seen;       /* the frame's urrt_cantx_frame_state.sent at the latest look */
     uint16_t inhibit_100us;   /* sub 3 */
     uint16_t event_ms;        /* sub 5 */
     uint8_t type;             /* sub 2 */
     uint8_t syncs;            /* SYNCs counted toward the next send */
+    bool inhibited;           /* inside the gap */
+    bool held;                /* a send waits for the gap's end */
 } urrt_co_tpdo_state;
 
 #define URRT_CO_HISTORY 8u        /* 0x1003's entries */
@@ -225,6 +237,63 @@ typedef struct urrt_co {
     bool emcy_sent;               /* emcy_last_us holds a time */
 } urrt_co;
 
+/* ---- the communication objects (0x1000-0x1FFF) ------------------------------
+ * One const table describes them: the SDO server looks every request up in
+ * it, and `urrt-gateway --print-eds` writes the EDS's communication objects
+ * from it, so that the two cannot disagree. A row is an object (a lone
+ * variable, or the header of an ARRAY or RECORD) or a run of its
+ * sub-indices; per-TPDO rows stand for index + n, n < tpdo_count. A row's
+ * default is the value it reads right after urrt_co_start (or a reset).
+ * A write is checked in one order for every object (CiA 301): exists, access,
+ * size, then value (the row's limits, then its write hook's own rules). */
+
+#define URRT_CO_OBJ_SUB 0x0u      /* a sub-index of the ARRAY or RECORD a header row opened */
+#define URRT_CO_OBJ_VAR 0x7u      /* object codes as CiA 306 numbers them */
+#define URRT_CO_OBJ_ARRAY 0x8u
+#define URRT_CO_OBJ_RECORD 0x9u
+
+/* urrt_co_comm.flags */
+#define URRT_CO_PER_TPDO 0x01u    /* one object per TPDO: index + n */
+#define URRT_CO_NODE_ID 0x02u     /* a COB-ID counted from the node id (an EDS's $NODEID) */
+#define URRT_CO_LIMITS 0x04u      /* low..high: a write outside is refused (0x06090032, 0x06090031) */
+
+/* A value as the SDO server sends it. */
+typedef struct urrt_co_value {
+    uint32_t value;       /* a number, in the row's type */
+    const char *text;     /* a VISIBLE_STRING: its bytes, `size` of them; else NULL */
+    uint32_t size;        /* bytes */
+} urrt_co_value;
+
+struct urrt_co;
+/* Row's sub-index `sub` of instance n: 0 and *v, or an abort code. */
+typedef uint32_t (*urrt_co_read_fn)(const struct urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v);
+/* A value the checks let through: 0 once it took effect, or an abort code. */
+typedef uint32_t (*urrt_co_write_fn)(struct urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us);
+
+typedef struct urrt_co_comm {
+    const char *name;         /* an EDS's ParameterName */
+    urrt_co_read_fn read;     /* NULL for a header row */
+    urrt_co_write_fn write;   /* NULL: read-only ("ro"), else "rw" */
+    uint32_t low, high;       /* with URRT_CO_LIMITS */
+    uint16_t index;
+    uint8_t sub;              /* its first sub-index */
+    uint8_t subs;             /* sub-indices from `sub` on (0: a header row, which holds none) */
+    uint8_t object;           /* URRT_CO_OBJ_* */
+    uint8_t type;             /* URRT_CO_UNSIGNED8 .. URRT_CO_VISIBLE_STRING */
+    uint8_t flags;            /* URRT_CO_PER_TPDO, _NODE_ID, _LIMITS */
+} urrt_co_comm;
+
+extern const urrt_co_comm urrt_co_comm_table[];
+extern const size_t urrt_co_comm_count;
+
+/* The row's objects on this node: 1, or the TPDO count for a per-TPDO row. */
+size_t urrt_co_comm_instances(const struct urrt_co *co, const urrt_co_comm *row);
+
+/* Reads sub-index `sub` of the row's instance n as the SDO server would
+ * (a row's sub-indices past what the node has: URRT_CO_ABORT_NO_SUB). */
+uint32_t urrt_co_comm_read(const struct urrt_co *co, const urrt_co_comm *row, size_t n, uint8_t sub,
+                           urrt_co_value *v);
+
 /*
  * Checks the description once and binds the caller's storage: tx an
  * initialised urrt_cantx (its tables hold the TPDOs' frames), tpdo_states
@@ -235,6 +304,11 @@ typedef struct urrt_co {
  */
 int urrt_co_init(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urrt_co_tpdo_state *tpdo_states,
                  uint32_t *vars, size_t var_count, size_t *bad_item);
+
+/* TPDO n's COB-ID after a reset (0x1800+n sub 1's default): the
+ * description's, or CiA 301's pre-defined one; bit 30 set (no RTR: the node
+ * serves none). After urrt_co_init. */
+uint32_t urrt_co_tpdo_cob_default(const urrt_co *co, size_t n);
 
 /* Power-on: every object to its default, urrt_cantx_start, the boot-up
  * frame, then PRE-OPERATIONAL (or OPERATIONAL when self-starting). NMT

@@ -2,6 +2,7 @@
 /* co_run.c: see co_run.h. */
 #include "co_run.h"
 
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -224,13 +225,34 @@ const uint32_t *co_run_rx_ids(const struct co_run *run, size_t *count)
     return run->rx_ids;
 }
 
+/* snprintf at the end of what buf holds so far (*len: snprintf's total). */
+static void append(char *buf, size_t size, int *len, const char *fmt, ...)
+{
+    size_t at = *len >= 0 && (size_t)*len < size ? (size_t)*len : size;
+    va_list ap;
+    int n;
+    if (*len < 0) {
+        return;
+    }
+    va_start(ap, fmt);
+    n = vsnprintf(buf + at, size - at, fmt, ap);
+    va_end(ap);
+    *len = n < 0 ? n : *len + n;
+}
+
 int co_run_describe(const struct co_run *run, char *buf, size_t size)
 {
     const urrt_co_desc *d = &run->desc;
-    return snprintf(buf, size,
-                    "node %u: TPDO1..%zu + status TPDO%zu (off until enabled), heartbeat %u ms at 0x%X, EMCY 0x%X, "
-                    "SDO 0x%X/0x%X, starts %s",
-                    (unsigned)d->node_id, d->tpdo_count - 1u, d->tpdo_count, (unsigned)d->heartbeat_ms,
-                    0x700u + d->node_id, 0x080u + d->node_id, SDO_RX_BASE + d->node_id, 0x580u + d->node_id,
-                    canopen_nmt_start_name(d->nmt_start));
+    size_t status = d->tpdo_count - 1u;
+    int len = 0;
+    append(buf, size, &len, "node %u: TPDO1..%zu at", (unsigned)d->node_id, status);
+    for (size_t n = 0; n < status; n++) {
+        append(buf, size, &len, " 0x%X", (unsigned)(urrt_co_tpdo_cob_default(&run->co, n) & 0x7FFu));
+    }
+    append(buf, size, &len,
+           ", status TPDO%zu at 0x%X (off until enabled), heartbeat %u ms at 0x%X, EMCY 0x%X, SDO 0x%X/0x%X, starts %s",
+           d->tpdo_count, (unsigned)(urrt_co_tpdo_cob_default(&run->co, status) & 0x7FFu),
+           (unsigned)d->heartbeat_ms, 0x700u + d->node_id, 0x080u + d->node_id, SDO_RX_BASE + d->node_id,
+           0x580u + d->node_id, canopen_nmt_start_name(d->nmt_start));
+    return len;
 }

@@ -7,6 +7,7 @@
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "dbc.h"
 
@@ -15,8 +16,11 @@
 #define OBJ_VAR 0x7u
 #define OBJ_ARRAY 0x8u
 #define OBJ_RECORD 0x9u
-#define TPDO_COMM 0x1800u
-#define TPDO_MAP 0x1A00u
+#define EMCY_INDEX 0x1014u
+#define EMCY_BASE 0x080u
+#define COUNT(a) (sizeof a / sizeof a[0])
+
+static const unsigned mandatory_indices[] = {0x1000, 0x1001, 0x1018}; /* CiA 301 */
 
 /* One VAR (an object or a sub-index). sub < 0: the object itself. */
 struct eds_var {
@@ -53,13 +57,6 @@ static void put_record(FILE *out, unsigned index, const char *name, unsigned typ
     fprintf(out, "[%04X]\nParameterName=%s\nObjectType=0x%X\nSubNumber=0x%X\n\n", index, name, type, subs);
 }
 
-static void put_u32(FILE *out, unsigned index, int sub, const char *name, const char *access, uint32_t value)
-{
-    char def[16];
-    snprintf(def, sizeof def, "0x%08X", (unsigned)value);
-    put_var(out, &(struct eds_var){index, sub, name, URRT_CO_UNSIGNED32, access, def, false, NULL, NULL});
-}
-
 static void put_small(FILE *out, unsigned index, int sub, const char *name, unsigned type, const char *access,
                       unsigned value)
 {
@@ -68,23 +65,49 @@ static void put_small(FILE *out, unsigned index, int sub, const char *name, unsi
     put_var(out, &(struct eds_var){index, sub, name, type, access, def, false, NULL, NULL});
 }
 
-static void put_text(FILE *out, unsigned index, const char *name, const char *text)
-{
-    put_var(out, &(struct eds_var){index, -1, name, URRT_CO_VISIBLE_STRING, ACCESS_RO, text ? text : "", false,
-                                   NULL, NULL});
-}
-
 /* ---- the sections before the objects ------------------------------------------------- */
 
 static const unsigned baud_kbits[] = {10, 20, 50, 125, 250, 500, 800, 1000};
 
-static void put_file_info(FILE *out, const urrt_co_desc *d, const char *source)
+/* When the EDS was made: SOURCE_DATE_EPOCH when set (reproducible builds),
+ * else now. */
+static struct tm made_at(void)
 {
-    fprintf(out, "[FileInfo]\nFileName=urrt-node%u.eds\nFileVersion=1\nFileRevision=0\nEDSVersion=4.0\n",
-            (unsigned)d->node_id);
+    const char *epoch = getenv("SOURCE_DATE_EPOCH");
+    char *end = NULL;
+    time_t t = time(NULL);
+    struct tm tm = {0};
+    if (epoch != NULL && *epoch != '\0') {
+        long long v = strtoll(epoch, &end, 10);
+        t = *end == '\0' && v >= 0 ? (time_t)v : t;
+    }
+    gmtime_r(&t, &tm);
+    return tm;
+}
+
+/* FileName: the file written (its last path component), or the default
+ * name when the EDS goes to standard output. CiA 306's dates: the time
+ * "hh:mm" with AM or PM, the date "mm-dd-yyyy". */
+static void put_file_info(FILE *out, const urrt_co_desc *d, const char *source, const char *file_name)
+{
+    struct tm tm = made_at();
+    const char *slash = file_name != NULL ? strrchr(file_name, '/') : NULL;
+    char when[48];
+    if (file_name != NULL) {
+        fprintf(out, "[FileInfo]\nFileName=%s\n", slash != NULL ? slash + 1 : file_name);
+    } else {
+        fprintf(out, "[FileInfo]\nFileName=urrt-node%u.eds\n", (unsigned)d->node_id);
+    }
+    fprintf(out, "FileVersion=1\nFileRevision=0\nEDSVersion=4.0\n");
     fprintf(out, "Description=urrt-gateway CANopen node%s%s: Universal Robots RealTime data as TPDOs\n",
             source ? " from " : "", source ? source : "");
-    fprintf(out, "CreatedBy=urrt-gateway %s --print-eds\n\n", URRT_VERSION_STRING);
+    snprintf(when, sizeof when, "%02d:%02d%s", tm.tm_hour % 12 == 0 ? 12 : tm.tm_hour % 12, tm.tm_min,
+             tm.tm_hour < 12 ? "AM" : "PM");
+    fprintf(out, "CreationTime=%s\nModificationTime=%s\n", when, when);
+    snprintf(when, sizeof when, "%02d-%02d-%04d", tm.tm_mon + 1, tm.tm_mday, tm.tm_year + 1900);
+    fprintf(out, "CreationDate=%s\nModificationDate=%s\n", when, when);
+    fprintf(out, "CreatedBy=urrt-gateway %s --print-eds\nModifiedBy=urrt-gateway %s --print-eds\n\n",
+            URRT_VERSION_STRING, URRT_VERSION_STRING);
 }
 
 static void put_device_info(FILE *out, const struct canopen_map *co, const struct can_map *can,
@@ -149,6 +172,10 @@ static void object_name(const struct can_map *can, const urrt_co_object *o, size
     } else {
         snprintf(field, sizeof field, "%s", info ? info->name : "?");
     }
+    if (m->bitmask) {
+        snprintf(buf, size, "%s: %s, a bit mask as the robot sends it", m->name, field);
+        return;
+    }
     snprintf(buf, size, "%s: %s, %s = raw x %s + %s", m->name, field, m->unit[0] ? m->unit : "1",
              dbc_number(sig->factor, f, sizeof f), dbc_number(sig->offset, off, sizeof off));
 }
@@ -161,7 +188,7 @@ static bool is_robot_value(const struct can_map *can, const urrt_co_object *o, s
 /* [Comments]: two notes, then the scaling of every mapped robot value with its limits. */
 static void put_comments(FILE *out, const struct can_map *can, const urrt_co_desc *d, size_t hb)
 {
-    size_t lines = 2;
+    size_t lines = 4;
     for (size_t i = 0; i < d->object_count; i++) {
         lines += is_robot_value(can, &d->objects[i], hb);
     }
@@ -170,18 +197,146 @@ static void put_comments(FILE *out, const struct can_map *can, const urrt_co_des
                  "(docs/canopen.md)\n");
     fprintf(out, "Line2=EMCY 0xFF01 robot link down, 0xFF02 robot data stale; TPDO%zu (status) is off until enabled\n",
             d->tpdo_count);
-    lines = 2;
+    fprintf(out, "Line3=TPDO transmission type (0x18xx sub 2): 1..240 (every nth SYNC), 254, 255; "
+                 "0 and 241..253 are refused\n");
+    fprintf(out, "Line4=TPDO event timer (0x18xx sub 5) 0: no timer, the TPDO goes with each robot packet; "
+                 "the inhibit time (sub 3) is a least gap between two\n");
+    lines = 4;
     for (size_t i = 0; i < d->object_count; i++) {
         const urrt_co_object *o = &d->objects[i];
         char name[160], lo[32], hi[32];
-        if (is_robot_value(can, o, hb)) {
-            const urrt_can_signal *sig = &can->frames[o->frame].sigs[o->item];
-            object_name(can, o, hb, name, sizeof name);
+        if (!is_robot_value(can, o, hb)) {
+            continue;
+        }
+        const urrt_can_signal *sig = &can->frames[o->frame].sigs[o->item];
+        object_name(can, o, hb, name, sizeof name);
+        if (can->frames[o->frame].meta[o->item].bitmask) {
+            fprintf(out, "Line%zu=0x%04X sub %u %s: no limits\n", ++lines, o->index, o->sub, name);
+        } else {
             fprintf(out, "Line%zu=0x%04X sub %u %s, limits %s..%s\n", ++lines, o->index, o->sub, name,
                     dbc_number(sig->min, lo, sizeof lo), dbc_number(sig->max, hi, sizeof hi));
         }
     }
     fputc('\n', out);
+}
+
+/* ---- the communication objects: lib/urrt_co's table, read on the node -------------------- */
+
+static bool is_header(const urrt_co_comm *row)
+{
+    return row->subs == 0u;
+}
+
+/* The pre-defined id a COB-ID counts from the node id (CiA 301), or 0. */
+static uint32_t predefined_id(const urrt_co_desc *d, const urrt_co_comm *row, size_t n)
+{
+    uint32_t pre;
+    if (row->index == EMCY_INDEX) {
+        return EMCY_BASE + d->node_id;
+    }
+    pre = canopen_predefined_tpdo_id((unsigned)n + 1u, d->node_id);
+    return pre != 0 || n + 1u != d->tpdo_count ? pre : CANOPEN_STATUS_ID_BASE + d->node_id;
+}
+
+/* A DefaultValue: the value right after a reset (urrt_co.h), with $NODEID
+ * where it is the pre-defined id (CiA 306); 0 where no value is there yet
+ * (0x1003's codes). */
+static void default_text(const urrt_co *node, const urrt_co_comm *row, size_t n, uint8_t sub, char *buf,
+                         size_t size)
+{
+    urrt_co_value v;
+    uint32_t pre = (row->flags & URRT_CO_NODE_ID) != 0u ? predefined_id(node->desc, row, n) : 0u;
+    if (urrt_co_comm_read(node, row, n, sub, &v) != 0u) {
+        v.value = 0;
+        v.text = NULL;
+    }
+    if (v.text != NULL) {
+        snprintf(buf, size, "%.*s", (int)v.size, v.text);
+    } else if (pre != 0 && (v.value & 0x7FFu) == pre) {
+        snprintf(buf, size, "$NODEID+0x%X", (unsigned)((v.value & ~UINT32_C(0x7FF)) | (pre - node->desc->node_id)));
+    } else if (row->type == URRT_CO_UNSIGNED32) {
+        snprintf(buf, size, "0x%08X", (unsigned)v.value);
+    } else {
+        snprintf(buf, size, "%u", (unsigned)v.value);
+    }
+}
+
+/* The sub-indices of a header row's object that instance n has. */
+static unsigned subs_present(const urrt_co *node, const urrt_co_comm *rows, size_t count, size_t n)
+{
+    unsigned present = 0;
+    urrt_co_value v;
+    for (size_t i = 1; i < count; i++) {
+        for (unsigned s = rows[i].sub; s < rows[i].sub + rows[i].subs; s++) {
+            present += urrt_co_comm_read(node, &rows[i], n, (uint8_t)s, &v) != URRT_CO_ABORT_NO_SUB;
+        }
+    }
+    return present;
+}
+
+/* One row's variables of instance n: each of its sub-indices the node has. */
+static void put_comm_row(FILE *out, const urrt_co *node, const urrt_co_comm *row, size_t n)
+{
+    unsigned index = row->index + (unsigned)n;
+    urrt_co_value v;
+    for (unsigned s = row->sub; s < row->sub + row->subs; s++) {
+        char name[64], def[64], low[16], high[16];
+        bool limits = (row->flags & URRT_CO_LIMITS) != 0u;
+        if (urrt_co_comm_read(node, row, n, (uint8_t)s, &v) == URRT_CO_ABORT_NO_SUB) {
+            continue;
+        }
+        snprintf(name, sizeof name, row->subs > 1u ? "%s %u" : "%s", row->name, s);
+        default_text(node, row, n, (uint8_t)s, def, sizeof def);
+        snprintf(low, sizeof low, "0x%X", (unsigned)row->low);
+        snprintf(high, sizeof high, "0x%X", (unsigned)row->high);
+        put_var(out, &(struct eds_var){index, row->object == URRT_CO_OBJ_VAR ? -1 : (int)s, name, row->type,
+                                       row->write != NULL ? ACCESS_RW : ACCESS_RO, def, false,
+                                       limits ? low : NULL, limits ? high : NULL});
+    }
+}
+
+/* Every object of the table, instance by instance: a header and the rows
+ * of its index after it. */
+static void put_communication(FILE *out, const urrt_co *node)
+{
+    size_t i = 0;
+    while (i < urrt_co_comm_count) {
+        const urrt_co_comm *first = &urrt_co_comm_table[i];
+        size_t count = 1;
+        while (i + count < urrt_co_comm_count && urrt_co_comm_table[i + count].index == first->index) {
+            count++;
+        }
+        for (size_t n = 0; n < urrt_co_comm_instances(node, first); n++) {
+            if (is_header(first)) {
+                put_record(out, first->index + (unsigned)n, first->name, first->object,
+                           subs_present(node, first, count, n));
+            }
+            for (size_t k = is_header(first) ? 1u : 0u; k < count; k++) {
+                put_comm_row(out, node, &first[k], n);
+            }
+        }
+        i += count;
+    }
+}
+
+/* The table's objects other than the mandatory ones, ascending: their number. */
+static size_t optional_indices(const urrt_co *node, unsigned *out)
+{
+    size_t count = 0;
+    for (size_t i = 0; i < urrt_co_comm_count; i++) {
+        const urrt_co_comm *row = &urrt_co_comm_table[i];
+        bool mandatory = false;
+        if (i > 0 && urrt_co_comm_table[i - 1].index == row->index) {
+            continue;
+        }
+        for (size_t k = 0; k < COUNT(mandatory_indices); k++) {
+            mandatory = mandatory || mandatory_indices[k] == row->index;
+        }
+        for (size_t n = 0; !mandatory && n < urrt_co_comm_instances(node, row); n++) {
+            out[count++] = row->index + (unsigned)n;
+        }
+    }
+    return count;
 }
 
 /* ---- object lists ------------------------------------------------------------------------ */
@@ -201,10 +356,6 @@ static void put_list(FILE *out, const char *section, const unsigned *indices, si
     fputc('\n', out);
 }
 
-static const unsigned mandatory[] = {0x1000, 0x1001, 0x1018};
-static const unsigned optional_comm[] = {0x1003, 0x1005, 0x1008, 0x1009, 0x100A, 0x1014, 0x1015, 0x1017};
-#define COUNT(a) (sizeof a / sizeof a[0])
-
 /* The manufacturer indices, ascending, each once: their number. */
 static size_t manufacturer_indices(const urrt_co_desc *d, unsigned *out)
 {
@@ -222,95 +373,15 @@ static size_t manufacturer_indices(const urrt_co_desc *d, unsigned *out)
     return n;
 }
 
-static int put_lists(FILE *out, const urrt_co_desc *d, unsigned *work)
+static int put_lists(FILE *out, const urrt_co *node, unsigned *work)
 {
-    size_t n = 0;
-    put_list(out, "MandatoryObjects", mandatory, COUNT(mandatory));
-    for (size_t i = 0; i < COUNT(optional_comm); i++) {
-        work[n++] = optional_comm[i];
-    }
-    for (size_t i = 0; i < d->tpdo_count; i++) {
-        work[n++] = TPDO_COMM + (unsigned)i;
-    }
-    for (size_t i = 0; i < d->tpdo_count; i++) {
-        work[n++] = TPDO_MAP + (unsigned)i;
-    }
-    put_list(out, "OptionalObjects", work, n);
-    put_list(out, "ManufacturerObjects", work, manufacturer_indices(d, work));
+    put_list(out, "MandatoryObjects", mandatory_indices, COUNT(mandatory_indices));
+    put_list(out, "OptionalObjects", work, optional_indices(node, work));
+    put_list(out, "ManufacturerObjects", work, manufacturer_indices(node->desc, work));
     return 0;
 }
 
 /* ---- the objects -------------------------------------------------------------------------- */
-
-static void put_communication(FILE *out, const urrt_co_desc *d)
-{
-    static const char *const identity[] = {"Vendor-ID", "Product code", "Revision number", "Serial number"};
-    const uint32_t ids[] = {d->vendor_id, d->product_code, d->revision, d->serial};
-    put_u32(out, 0x1000, -1, "Device type", ACCESS_RO, d->device_type);
-    put_small(out, 0x1001, -1, "Error register", URRT_CO_UNSIGNED8, ACCESS_RO, 0);
-    put_record(out, 0x1003, "Pre-defined error field", OBJ_ARRAY, URRT_CO_HISTORY + 1u);
-    put_small(out, 0x1003, 0, "Number of errors", URRT_CO_UNSIGNED8, ACCESS_RW, 0);
-    for (unsigned k = 1; k <= URRT_CO_HISTORY; k++) {
-        put_u32(out, 0x1003, (int)k, "Standard error field", ACCESS_RO, 0);
-    }
-    put_u32(out, 0x1005, -1, "COB-ID SYNC", ACCESS_RW, 0x80);
-    put_text(out, 0x1008, "Manufacturer device name", d->device_name);
-    put_text(out, 0x1009, "Manufacturer hardware version", d->hardware_version);
-    put_text(out, 0x100A, "Manufacturer software version", d->software_version);
-    put_var(out, &(struct eds_var){0x1014, -1, "COB-ID EMCY", URRT_CO_UNSIGNED32, ACCESS_RW, "$NODEID+0x80", false,
-                                   NULL, NULL});
-    put_small(out, 0x1015, -1, "Inhibit time EMCY", URRT_CO_UNSIGNED16, ACCESS_RW, 0);
-    put_small(out, 0x1017, -1, "Producer heartbeat time", URRT_CO_UNSIGNED16, ACCESS_RW, d->heartbeat_ms);
-    put_record(out, 0x1018, "Identity object", OBJ_RECORD, 5);
-    put_small(out, 0x1018, 0, "Highest sub-index supported", URRT_CO_UNSIGNED8, ACCESS_RO, 4);
-    for (unsigned k = 0; k < 4; k++) {
-        put_u32(out, 0x1018, (int)k + 1, identity[k], ACCESS_RO, ids[k]);
-    }
-}
-
-/* TPDO n's COB-ID default: with $NODEID where it is the pre-defined one (CiA 306). */
-static void cob_text(const urrt_co_desc *d, size_t n, char *buf, size_t size)
-{
-    uint32_t pre = canopen_predefined_tpdo_id((unsigned)n + 1u, d->node_id);
-    uint32_t cob = d->tpdos[n].cob_id;
-    if (cob == URRT_CO_COB_DEFAULT) {
-        cob = pre != 0 ? pre : URRT_CO_COB_INVALID;
-    }
-    if (pre == 0 && n + 1u == d->tpdo_count) {
-        pre = CANOPEN_STATUS_ID_BASE + d->node_id; /* the status TPDO's default past TPDO4 */
-    }
-    if (pre != 0 && (cob & 0x7FFu) == pre) {
-        snprintf(buf, size, "$NODEID+0x%X", (unsigned)((cob & ~UINT32_C(0x7FF)) | (pre - d->node_id)));
-    } else {
-        snprintf(buf, size, "0x%08X", (unsigned)cob);
-    }
-}
-
-static void put_tpdo(FILE *out, const urrt_co *node, size_t n)
-{
-    const urrt_co_desc *d = node->desc;
-    const urrt_co_tpdo *p = &d->tpdos[n];
-    unsigned comm = TPDO_COMM + (unsigned)n, map = TPDO_MAP + (unsigned)n;
-    char cob[32], type[8];
-    put_record(out, comm, "TPDO communication parameter", OBJ_RECORD, 5);
-    put_small(out, comm, 0, "Highest sub-index supported", URRT_CO_UNSIGNED8, ACCESS_RO, 5);
-    cob_text(d, n, cob, sizeof cob);
-    put_var(out, &(struct eds_var){comm, 1, "COB-ID used by TPDO", URRT_CO_UNSIGNED32, ACCESS_RW, cob, false, NULL,
-                                   NULL});
-    snprintf(type, sizeof type, "%u", p->transmission_type);
-    put_var(out, &(struct eds_var){comm, 2, "Transmission type", URRT_CO_UNSIGNED8, ACCESS_RW, type, false, "0x01",
-                                   "0xFF"});
-    put_small(out, comm, 3, "Inhibit time", URRT_CO_UNSIGNED16, ACCESS_RW, p->inhibit_100us);
-    put_small(out, comm, 5, "Event timer", URRT_CO_UNSIGNED16, ACCESS_RW,
-              (unsigned)(node->tx->tables->frames[p->frame].period_us / 1000u));
-    put_record(out, map, "TPDO mapping parameter", OBJ_RECORD, p->mapping_count + 1u);
-    put_small(out, map, 0, "Number of mapped objects", URRT_CO_UNSIGNED8, ACCESS_RO, p->mapping_count);
-    for (unsigned k = 0; k < p->mapping_count; k++) {
-        char name[32];
-        snprintf(name, sizeof name, "Mapped object %u", k + 1u);
-        put_u32(out, map, (int)k + 1, name, ACCESS_RO, p->mapping[k]);
-    }
-}
 
 static void put_manufacturer(FILE *out, const struct co_run *run, const struct can_map *can, size_t hb,
                              const unsigned *indices, size_t count)
@@ -343,26 +414,35 @@ static void put_manufacturer(FILE *out, const struct co_run *run, const struct c
     }
 }
 
-int eds_write(FILE *out, struct co_run *run, const struct canopen_map *co, const struct can_map *can,
-              const char *source)
+/* The most indices a list holds: the table's per node, and every manufacturer object. */
+static size_t list_capacity(const urrt_co *node)
 {
-    const urrt_co *node = co_run_node(run);
+    size_t count = node->desc->object_count;
+    for (size_t i = 0; i < urrt_co_comm_count; i++) {
+        count += urrt_co_comm_instances(node, &urrt_co_comm_table[i]);
+    }
+    return count;
+}
+
+int eds_write(FILE *out, struct co_run *run, const struct canopen_map *co, const struct can_map *can,
+              const char *source, const char *file_name)
+{
+    urrt_co *node = co_run_node(run);
     const urrt_co_desc *d = co_run_desc(run);
     size_t hb = can->frame_count; /* can_run's heartbeat index: the status TPDO's frame */
-    unsigned *work = calloc(COUNT(optional_comm) + 2u * d->tpdo_count + d->object_count + 1u, sizeof *work);
+    unsigned *work = calloc(list_capacity(node), sizeof *work);
     size_t manufacturers;
     if (work == NULL) {
         return -1;
     }
-    put_file_info(out, d, source);
+    /* The defaults are the values right after a reset (urrt_co.h): reset it, silently. */
+    urrt_co_start(node, 0, NULL, NULL);
+    put_file_info(out, d, source, file_name);
     put_device_info(out, co, can, d);
     put_dummy_usage(out, d);
     put_comments(out, can, d, hb);
-    put_lists(out, d, work);
-    put_communication(out, d);
-    for (size_t n = 0; n < d->tpdo_count; n++) {
-        put_tpdo(out, node, n);
-    }
+    put_lists(out, node, work);
+    put_communication(out, node);
     manufacturers = manufacturer_indices(d, work);
     put_manufacturer(out, run, can, hb, work, manufacturers);
     free(work);

@@ -21,8 +21,12 @@
 #include "co_run.h"
 
 /* Writes the EDS (source: the configuration's name for FileInfo's
- * Description; NULL: none). 0, or -1 when the stream failed. */
+ * Description, NULL: none; file_name: the file it goes to, for FileName,
+ * NULL: standard output, "urrt-nodeN.eds"). The communication objects are
+ * lib/urrt_co's table (urrt_co_comm_table), their defaults read on the
+ * node right after a reset, which eds_write does (silently). The dates are
+ * SOURCE_DATE_EPOCH's when it is set. 0, or -1 when the stream failed. */
 int eds_write(FILE *out, struct co_run *run, const struct canopen_map *co, const struct can_map *can,
-              const char *source);
+              const char *source, const char *file_name);
 
 #endif

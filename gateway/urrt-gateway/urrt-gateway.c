@@ -106,6 +106,9 @@ static void print_plan(const gw_config *cfg, const char *url)
         char line[256];
         can_map_describe(&cfg->can, line, sizeof line);
         printf("can %s\n", line);
+        for (size_t i = 0; i < can_map_notice_count(&cfg->can); i++) {
+            printf("notice: %s\n", can_map_notice(&cfg->can, i));
+        }
     }
     if (cfg->co_run != NULL) {
         char line[256];
@@ -134,21 +137,23 @@ static void print_plan(const gw_config *cfg, const char *url)
 }
 
 /* What --print-dbc and --print-c-tables write. */
-typedef int (*writer_fn)(FILE *out, gw_config *cfg);
+typedef int (*writer_fn)(FILE *out, gw_config *cfg, const char *path); /* path NULL: stdout */
 
-static int dbc_writer(FILE *out, gw_config *cfg)
+static int dbc_writer(FILE *out, gw_config *cfg, const char *path)
 {
+    (void)path;
     return dbc_write(out, &cfg->can, cfg->path);
 }
 
-static int c_tables_writer(FILE *out, gw_config *cfg)
+static int c_tables_writer(FILE *out, gw_config *cfg, const char *path)
 {
+    (void)path;
     return can_ctables_write(out, &cfg->can, cfg->can_run, cfg->co_run, cfg->path);
 }
 
-static int eds_writer(FILE *out, gw_config *cfg)
+static int eds_writer(FILE *out, gw_config *cfg, const char *path)
 {
-    return eds_write(out, cfg->co_run, &cfg->co, &cfg->can, cfg->path);
+    return eds_write(out, cfg->co_run, &cfg->co, &cfg->can, cfg->path, path);
 }
 
 static int write_output(gw_config *cfg, const char *path, writer_fn write, const char *what)
@@ -168,7 +173,7 @@ static int write_output(gw_config *cfg, const char *path, writer_fn write, const
         fprintf(stderr, "urrt-gateway: cannot write %s: %s\n", path, strerror(errno));
         return CLI_EXIT_RUNTIME;
     }
-    ok = write(out, cfg) == 0;
+    ok = write(out, cfg, path) == 0;
     ok = fflush(out) == 0 && ok;
     if (out != stdout) {
         ok = fclose(out) == 0 && ok;
@@ -333,6 +338,9 @@ static int run(gw_config *cfg, const options *o)
         gw_add_output(&gw, &output);
         can_map_describe(&cfg->can, line, sizeof line);
         urrt_log(URRT_LOG_NOTICE, "CAN: %s", line);
+        for (size_t i = 0; i < can_map_notice_count(&cfg->can); i++) {
+            urrt_log(URRT_LOG_NOTICE, "CAN: %s", can_map_notice(&cfg->can, i));
+        }
         if (cfg->co_run != NULL) {
             co_run_describe(cfg->co_run, line, sizeof line);
             urrt_log(URRT_LOG_NOTICE, "CANopen %s", line);

@@ -11,8 +11,15 @@ or ARRAY has SubNumber sections [XXXXsubN], sub 0 among them; every DefaultValue
 parses for its type ($NODEID forms included); 0x1017 is there (no node guarding);
 each TPDO mapping (0x1A00+n) names existing objects marked PDOMapping=1 whose size
 matches the bit length, fits 64 bits, and has its communication object 0x1800+n;
-NrOfTXPDO equals the number of TPDOs and NrOfRXPDO the RPDOs.
+NrOfTXPDO equals the number of TPDOs and NrOfRXPDO the RPDOs; [FileInfo] FileName is the
+file's own name, CreationTime/ModificationTime "hh:mm" + AM/PM and CreationDate/
+ModificationDate "mm-dd-yyyy"; a LowLimit/HighLimit pair parses, is ordered and holds the
+DefaultValue; every TPDO COB-ID (0x18xx sub 1) has bit 30 set (no RTR: the node serves
+none); an object mapped from a bit-mask field (unit "bits" in lib/urrt.h's field table)
+carries no LowLimit/HighLimit and its [Comments] line no limits.
 """
+import os
+import re
 import struct
 import sys
 
@@ -20,6 +27,15 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 import eds  # noqa: E402
 
 MANDATORY = {0x1000, 0x1001, 0x1018}
+URRT_H = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'lib', 'urrt.h')
+TIME = re.compile(r'(0[1-9]|1[0-2]):[0-5][0-9](AM|PM)')
+DATE = re.compile(r'(0[1-9]|1[0-2])-(0[1-9]|[12][0-9]|3[01])-[0-9]{4}')
+
+
+def mask_fields():
+    """The field names lib/urrt.h's X-macro table gives the unit "bits"."""
+    with open(URRT_H) as f:
+        return set(re.findall(r'X\(\w+, (\w+), [^"]*"bits"', f.read()))
 
 
 class Checker:
@@ -147,13 +163,47 @@ def check_pdos(c, cp, node_id):
                 not cp.has_section('%04X' % (0x1A00 + n)) or cp.has_section('%04X' % (0x1800 + n)))
 
 
+def check_file_info(c, cp, path):
+    info = cp['FileInfo'] if cp.has_section('FileInfo') else {}
+    name = info.get('FileName', '').strip()
+    c.check('[FileInfo] FileName "%s" is the file\'s name' % name, name == os.path.basename(path))
+    for key, form in (('CreationTime', TIME), ('ModificationTime', TIME), ('CreationDate', DATE),
+                      ('ModificationDate', DATE)):
+        c.check('[FileInfo] %s "%s" as CiA 306 writes it' % (key, info.get(key, '')),
+                form.fullmatch(info.get(key, '').strip()) is not None)
+
+
+def check_limits(c, cp, node_id):
+    masks = mask_fields()
+    c.check('lib/urrt.h names bit-mask fields', bool(masks))
+    comments = cp['Comments'] if cp.has_section('Comments') else {}
+    for (index, sub), sec in eds.objects(cp).items():
+        where = '[%04X%s]' % (index, '' if sub is None else 'sub%X' % sub)
+        field = re.match(r'\w+: (\w+)', sec.get('ParameterName', ''))
+        if index >= 0x2000 and field and field.group(1) in masks:
+            c.check('%s bit mask %s: no LowLimit/HighLimit' % (where, field.group(1)),
+                    'LowLimit' not in sec and 'HighLimit' not in sec)
+            lines = [v for v in comments.values() if v.startswith('0x%04X sub %d ' % (index, sub))]
+            c.check('%s bit mask: its [Comments] line gives no limits' % where,
+                    bool(lines) and all('limits' not in v or 'no limits' in v for v in lines), ' / '.join(lines))
+        if 'LowLimit' in sec or 'HighLimit' in sec:
+            low, high = (eds.resolve(sec.get(k, '0'), node_id) for k in ('LowLimit', 'HighLimit'))
+            default = eds.resolve(sec.get('DefaultValue', str(low)), node_id)
+            c.check('%s limits %d..%d hold the default %d' % (where, low, high, default), low <= default <= high)
+        if 0x1800 <= index < 0x1A00 and sub == 1:
+            value = eds.resolve(sec.get('DefaultValue', '0'), node_id)
+            c.check('%s COB-ID 0x%08X: bit 30 (no RTR)' % (where, value), value & 0x40000000 != 0)
+
+
 def check(path, node_id=1):
     c = Checker()
     cp = eds.read(path)
     check_sections(c, cp)
+    check_file_info(c, cp, path)
     check_lists(c, cp)
     check_objects(c, cp, node_id)
     check_pdos(c, cp, node_id)
+    check_limits(c, cp, node_id)
     return c
 
 

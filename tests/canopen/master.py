@@ -365,7 +365,8 @@ def step_operational(m, cp, out):
 def step_pdo_configuration(m, tps):
     """What a manager writes at boot: a TPDO the EDS declares off (COB-ID bit 31)
     enabled; a TPDO moved to another COB-ID by CiA 301's sequence (bit 31 set, the
-    new id, bit 31 clear), its frames seen there, then moved back."""
+    new id, bit 31 clear), its frames seen there, then moved back; the same with
+    the new id in the disabling write (python-canopen's PdoMap.save)."""
     for t in [t for t in tps if t['cob_id'] & 0x80000000]:
         index, cob = 0x1800 + t['n'] - 1, t['cob_id'] & 0x7FF
         m.write_u(index, 1, cob, 4)
@@ -383,8 +384,18 @@ def step_pdo_configuration(m, tps):
     for value in (new | 0x80000000, old | 0x80000000, old):
         m.write_u(index, 1, value, 4)
     m.fence()
-    m.wait('TPDO%d back at 0x%03X' % (t['n'], old), lambda f: f[1] == old)
+    m.wait('TPDO%d back at 0x%03X' % (t['n'], old & 0x7FF), lambda f: f[1] == old & 0x7FF)
     m.check('TPDO%d moved to 0x%03X and back by the bit 31 sequence' % (t['n'], new), True)
+    # python-canopen's PdoMap.save: disabled and given the new id in one write, then enabled.
+    m.check('TPDO%d COB-ID 0x%08X reads bit 30 set (no RTR)' % (t['n'], old), (m.read_u(index, 1) & 0x40000000) != 0)
+    for value in (new | 0xC0000000, new | 0x40000000):
+        m.write_u(index, 1, value, 4)
+    m.wait('TPDO%d at 0x%03X after one disabling write' % (t['n'], new), lambda f: f[1] == new)
+    for value in (old | 0x80000000, old):
+        m.write_u(index, 1, value, 4)
+    m.fence()
+    m.wait('TPDO%d back at 0x%03X' % (t['n'], old & 0x7FF), lambda f: f[1] == old & 0x7FF)
+    m.check('TPDO%d moved to 0x%03X and back, each in one write with bit 31' % (t['n'], new), True)
 
 
 def tpdos_per_heartbeats(m, cob_id, beats):
@@ -410,6 +421,21 @@ def step_event_timer(m, t):
     slow = tpdos_per_heartbeats(m, cob, 8)
     m.check('TPDO%d event timer 10 ms: 20 or more per 8 heartbeats of 50 ms (%d)' % (t['n'], fast), fast >= 20)
     m.check('TPDO%d event timer 200 ms: 4 or fewer per 8 heartbeats of 50 ms (%d)' % (t['n'], slow), slow <= 4)
+    # 0: no timer, the TPDO goes with each packet (urrt-sim at 125 Hz: 50 in 400 ms); the
+    # inhibit time (written while the PDO is invalid) then caps it at one per 20 ms.
+    m.write_u(index, 5, 0, 2)
+    m.wait('heartbeat', m.heartbeat(0x05))
+    packets = tpdos_per_heartbeats(m, cob, 8)
+    m.check('TPDO%d event timer 0: one per packet, 30 or more per 8 heartbeats (%d)' % (t['n'], packets),
+            packets >= 30)
+    for sub, value, size in ((1, t['cob_id'] | 0x80000000, 4), (3, 200, 2), (1, t['cob_id'], 4)):
+        m.write_u(index, sub, value, size)
+    m.wait('heartbeat', m.heartbeat(0x05))
+    gapped = tpdos_per_heartbeats(m, cob, 8)
+    m.check('TPDO%d inhibit time 20 ms: 10..21 per 8 heartbeats of 50 ms (%d)' % (t['n'], gapped),
+            10 <= gapped <= 21)
+    for sub, value, size in ((1, t['cob_id'] | 0x80000000, 4), (3, 0, 2), (1, t['cob_id'], 4)):
+        m.write_u(index, sub, value, size)
     m.write_u(index, 5, was, 2)
 
 

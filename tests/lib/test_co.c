@@ -225,7 +225,10 @@ static void test_nmt(void)
     EXPECT(0, 0x70A, 0x00);
     EQ(urrt_co_state(&co), URRT_CO_PRE_OPERATIONAL);
     nmt(0x01, NODE, 1000);
-    EXPECT_NONE("start: no answer");
+    EQ(out_count, 1);
+    EXPECT(0, 0x70A, 0x05); /* a new state: its heartbeat at once */
+    nmt(0x01, NODE, 1500);
+    EXPECT_NONE("start while operational: no change, no heartbeat");
     EQ(urrt_co_state(&co), URRT_CO_OPERATIONAL);
     nmt(0x80, NODE, 2000);
     EQ(urrt_co_state(&co), URRT_CO_PRE_OPERATIONAL);
@@ -267,7 +270,8 @@ static void test_nmt(void)
         const uint8_t req[8] = {0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0};
         EQ(rx(0x60A, req, 8, 12000), 0);
     }
-    EQ(run(110000), 1);
+    EQ(run(111999), 0); /* the cadence restarted at the change to STOPPED */
+    EQ(run(112000), 1);
     EXPECT(0, 0x70A, 0x04);
 
     /* Self-starting: operational right after the boot-up. */
@@ -291,12 +295,18 @@ static void test_heartbeat(void)
     EQ(run(100000), 1);
     EXPECT(0, 0x70A, 0x7F);
     nmt(0x01, NODE, 150000);
-    EQ(run(200000), 2); /* the heartbeat and TPDO1 (no data: invalid) */
+    EQ(out_count, 1);
+    EXPECT(0, 0x70A, 0x05); /* at once, then every 100 ms from here */
+    EQ(run(200000), 1);     /* TPDO1 (no data: invalid) */
+    EQ(out[0].id, 0x18A);
+    EQ(run(249999), 1); /* TPDO1 again (its missed slots skipped), next due at 259999 */
+    EQ(run(250000), 1);
     EXPECT(0, 0x70A, 0x05);
     /* Off by SDO: 0x1017 = 0. */
-    SDO(210000, 0x2B, 0x17, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
+    SDO(250000, 0x2B, 0x17, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
     ANSWER(0x60, 0x17, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
-    nmt(0x80, NODE, 210000);
+    nmt(0x80, NODE, 250000);
+    EXPECT_NONE("heartbeat off: no heartbeat on a state change");
     EQ(run(300000), 0);
     EQ(run(400000), 0);
     /* On again: 250 ms from the write. */
@@ -348,9 +358,9 @@ static void test_sdo_upload(void)
     SDO(1000, 0x40, 0x00, 0x18, 0x00, 0, 0, 0, 0);
     ANSWER(0x4F, 0x00, 0x18, 0x00, 0x05, 0x00, 0x00, 0x00);
     SDO(1000, 0x40, 0x00, 0x18, 0x01, 0, 0, 0, 0);
-    ANSWER(0x43, 0x00, 0x18, 0x01, 0x8A, 0x01, 0x00, 0x00);
+    ANSWER(0x43, 0x00, 0x18, 0x01, 0x8A, 0x01, 0x00, 0x40); /* bit 30: no RTR */
     SDO(1000, 0x40, 0x01, 0x18, 0x01, 0, 0, 0, 0);
-    ANSWER(0x43, 0x01, 0x18, 0x01, 0x8A, 0x02, 0x00, 0x00);
+    ANSWER(0x43, 0x01, 0x18, 0x01, 0x8A, 0x02, 0x00, 0x40);
     SDO(1000, 0x40, 0x00, 0x18, 0x02, 0, 0, 0, 0);
     ANSWER(0x4F, 0x00, 0x18, 0x02, 0xFE, 0x00, 0x00, 0x00);
     SDO(1000, 0x40, 0x00, 0x18, 0x03, 0, 0, 0, 0);
@@ -437,7 +447,6 @@ static void sdo_refused_requests(void)
     ABORT(1000, 0x06090032, 0x2B, 0x00, 0x21, 0x00, 0x09, 0x00, 0, 0); /* 9 < 10 */
     ABORT(1000, 0x06090031, 0x2F, 0x00, 0x18, 0x02, 0xFC, 0, 0, 0);    /* type 252: RTR only */
     ABORT(1000, 0x06090032, 0x2F, 0x00, 0x18, 0x02, 0x00, 0, 0, 0);    /* type 0 */
-    ABORT(1000, 0x06090032, 0x2B, 0x00, 0x18, 0x05, 0x00, 0x00, 0, 0); /* invalid policy needs a period */
     ABORT(1000, 0x05040001, 0xA0, 0x00, 0x10, 0x00, 0, 0, 0, 0);       /* block upload */
     ABORT(1000, 0x05040001, 0xC0, 0x00, 0x10, 0x00, 0, 0, 0, 0);       /* block download */
     ABORT(1000, 0x05040001, 0x21, 0x00, 0x21, 0x00, 2, 0, 0, 0);       /* segmented download */
@@ -627,6 +636,171 @@ static void test_sync(void)
     SDO(200000, 0x23, 0x01, 0x18, 0x01, 0x8A, 0x02, 0x00, 0x80);
     EQ(rx(0x081, NULL, 0, 200000), 0);
     EQ(rx(0x081, NULL, 0, 200000), 0);
+}
+
+/* ---- TPDO timing: inhibit time and event timer, in frames per interval ------------------- */
+
+/* The node from t0 for span_us as a loop would run it: woken at every
+ * deadline, and a robot packet (q0 rising by 0.001 rad each) every
+ * packet_us (0: none). Returns the frames sent on `id`; *last_q0 (if not
+ * NULL) the raw q0 of the latest such frame. */
+static size_t frames_in(uint32_t id, uint64_t t0, uint64_t span_us, uint64_t packet_us, int *last_q0)
+{
+    uint64_t next_packet = t0;
+    uint64_t t = t0;
+    size_t sent = 0;
+    unsigned wakes;
+    double q0 = 0.0;
+    for (wakes = 0; wakes < 10000u; wakes++) {
+        uint64_t due = urrt_co_deadline(&co);
+        due = due < t ? t : due;
+        if (packet_us != 0u && next_packet <= due) {
+            t = next_packet;
+            q0 += 0.001;
+            next_packet += packet_us;
+            if (t < t0 + span_us) {
+                packet(t, q0, 7);
+            }
+        } else {
+            t = due;
+        }
+        if (t >= t0 + span_us) {
+            break;
+        }
+        run(t);
+        sent += count_id(id);
+        if (last_q0 != NULL && count_id(id) > 0u) {
+            size_t i;
+            for (i = 0; i < out_count && i < MAX_OUT; i++) {
+                *last_q0 = out[i].id == id ? (int16_t)(out[i].data[0] | out[i].data[1] << 8) : *last_q0;
+            }
+        }
+    }
+    CHECK(wakes < 10000u, "the node woke without end at %llu", (unsigned long long)t);
+    return sent;
+}
+
+/* A node with TPDO n alone (the other's COB-ID invalid), operational, its
+ * inhibit time and event timer set by SDO as a manager does it (invalid,
+ * inhibit, event timer, valid again): the requests and answers of CiA 301. */
+static void timing_node(unsigned n, uint8_t inhibit_100us, uint8_t event_ms)
+{
+    const uint8_t off = (uint8_t)(1u - n);
+    const uint8_t id_high = (uint8_t)(0x01u + n);
+    const uint8_t invalid[8] = {0x23, off, 0x18, 0x01, 0x8A, (uint8_t)(0x01u + off), 0x00, 0xC0};
+    const uint8_t disable[8] = {0x23, (uint8_t)n, 0x18, 0x01, 0x8A, id_high, 0x00, 0xC0};
+    const uint8_t inhibit[8] = {0x2B, (uint8_t)n, 0x18, 0x03, inhibit_100us, 0x00, 0x00, 0x00};
+    const uint8_t event[8] = {0x2B, (uint8_t)n, 0x18, 0x05, event_ms, 0x00, 0x00, 0x00};
+    const uint8_t enable[8] = {0x23, (uint8_t)n, 0x18, 0x01, 0x8A, id_high, 0x00, 0x40};
+    const uint8_t *reqs[5] = {invalid, disable, inhibit, event, enable};
+    unsigned k;
+    desc_defaults();
+    desc.heartbeat_ms = 0;
+    setup();
+    for (k = 0; k < 5u; k++) {
+        const uint8_t answer[8] = {0x60, reqs[k][1], 0x18, reqs[k][3], 0, 0, 0, 0};
+        EQ(rx(0x60A, reqs[k], 8, 0), 1);
+        expect_at(__LINE__, 0, 0x58A, answer, 8);
+    }
+    nmt(0x01, NODE, 0);
+}
+
+/* The inhibit time is a least gap between two sends: it lowers a rate,
+ * never raises it, and a send that falls in the gap goes at its end with
+ * the newest data. TPDO2: per packet (event timer 0); TPDO1: event timer. */
+static void test_inhibit_time(void)
+{
+    int q0 = 0;
+    timing_node(1, 0, 0);
+    EQ(frames_in(0x28A, 0, 80000, 8000, NULL), 10); /* a packet every 8 ms: 10 frames in 80 ms */
+    timing_node(1, 20, 0);
+    EQ(frames_in(0x28A, 0, 80000, 8000, NULL), 10); /* 2 ms inhibit: still 10, not 40 */
+    timing_node(1, 200, 0);
+    EQ(frames_in(0x28A, 0, 80000, 8000, &q0), 4); /* 20 ms inhibit: at 0, 20, 40, 60 ms */
+    EQ(q0, 8);                                      /* at 60 ms: the newest packet, 56 ms's (the 8th) */
+    timing_node(0, 0, 10);
+    EQ(frames_in(0x18A, 0, 80000, 8000, NULL), 8); /* event timer 10 ms: 8 in 80 ms */
+    timing_node(0, 20, 10);
+    EQ(frames_in(0x18A, 0, 80000, 8000, NULL), 8); /* 2 ms inhibit under a 10 ms timer: no change */
+    timing_node(0, 250, 10);
+    EQ(frames_in(0x18A, 0, 80000, 8000, NULL), 4); /* 25 ms inhibit: at 0, 25, 50, 75 ms */
+    timing_node(0, 0, 10);
+    EQ(frames_in(0x18A, 0, 80000, 0, NULL), 8); /* no data: the invalid policy goes on, validity 0 */
+    EQ(out[0].data[4], 0x00);
+}
+
+/* Event timer 0 means "no event timer" (CiA 301), for every TPDO and
+ * every transmission type. On a frame whose stale policy needs a period
+ * (TPDO1: invalid) the node then sends it with each robot packet, and
+ * nothing while no packet comes: the validity bit has no slot to go out in. */
+static void test_event_timer_zero(void)
+{
+    timing_node(0, 0, 0);
+    SDO(0, 0x40, 0x00, 0x18, 0x05, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x00, 0x18, 0x05, 0x00, 0x00, 0x00, 0x00);
+    EQ(frames_in(0x18A, 0, 80000, 8000, NULL), 10); /* with the packets, every 8 ms */
+    EQ(frames_in(0x18A, 80000, 80000, 0, NULL), 0); /* none without them */
+    EQ(frames_in(0x18A, 160000, 80000, 20000, NULL), 4);
+    EQ(out[0].data[4], 0x01); /* fresh: valid */
+    timing_node(0, 200, 0);
+    EQ(frames_in(0x18A, 0, 80000, 8000, NULL), 4); /* with a 20 ms inhibit time */
+    /* The requests of the report, for both TPDOs and under SYNC type 1. */
+    desc_defaults();
+    setup();
+    SDO(0, 0x2B, 0x00, 0x18, 0x05, 0x00, 0x00, 0x00, 0x00);
+    ANSWER(0x60, 0x00, 0x18, 0x05, 0x00, 0x00, 0x00, 0x00);
+    SDO(0, 0x2B, 0x01, 0x18, 0x05, 0x00, 0x00, 0x00, 0x00);
+    ANSWER(0x60, 0x01, 0x18, 0x05, 0x00, 0x00, 0x00, 0x00);
+    SDO(0, 0x2F, 0x00, 0x18, 0x02, 0x01, 0x00, 0x00, 0x00);
+    ANSWER(0x60, 0x00, 0x18, 0x02, 0x00, 0x00, 0x00, 0x00);
+    SDO(0, 0x2B, 0x00, 0x18, 0x05, 0x00, 0x00, 0x00, 0x00);
+    ANSWER(0x60, 0x00, 0x18, 0x05, 0x00, 0x00, 0x00, 0x00);
+    nmt(0x01, NODE, 1000);
+    packet(1000, 0.5, 7);
+    run(1000);
+    EQ(count_id(0x18A), 0); /* type 1: not on packets */
+    EQ(rx(0x080, NULL, 0, 2000), 1);
+    EXPECT(0, 0x18A, 0xF4, 0x01, 0x07, 0x00, 0x01); /* on the SYNC */
+}
+
+/* A manager disables a TPDO and gives it a new COB-ID in one write
+ * (python-canopen's PdoMap.save); only a new id while valid is refused. */
+static void test_cob_move(void)
+{
+    desc_defaults();
+    desc.heartbeat_ms = 0;
+    setup();
+    SDO(0, 0x23, 0x00, 0x18, 0x01, 0x90, 0x01, 0x00, 0x80);
+    ANSWER(0x60, 0x00, 0x18, 0x01, 0x00, 0x00, 0x00, 0x00);
+    SDO(0, 0x40, 0x00, 0x18, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x00, 0x18, 0x01, 0x90, 0x01, 0x00, 0x80);
+    ABORT(0, 0x06090030, 0x23, 0x01, 0x18, 0x01, 0x8B, 0x02, 0x00, 0x40); /* TPDO2: new id, valid */
+    SDO(0, 0x23, 0x00, 0x18, 0x01, 0x90, 0x01, 0x00, 0x40);            /* valid at the new id */
+    ANSWER(0x60, 0x00, 0x18, 0x01, 0x00, 0x00, 0x00, 0x00);
+    SDO(0, 0x23, 0x14, 0x10, 0x00, 0x8B, 0x00, 0x00, 0x80); /* EMCY: the same rule */
+    ANSWER(0x60, 0x14, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00);
+    nmt(0x01, NODE, 1000);
+    EQ(run(10000), 1);
+    EXPECT(0, 0x190, 0x00, 0x00, 0x00, 0x00, 0x00); /* no data yet: validity 0 */
+}
+
+/* One order of checks for every object: exists, access, size, value. */
+static void test_abort_order(void)
+{
+    desc_defaults();
+    desc.heartbeat_ms = 0;
+    setup();
+    ABORT(0, 0x06010002, 0x23, 0x03, 0x10, 0x01, 0, 0, 0, 0); /* 0x1003 sub 1, history empty */
+    ABORT(0, 0x06090011, 0x23, 0x03, 0x10, 0x09, 0, 0, 0, 0); /* sub 9 does not exist */
+    ABORT(0, 0x06010002, 0x2F, 0x00, 0x10, 0x00, 1, 0, 0, 0); /* read-only before size */
+    ABORT(0, 0x06070012, 0x23, 0x00, 0x18, 0x02, 0, 0, 0, 0); /* size before value (type 0) */
+    ABORT(0, 0x06090032, 0x2F, 0x00, 0x18, 0x02, 0, 0, 0, 0); /* then the value */
+    nmt(0x01, NODE, 0);
+    EQ(run(1000000), 2); /* EMCY: no robot by the end of the startup time; TPDO1 */
+    SDO(1000000, 0x40, 0x03, 0x10, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x03, 0x10, 0x01, 0x01, 0xFF, 0x00, 0x00);
+    ABORT(1000000, 0x06010002, 0x23, 0x03, 0x10, 0x01, 0, 0, 0, 0); /* the same with one error */
+    ABORT(1000000, 0x06010002, 0x23, 0x03, 0x10, 0x02, 0, 0, 0, 0);
 }
 
 /* ---- EMCY ------------------------------------------------------------------------- */
@@ -840,6 +1014,10 @@ int main(void)
     test_sdo_download();
     test_tpdo_gating();
     test_sync();
+    test_inhibit_time();
+    test_event_timer_zero();
+    test_cob_move();
+    test_abort_order();
     test_emcy();
     test_lengths();
     test_random();

@@ -132,6 +132,12 @@ static void test_description(const gw_config *cfg)
     CHECK_EQ_INT(d->tpdos[0].cob_id, URRT_CO_COB_DEFAULT);
     CHECK_EQ_INT(d->tpdos[3].transmission_type, 1);
     CHECK_EQ_INT(d->tpdos[4].cob_id, 0x80000685u);
+    {
+        char line[512];
+        co_run_describe(cfg->co_run, line, sizeof line);
+        CHECK(strstr(line, "node 5: TPDO1..4 at 0x185 0x285 0x385 0x485, status TPDO5 at 0x685 (off until enabled)") ==
+                  line, "--check-config's line names the COB-IDs: %s", line);
+    }
     /* TPDO1: q0..q2 INTEGER16 at 0x2100 sub 1..3, the alive counter and validity bit a byte each. */
     CHECK_EQ_INT(d->tpdos[0].mapping_count, 5);
     CHECK_EQ_INT(d->tpdos[0].mapping[0], 0x21000110u);
@@ -160,11 +166,14 @@ static const char *eds_get(const char *eds, const char *section, const char *key
     char head[64];
     const char *p;
     snprintf(head, sizeof head, "\n[%s]\n", section);
-    p = strstr(eds, head);
-    if (p == NULL) {
+    if (strncmp(eds, head + 1, strlen(head + 1)) == 0) {
+        p = eds + strlen(head + 1); /* the first section: no '\n' before it */
+    } else if ((p = strstr(eds, head)) != NULL) {
+        p += strlen(head);
+    } else {
         return NULL;
     }
-    for (p += strlen(head); *p != '\0' && *p != '\n' && *p != '['; p = strchr(p, '\n') + 1) {
+    for (; *p != '\0' && *p != '\n' && *p != '['; p = strchr(p, '\n') + 1) {
         size_t n = strlen(key);
         if (strncmp(p, key, n) == 0 && p[n] == '=') {
             size_t len = strcspn(p + n + 1, "\n");
@@ -288,22 +297,96 @@ static void test_eds(gw_config *cfg)
     urrt_co *node = co_run_node(cfg->co_run);
     struct sink s = {0};
     unsigned vars;
-    CHECK_EQ_INT(eds_write(out, cfg->co_run, &cfg->co, &cfg->can, "canopen.ini"), 0);
+    CHECK_EQ_INT(eds_write(out, cfg->co_run, &cfg->co, &cfg->can, "canopen.ini", NULL), 0);
     fclose(out);
     CHECK(strncmp(eds, "[FileInfo]\n", 11) == 0, "EDS begins with [FileInfo]");
+    CHECK(eds_get(eds, "FileInfo", "FileName", buf, sizeof buf) && strcmp(buf, "urrt-node5.eds") == 0,
+          "FileName on standard output: %s", buf);
     CHECK(eds_get(eds, "DeviceInfo", "NrOfTXPDO", buf, sizeof buf) && strcmp(buf, "5") == 0, "NrOfTXPDO %s", buf);
     CHECK(eds_get(eds, "DeviceInfo", "BaudRate_500", buf, sizeof buf) && strcmp(buf, "1") == 0, "BaudRate_500");
-    CHECK(eds_get(eds, "1800sub1", "DefaultValue", buf, sizeof buf) && strcmp(buf, "$NODEID+0x180") == 0, "%s", buf);
+    CHECK(eds_get(eds, "1800sub1", "DefaultValue", buf, sizeof buf) && strcmp(buf, "$NODEID+0x40000180") == 0, "%s", buf);
     CHECK(eds_get(eds, "1014", "DefaultValue", buf, sizeof buf) && strcmp(buf, "$NODEID+0x80") == 0, "%s", buf);
     CHECK(eds_get(eds, "1A00sub1", "DefaultValue", buf, sizeof buf) && strcmp(buf, "0x21000110") == 0, "%s", buf);
     CHECK(eds_get(eds, "2100sub1", "ParameterName", buf, sizeof buf) &&
           strstr(buf, "q0: q_actual[0], rad = raw x 0.0002") == buf, "scaling in the name: %s", buf);
+    for (unsigned n = 0; n < 5; n++) {
+        char sec[16];
+        snprintf(sec, sizeof sec, "%04Xsub1", 0x1800 + n);
+        CHECK(eds_get(eds, sec, "DefaultValue", buf, sizeof buf) && strncmp(buf, "$NODEID+0x", 10) == 0 &&
+                  (strtoul(buf + 8, NULL, 16) & 0x40000000u) != 0, "[%s] bit 30 (no RTR): %s", sec, buf);
+    }
+    CHECK(eds_get(eds, "1800sub2", "LowLimit", buf, sizeof buf) && strcmp(buf, "0x1") == 0, "1800sub2 LowLimit");
+    CHECK(eds_get(eds, "1800sub2", "HighLimit", buf, sizeof buf) && strcmp(buf, "0xFF") == 0, "1800sub2 HighLimit");
+    CHECK(strstr(eds, "241..253 are refused") != NULL, "[Comments] states sub 2's accepted set");
+    /* din and dout (0x2103 sub 4, 5) are bit masks: no limits anywhere. */
+    CHECK(eds_get(eds, "2103sub4", "LowLimit", buf, sizeof buf) == NULL, "no LowLimit on a mask");
+    CHECK(eds_get(eds, "2103sub5", "HighLimit", buf, sizeof buf) == NULL, "no HighLimit on a mask");
+    CHECK(strstr(eds, "=0x2103 sub 4 din: digital_input_bits, a bit mask as the robot sends it: no limits\n") != NULL,
+          "[Comments]: din without limits");
+    CHECK(strstr(eds, "=0x2100 sub 1 q0: q_actual[0], rad = raw x 0.0002 + 0, limits ") != NULL,
+          "[Comments]: q0 with its limits");
     urrt_co_start(node, 0, sink_emit, &s);
     CHECK(s.count == 1 && s.last.id == 0x705 && s.last.len == 1 && s.last.data[0] == 0, "boot-up 0x705 [00]");
     vars = check_listed(eds, node, "MandatoryObjects") + check_listed(eds, node, "OptionalObjects") +
            check_listed(eds, node, "ManufacturerObjects");
     CHECK(vars > 100, "%u objects and sub-indices read by SDO", vars);
     free(eds);
+}
+
+/* FileName is the file -o names; the dates are SOURCE_DATE_EPOCH's (CiA 306's formats). */
+static void test_eds_file_info(gw_config *cfg)
+{
+    char *eds = NULL, buf[64];
+    size_t size = 0;
+    FILE *out = open_memstream(&eds, &size);
+    setenv("SOURCE_DATE_EPOCH", "1700000000", 1); /* date -u -d @1700000000: Tue Nov 14 22:13:20 UTC 2023 */
+    CHECK_EQ_INT(eds_write(out, cfg->co_run, &cfg->co, &cfg->can, "canopen.ini", "out/plc/node5-line2.eds"), 0);
+    fclose(out);
+    unsetenv("SOURCE_DATE_EPOCH");
+    CHECK(eds_get(eds, "FileInfo", "FileName", buf, sizeof buf) && strcmp(buf, "node5-line2.eds") == 0, "%s", buf);
+    CHECK(eds_get(eds, "FileInfo", "CreationTime", buf, sizeof buf) && strcmp(buf, "10:13PM") == 0, "%s", buf);
+    CHECK(eds_get(eds, "FileInfo", "CreationDate", buf, sizeof buf) && strcmp(buf, "11-14-2023") == 0, "%s", buf);
+    CHECK(eds_get(eds, "FileInfo", "ModificationDate", buf, sizeof buf) && strcmp(buf, "11-14-2023") == 0, "%s", buf);
+    free(eds);
+}
+
+static void count_status(void *ctx, const urrt_can_frame *frame, uint64_t now_us)
+{
+    (void)now_us;
+    *(unsigned *)ctx += frame->id == 0x685;
+}
+
+/* The status TPDO (TPDO5, the [can] heartbeat frame: a policy that needs a
+ * period) takes event timer 0: it then goes with each robot packet, and
+ * not at all without one. */
+static void test_status_event_timer_zero(gw_config *cfg)
+{
+    static const uint8_t start[2] = {0x01, 0x05};
+    static const uint8_t enable[8] = {0x23, 0x04, 0x18, 0x01, 0x85, 0x06, 0x00, 0x40};
+    static const uint8_t no_timer[8] = {0x2B, 0x04, 0x18, 0x05, 0x00, 0x00, 0x00, 0x00};
+    static const uint8_t done[8] = {0x60, 0x04, 0x18, 0x00, 0x00, 0x00, 0x00, 0x00};
+    static urrt_state st;
+    urrt_co *node = co_run_node(cfg->co_run);
+    struct sink s = {0};
+    unsigned status = 0;
+    urrt_co_start(node, 0, sink_emit, &s);
+    urrt_co_on_frame(node, 0x000, 0, start, 2, 0, sink_emit, &s);
+    for (unsigned k = 0; k < 2; k++) {
+        const uint8_t *req = k == 0 ? enable : no_timer;
+        s.count = 0;
+        urrt_co_on_frame(node, 0x605, 0, req, 8, 0, sink_emit, &s);
+        CHECK(s.count == 1 && s.last.id == 0x585 && s.last.data[0] == done[0] && s.last.data[3] == req[3],
+              "0x1804 sub %u written: [%02X ... sub %u]", req[3], s.last.data[0], s.last.data[3]);
+    }
+    urrt_state_clear(&st);
+    st.generation = URRT_GEN_3X;
+    for (uint64_t t = 1000; t < 2000000; t += 1000) {
+        if (t % 8000 == 0 && t <= 400000) { /* 50 packets, then none for 1.6 s */
+            urrt_cantx_on_packet(node->tx, 0, &st, t);
+        }
+        urrt_co_run(node, t, count_status, &status);
+    }
+    CHECK(status == 50, "status TPDO with event timer 0: one frame per packet, none without (%u)", status);
 }
 
 /* ---- docs/canopen.md's table of the example's object dictionary --------------------------- */
@@ -364,7 +447,7 @@ static char *eds_text(gw_config *cfg)
     char *eds = NULL;
     size_t size = 0;
     FILE *out = open_memstream(&eds, &size);
-    eds_write(out, cfg->co_run, &cfg->co, &cfg->can, "canopen.ini");
+    eds_write(out, cfg->co_run, &cfg->co, &cfg->can, "canopen.ini", NULL);
     fclose(out);
     return eds;
 }
@@ -446,6 +529,8 @@ int main(int argc, char **argv)
     if (cfg.co_run != NULL) {
         test_description(&cfg);
         test_eds(&cfg);
+        test_eds_file_info(&cfg);
+        test_status_event_timer_zero(&cfg);
         test_dbc(&cfg);
         test_doc_table(&cfg, argv[3]);
     }
