@@ -78,12 +78,21 @@ void urrt_log_set_sink(urrt_log_sink_fn fn, void *ctx);
 /* ---- robot link ------------------------------------------------------------ */
 
 /*
- * A read-only TCP link to a robot's RealTime port. It never writes a byte
- * (port 30003 executes URScript sent to it). It connects without blocking,
- * frames the stream with urrt_framer, and on a closed or reset connection, a
- * failed connect or silence longer than silence_timeout_ms (a half-open
- * link) it closes and reconnects with capped exponential backoff. Each state
- * change is logged once, not once per attempt.
+ * A TCP link to a robot. By default it reads the RealTime port and never
+ * writes a byte (port 30003 executes URScript sent to it): it frames the
+ * stream with urrt_framer. A source that speaks first (RTDE, port 30004)
+ * plugs in with urrt_link_set_source, below: it queues its handshake at
+ * every connect, takes the bytes read and says when its data flows. Either
+ * way the link connects without blocking, and on a closed or reset
+ * connection, a failed connect or silence longer than silence_timeout_ms (a
+ * half-open link) it closes and reconnects with capped exponential backoff.
+ * Each state change is logged once, not once per attempt.
+ *
+ * The link is up when data flows, not when TCP connects: a controller whose
+ * process is stopped still has its kernel accept connections. A connection
+ * is URRT_LINK_WAITING until its first packet (for a source: until the
+ * source reports its first data package), and one that ends before it is a
+ * failed attempt, not a connect and a disconnect.
  */
 typedef struct urrt_link_config {
     const char *name;            /* robot name for log lines */
@@ -106,19 +115,24 @@ typedef struct urrt_link_config {
  * backoff 100 ms doubling to 5 s. */
 void urrt_link_config_defaults(urrt_link_config *cfg);
 
+/* The values are on the wire (urrt-gateway's GATEWAY message): WAITING was
+ * added after UP, and none of them changes. */
 typedef enum urrt_link_state {
-    URRT_LINK_IDLE = 0,      /* waiting out the backoff before the next attempt */
-    URRT_LINK_CONNECTING,
-    URRT_LINK_UP             /* connected; packets may flow */
+    URRT_LINK_IDLE = 0,       /* waiting out the backoff before the next attempt */
+    URRT_LINK_CONNECTING = 1, /* the TCP connect is in progress */
+    URRT_LINK_UP = 2,         /* data flows: a packet arrived on this connection */
+    URRT_LINK_WAITING = 3     /* TCP connected, no packet yet (a source's handshake, or
+                                 a peer that accepts and sends nothing) */
 } urrt_link_state;
 
 const char *urrt_link_state_name(urrt_link_state state);
 
 typedef struct urrt_link_stats {
-    uint64_t connects;       /* connections established */
-    uint64_t reconnects;     /* connections established after a loss */
-    uint64_t disconnects;    /* established connections lost (closed, reset, silent) */
-    uint64_t connect_failures;
+    uint64_t connects;       /* times the link came up (a connection delivered a packet) */
+    uint64_t reconnects;     /* of those, the ones after a loss */
+    uint64_t disconnects;    /* times an up link went down (closed, reset, silent, dropped) */
+    uint64_t connect_failures; /* attempts that never came up: refused, timed out, or a
+                                  connection that ended before its first packet */
     uint64_t silences;       /* disconnects caused by silence */
     uint64_t bytes;
     uint64_t packets;
@@ -142,16 +156,18 @@ typedef void (*urrt_packet_fn)(void *ctx, const uint8_t *packet, size_t len, uin
 urrt_link *urrt_link_new(const urrt_link_config *cfg);
 void urrt_link_free(urrt_link *link);
 
-/* The descriptor to wait on and the poll events to wait for (POLLIN or
- * POLLOUT), or -1 when there is none (waiting out the backoff). It changes
- * across reconnects: ask again before each wait. */
+/* The descriptor to wait on and the poll events to wait for (POLLOUT while
+ * connecting; POLLIN once connected, with POLLOUT while a source's bytes
+ * wait to be written), or -1 when there is none (waiting out the backoff).
+ * It changes across reconnects: ask again before each wait. */
 int urrt_link_poll_fd(const urrt_link *link, short *events);
 
 /* Monotonic time by which urrt_link_service must run again at the latest. */
 uint64_t urrt_link_deadline(const urrt_link *link);
 
-/* Does what is due: connect progress, reads (bounded per call), framing,
- * timeouts, backoff. Calls fn for each complete packet. Never blocks. */
+/* Does what is due: connect progress, writes of a source's queue, reads
+ * (bounded per call), framing, timeouts, backoff. Calls fn for each
+ * complete packet (with a source: each package it reports). Never blocks. */
 void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void *ctx);
 
 urrt_link_state urrt_link_get_state(const urrt_link *link);
@@ -177,9 +193,73 @@ const char *urrt_link_peer(const urrt_link *link);
  * packet callback for the packet it completes (so a recorder can keep the
  * bytes up to the last complete packet). Bytes of a packet that a lost
  * connection ended inside are never completed: the next connection starts
- * afresh, and stats.disconnects has gone up. NULL removes the tap. */
+ * afresh. With a source (below) the pieces are the reads, each before the
+ * source receives it. NULL removes the tap. */
 typedef void (*urrt_bytes_fn)(void *ctx, const uint8_t *data, size_t len);
 void urrt_link_set_tap(urrt_link *link, urrt_bytes_fn fn, void *ctx);
+
+/*
+ * A source that speaks first. Without one the link is the RealTime reader
+ * above and never writes. With one (set before the first service call):
+ *
+ * - connected() runs at every TCP connect, before any byte is read: the
+ *   source starts its session afresh (a reconnect redoes all of it) and
+ *   queues its opening bytes with urrt_link_send.
+ * - received() gets every byte read, in order, as read (the link's framer
+ *   is not used); rx_us as for urrt_packet_fn. The link reads whenever
+ *   bytes arrive, so the source is never a slow reader.
+ * - The source calls urrt_link_source_packet for each data package its
+ *   session decodes: the link counts it, comes up at the first one of the
+ *   connection (so "up" means the handshake is done and data arrived), and
+ *   hands it to the urrt_packet_fn of the service call in progress.
+ * - urrt_link_drop(URRT_LINK_DROP_PROTOCOL, why) ends the connection (the
+ *   peer broke the protocol): logged like a lost connection or a failed
+ *   attempt, retried with the usual backoff.
+ *   urrt_link_drop(URRT_LINK_DROP_CONFIG, why) ends it because the peer
+ *   refuses what the configuration asks (an RTDE recipe names a field the
+ *   controller does not have: why should name them and the controller's
+ *   version): logged once as an error, not again until the link has come
+ *   up or the reason changes, and retried every backoff_max_ms.
+ *
+ * Bytes queued with urrt_link_send are written when the socket is writable
+ * (urrt_link_poll_fd asks for POLLOUT while some wait), never blocking,
+ * partial writes continued; the queue holds URRT_LINK_SEND_MAX bytes and is
+ * emptied at every new connection. Silence detection, keepalive, the
+ * connect timeout and the backoff are the same as without a source.
+ * urrt_link_send, urrt_link_source_packet and urrt_link_drop may be called
+ * from inside the source's functions; the link acts on a drop when the
+ * function returns. In the packet callback of a source's package,
+ * urrt_link_packet_empty_us is a time the queue was seen empty before the
+ * read that brought the first byte after the previous package (never later
+ * than the package's first byte), and urrt_link_packet_newest whether the
+ * current read emptied the queue.
+ */
+typedef struct urrt_link_source {
+    void *ctx;
+    void (*connected)(void *ctx, urrt_link *link, uint64_t now_us);
+    void (*received)(void *ctx, urrt_link *link, const uint8_t *data, size_t len, uint64_t rx_us);
+} urrt_link_source;
+
+#define URRT_LINK_SEND_MAX 8192
+
+typedef enum urrt_link_drop_kind {
+    URRT_LINK_DROP_PROTOCOL = 0, /* the peer broke the protocol: reconnect with the usual backoff */
+    URRT_LINK_DROP_CONFIG        /* the peer refuses the configuration: report once, long backoff */
+} urrt_link_drop_kind;
+
+/* Copies *source; NULL goes back to the RealTime reader. */
+void urrt_link_set_source(urrt_link *link, const urrt_link_source *source);
+/* Queues len bytes to write, all or none. URRT_OK; URRT_E_NO_SPACE when the
+ * queue has no room for them; URRT_E_ARG without a source (the RealTime
+ * reader never writes) or without a connection (the bytes belong to a
+ * session: the next one starts with connected()). */
+int urrt_link_send(urrt_link *link, const uint8_t *data, size_t len);
+/* From received(): one data package, complete and decoded; packet and len
+ * are what the packet function receives (the source's bytes or record). */
+void urrt_link_source_packet(urrt_link *link, const uint8_t *packet, size_t len, uint64_t rx_us);
+/* Ends the connection for the reason given (copied; one line, what failed
+ * and what to do). */
+void urrt_link_drop(urrt_link *link, urrt_link_drop_kind kind, const char *reason);
 
 /* ---- CAN link ---------------------------------------------------------------- */
 
@@ -225,6 +305,15 @@ void urrt_link_set_tap(urrt_link *link, urrt_bytes_fn fn, void *ctx);
  * with the bit rate switch, as candump shows FD frames on current kernels),
  * ID in 3 hex digits (11-bit) or 8 (29-bit), DATA in upper-case hex,
  * wall-clock time (or, with log_caller_clock, the caller's now_us).
+ * "log:-" never waits for its reader either: a stdout that is a pipe, FIFO,
+ * terminal or socket is written without blocking, through an open file
+ * description of the link's own (stdout's, shared with the shell, is left
+ * blocking). The reader sees whole lines only: a line it has no room for
+ * is dropped and counted (dropped, busy), and one it took in part is
+ * finished before any other (at the next send, and every retry_interval_ms:
+ * pending is 1 meanwhile). A log file, and a stdout that
+ * is a regular file, is written with write(2), which the kernel may make
+ * wait briefly on the filesystem.
  */
 typedef struct urrt_canlink_config {
     const char *interface;     /* "can0", or "log:PATH[,ifname=NAME]" ("log:-" is stdout) */
@@ -282,10 +371,11 @@ typedef struct urrt_canlink urrt_canlink;
 urrt_canlink *urrt_canlink_new(const urrt_canlink_config *cfg);
 void urrt_canlink_free(urrt_canlink *can);
 
-/* Sends a frame now, never waiting for the bus (a log: link writes a file
- * with write(2), which the kernel may make wait briefly on the
- * filesystem). 1: the driver (or the log) took it;
- * 0: held for a retry, or dropped and counted because the link is down;
+/* Sends a frame now, never waiting for the bus or a log:- reader (a log
+ * file is written with write(2), which the kernel may make wait briefly on
+ * the filesystem). 1: the driver (or the log) took it;
+ * 0: held for a retry, or dropped and counted because the link is down (or
+ * the log:- reader has no room);
  * URRT_E_ARG for a frame the link can never send (FD frame on a classic
  * link, a length FD does not have, an ID out of range). */
 int urrt_canlink_send(urrt_canlink *can, const urrt_can_frame *frame, uint64_t now_us);

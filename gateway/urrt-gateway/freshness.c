@@ -47,3 +47,39 @@ uint64_t gw_age_lag_us(gw_age *age, uint64_t rx_us, uint64_t empty_us, bool has_
     uint64_t controller = has_clock ? controller_lag(age, rx_us, controller_us, newest) : 0;
     return host > controller ? host : controller;
 }
+
+void gw_meter_event(gw_meter *m, uint64_t now_us)
+{
+    m->count++;
+    m->last_us = now_us;
+    if (!m->marked) {
+        m->marked = true;
+        m->mark_count = m->count;
+        m->mark_us = now_us;
+    }
+}
+
+double gw_meter_rate(gw_meter *m, uint64_t now_us)
+{
+    double stop_us;
+    if (!m->marked) {
+        return m->measured ? m->rate : -1.0;
+    }
+    if (m->count > m->mark_count && m->last_us - m->mark_us >= GW_METER_MIN_SPAN_US) {
+        m->rate = (double)(m->count - m->mark_count) * 1e6 / (double)(m->last_us - m->mark_us);
+        m->measured = true;
+        m->mark_count = m->count;
+        m->mark_us = m->last_us;
+    }
+    if (!m->measured) {
+        return -1.0;
+    }
+    /* Without a measured rate there is no period to call overdue. */
+    stop_us = m->rate > 0 ? 2e6 / m->rate : 0;
+    stop_us = stop_us > GW_METER_MIN_SPAN_US ? stop_us : GW_METER_MIN_SPAN_US;
+    if (m->rate > 0 && now_us > m->last_us && (double)(now_us - m->last_us) > stop_us) {
+        m->rate = 0; /* stopped: the next message starts a new measurement */
+        m->marked = false;
+    }
+    return m->rate;
+}

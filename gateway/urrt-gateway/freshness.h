@@ -63,4 +63,33 @@ void gw_age_reset(gw_age *age);
 uint64_t gw_age_lag_us(gw_age *age, uint64_t rx_us, uint64_t empty_us, bool has_clock, int64_t controller_us,
                        bool newest);
 
+/*
+ * How often a message goes out, for the --summary line: the messages between
+ * two of them divided by the exact time between those two, measured over at
+ * least GW_METER_MIN_SPAN_US. A count per one-second window would show a
+ * 1 Hz message that is on time as 0, 1 or 2 per second by where the window
+ * falls; this shows 1.0, and 500 at 500 Hz. A measured stream with nothing
+ * for twice its period (and at least the span) reads 0, and its next
+ * measurement starts at its next message, so that the pause does not dilute
+ * it.
+ */
+#define GW_METER_MIN_SPAN_US 900000u
+
+typedef struct gw_meter {
+    uint64_t count;           /* messages so far */
+    uint64_t last_us;         /* time of the latest */
+    bool marked;              /* a measurement has started */
+    uint64_t mark_count;      /* count at the message it started at */
+    uint64_t mark_us;         /* that message's time */
+    bool measured;            /* rate holds a measurement */
+    double rate;              /* per second, as last measured */
+} gw_meter;
+
+/* One message at now_us (monotonic; times never go back). */
+void gw_meter_event(gw_meter *m, uint64_t now_us);
+/* Messages per second as of now_us: measured anew when a span is complete,
+ * else as last measured; 0 once stopped; -1 before the first measurement
+ * (not yet known, which is not 0). */
+double gw_meter_rate(gw_meter *m, uint64_t now_us);
+
 #endif

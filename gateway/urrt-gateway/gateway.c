@@ -25,12 +25,10 @@ bool gw_robot_data_fresh(const gw_robot *robot, uint64_t data_us, uint64_t now_u
 
 bool gw_robot_fresh(const gw_robot *robot, uint64_t now_us)
 {
+    /* Up means a packet came on this connection: a connection made after
+     * the last packet read, which has sent nothing yet, is not. */
     if (urrt_link_get_state(robot->link) != URRT_LINK_UP || robot->data_us == 0 || robot->mismatch ||
         robot->late) {
-        return false;
-    }
-    /* A connection made after the last packet has sent nothing yet. */
-    if (urrt_link_get_stats(robot->link)->connects != robot->connects_seen) {
         return false;
     }
     return gw_robot_data_fresh(robot, robot->data_us, now_us);

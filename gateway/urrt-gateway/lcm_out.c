@@ -39,8 +39,7 @@ typedef struct lcm_robot {
     uint64_t published[GW_KIND_COUNT];
     uint64_t stale_dropped;           /* too old by the moment of sending: not published */
     uint64_t errors;
-    uint64_t summary_published[GW_KIND_COUNT];
-    uint64_t summary_us;
+    gw_meter sent[GW_KIND_COUNT];    /* messages/s for the summary line */
     uint64_t report_due_us;
     uint64_t report_us;
     uint64_t report_packets;
@@ -144,6 +143,7 @@ static void publish(lcm_out *out, gw_robot *robot, gw_kind kind, int length, uin
         return;
     }
     lr->published[kind]++;
+    gw_meter_event(&lr->sent[kind], now_us);
     if (out->failing_since_us != 0) {
         urrt_log(URRT_LOG_NOTICE, "lcm: publishing works again (%" PRIu64 " messages lost)", out->errors_total);
         out->failing_since_us = 0;
@@ -486,21 +486,23 @@ static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *b
 {
     lcm_out *out = ctx;
     lcm_robot *lr = &out->robots[robot->index];
-    double dt = lr->summary_us != 0 && now_us > lr->summary_us ? (double)(now_us - lr->summary_us) / 1e6 : 0;
     size_t n = 0;
     for (unsigned k = 0; k < GW_KIND_COUNT && n < size; k++) {
-        double rate = dt > 0 ? (double)(lr->published[k] - lr->summary_published[k]) / dt : 0;
+        double rate = gw_meter_rate(&lr->sent[k], now_us);
         if (out->cfg->rate[k].mode == GW_RATE_OFF) {
             continue;
         }
-        n += (size_t)snprintf(buf + n, size - n, " %s %.0f/s", lr->channel[k], rate);
-        lr->summary_published[k] = lr->published[k];
+        if (rate < 0) {
+            n += (size_t)snprintf(buf + n, size - n, " %s -/s", lr->channel[k]); /* not measured yet */
+        } else {
+            /* A slow channel with its tenths: 1.0/s, 0.5/s; a fast one as 500/s. */
+            n += (size_t)snprintf(buf + n, size - n, rate < 9.95 ? " %s %.1f/s" : " %s %.0f/s", lr->channel[k], rate);
+        }
     }
     if (n < size) {
         n += (size_t)snprintf(buf + n, size - n, " | stale %" PRIu64 " lost %" PRIu64 "%s", lr->stale_dropped, lr->errors,
                               out->lcm == NULL ? " (LCM not open)" : "");
     }
-    lr->summary_us = now_us;
     return n < size ? (int)n : (int)size - 1;
 }
 
@@ -549,9 +551,6 @@ lcm_out *lcm_out_new(gateway *gw, const gw_lcm_config *cfg)
         }
     }
     out->retry_ms = LCM_OUT_RETRY_MIN_MS;
-    for (unsigned i = 0; i < gw->robot_count; i++) {
-        out->robots[i].summary_us = urrt_port_monotonic_us();
-    }
     try_open(out, urrt_port_monotonic_us());
     return out;
 }

@@ -1,21 +1,27 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * link.c: the read-only robot link on POSIX sockets.
+ * link.c: the robot link on POSIX sockets.
  *
  * One state machine per robot, driven by urrt_link_service from the
  * program's poll loop:
  *
- *   IDLE --(backoff over)--> CONNECTING --(connected)--> UP
- *     ^                          |                        |
- *     +---(failed, timed out)----+----(closed, reset, silent)
+ *   IDLE --(backoff over)--> CONNECTING --(connected)--> WAITING --(first packet)--> UP
+ *     ^                          |                         |                         |
+ *     +---(failed, timed out)----+--(closed, reset, silent, dropped: a failed attempt)
+ *     +-------------------------------------------(closed, reset, silent, dropped: a loss)
+ *
+ * A connection is only "up" once data flows: a stopped controller's kernel
+ * still accepts connections, and calling that up would raise and clear
+ * every "link down" alarm downstream at each reconnect.
  *
  * Name resolution uses getaddrinfo, which blocks while a DNS server answers:
  * acceptable once per attempt (controllers are usually addressed by IP
  * literal, and a literal is parsed with AI_NUMERICHOST, so it never waits
  * for DNS). Everything after that is non-blocking.
  *
- * The link never sends: no write, no send, no shutdown. Closing the socket
- * is the only thing it does to the peer.
+ * Without a source the link never sends: no write, no send, no shutdown;
+ * closing the socket is the only thing it does to the peer. It writes only
+ * bytes a source queued (urrt_link_send), and those only from its queue.
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -40,6 +46,7 @@
 /* Connect failures are logged at the first one and then when their count
  * reaches 10, 100, 1000, ...: the log grows with the logarithm of an outage. */
 #define LINK_FAILURE_REPORT_BASE 10
+#define LINK_REASON_MAX 256
 
 struct urrt_link {
     urrt_link_config cfg;
@@ -51,7 +58,7 @@ struct urrt_link {
     struct addrinfo *addrs;
     struct addrinfo *next_addr;
     uint64_t deadline_us;     /* IDLE: next attempt; CONNECTING: connect timeout */
-    uint64_t last_rx_us;      /* UP: last bytes received (or the connect) */
+    uint64_t last_rx_us;      /* WAITING, UP: last bytes received (or the connect) */
     /* The socket's queue was seen empty at empty_us (just before the last
      * read that emptied it, or at the connect): every byte read later
      * arrived after it. packet_empty_us is empty_us as it was when the first
@@ -73,6 +80,20 @@ struct urrt_link {
     urrt_link_stats stats;
     urrt_bytes_fn tap;
     void *tap_ctx;
+    /* The service call in progress: where packets go. */
+    urrt_packet_fn fn;
+    void *fn_ctx;
+    /* A source that speaks first (port.h), and what it asked for. */
+    urrt_link_source source;
+    bool has_source;
+    uint64_t source_empty_us;  /* empty_us before the read of the next package's first byte */
+    bool drop_pending;
+    urrt_link_drop_kind drop_kind;
+    char drop_reason[LINK_REASON_MAX];
+    char config_logged[LINK_REASON_MAX]; /* the configuration error last reported, "" if none */
+    int write_errno;          /* a write failed: the connection ends at the next service */
+    size_t out_head, out_len; /* queued bytes: out[out_head .. out_head + out_len) */
+    uint8_t out[URRT_LINK_SEND_MAX];
 };
 
 void urrt_link_config_defaults(urrt_link_config *cfg)
@@ -95,6 +116,7 @@ const char *urrt_link_state_name(urrt_link_state state)
     case URRT_LINK_IDLE: return "idle";
     case URRT_LINK_CONNECTING: return "connecting";
     case URRT_LINK_UP: return "up";
+    case URRT_LINK_WAITING: return "waiting";
     default: return "unknown";
     }
 }
@@ -169,6 +191,12 @@ static void forget_addresses(urrt_link *link)
     link->next_addr = NULL;
 }
 
+/* A TCP connection exists: waiting for data or up. */
+static bool connected(const urrt_link *link)
+{
+    return link->state == URRT_LINK_WAITING || link->state == URRT_LINK_UP;
+}
+
 void urrt_link_free(urrt_link *link)
 {
     if (link == NULL) {
@@ -190,7 +218,7 @@ int urrt_link_poll_fd(const urrt_link *link, short *events)
         return -1;
     }
     if (events != NULL) {
-        *events = link->state == URRT_LINK_CONNECTING ? POLLOUT : POLLIN;
+        *events = link->state == URRT_LINK_CONNECTING ? POLLOUT : (short)(POLLIN | (link->out_len > 0 ? POLLOUT : 0));
     }
     return link->fd;
 }
@@ -201,8 +229,9 @@ uint64_t urrt_link_deadline(const urrt_link *link)
         return UINT64_MAX;
     }
     switch (link->state) {
+    case URRT_LINK_WAITING:
     case URRT_LINK_UP:
-        if (link->more_to_read) {
+        if (link->more_to_read || link->drop_pending || link->write_errno != 0) {
             return 0;
         }
         if (link->cfg.silence_timeout_ms == 0) {
@@ -282,56 +311,104 @@ static void attempt_failed(urrt_link *link, uint64_t now_us, const char *reason)
     schedule_retry(link, now_us);
 }
 
-static void became_up(urrt_link *link, uint64_t now_us)
+/* TCP connected: no data yet. The source (if any) starts its session. */
+static void became_connected(urrt_link *link, uint64_t now_us)
 {
     forget_addresses(link);
-    link->state = URRT_LINK_UP;
+    link->state = URRT_LINK_WAITING;
     link->last_rx_us = now_us;
     link->empty_us = now_us;
+    link->source_empty_us = now_us;
     link->more_to_read = false;
     link->conn_packets = 0;
     link->conn_bytes_start = link->stats.bytes;
+    link->out_head = 0;
+    link->out_len = 0;
+    link->write_errno = 0;
+    link->drop_pending = false;
+    urrt_framer_reset(&link->framer);
+    urrt_log(URRT_LOG_DEBUG, "robot %s: TCP connection to %s established; waiting for data", link->name, link->peer);
+    if (link->has_source && link->source.connected != NULL) {
+        link->source.connected(link->source.ctx, link, now_us);
+    }
+}
+
+/* The first packet of a connection: data flows, the link is up. */
+static void became_up(urrt_link *link, size_t plen)
+{
+    char after[64] = "";
+    link->state = URRT_LINK_UP;
     link->stats.connects++;
     if (link->stats.disconnects > 0) {
         link->stats.reconnects++;
     }
-    urrt_framer_reset(&link->framer);
-    urrt_log(URRT_LOG_DEBUG, "robot %s: TCP connection to %s established", link->name, link->peer);
+    if (link->failed_attempts > 0) {
+        snprintf(after, sizeof after, " after %" PRIu64 " failed attempts", link->failed_attempts);
+    }
+    if (link->has_source) {
+        urrt_log(URRT_LOG_NOTICE, "robot %s: connected to %s%s: data flows (%zu-byte packages)", link->name,
+                 link->peer, after, plen);
+    } else {
+        const char *versions = urrt_versions_of((uint32_t)plen);
+        urrt_log(URRT_LOG_NOTICE, "robot %s: connected to %s%s: %zu-byte packets (%s)", link->name, link->peer,
+                 after, plen, versions != NULL ? versions : "a length no known controller sends");
+    }
+    link->failed_attempts = 0;
+    link->next_report = 1;
+    link->backoff_ms = link->cfg.backoff_initial_ms;
+    link->lost_logged = false;
+    link->config_logged[0] = '\0';
 }
 
-/* An established connection ended. A connection that never delivered a
- * packet counts as a failed attempt too, so that a peer accepting and closing
- * at once is logged like a refusal: once, not once per attempt. */
-static void connection_lost(urrt_link *link, uint64_t now_us, const char *reason, bool silent)
+/* Ends the current connection: what it left half-read is dropped. */
+static void end_connection(urrt_link *link)
 {
     size_t partial = urrt_framer_finish(&link->framer);
-    link->stats.disconnects++;
-    if (silent) {
-        link->stats.silences++;
-    }
     if (partial > 0) {
         link->stats.partial_drops++;
         link->stats.partial_bytes += partial;
     }
     link->more_to_read = false;
-    if (link->conn_packets == 0) {
-        /* Something listens there but sends no RealTime stream: a wrong
-         * port (the dashboard's 29999, the primary 30001), or a peer that
-         * turns clients away. Say so, not just how it ended. */
-        char why[256];
-        uint64_t got = link->stats.bytes - link->conn_bytes_start;
-        if (got > 0) {
-            snprintf(why, sizeof why,
-                     "it accepted and sent %" PRIu64 " bytes but no RealTime packet, then %s: "
-                     "is %u the RealTime port (30003, or 30013)?",
-                     got, reason, (unsigned)link->cfg.port);
-        } else {
-            snprintf(why, sizeof why, "it accepted, then %s before sending anything", reason);
-        }
-        attempt_failed(link, now_us, why);
+    link->drop_pending = false;
+    link->write_errno = 0;
+    link->out_len = 0;
+    close_socket(link);
+}
+
+/* A connection that never delivered a packet is a failed attempt, logged
+ * like a refusal (once, not once per attempt), and says what came: a wrong
+ * port (the dashboard's 29999, the primary 30001), a peer that turns
+ * clients away, or a stopped controller whose kernel still accepts. */
+static void waiting_failed(urrt_link *link, uint64_t now_us, const char *reason)
+{
+    char why[LINK_REASON_MAX + 160];
+    uint64_t got = link->stats.bytes - link->conn_bytes_start;
+    if (got == 0) {
+        snprintf(why, sizeof why, "it accepted, then %s before sending anything", reason);
+    } else if (link->has_source) {
+        snprintf(why, sizeof why, "it accepted and sent %" PRIu64 " bytes but no data, then %s", got, reason);
+    } else {
+        snprintf(why, sizeof why,
+                 "it accepted and sent %" PRIu64 " bytes but no RealTime packet, then %s: "
+                 "is %u the RealTime port (30003, or 30013)?",
+                 got, reason, (unsigned)link->cfg.port);
+    }
+    attempt_failed(link, now_us, why);
+}
+
+/* A connection ended (closed, reset, silent, or dropped by the source). */
+static void connection_lost(urrt_link *link, uint64_t now_us, const char *reason, bool silent)
+{
+    bool was_up = link->state == URRT_LINK_UP;
+    end_connection(link);
+    if (!was_up) {
+        waiting_failed(link, now_us, reason);
         return;
     }
-    close_socket(link);
+    link->stats.disconnects++;
+    if (silent) {
+        link->stats.silences++;
+    }
     urrt_log(URRT_LOG_WARNING, "robot %s: connection to %s lost (%s); reconnecting", link->name, link->peer, reason);
     link->lost_logged = true;
     /* It worked until now: start again from the short wait. */
@@ -339,6 +416,37 @@ static void connection_lost(urrt_link *link, uint64_t now_us, const char *reason
     link->failed_attempts = 0;
     link->next_report = LINK_FAILURE_REPORT_BASE;
     schedule_retry(link, now_us);
+}
+
+/* The peer refuses what the configuration asks: retrying soon cannot help,
+ * and the log says it once, not once per attempt. */
+static void configuration_refused(urrt_link *link, uint64_t now_us, const char *reason)
+{
+    if (link->state == URRT_LINK_UP) {
+        link->stats.disconnects++;
+    } else {
+        link->stats.connect_failures++;
+    }
+    end_connection(link);
+    if (strcmp(link->config_logged, reason) != 0) {
+        urrt_log(URRT_LOG_ERR, "robot %s: %s refuses the configuration: %s; fix the configuration (retrying every %" PRIu32
+                 " ms meanwhile)", link->name, link->peer, reason, link->cfg.backoff_max_ms);
+        snprintf(link->config_logged, sizeof link->config_logged, "%s", reason);
+    }
+    link->backoff_ms = link->cfg.backoff_max_ms;
+    schedule_retry(link, now_us);
+}
+
+/* Acts on the source's urrt_link_drop, once its function has returned. */
+static void handle_drop(urrt_link *link, uint64_t now_us)
+{
+    char reason[LINK_REASON_MAX];
+    snprintf(reason, sizeof reason, "%s", link->drop_reason);
+    if (link->drop_kind == URRT_LINK_DROP_CONFIG) {
+        configuration_refused(link, now_us, reason);
+    } else {
+        connection_lost(link, now_us, reason, false);
+    }
 }
 
 static void set_keepalive(int fd)
@@ -371,7 +479,7 @@ static void try_next_address(urrt_link *link, uint64_t now_us)
         }
         set_keepalive(link->fd);
         if (connect(link->fd, ai->ai_addr, ai->ai_addrlen) == 0) {
-            became_up(link, now_us);
+            became_connected(link, now_us);
             return;
         }
         if (errno == EINPROGRESS) {
@@ -431,7 +539,7 @@ static void check_connect(urrt_link *link, uint64_t now_us)
             err = errno;
         }
         if (err == 0) {
-            became_up(link, now_us);
+            became_connected(link, now_us);
             return;
         }
         link->last_errno = err;
@@ -444,7 +552,22 @@ static void check_connect(urrt_link *link, uint64_t now_us)
     try_next_address(link, now_us);
 }
 
-static void deliver(urrt_link *link, const uint8_t *data, size_t len, uint64_t now_us, urrt_packet_fn fn, void *ctx)
+/* A packet (framed here, or a source's package): counted, the link up at
+ * the first of the connection, then handed to the service's function. */
+static void packet_arrived(urrt_link *link, const uint8_t *packet, size_t plen, uint64_t now_us)
+{
+    link->stats.packets++;
+    link->stats.last_packet_us = now_us;
+    link->stats.last_length = (uint32_t)plen;
+    if (link->conn_packets++ == 0) {
+        became_up(link, plen);
+    }
+    if (link->fn != NULL) {
+        link->fn(link->fn_ctx, packet, plen, now_us);
+    }
+}
+
+static void deliver(urrt_link *link, const uint8_t *data, size_t len, uint64_t now_us)
 {
     while (len > 0) {
         size_t used = 0;
@@ -465,50 +588,62 @@ static void deliver(urrt_link *link, const uint8_t *data, size_t len, uint64_t n
             size_t plen = 0;
             const uint8_t *packet = urrt_framer_packet(&link->framer, &plen);
             link->packet_newest = link->read_drained && len - used < plen;
-            link->stats.packets++;
-            link->stats.last_packet_us = now_us;
-            link->stats.last_length = (uint32_t)plen;
-            if (link->conn_packets++ == 0) {
-                const char *versions = urrt_versions_of((uint32_t)plen);
-                char after[64] = "";
-                if (link->failed_attempts > 0) {
-                    snprintf(after, sizeof after, " after %" PRIu64 " failed attempts", link->failed_attempts);
-                }
-                urrt_log(URRT_LOG_NOTICE, "robot %s: connected to %s%s: %zu-byte packets (%s)", link->name,
-                         link->peer, after, plen,
-                         versions != NULL ? versions : "a length no known controller sends");
-                link->failed_attempts = 0;
-                link->next_report = 1;
-                link->backoff_ms = link->cfg.backoff_initial_ms;
-                link->lost_logged = false;
-            }
-            if (fn != NULL) {
-                fn(ctx, packet, plen, now_us);
-            }
+            packet_arrived(link, packet, plen, now_us);
         }
         data += used;
         len -= used;
     }
 }
 
+/* A source takes every byte as read; empty_us is still the time before
+ * this read, when the queue was last seen empty. */
+static void deliver_to_source(urrt_link *link, const uint8_t *data, size_t len, uint64_t now_us)
+{
+    link->stats.bytes += len;
+    if (link->tap != NULL) {
+        link->tap(link->tap_ctx, data, len);
+    }
+    link->packet_newest = link->read_drained;
+    if (link->source.received != NULL) {
+        link->source.received(link->source.ctx, link, data, len, now_us);
+    }
+    /* Whatever follows in the stream arrived after the empty queue seen
+     * before this read (or a later one). */
+    link->source_empty_us = link->empty_us;
+}
+
+void urrt_link_source_packet(urrt_link *link, const uint8_t *packet, size_t len, uint64_t rx_us)
+{
+    if (link == NULL || !link->has_source || !connected(link) || link->drop_pending) {
+        return;
+    }
+    link->packet_empty_us = link->source_empty_us;
+    link->source_empty_us = link->empty_us;
+    packet_arrived(link, packet, len, rx_us);
+}
+
 /* Each read is stamped with the clock taken just after it returns, so a
  * packet's rx_us is when its last bytes left the socket, whatever the loop
  * did since it woke up. A read shorter than asked emptied the queue: the
  * clock taken just before it is then a time the queue was empty. */
-static void read_available(urrt_link *link, urrt_packet_fn fn, void *ctx)
+static void read_available(urrt_link *link)
 {
     uint8_t buf[LINK_READ_CHUNK];
     size_t budget = LINK_READ_BUDGET;
 
     link->more_to_read = false;
-    while (link->state == URRT_LINK_UP) {
+    while (connected(link) && !link->drop_pending) {
         uint64_t before_us = urrt_port_monotonic_us();
         ssize_t n = recv(link->fd, buf, sizeof buf, MSG_DONTWAIT);
         uint64_t read_us = urrt_port_monotonic_us();
         if (n > 0) {
             link->last_rx_us = read_us;
             link->read_drained = (size_t)n < sizeof buf;
-            deliver(link, buf, (size_t)n, read_us, fn, ctx);
+            if (link->has_source) {
+                deliver_to_source(link, buf, (size_t)n, read_us);
+            } else {
+                deliver(link, buf, (size_t)n, read_us);
+            }
             if ((size_t)n < sizeof buf) {
                 link->empty_us = before_us;
                 return; /* drained: poll says when there is more */
@@ -531,6 +666,70 @@ static void read_available(urrt_link *link, urrt_packet_fn fn, void *ctx)
     }
 }
 
+/* Writes what the source queued, as much as the socket takes now. A failed
+ * write is kept for the service to act on: this may run inside a source's
+ * function, where the connection must not end under it. */
+static void flush_queue(urrt_link *link)
+{
+    while (link->out_len > 0 && link->write_errno == 0 && link->fd >= 0) {
+        ssize_t n = send(link->fd, link->out + link->out_head, link->out_len, MSG_DONTWAIT | MSG_NOSIGNAL);
+        if (n > 0) {
+            link->out_head += (size_t)n;
+            link->out_len -= (size_t)n;
+        } else if (n < 0 && errno == EINTR) {
+            continue;
+        } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+            break; /* POLLOUT says when there is room */
+        } else {
+            link->write_errno = n < 0 ? errno : EPIPE;
+        }
+    }
+    if (link->out_len == 0) {
+        link->out_head = 0;
+    }
+}
+
+void urrt_link_set_source(urrt_link *link, const urrt_link_source *source)
+{
+    if (link != NULL) {
+        link->has_source = source != NULL;
+        if (source != NULL) {
+            link->source = *source;
+        }
+    }
+}
+
+int urrt_link_send(urrt_link *link, const uint8_t *data, size_t len)
+{
+    if (link == NULL || (data == NULL && len > 0) || !link->has_source || !connected(link)) {
+        return URRT_E_ARG; /* the RealTime reader never writes */
+    }
+    if (len > URRT_LINK_SEND_MAX - link->out_len) {
+        return URRT_E_NO_SPACE;
+    }
+    if (link->out_head + link->out_len + len > URRT_LINK_SEND_MAX) {
+        memmove(link->out, link->out + link->out_head, link->out_len);
+        link->out_head = 0;
+    }
+    if (len > 0) {
+        memcpy(link->out + link->out_head + link->out_len, data, len);
+        link->out_len += len;
+    }
+    flush_queue(link);
+    return URRT_OK;
+}
+
+void urrt_link_drop(urrt_link *link, urrt_link_drop_kind kind, const char *reason)
+{
+    if (link == NULL || !connected(link) || link->drop_pending) {
+        return;
+    }
+    link->drop_pending = true;
+    link->drop_kind = kind;
+    snprintf(link->drop_reason, sizeof link->drop_reason, "%s",
+             reason != NULL && reason[0] != '\0' ? reason : "the source ended the session");
+}
+
 uint64_t urrt_link_packet_empty_us(const urrt_link *link)
 {
     return link->packet_empty_us;
@@ -539,6 +738,34 @@ uint64_t urrt_link_packet_empty_us(const urrt_link *link)
 bool urrt_link_packet_newest(const urrt_link *link)
 {
     return link->packet_newest;
+}
+
+/* What a connection does in one service call: the queue written, bytes
+ * read, the source's requests acted on, silence judged. */
+static void service_connection(urrt_link *link, uint64_t now_us)
+{
+    if (!link->drop_pending) {
+        flush_queue(link);
+        read_available(link);
+    }
+    if (connected(link) && link->drop_pending) {
+        handle_drop(link, now_us);
+        return;
+    }
+    if (!connected(link)) {
+        return;
+    }
+    flush_queue(link); /* replies the source queued while reading */
+    if (link->write_errno != 0) {
+        connection_lost(link, now_us, errno_text(link->write_errno), false);
+        return;
+    }
+    if (!link->more_to_read && link->cfg.silence_timeout_ms != 0 && now_us > link->last_rx_us &&
+        now_us - link->last_rx_us >= (uint64_t)link->cfg.silence_timeout_ms * 1000u) {
+        char reason[64];
+        snprintf(reason, sizeof reason, "no data for %" PRIu32 " ms", link->cfg.silence_timeout_ms);
+        connection_lost(link, now_us, reason, true);
+    }
 }
 
 void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void *ctx)
@@ -555,17 +782,16 @@ void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void
     case URRT_LINK_CONNECTING:
         check_connect(link, now_us);
         break;
+    case URRT_LINK_WAITING:
     case URRT_LINK_UP:
         break;
     }
-    if (link->state != URRT_LINK_UP) {
+    if (!connected(link)) {
         return;
     }
-    read_available(link, fn, ctx);
-    if (link->state == URRT_LINK_UP && !link->more_to_read && link->cfg.silence_timeout_ms != 0 &&
-        now_us > link->last_rx_us && now_us - link->last_rx_us >= (uint64_t)link->cfg.silence_timeout_ms * 1000u) {
-        char reason[64];
-        snprintf(reason, sizeof reason, "no data for %" PRIu32 " ms", link->cfg.silence_timeout_ms);
-        connection_lost(link, now_us, reason, true);
-    }
+    link->fn = fn;
+    link->fn_ctx = ctx;
+    service_connection(link, now_us);
+    link->fn = NULL;
+    link->fn_ctx = NULL;
 }

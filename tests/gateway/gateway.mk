@@ -1,7 +1,10 @@
 # SPDX-License-Identifier: MIT
 # tests/gateway/gateway.mk: urrt-gateway against urrt-sim, through LCM.
-#   check-gateway   values, decimation, two robots, restart/stall, mismatch,
-#                   zero allocations, publish errors, bad configurations, jar
+#   check-gateway   values, decimation, two robots, restart/stall, a stopped
+#                   simulator (GATEWAY's link state, EMCY 0xFF01 and the CAN
+#                   heartbeat down until data flows), the summary's rates,
+#                   mismatch, zero allocations, publish errors, bad configurations, jar
+#   check-freshness the age estimator and the summary's rate meter on a fake clock
 #   bench-gateway   latency robot -> subscriber and CPU per packet beside a
 #                   minimal relay (bench_relay.c), 1/10/50 robots, highest rate,
 #                   and the 500 Hz robots one core serves
@@ -12,7 +15,7 @@ CHECKS += check-freshness check-gateway
 BENCHES += bench-gateway
 .PHONY: check-freshness check-gateway bench-gateway
 
-# The age estimator on a fake clock (gateway/urrt-gateway/freshness.h).
+# The age estimator and the rate meter on a fake clock (gateway/urrt-gateway/freshness.h).
 $(GWT)/test_freshness: tests/gateway/test_freshness.c tests/check.h gateway/urrt-gateway/freshness.c gateway/urrt-gateway/freshness.h
 	@mkdir -p $(@D)
 	$(CC) $(PROG_WARN) $(OPT) $(GATEWAY_INC) -Itests $< gateway/urrt-gateway/freshness.c -o $@

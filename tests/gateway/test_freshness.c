@@ -238,6 +238,86 @@ static void no_clock(void)
     CHECK(gw_age_lag_us(&age, 10 * S, 10 * S + 300, false, 0, true) == 0, "an empty time after the read: no wait");
 }
 
+
+/* ---- the summary's rate meter ------------------------------------------------ */
+
+/* A deterministic jitter of up to +-max_us. */
+static int64_t jitter(uint32_t *seed, int64_t max_us)
+{
+    *seed = *seed * 1103515245u + 12345u;
+    return (int64_t)((*seed >> 8) % (uint32_t)(2 * max_us + 1)) - max_us;
+}
+
+/* A stream of period_us (with jitter) read once a second at phase_us past
+ * each second, for seconds: every reading after the first measurement is
+ * within tolerance of the true rate, none is 0, and none comes before it
+ * says "not measured" (-1). Returns the number of readings that measured. */
+static int meter_stream(uint64_t period_us, int64_t jitter_us, uint64_t phase_us, unsigned seconds, double tolerance)
+{
+    gw_meter m = {0};
+    uint32_t seed = (uint32_t)(period_us + phase_us);
+    uint64_t t0 = 1000u * S, nominal = t0 + S / 3u, read = t0 + S + phase_us;
+    uint64_t at = nominal; /* the next message's time: nominal, jittered (the order is kept) */
+    double want = 1e6 / (double)period_us;
+    int measured = 0, bad = 0;
+    for (unsigned i = 0; i < seconds; i++, read += S) {
+        double rate;
+        for (; at <= read; nominal += period_us, at = (uint64_t)((int64_t)nominal + jitter(&seed, jitter_us))) {
+            gw_meter_event(&m, at);
+        }
+        rate = gw_meter_rate(&m, read);
+        if (rate < 0 && measured == 0) {
+            continue;
+        }
+        measured++;
+        if (rate < want * (1 - tolerance) || rate > want * (1 + tolerance)) {
+            bad++;
+            printf("  reading %u: %.3f/s, want %.3f/s\n", i, rate, want);
+        }
+    }
+    CHECK(bad == 0, "a %.1f Hz stream read at +%llu ms: every reading within %.0f %% (%d of %d not)", want,
+          (unsigned long long)(phase_us / MS), tolerance * 100, bad, measured);
+    return measured;
+}
+
+static void meter_rates(void)
+{
+    /* A 1 Hz message (GATEWAY's default) counted in 1 s windows reads 0, 1
+     * or 2 by where the window falls: every phase, with 20 ms of jitter,
+     * and finely where the readings fall among the messages (at +333 ms). */
+    for (uint64_t phase = 0; phase < S; phase += phase >= 300 * MS && phase < 370 * MS ? 5 * MS : 50 * MS) {
+        CHECK(meter_stream(S, 20 * MS, phase, 30, 0.05) >= 27, "1 Hz at +%llu ms: measured from the third second on",
+              (unsigned long long)(phase / MS));
+    }
+    meter_stream(S / 2, 10 * MS, 300 * MS, 20, 0.05);   /* 2 Hz */
+    meter_stream(100 * MS, 5 * MS, 700 * MS, 20, 0.05); /* 10 Hz */
+    meter_stream(2 * MS, 0, 0, 20, 0.01);              /* 500 Hz */
+    meter_stream(2 * MS, 300, 999 * MS, 20, 0.01);     /* 500 Hz with jitter */
+}
+
+static void meter_stop_and_resume(void)
+{
+    gw_meter m = {0};
+    uint64_t t = 1000u * S;
+    CHECK(gw_meter_rate(&m, t) == -1.0, "nothing yet: not measured");
+    gw_meter_event(&m, t);
+    CHECK(gw_meter_rate(&m, t + S / 2) == -1.0, "one message: not measured");
+    for (int i = 1; i <= 5; i++) {
+        gw_meter_event(&m, t + (uint64_t)i * S);
+    }
+    CHECK(gw_meter_rate(&m, t + 5 * S + S / 2) == 1.0, "1 Hz: exactly 1.0");
+    /* Stopped: 0 once twice the period has passed, not before. */
+    CHECK(gw_meter_rate(&m, t + 6 * S + S / 2) == 1.0, "1.5 periods without a message: still 1.0");
+    CHECK(gw_meter_rate(&m, t + 7 * S + 1) == 0.0, "more than 2 periods without one: 0");
+    CHECK(gw_meter_rate(&m, t + 9 * S) == 0.0, "still 0");
+    /* Resumed at 500 Hz 5 s later: the pause does not dilute the next measurement. */
+    t += 12 * S;
+    for (int i = 0; i <= 500; i++) {
+        gw_meter_event(&m, t + (uint64_t)i * 2 * MS);
+    }
+    CHECK(gw_meter_rate(&m, t + S + 1 * MS) == 500.0, "resumed at 500 Hz: 500 (%.3f)", gw_meter_rate(&m, t + S + MS));
+}
+
 int main(void)
 {
     prompt_reader();
@@ -248,5 +328,7 @@ int main(void)
     controller_restart();
     burst_at_connect();
     no_clock();
+    meter_rates();
+    meter_stop_and_resume();
     return check_report();
 }

@@ -2,7 +2,9 @@
 # tests/port/port.mk: port/posix, the seam a firmware replaces.
 #   check-link     tests/port/test_link.c: the robot link (port/posix/link.c) against
 #                  in-process servers: framing across reads, read stamps, silence, backoff,
-#                  reconnects; and gateway/common/cli.c's host:port parsing
+#                  reconnects, a frozen peer (up only when data flows), a source that speaks
+#                  first (handshake, partial writes, drops); and gateway/common/cli.c's
+#                  host:port parsing
 #   check-can-log  the CAN link's candump-log output (port/posix/can.c) on the host, no CAN
 #                  needed: exact lines from can_link_test, then python-can's candump-log reader
 #   (check-vm)     the CAN link on a real kernel's vcan: tests/port/can-link.sh runs

@@ -78,6 +78,12 @@ static void on_tap(void *ctx, const uint8_t *data, size_t len)
 
 typedef bool (*until_fn)(const urrt_link *link, const rx *r);
 
+/* A server descriptor pump() waits on too (-1: none), so that a done()
+ * that reads it runs as soon as bytes arrive. */
+static int pump_also_fd = -1;
+/* Set when urrt_link_poll_fd asked for POLLOUT: bytes waited for room. */
+static bool pump_saw_pollout;
+
 /* Polls and services the link until done() or ms pass. Returns done(). When
  * delays is given, each connect failure or loss records the backoff chosen
  * (deadline - now of that call) in milliseconds. */
@@ -105,8 +111,9 @@ static bool pump(urrt_link *link, rx *r, int ms, until_fn done, uint64_t *delays
         if (timeout > (int)((end - now) / 1000) + 1) {
             timeout = (int)((end - now) / 1000) + 1;
         }
-        struct pollfd p = {.fd = fd, .events = ev};
-        poll(&p, fd >= 0, timeout);
+        struct pollfd p[2] = {{.fd = fd, .events = ev}, {.fd = pump_also_fd, .events = POLLIN}};
+        pump_saw_pollout |= (ev & POLLOUT) != 0 && urrt_link_get_state(link) != URRT_LINK_CONNECTING;
+        poll(p, 2, timeout); /* a negative fd is ignored */
         now = urrt_port_monotonic_us();
         events_before = st->connect_failures + st->disconnects;
         urrt_link_service(link, now, on_packet, r);
@@ -120,6 +127,12 @@ static bool is_up(const urrt_link *l, const rx *r)
 {
     (void)r;
     return urrt_link_get_state(l) == URRT_LINK_UP;
+}
+
+static bool is_waiting(const urrt_link *l, const rx *r)
+{
+    (void)r;
+    return urrt_link_get_state(l) == URRT_LINK_WAITING;
 }
 
 static bool one_disconnect(const urrt_link *l, const rx *r)
@@ -144,6 +157,14 @@ static bool one_failure(const urrt_link *l, const rx *r)
 {
     (void)r;
     return urrt_link_get_stats(l)->connect_failures >= 1;
+}
+
+/* One more failure than when the pump began (pump_failures_base). */
+static uint64_t pump_failures_base;
+static bool one_failure_more(const urrt_link *l, const rx *r)
+{
+    (void)r;
+    return urrt_link_get_stats(l)->connect_failures > pump_failures_base;
 }
 
 static uint64_t want_packets;
@@ -192,6 +213,24 @@ static int accept_within(int lfd, int ms)
         return -1;
     }
     return accept4(lfd, NULL, NULL, SOCK_CLOEXEC);
+}
+
+/* Pumps the link until it has connected to lfd, then accepts every queued
+ * connection and returns the newest (the link's, as long as it is still
+ * waiting), or -1. */
+static int accept_link(urrt_link *l, rx *r, int lfd)
+{
+    int s = -1, next;
+    if (!pump(l, r, 2000, is_waiting, NULL, NULL, 0)) {
+        return -1;
+    }
+    while ((next = accept_within(lfd, s < 0 ? 2000 : 0)) >= 0) {
+        if (s >= 0) {
+            close(s);
+        }
+        s = next;
+    }
+    return s;
 }
 
 /* What the link sent: must stay 0. -1 on error. */
@@ -336,10 +375,14 @@ static void test_session(void)
     urrt_link_set_tap(l, on_tap, &r);
     log_count = 0;
 
-    /* 1: three packets in awkward pieces, half a fourth, then close. */
-    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "connects");
-    s = accept_within(lfd, 2000);
+    /* 1: three packets in awkward pieces, half a fourth, then close. Up
+     * only once the first packet is in. */
+    s = accept_link(l, &r, lfd);
     CHECK(s >= 0, "accept");
+    CHECK_EQ_INT(urrt_link_get_state(l), URRT_LINK_WAITING);
+    CHECK_EQ_INT(urrt_link_get_stats(l)->connects, 0);
+    CHECK_EQ_STR(urrt_link_state_name(URRT_LINK_WAITING), "waiting");
+    CHECK_EQ_INT(urrt_link_send(l, (const uint8_t *)"x", 1), URRT_E_ARG); /* the RealTime reader never writes */
     for (int i = 0; i < 3; i++) {
         make_packet(pkt, sizeof pkt, (uint8_t)(i + 1));
         send_all(s, pkt, 3);
@@ -378,9 +421,9 @@ static void test_session(void)
     CHECK_EQ_INT(lines_with("lost (closed by peer); reconnecting"), 1);
 
     /* 2: reconnect; a packet, garbage, a packet, then silence. */
-    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "reconnects");
-    s = accept_within(lfd, 2000);
+    s = accept_link(l, &r, lfd);
     CHECK(s >= 0, "accept again");
+    CHECK_EQ_INT(urrt_link_get_stats(l)->reconnects, 0);
     make_packet(pkt, sizeof pkt, 5);
     send_all(s, pkt, sizeof pkt);
     send_all(s, (const uint8_t *)"\x01\x02\x03\x04\x05", 5);
@@ -402,8 +445,8 @@ static void test_session(void)
     CHECK_EQ_INT(lines_with("connected to 127.0.0.1"), 2);
 
     /* 3: more than one service call's budget arrives at once. */
-    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "third connection");
-    s = accept_within(lfd, 2000);
+    s = accept_link(l, &r, lfd);
+    CHECK(s >= 0, "third connection");
     {
         static uint8_t burst[80 * 1116];
         uint64_t before = r.packets;
@@ -489,8 +532,8 @@ static void test_ipv6(void)
     l = urrt_link_new(&c);
     snprintf(peer, sizeof peer, "[::1]:%u", port);
     CHECK_EQ_STR(urrt_link_peer(l), peer);
-    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "connects over IPv6");
-    s = accept_within(lfd, 2000);
+    s = accept_link(l, &r, lfd);
+    CHECK(s >= 0, "connects over IPv6");
     make_packet(pkt, sizeof pkt, 9);
     send_all(s, pkt, sizeof pkt);
     want_packets = 1;
@@ -518,8 +561,8 @@ static void test_name(void)
     c.port = port;
     l = urrt_link_new(&c);
     log_count = 0;
-    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "connects to localhost");
-    s = accept_within(lfd, 2000);
+    s = accept_link(l, &r, lfd);
+    CHECK(s >= 0, "connects to localhost");
     make_packet(pkt, sizeof pkt, 1);
     send_all(s, pkt, sizeof pkt);
     want_packets = 1;
@@ -555,14 +598,16 @@ static void test_wrong_port(void)
     c.backoff_initial_ms = 20;
     l = urrt_link_new(&c);
     log_count = 0;
-    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "connects");
+    s = accept_link(l, &r, lfd);
+    CHECK(s >= 0, "connects");
     fd = urrt_link_poll_fd(l, NULL);
     CHECK(getsockopt(fd, SOL_SOCKET, SO_KEEPALIVE, &on, &len) == 0 && on == 1, "SO_KEEPALIVE on");
     len = sizeof idle;
     CHECK(getsockopt(fd, IPPROTO_TCP, TCP_KEEPIDLE, &idle, &len) == 0 && idle == 1, "keepalive after %d s idle", idle);
-    s = accept_within(lfd, 2000);
     send_all(s, (const uint8_t *)banner, sizeof banner - 1);
     CHECK(pump(l, &r, 2000, one_failure, NULL, NULL, 0), "no packet: a failed attempt");
+    CHECK_EQ_INT(urrt_link_get_stats(l)->connects, 0);
+    CHECK_EQ_INT(urrt_link_get_stats(l)->disconnects, 0); /* it never came up: not a loss */
     CHECK_EQ_INT(bytes_from_client(s), 0);
     close(s);
     snprintf(want, sizeof want, "sent %zu bytes but no RealTime packet, then no data for 100 ms: is %u the RealTime port",
@@ -572,14 +617,345 @@ static void test_wrong_port(void)
     /* A peer that accepts and closes at once (a fresh link: only the first
      * failure is logged). */
     l = urrt_link_new(&c);
-    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "connects again");
-    s = accept_within(lfd, 2000);
+    s = accept_link(l, &r, lfd);
     CHECK(s >= 0, "second connection");
     close(s);
     CHECK(pump(l, &r, 2000, one_failure, NULL, NULL, 0), "the close is a failed attempt");
     CHECK_EQ_INT(lines_with("it accepted, then closed by peer before sending anything"), 1);
     CHECK_EQ_INT(r.packets, 0);
     if (lines_with("RealTime port") != 1 || lines_with("before sending anything") != 1) {
+        dump_log();
+    }
+    urrt_link_free(l);
+    close(lfd);
+}
+
+
+/* Sends a packet on the link's newest connection until the link is up: a
+ * connection the link dropped (silent too long) just before the packet went
+ * out is replaced by the next, which gets the packet again. Returns the
+ * socket the link came up on, or -1. */
+static int send_until_up(urrt_link *l, rx *r, int lfd, const uint8_t *pkt, size_t len)
+{
+    const urrt_link_stats *st = urrt_link_get_stats(l);
+    for (int i = 0; i < 10; i++) {
+        int s = accept_link(l, r, lfd);
+        uint64_t before = st->connect_failures;
+        if (s < 0) {
+            continue;
+        }
+        send_all(s, pkt, len);
+        while (st->connect_failures == before) {
+            if (pump(l, r, 20, is_up, NULL, NULL, 0)) {
+                return s;
+            }
+        }
+        close(s);
+    }
+    return -1;
+}
+
+/* A frozen controller (its process stopped, its kernel still accepting): the
+ * link that was up goes down once at the silence and stays down through
+ * every connection that sends nothing; it comes up once when data flows. */
+static void test_frozen_peer(void)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    rx r = {0};
+    uint8_t pkt[1116];
+    uint16_t port = 0;
+    int lfd = bind_any(AF_INET, &port, 16), s;
+    const urrt_link_stats *st;
+    uint64_t failures;
+    bool up = false;
+
+    CHECK(lfd >= 0, "listen");
+    urrt_link_config_defaults(&c);
+    c.name = "arm3";
+    c.host = "127.0.0.1";
+    c.port = port;
+    c.silence_timeout_ms = 60;
+    c.backoff_initial_ms = 10;
+    c.backoff_max_ms = 40;
+    l = urrt_link_new(&c);
+    st = urrt_link_get_stats(l);
+    log_count = 0;
+    s = accept_link(l, &r, lfd);
+    CHECK(s >= 0, "accept");
+    make_packet(pkt, sizeof pkt, 1);
+    send_all(s, pkt, sizeof pkt);
+    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "up at the first packet");
+    CHECK_EQ_INT(st->connects, 1);
+    /* Frozen: s stays open and silent; the kernel accepts the reconnects
+     * (nobody calls accept). At least three more attempts must come and go
+     * without the link coming up. */
+    CHECK(pump(l, &r, 3000, one_disconnect, NULL, NULL, 0), "the silence drops the link");
+    failures = st->connect_failures;
+    for (int i = 0; i < 3 && !up; i++) {
+        uint64_t before = st->connect_failures;
+        CHECK(pump(l, &r, 2000, is_waiting, NULL, NULL, 0), "reconnect %d: TCP connects", i + 1);
+        CHECK_EQ_INT(urrt_link_get_state(l), URRT_LINK_WAITING);
+        while (st->connect_failures == before && !up) {
+            up = pump(l, &r, 20, is_up, NULL, NULL, 0);
+        }
+    }
+    CHECK(!up, "never up while frozen");
+    CHECK(st->connect_failures >= failures + 3, "each silent connection a failed attempt (%llu)",
+          (unsigned long long)(st->connect_failures - failures));
+    CHECK_EQ_INT(st->connects, 1);
+    CHECK_EQ_INT(st->reconnects, 0);
+    CHECK_EQ_INT(st->disconnects, 1);
+    CHECK_EQ_INT(st->silences, 1);
+    CHECK_EQ_INT(lines_with("lost (no data for 60 ms); reconnecting"), 1);
+    CHECK_EQ_INT(lines_with("connected to 127.0.0.1"), 1);
+    /* Thawed: data on the link's newest connection brings it up once. */
+    close(s);
+    s = send_until_up(l, &r, lfd, pkt, sizeof pkt);
+    CHECK(s >= 0, "up again once data flows");
+    CHECK_EQ_INT(st->connects, 2);
+    CHECK_EQ_INT(st->reconnects, 1);
+    CHECK_EQ_INT(lines_with("connected to 127.0.0.1"), 2);
+    CHECK_EQ_INT(lines_with("failed attempts: 1116-byte packets"), 1);
+    if (lines_with("connected to 127.0.0.1") != 2) {
+        dump_log();
+    }
+    close(s);
+    urrt_link_free(l);
+    close(lfd);
+}
+
+/* ---- a source that speaks first ------------------------------------------------ */
+
+/* The test's protocol: after every connect the client sends HANDSHAKE_LEN
+ * bytes (byte i is (i * 7 + connection) & 0xFF); the server answers with
+ * 8-byte packages: 'D' data, 'X' a protocol error, 'N' a refusal of the
+ * configuration. */
+#define HANDSHAKE_LEN 8000
+typedef struct test_source {
+    unsigned connections;     /* connected() calls */
+    int queued;               /* urrt_link_send's result for the handshake */
+    int too_much;             /* its result for a byte more than fits */
+    int small_sndbuf;         /* SO_SNDBUF to set before queueing, 0: leave */
+    uint8_t pending[8];
+    size_t have;
+    uint64_t packages;
+} test_source;
+
+static void source_connected(void *ctx, urrt_link *link, uint64_t now_us)
+{
+    test_source *src = ctx;
+    static uint8_t hs[URRT_LINK_SEND_MAX + 1];
+    (void)now_us;
+    src->connections++;
+    src->have = 0; /* a reconnect starts the session afresh */
+    if (src->small_sndbuf > 0) {
+        (void)setsockopt(urrt_link_poll_fd(link, NULL), SOL_SOCKET, SO_SNDBUF, &src->small_sndbuf,
+                         sizeof src->small_sndbuf);
+    }
+    for (size_t i = 0; i < sizeof hs; i++) {
+        hs[i] = (uint8_t)(i * 7u + src->connections);
+    }
+    src->too_much = urrt_link_send(link, hs, URRT_LINK_SEND_MAX + 1); /* all or nothing: nothing */
+    src->queued = urrt_link_send(link, hs, HANDSHAKE_LEN);
+}
+
+static void source_received(void *ctx, urrt_link *link, const uint8_t *data, size_t len, uint64_t rx_us)
+{
+    test_source *src = ctx;
+    for (size_t i = 0; i < len; i++) {
+        src->pending[src->have++] = data[i];
+        if (src->have < sizeof src->pending) {
+            continue;
+        }
+        src->have = 0;
+        if (src->pending[0] == 'D') {
+            src->packages++;
+            urrt_link_source_packet(link, src->pending, sizeof src->pending, rx_us);
+        } else if (src->pending[0] == 'N') {
+            urrt_link_drop(link, URRT_LINK_DROP_CONFIG,
+                           "output field \"no_such_field\" is NOT_FOUND on controller 5.10.0");
+            return;
+        } else {
+            urrt_link_drop(link, URRT_LINK_DROP_PROTOCOL, "a package of unknown type");
+            return;
+        }
+    }
+}
+
+/* Reads the server's socket into a buffer: pump's done() while a
+ * handshake comes in. */
+static int hs_fd = -1;
+static uint8_t hs_buf[HANDSHAKE_LEN + 64];
+static size_t hs_got;
+static bool handshake_in(const urrt_link *l, const rx *r)
+{
+    (void)l;
+    (void)r;
+    for (;;) {
+        ssize_t n = recv(hs_fd, hs_buf + hs_got, sizeof hs_buf - hs_got, MSG_DONTWAIT);
+        if (n <= 0) {
+            break;
+        }
+        hs_got += (size_t)n;
+    }
+    return hs_got >= HANDSHAKE_LEN;
+}
+
+/* The server's side of one session: accept, read the whole handshake while
+ * the link writes it, check every byte. Returns the socket, or -1. */
+static int serve_handshake(urrt_link *l, rx *r, int lfd, unsigned connection)
+{
+    int s = accept_link(l, r, lfd), bad = 0;
+    if (s < 0) {
+        return -1;
+    }
+    hs_fd = s;
+    hs_got = 0;
+    pump_also_fd = s;
+    CHECK(pump(l, r, 3000, handshake_in, NULL, NULL, 0), "connection %u: the handshake arrives (%zu bytes)",
+          connection, hs_got);
+    pump_also_fd = -1;
+    for (size_t i = 0; i < hs_got && i < HANDSHAKE_LEN; i++) {
+        bad += hs_buf[i] != (uint8_t)(i * 7u + connection);
+    }
+    CHECK(hs_got == HANDSHAKE_LEN && bad == 0, "connection %u: exactly the handshake, byte for byte (%zu bytes, %d wrong)",
+          connection, hs_got, bad);
+    return s;
+}
+
+static void send_package(int s, char type)
+{
+    uint8_t p[8] = {(uint8_t)type, 1, 2, 3, 4, 5, 6, 7};
+    send_all(s, p, sizeof p);
+}
+
+static void test_source_handshake(void)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    rx r = {0};
+    test_source src = {.small_sndbuf = 1024};
+    urrt_link_source source = {.ctx = &src, .connected = source_connected, .received = source_received};
+    uint16_t port = 0;
+    int lfd = bind_any(AF_INET, &port, 4), s;
+    int small = 1024;
+    const urrt_link_stats *st;
+
+    CHECK(lfd >= 0, "listen");
+    /* A small receive window too: the handshake cannot go in one write. */
+    (void)setsockopt(lfd, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
+    urrt_link_config_defaults(&c);
+    c.name = "rtde";
+    c.host = "127.0.0.1";
+    c.port = port;
+    c.silence_timeout_ms = 2000; /* the handshake takes a few round trips of a small window */
+    c.backoff_initial_ms = 10;
+    c.backoff_max_ms = 1000;
+    l = urrt_link_new(&c);
+    st = urrt_link_get_stats(l);
+    urrt_link_set_source(l, &source);
+    log_count = 0;
+    pump_saw_pollout = false;
+
+    /* 1: the handshake in partial writes, then data: up at the first package. */
+    s = serve_handshake(l, &r, lfd, 1);
+    CHECK_EQ_INT(src.connections, 1);
+    CHECK_EQ_INT(src.queued, URRT_OK);
+    CHECK_EQ_INT(src.too_much, URRT_E_NO_SPACE);
+    CHECK(pump_saw_pollout, "the link waited for room and continued a partial write");
+    CHECK_EQ_INT(urrt_link_get_state(l), URRT_LINK_WAITING);
+    CHECK_EQ_INT(st->connects, 0);
+    send_package(s, 'D');
+    want_packets = 1;
+    CHECK(pump(l, &r, 2000, enough_packets, NULL, NULL, 0), "the first package reaches the packet function");
+    CHECK_EQ_INT(urrt_link_get_state(l), URRT_LINK_UP);
+    CHECK_EQ_INT(st->connects, 1);
+    CHECK_EQ_INT(st->packets, 1);
+    CHECK_EQ_INT(st->last_length, 8);
+    CHECK_EQ_INT(st->bytes, 8);
+    CHECK_EQ_INT(r.first_byte_of_last, 4); /* pkt[4] of the package */
+    CHECK_EQ_INT(lines_with("rtde: connected to 127.0.0.1"), 1);
+    CHECK_EQ_INT(lines_with("data flows (8-byte packages)"), 1);
+    CHECK_EQ_INT(bytes_from_client(s), 0); /* the handshake and nothing more */
+
+    /* 2: the server ends the session; the reconnect redoes the handshake
+     * from its first byte, with nothing left over from the first session. */
+    close(s);
+    s = serve_handshake(l, &r, lfd, 2);
+    CHECK_EQ_INT(src.connections, 2);
+    CHECK_EQ_INT(urrt_link_get_state(l), URRT_LINK_WAITING);
+    send_package(s, 'D');
+    send_package(s, 'D');
+    want_packets = 3;
+    CHECK(pump(l, &r, 2000, enough_packets, NULL, NULL, 0), "packages again after the reconnect");
+    CHECK_EQ_INT(st->connects, 2);
+    CHECK_EQ_INT(st->reconnects, 1);
+
+    /* 3: a protocol error: the source drops the connection; a loss, retried
+     * after the initial backoff. */
+    send_package(s, 'X');
+    CHECK(pump(l, &r, 2000, two_disconnects, NULL, NULL, 0), "a protocol error drops the link");
+    CHECK_EQ_INT(urrt_link_get_state(l), URRT_LINK_IDLE);
+    CHECK((int64_t)(urrt_link_deadline(l) - urrt_port_monotonic_us()) <= 10000, "retried after the initial backoff");
+    CHECK_EQ_INT(lines_with("lost (a package of unknown type); reconnecting"), 1);
+    CHECK_EQ_INT(bytes_from_client(s), 0); /* nothing after the handshake */
+    close(s);
+    urrt_link_free(l);
+    close(lfd);
+}
+
+/* A controller that refuses the configuration: reported once, however
+ * often it refuses, and retried with the long backoff, never in a loop. */
+static void test_source_refused(void)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    rx r = {0};
+    test_source src = {0};
+    urrt_link_source source = {.ctx = &src, .connected = source_connected, .received = source_received};
+    uint16_t port = 0;
+    int lfd = bind_any(AF_INET, &port, 4), s;
+    const urrt_link_stats *st;
+    uint64_t delays[4];
+    int nd = 0;
+
+    CHECK(lfd >= 0, "listen");
+    urrt_link_config_defaults(&c);
+    c.name = "rtde";
+    c.host = "127.0.0.1";
+    c.port = port;
+    c.silence_timeout_ms = 2000;
+    c.backoff_initial_ms = 10;
+    c.backoff_max_ms = 300;
+    l = urrt_link_new(&c);
+    st = urrt_link_get_stats(l);
+    urrt_link_set_source(l, &source);
+    log_count = 0;
+    for (unsigned i = 1; i <= 3; i++) {
+        uint64_t before = st->connect_failures;
+        s = serve_handshake(l, &r, lfd, i);
+        if (s < 0) {
+            break;
+        }
+        send_package(s, 'N');
+        pump_failures_base = before;
+        CHECK(pump(l, &r, 2000, one_failure_more, delays, &nd, 4), "refusal %u ends the attempt", i);
+        CHECK_EQ_INT(urrt_link_get_state(l), URRT_LINK_IDLE);
+        close(s);
+    }
+    CHECK_EQ_INT(st->connect_failures, 3);
+    CHECK_EQ_INT(st->connects, 0);
+    CHECK_EQ_INT(st->disconnects, 0);
+    CHECK(nd == 3, "%d waits recorded", nd);
+    for (int i = 0; i < nd; i++) {
+        CHECK(delays[i] >= 299 && delays[i] <= 300, "refusal %d: the long backoff (%llu ms)", i + 1,
+              (unsigned long long)delays[i]);
+    }
+    CHECK_EQ_INT(lines_with("refuses the configuration: output field \"no_such_field\" is NOT_FOUND on controller "
+                            "5.10.0; fix the configuration (retrying every 300 ms meanwhile)"), 1);
+    CHECK_EQ_INT(lines_with("error: robot rtde:"), 1);
+    if (lines_with("refuses the configuration") != 1) {
         dump_log();
     }
     urrt_link_free(l);
@@ -652,5 +1028,8 @@ int main(void)
     test_ipv6();
     test_name();
     test_wrong_port();
+    test_frozen_peer();
+    test_source_handshake();
+    test_source_refused();
     return check_report();
 }
