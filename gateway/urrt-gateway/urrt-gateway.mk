@@ -67,7 +67,7 @@ demo: deps-build all
 	if [ '$(DEMO_SECONDS)' != 0 ]; then (sleep '$(DEMO_SECONDS)'; kill $$gw 2>/dev/null) & timer=$$!; fi; \
 	echo "demo: watch it in another terminal: make spy$(if $(filter-out $(origin DEMO_LCM_URL),file), DEMO_LCM_URL='$(DEMO_LCM_URL)')" \
 	  "(lcm-spy on $(DEMO_LCM_URL)), or $(BUILD)/bin/urrt-dump -n 1 127.0.0.1:$$port (the raw stream)"; \
-	echo "demo: Ctrl-C stops$(if $(filter-out 0,$(DEMO_SECONDS)), (or after $(DEMO_SECONDS) s))"; \
+	echo "demo: runs until Ctrl-C$(if $(filter-out 0,$(DEMO_SECONDS)), (or $(DEMO_SECONDS) s), (make demo DEMO_SECONDS=10 stops after 10 s))"; \
 	wait $$gw; rc=$$?; gw=; \
 	echo "demo: stopped. To watch the next one: make demo in one terminal, make spy in another" \
 	  "(both take DEMO_LCM_URL; channels $(DEMO_ROBOT).STATE, .JOINTS, .TOOL, .STATUS, .GATEWAY)"; \

@@ -46,6 +46,7 @@ check "demo: its own robot and LCM URL, not production's default" \
 check "demo: the gateway connected at once (the simulator listened first)" \
   sh -c "grep -q 'robot demo: connected to 127.0.0.1' '$T/demo.err' && ! grep -qi 'refused' '$T/demo.err'"
 check "demo: summary lines with demo.STATE at 500/s" grep -q 'demo.STATE 5[0-9][0-9]/s' "$T/demo.out"
+check "demo: says it runs until Ctrl-C, or for DEMO_SECONDS" grep -qx 'demo: runs until Ctrl-C (or 3 s)' "$T/demo.out"
 check "demo: the closing lines say how to watch it" sh -c "tail -n 1 '$T/demo.out' | grep -q 'make spy'"
 check "demo: no process left behind" sh -c "! pgrep -s $(cat "$T/demo.sid")"
 # A port that is taken: the simulator cannot listen, the demo stops and names the variable.
@@ -61,6 +62,34 @@ kill $BUSY 2>/dev/null
 check "demo on a taken port: exit non-zero, names DEMO_PORT, no gateway started" \
   sh -c "[ $rc != 0 ] && grep -q 'make demo DEMO_PORT=N' '$T/busy.err' && ! grep -q 'urrt-gateway' '$T/busy.out'"
 
+# ---- the README's urrt-sim + urrt-dump lines --------------------------------------------
+# The text as the README shows it (the one shell block that passes --port-file), run twice
+# in a row as a reader would, each run in a session of its own: three packets of 3.10's
+# 1116 bytes each time, no "Address already in use", no simulator and no file left behind.
+awk '/^```/ { if (inside && block ~ /--port-file/) { printf "%s", block; exit }
+              inside = !inside; block = ""; next }
+     inside { block = block $0 "\n" }' README.md > "$T/readme.sh"
+check "README: one shell block starts urrt-sim and urrt-dump from build/bin/ ($(wc -l < "$T/readme.sh") lines)" \
+  sh -c "grep -q 'build/bin/urrt-sim ' '$T/readme.sh' && grep -q 'build/bin/urrt-dump ' '$T/readme.sh'"
+sed -i "s|build/bin/|$BUILD/bin/|g" "$T/readme.sh"
+mkdir "$T/readme.tmp"; sids=""
+for shell in sh bash; do
+  TMPDIR="$T/readme.tmp" setsid -w sh -c 'echo $$ > "$1"; shift; exec "$@"' sh "$T/readme.sid" \
+    timeout -k 2 30 $shell "$T/readme.sh" > "$T/readme.out" 2> "$T/readme.err"; rc=$?
+  sid=$(cat "$T/readme.sid"); sids="$sids $sid"
+  check "README's urrt-sim + urrt-dump under $shell: exit 0, packets 1-3 of 1116 bytes with time and q_actual" \
+    sh -c "[ $rc = 0 ] && [ \"\$(grep -c '^packet [123]: 1116 bytes' '$T/readme.out')\" = 3 ] &&
+           ! grep -q '^packet 4' '$T/readme.out' && [ \"\$(grep -c '^  q_actual ' '$T/readme.out')\" = 3 ] &&
+           [ \"\$(grep -c '^  time ' '$T/readme.out')\" = 3 ] && grep -q '^summary: packets: 3\$' '$T/readme.err'"
+  check "README's urrt-sim + urrt-dump under $shell: no 'Address already in use'" \
+    sh -c "! grep -qi 'address already in use' '$T/readme.err'"
+  check "README's urrt-sim + urrt-dump under $shell: no urrt-sim left running" sh -c "! pgrep -s $sid"
+  check "README's urrt-sim + urrt-dump under $shell: its temporary directory removed" \
+    sh -c "[ -z \"\$(ls -A '$T/readme.tmp')\" ]"
+done
+# What a failed run left (after both, so that a second run meets the first's simulator).
+for sid in $sids; do pkill -s "$sid" 2>/dev/null; done
+
 # ---- urrt-spy -------------------------------------------------------------------------
 spy() { URRT_LCMTYPES_JAR="$BUILD/urrt_lcmtypes.jar" DISPLAY=:99 gateway/install/urrt-spy --check "$@"; }
 mkdir -p "$T/jre/bin"; printf '#!/bin/sh\nexit 0\n' > "$T/jre/bin/java"; chmod +x "$T/jre/bin/java"
@@ -71,6 +100,19 @@ JCHART2D_JAR=$T/none.jar spy > "$T/spy2" 2>&1; rc=$?
 check "urrt-spy without jchart2d: names libjchart2d-java" sh -c "[ $rc = 1 ] && grep -q 'apt-get install libjchart2d-java' '$T/spy2'"
 URRT_LCMTYPES_JAR="$BUILD/urrt_lcmtypes.jar" DISPLAY= WAYLAND_DISPLAY= gateway/install/urrt-spy --check > "$T/spy3" 2>&1; rc=$?
 check "urrt-spy without a display: says so" sh -c "[ $rc = 1 ] && grep -q 'no display' '$T/spy3'"
+# From the source tree with no URRT_LCMTYPES_JAR: the jar is where `make` put it, $BUILD
+# (build/ when BUILD is not set). A stand-in GUI runtime and jars, so that the jar is the
+# one thing looked for.
+mkdir -p "$T/gui/bin" "$T/gui/lib"; cp "$T/jre/bin/java" "$T/gui/bin/java"
+touch "$T/gui/lib/libawt_xawt.so" "$T/lcm.jar" "$T/jchart2d.jar"
+tree_spy() { env -u URRT_LCMTYPES_JAR "$@" URRT_JAVA="$T/gui/bin/java" LCM_JAR="$T/lcm.jar" \
+  JCHART2D_JAR="$T/jchart2d.jar" DISPLAY=:99 gateway/install/urrt-spy --check; }
+tree_spy BUILD="$BUILD" > "$T/spy5" 2>&1; rc=$?
+check "urrt-spy --check from the source tree after make BUILD=$BUILD: ready, with $BUILD/urrt_lcmtypes.jar" \
+  sh -c "[ $rc = 0 ] && grep -qx 'urrt-spy: ready: $T/gui/bin/java, $(cd "$BUILD" && pwd)/urrt_lcmtypes.jar' '$T/spy5'"
+tree_spy -u BUILD > "$T/spy6" 2>&1; rc=$?
+check "urrt-spy --check from the source tree without BUILD: looks in build/" \
+  sh -c "grep -Eq '(ready: .*|not found \()$(pwd)/build/urrt_lcmtypes.jar' '$T/spy6'"
 if [ -f "$(dirname "$(dirname "$(readlink -f "$(command -v java)")")")/lib/libawt_xawt.so" ]; then
   spy > "$T/spy4" 2>&1; rc=$?
   check "urrt-spy with the spy tier installed: ready" sh -c "[ $rc = 0 ] && grep -q 'ready' '$T/spy4'"
