@@ -213,6 +213,9 @@ symbol_size() {
 state=$(symbol_size urrt_probe_state)
 framer=$(symbol_size urrt_probe_framer)
 printf '| sizeof(urrt_state) | %s |\n| sizeof(urrt_framer) | %s |\n' "$state" "$framer" >> "$measured"
+# The RTDE client's session and its RTDE-only values (lib/urrt_rtde.h).
+printf '| sizeof(urrt_rtde) | %s |\n| sizeof(urrt_rtde_values) | %s |\n' \
+  "$(symbol_size urrt_probe_rtde)" "$(symbol_size urrt_probe_rtde_values)" >> "$measured"
 rm -f "$out"/*.O2.su
 echo "cross: largest stack frames of lib/ functions (-fstack-usage, bytes; lib/ has no recursion):"
 for obj in $objs; do cat "${obj%.o}.su"; done | sort -t "$(printf '\t')" -k2 -n -r | head -n 5 | sed 's/^/cross:   /'

@@ -18,6 +18,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "urrt.h"
+#include "urrt_rtde.h"
 
 /* Names a second build's figures apart ("edge_"), see tests/lib/lib.mk. */
 #ifndef URRT_BENCH_PREFIX
@@ -174,6 +175,100 @@ static size_t bench_decode(void *ctx, size_t n)
         sum += state.present;
     }
     checksum += sum;
+    return n;
+}
+
+/* ---- RTDE: one data package of the STATE recipe --------------------------- */
+
+/* The recipe that mirrors what urrt publishes from RealTime (docs/rtde.md):
+ * a 904-byte data package. */
+static const char *const rtde_state_names[] = {
+    "timestamp", "target_q", "target_qd", "target_qdd", "target_current", "target_moment", "actual_q",
+    "actual_qd", "actual_current", "joint_control_output", "actual_TCP_pose", "actual_TCP_speed",
+    "actual_TCP_force", "target_TCP_pose", "target_TCP_speed", "actual_digital_input_bits",
+    "joint_temperatures", "actual_execution_time", "robot_mode", "joint_mode", "safety_mode",
+    "actual_tool_accelerometer", "speed_scaling", "actual_momentum", "actual_main_voltage",
+    "actual_robot_voltage", "actual_robot_current", "actual_joint_voltage", "actual_digital_output_bits",
+    "runtime_state"};
+#define RTDE_STATE_VARS (sizeof rtde_state_names / sizeof rtde_state_names[0])
+
+static urrt_rtde rtde_session;
+
+/* Feeds one package (size and letter in front of body) to the session. */
+static int rtde_reply(uint8_t type, const uint8_t *body, size_t n)
+{
+    static uint8_t pkg[URRT_RTDE_PACKAGE_MAX];
+    urrt_rtde_event ev;
+    size_t used;
+    uint8_t out[URRT_RTDE_REQUEST_MAX];
+    pkg[0] = (uint8_t)((n + 3) >> 8);
+    pkg[1] = (uint8_t)(n + 3);
+    pkg[2] = type;
+    memcpy(pkg + 3, body, n);
+    while (urrt_rtde_output(&rtde_session, out, sizeof out) > 0) {
+    }
+    return urrt_rtde_feed(&rtde_session, pkg, n + 3, &used, &ev, &state, NULL);
+}
+
+/* The session through the handshake (the bench's own replies: what is
+ * measured is the decode, not the replies), and its data packages. */
+static void rtde_setup(packets *p)
+{
+    uint16_t vars[RTDE_STATE_VARS];
+    char types[RTDE_STATE_VARS * 14 + 1] = {1}; /* recipe id 1, then the types */
+    size_t at = 1;
+    static const uint8_t yes = 1, version[16] = {0, 0, 0, 5, 0, 0, 0, 12};
+    for (size_t i = 0; i < RTDE_STATE_VARS; i++) {
+        const char *t;
+        vars[i] = (uint16_t)urrt_rtde_var_find(rtde_state_names[i], strlen(rtde_state_names[i]));
+        t = urrt_rtde_type_name(urrt_rtde_var_type(vars[i]));
+        at += (size_t)sprintf(types + at, "%s%s", i > 0 ? "," : "", t);
+    }
+    urrt_rtde_init(&rtde_session);
+    if (urrt_rtde_begin(&rtde_session, vars, RTDE_STATE_VARS, 0.0) != URRT_OK ||
+        rtde_reply('V', &yes, 1) != URRT_RTDE_EV_PROTOCOL || rtde_reply('v', version, 16) != URRT_RTDE_EV_CONTROLLER ||
+        rtde_reply('O', (const uint8_t *)types, at) != URRT_RTDE_EV_RECIPE ||
+        rtde_reply('S', &yes, 1) != URRT_RTDE_EV_STARTED || rtde_session.data_size != 904) {
+        fprintf(stderr, "bench: the RTDE handshake failed\n");
+        exit(1);
+    }
+    p->length = rtde_session.data_size;
+    for (size_t v = 0; v < VARIANTS; v++) {
+        uint8_t *b = p->storage + v * STRIDE;
+        for (size_t i = 0; i < p->length; i++) {
+            b[i] = (uint8_t)(i * 7 + v * 13 + 1);
+        }
+        b[0] = (uint8_t)(p->length >> 8);
+        b[1] = (uint8_t)p->length;
+        b[2] = 'U';
+        b[3] = 1;
+        p->bytes[v] = b;
+    }
+}
+
+static size_t bench_rtde_decode(void *ctx, size_t n)
+{
+    const packets *p = ctx;
+    uint64_t sum = 0;
+    for (size_t i = 0; i < n; i++) {
+        sum += (uint64_t)urrt_rtde_decode(&rtde_session, p->bytes[i % VARIANTS], p->length, &state, NULL);
+        USE(&state);
+        sum += state.present;
+    }
+    checksum += sum;
+    return n;
+}
+
+/* The copy floor: the same package's bytes after the recipe id, byte-swapped
+ * eight at a time into doubles (the plain loop). */
+static size_t bench_rtde_copy(void *ctx, size_t n)
+{
+    const packets *p = ctx;
+    for (size_t i = 0; i < n; i++) {
+        plain_swap(plain_target, p->bytes[i % VARIANTS] + 4, (p->length - 4) / 8);
+        USE(plain_target);
+    }
+    checksum += (uint64_t)plain_target[3];
     return n;
 }
 
@@ -364,6 +459,15 @@ int main(void)
     }
     measure(bench_read10, &p1116, bench_memcpy, &p1116, &s, &b, &r);
     report("read10_1116", s, b, r);
+
+    {
+        static packets rtde;
+        rtde_setup(&rtde);
+        measure(bench_rtde_decode, &rtde, bench_rtde_copy, &rtde, &s, &b, &r);
+        printf("%srtde_decode_state_ns: %.1f\n", URRT_BENCH_PREFIX, s);
+        printf("%srtde_decode_state_copy_floor_ns: %.1f\n", URRT_BENCH_PREFIX, b);
+        printf("%srtde_decode_state_vs_copy_floor: %.2f\n", URRT_BENCH_PREFIX, r);
+    }
 
     for (int i = 0; i < 3; i++) {
         stream *st = &streams[i];

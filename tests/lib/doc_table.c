@@ -1,11 +1,13 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * Prints the tables of docs/protocol.md from the library's own metadata
- * (urrt_field(), urrt_enum_entries()), so the document cannot drift from the
+ * (urrt_field(), urrt_enum_entries(), and urrt_rtde.h's map from each field
+ * to the RTDE output that fills it), so the document cannot drift from the
  * code. `make docs` splices the output between the markers; `make
  * check-docs` fails when the document differs from it.
  */
 #include "urrt.h"
+#include "urrt_rtde.h"
 
 #include <stdio.h>
 
@@ -17,6 +19,18 @@ static void columns(char *buf, size_t size, unsigned first, unsigned count)
         snprintf(buf, size, "%u", first);
     } else {
         snprintf(buf, size, "%u-%u", first, first + count - 1);
+    }
+}
+
+/* The RTDE output that fills a field, with its wire type, or "-". */
+static void rtde_name(char *buf, size_t size, urrt_field_id id)
+{
+    int var = urrt_rtde_var_of_field(id);
+    char name[URRT_RTDE_NAME_MAX];
+    if (var < 0 || urrt_rtde_var_name(var, name, sizeof name) < 0) {
+        snprintf(buf, size, "-");
+    } else {
+        snprintf(buf, size, "`%s` %s", name, urrt_rtde_type_name(urrt_rtde_var_type(var)));
     }
 }
 
@@ -33,15 +47,16 @@ static void enum_table(const char *title, urrt_enum_kind kind)
 int main(void)
 {
     int id;
-    printf("| field | count | unit | columns 3.x/5.x | columns 1.x | since | description |\n");
-    printf("|---|---:|---|---|---|---|---|\n");
+    printf("| field | count | unit | columns 3.x/5.x | columns 1.x | since | RTDE output (type) | description |\n");
+    printf("|---|---:|---|---|---|---|---|---|\n");
     for (id = 0; id < URRT_FIELD_COUNT; id++) {
         const urrt_field_info *f = urrt_field((urrt_field_id)id);
-        char c3[16], c1[16];
+        char c3[16], c1[16], rtde[64];
         columns(c3, sizeof c3, f->col_3x, f->count);
         columns(c1, sizeof c1, f->col_1x, f->count);
-        printf("| `%s` | %u | %s | %s | %s | %s | %s |\n", f->name, f->count, f->unit[0] ? f->unit : "-", c3, c1,
-               f->since, f->description);
+        rtde_name(rtde, sizeof rtde, (urrt_field_id)id);
+        printf("| `%s` | %u | %s | %s | %s | %s | %s | %s |\n", f->name, f->count, f->unit[0] ? f->unit : "-", c3,
+               c1, f->since, rtde, f->description);
     }
     printf("\n%d fields; the 3.x/5.x grid has %d columns (%d bytes); "
            "a packet may hold up to %d doubles (URRT_MAX_DOUBLES, %d bytes).\n",

@@ -9,9 +9,12 @@
 #                  images, results through semihosting and qemu's exit status; and the painted
 #                  stack of every public lib/ function against -fstack-usage and docs/footprint.md;
 #                  the CAN core's and the CANopen node's tests (tests/lib/test_cantx.c, test_co.c)
-#                  on the M4 (soft and hard float) and the M0
+#                  on the M4 (soft and hard float) and the M0; the RTDE client on the reference's
+#                  sessions (tests/target/rtde_target.c) on the same three, which also paints the
+#                  stack of the urrt_rtde functions (its log joins stack_target.h's for stack.py)
 #   check-lib-be   tests/lib/test_lib.c on big-endian s390x, powerpc and mips (with the lib/urrt_can,
-#                  urrt_cantx and urrt_co tests of tests/lib/test_can.c, test_cantx.c, test_co.c),
+#                  urrt_cantx, urrt_co and urrt_rtde tests of tests/lib/test_can.c, test_cantx.c,
+#                  test_co.c, test_rtde.c),
 #                  lib/*.c alone, and on little-endian NEON
 #                  (aarch64, armhf; lib/vector/urrt_vector.c, and aarch64 also lib/*.c alone)
 #                  under qemu-user; on big-endian NEON (aarch64_be, armeb; freestanding)
@@ -86,14 +89,35 @@ $(eval $(call tgt_unit,m4f-o2,$(TGT_M4F),-O2,an386.ld))
 $(eval $(call tgt_unit,m0-os,$(TGT_M0),-Os,microbit.ld))
 TGT_UNIT_BOARDS := m4-os:mps2-an386 m4f-o2:mps2-an386 m0-os:microbit
 
+# The RTDE client (tests/target/rtde_target.c) on the reference's sessions as C data
+# (tests/target/rtde_vectors_c.py), NAME/rtde.elf on the lib/ objects of an image above:
+# $(call tgt_rtde_image,NAME,CPU FLAGS,OPT,LINKER SCRIPT).
+$(TGT)/rtde_vectors.c: $(RTDE_VECTORS) tests/target/rtde_vectors_c.py
+	@mkdir -p $(@D)
+	$(PYTHON) tests/target/rtde_vectors_c.py $(RTDE_VECTORS) $@
+define tgt_rtde_image
+$(TGT)/$(1)/rtde.elf: tests/target/rtde_target.c tests/target/rtde_vectors.h $(TGT_UNIT_DEPS) tests/target/$(4) \
+  $(TGT)/rtde_vectors.c $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
+	$(TGT_CM) $(2) $(3) $(TGT_FLAGS) -Itests -DURRT_TARGET_CORTEX_M tests/target/cm.c $$< $(TGT)/rtde_vectors.c \
+	  $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -T tests/target/$(4) $(TGT_LINK) -o $$@
+endef
+$(eval $(call tgt_rtde_image,m4-os,$(TGT_M4),-Os,an386.ld))
+$(eval $(call tgt_rtde_image,m4f-o2,$(TGT_M4F),-O2,an386.ld))
+$(eval $(call tgt_rtde_image,m0-os,$(TGT_M0),-Os,microbit.ld))
+TGT_RTDE_BOARDS := m4-os:mps2-an386 m4f-o2:mps2-an386 m0-os:microbit
+
 check-lib-m4: $(foreach b,$(TGT_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/test.elf) tests/target/stack.py \
-  $(foreach u,$(TGT_UNITS),$(foreach b,$(TGT_UNIT_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/$(u).elf))
+  $(foreach u,$(TGT_UNITS),$(foreach b,$(TGT_UNIT_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/$(u).elf)) \
+  $(foreach b,$(TGT_RTDE_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/rtde.elf)
 	$(call suite,check-lib-m4,sh tests/target/run.sh $(TGT)/logs \
+	  $(foreach b,$(TGT_RTDE_BOARDS),rtde-$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M) \
+	    -M $(lastword $(subst :, ,$(b))) -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/rtde.elf") \
 	  $(foreach b,$(TGT_BOARDS),$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M) -M $(lastword $(subst :, ,$(b))) \
 	    -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/test.elf") \
 	  $(foreach u,$(TGT_UNITS),$(foreach b,$(TGT_UNIT_BOARDS),$(u)-$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M) \
 	    -M $(lastword $(subst :, ,$(b))) -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/$(u).elf")) \
-	  stack-m4-os="$(PYTHON) tests/target/stack.py $(TGT)/logs/m4-os.log docs/footprint.md $(TGT)/m4-os/lib/*.ci")
+	  stack-m4-os="cat $(TGT)/logs/m4-os.log $(TGT)/logs/rtde-m4-os.log > $(TGT)/logs/stack-m4-os.marks && \
+	    $(PYTHON) tests/target/stack.py $(TGT)/logs/stack-m4-os.marks docs/footprint.md $(TGT)/m4-os/lib/*.ci")
 
 # ---- big-endian and NEON under qemu-user ---------------------------------------------
 
@@ -159,7 +183,19 @@ $(TGT)/%/neon_be_old: $(TGT_DRIVER) tests/target/linux_start.c $(TGT)/vectors_na
 	$(if $(filter armeb,$*),$(TGT_ARMEB),$(TGT_A64BE)) $(TGT_BE_FREE) -Ilib/vector $(TGT_OLD_NEON) -o $@
 TGT_BE_BINS += $(foreach a,armeb aarch64_be,$(TGT)/$(a)/neon_be $(TGT)/$(a)/neon_be_old)
 
-check-lib-be: $(TGT_BE_BINS) $(LIB_VECTORS) $(TGT_OLD_NEON)
+# The RTDE client's tests (tests/lib/test_rtde.c, tests/lib/rtde.mk) on the big-endian CPUs,
+# on the reference's sessions: $(call tgt_rtde,NAME,CC,QEMU), on the lib/ objects of tgt_linux.
+define tgt_rtde
+$(TGT)/$(1)/test_rtde: tests/lib/test_rtde.c tests/check.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
+	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
+TGT_BE_BINS += $(TGT)/$(1)/test_rtde
+TGT_BE_RUNS += $(1)-rtde="$(3) $(TGT)/$(1)/test_rtde $(RTDE_VECTORS)"
+endef
+$(eval $(call tgt_rtde,s390x,s390x-linux-gnu-gcc,qemu-s390x))
+$(eval $(call tgt_rtde,powerpc,powerpc-linux-gnu-gcc,qemu-ppc))
+$(eval $(call tgt_rtde,mips,mips-linux-gnu-gcc,qemu-mips))
+
+check-lib-be: $(TGT_BE_BINS) $(LIB_VECTORS) $(RTDE_VECTORS) $(TGT_OLD_NEON)
 	$(call suite,check-lib-be,sh tests/target/run.sh $(TGT)/logs-be $(TGT_BE_RUNS) \
 	  aarch64-vector-path="$(call tgt_vector,aarch64-linux-gnu-gcc)" \
 	  armhf-vector-path="$(call tgt_vector,arm-linux-gnueabihf-gcc $(TGT_NEON))" \

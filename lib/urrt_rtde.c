@@ -1,0 +1,1274 @@
+/* SPDX-License-Identifier: MIT */
+/* urrt_rtde: a read-only RTDE client without I/O. See urrt_rtde.h for the
+ * API and docs/rtde.md for the wire format, the errors and the bounds. */
+#include "urrt_rtde.h"
+
+#define RTDE_STATIC_ASSERT(name, cond) typedef char urrt_rtde_assert_##name[(cond) ? 1 : -1]
+
+RTDE_STATIC_ASSERT(double_is_binary64, sizeof(double) == 8);
+RTDE_STATIC_ASSERT(state_offsets_fit, sizeof(urrt_state) <= 0xFFFF);
+RTDE_STATIC_ASSERT(values_offsets_fit, sizeof(urrt_rtde_values) <= 0xFFFF);
+RTDE_STATIC_ASSERT(package_size_fits, URRT_RTDE_PACKAGE_MAX <= 0xFFFF);
+/* A setup reply for the most variables (14 bytes per type and comma) and
+ * a protocol-2 text message (1 + 255 + 1 + 255 + 1) fit the buffer. */
+RTDE_STATIC_ASSERT(setup_reply_fits, 4 + 14 * URRT_RTDE_MAX_VARS <= URRT_RTDE_PACKAGE_MAX);
+RTDE_STATIC_ASSERT(text_fits, 3 + 513 <= URRT_RTDE_PACKAGE_MAX);
+RTDE_STATIC_ASSERT(not_found_bits, URRT_RTDE_MAX_VARS % 8 == 0);
+RTDE_STATIC_ASSERT(vars_fit_ids, URRT_RTDE_VAR_COUNT <= 0xFFFF);
+
+/* Each mapped variable fills a whole urrt_state member. */
+#define X_SIZE_CHECK(ID, name, TYPE, FIELD, member, since) \
+    RTDE_STATIC_ASSERT(size_##member, sizeof(((urrt_state *)0)->member) == 8 * URRT_RTDE_COUNT_##TYPE);
+URRT_RTDE_MAPPED(X_SIZE_CHECK)
+#undef X_SIZE_CHECK
+
+/* A value in urrt_rtde_values takes as many bytes as on the wire, so the
+ * names of a family sit type_size apart. */
+#define X_CSIZE_CHECK(ID, member, name, TYPE, first, names, split, since, since_hi) \
+    RTDE_STATIC_ASSERT(csize_##member, sizeof(((urrt_rtde_values *)0)->member) == \
+                                           (names) * sizeof(URRT_RTDE_CTYPE_##TYPE) * URRT_RTDE_COUNT_##TYPE);
+URRT_RTDE_ONLY(X_CSIZE_CHECK)
+#undef X_CSIZE_CHECK
+
+#define RTDE_NAN_BITS UINT64_C(0x7FF8000000000000)
+
+/* ---- tables ------------------------------------------------------------- */
+
+typedef struct type_info {
+    const char *name;
+    uint8_t size;  /* bytes on the wire */
+    uint8_t count; /* elements */
+} type_info;
+
+static const type_info type_table[URRT_RTDE_T_COUNT] = {
+    {0, 0, 0},
+    {"BOOL", 1, 1},
+    {"UINT8", 1, 1},
+    {"UINT32", 4, 1},
+    {"UINT64", 8, 1},
+    {"INT32", 4, 1},
+    {"DOUBLE", 8, 1},
+    {"VECTOR3D", 24, 3},
+    {"VECTOR6D", 48, 6},
+    {"VECTOR6INT32", 24, 6},
+    {"VECTOR6UINT32", 24, 6},
+};
+
+#define SINCE_INIT_(cb3, e, x) {cb3, e, x}
+#define SINCE_INIT(triple) SINCE_INIT_ triple
+
+typedef struct mapped_row {
+    const char *name;
+    uint32_t since[3];
+    uint16_t offset; /* in urrt_state */
+    uint8_t type;
+    uint8_t field;
+} mapped_row;
+
+static const mapped_row mapped_table[URRT_RTDE_MAPPED_COUNT] = {
+#define X_MAPPED(ID, name, TYPE, FIELD, member, since) \
+    {name, SINCE_INIT(since), (uint16_t)offsetof(urrt_state, member), URRT_RTDE_T_##TYPE, URRT_F_##FIELD},
+    URRT_RTDE_MAPPED(X_MAPPED)
+#undef X_MAPPED
+};
+
+typedef struct only_row {
+    const char *name;
+    uint32_t since[3];
+    uint32_t since_hi[3]; /* of indexes first + split and later */
+    uint16_t offset;      /* in urrt_rtde_values */
+    uint16_t var;         /* id of the first name */
+    uint8_t type;
+    uint8_t first;
+    uint8_t names;
+    uint8_t split;
+} only_row;
+
+#define ONLY_ROWS (sizeof(only_table) / sizeof(only_table[0]))
+
+static const only_row only_table[] = {
+#define X_ONLY(ID, member, name, TYPE, first, names, split, since, since_hi)                           \
+    {name, SINCE_INIT(since), SINCE_INIT(since_hi), (uint16_t)offsetof(urrt_rtde_values, member), \
+     URRT_RTDE_V_##ID, URRT_RTDE_T_##TYPE, first, names, split},
+    URRT_RTDE_ONLY(X_ONLY)
+#undef X_ONLY
+};
+
+/* Where each urrt_state field sits, for the decode's NaN fill of the fields
+ * a recipe does not have. */
+typedef struct state_field {
+    uint16_t offset;
+    uint8_t count;
+} state_field;
+
+static const state_field state_fields[URRT_FIELD_COUNT] = {
+#define X_STATE(ID, name, count, c1, c3, unit, since, desc) {(uint16_t)offsetof(urrt_state, name), count},
+    URRT_FIELDS(X_STATE)
+#undef X_STATE
+};
+
+/* ---- bytes ----------------------------------------------------------------- */
+
+typedef union rtde_bits {
+    uint64_t u;
+    double d;
+} rtde_bits;
+
+static uint16_t load_be16(const uint8_t *p)
+{
+    return (uint16_t)((unsigned)p[0] << 8 | (unsigned)p[1]);
+}
+
+/* As urrt.c loads: one load and a byte swap where GCC or clang may load
+ * unaligned (little-endian x86, AArch64, ARM with unaligned access), bytes
+ * elsewhere (a __builtin_memcpy of unaligned bytes may be a memcpy call
+ * there, which lib/ must not need). Inline: the decode walks these. */
+#if defined(__GNUC__) && defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__)
+#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#if defined(__x86_64__) || defined(__i386__) || defined(__aarch64__) || defined(__ARM_FEATURE_UNALIGNED)
+#define RTDE_LOAD_UNALIGNED 1
+#endif
+#endif
+#endif
+
+#ifdef RTDE_LOAD_UNALIGNED
+static inline uint32_t load_be32(const uint8_t *p)
+{
+    uint32_t v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return __builtin_bswap32(v);
+}
+
+static inline uint64_t load_be64(const uint8_t *p)
+{
+    uint64_t v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return __builtin_bswap64(v);
+}
+#else
+static inline uint32_t load_be32(const uint8_t *p)
+{
+    return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | (uint32_t)p[3];
+}
+
+static inline uint64_t load_be64(const uint8_t *p)
+{
+    return (uint64_t)load_be32(p) << 32 | (uint64_t)load_be32(p + 4);
+}
+#endif
+
+static inline double load_double(const uint8_t *p)
+{
+    rtde_bits b;
+    b.u = load_be64(p);
+    return b.d;
+}
+
+static void store_be16(uint8_t *p, unsigned v)
+{
+    p[0] = (uint8_t)(v >> 8);
+    p[1] = (uint8_t)v;
+}
+
+/* ---- results --------------------------------------------------------------- */
+
+const char *urrt_rtde_strerror(int result)
+{
+    switch (result) {
+    case URRT_RTDE_E_SIZE_SMALL: return "package size below its 3-byte header";
+    case URRT_RTDE_E_SIZE_LARGE: return "package size past the largest accepted";
+    case URRT_RTDE_E_REPLY_LENGTH: return "reply length does not match its layout";
+    case URRT_RTDE_E_REPLY_VALUE: return "accepted flag neither 0 nor 1";
+    case URRT_RTDE_E_VERSION_ZERO: return "controller version 0.0.0.0";
+    case URRT_RTDE_E_DATA_EARLY: return "data package before a recipe was accepted";
+    case URRT_RTDE_E_RECIPE_ID: return "data package of another recipe";
+    case URRT_RTDE_E_DATA_SIZE: return "data package size differs from the recipe's";
+    case URRT_RTDE_E_TYPE_TOKEN: return "setup reply holds a word that is no type";
+    case URRT_RTDE_E_TYPE_COUNT: return "setup reply has more or fewer types than names";
+    case URRT_RTDE_E_TEXT_LENGTH: return "text message lengths do not fill the package";
+    case URRT_RTDE_E_PAUSE_REFUSED: return "controller refused to pause";
+    case URRT_RTDE_E_ENDED: return "session ended: begin a new one";
+    case URRT_RTDE_E_NOT_FOUND: return "controller does not have some of the variables";
+    case URRT_RTDE_E_TYPE_MISMATCH: return "controller's type for a variable is not urrt's";
+    case URRT_RTDE_E_PROTOCOL_REFUSED: return "controller refused protocol versions 2 and 1";
+    case URRT_RTDE_E_START_REFUSED: return "controller refused to start the recipe";
+    case URRT_RTDE_E_FREQUENCY: return "frequency past the controller's maximum";
+    case URRT_RTDE_E_NAMES_TOO_LONG: return "name list past 2048 bytes";
+    case URRT_RTDE_E_DUPLICATE: return "variable asked for twice";
+    case URRT_RTDE_E_UNKNOWN_NAME: return "no RTDE output of that name";
+    default: return urrt_strerror(result);
+    }
+}
+
+bool urrt_rtde_is_config_error(int result)
+{
+    return result <= URRT_RTDE_E_NOT_FOUND && result >= URRT_RTDE_E_FREQUENCY;
+}
+
+/* ---- types and variables -------------------------------------------------- */
+
+const char *urrt_rtde_type_name(urrt_rtde_type type)
+{
+    return (unsigned)type < (unsigned)URRT_RTDE_T_COUNT ? type_table[type].name : 0;
+}
+
+unsigned urrt_rtde_type_size(urrt_rtde_type type)
+{
+    return (unsigned)type < (unsigned)URRT_RTDE_T_COUNT ? type_table[type].size : 0u;
+}
+
+/* The RTDE-only row of a variable, NULL for mapped ones and ids out of range. */
+static const only_row *only_row_of(int var)
+{
+    size_t i;
+    if (var < (int)URRT_RTDE_MAPPED_COUNT || var >= (int)URRT_RTDE_VAR_COUNT) {
+        return 0;
+    }
+    for (i = ONLY_ROWS; i-- > 0;) {
+        if (var >= (int)only_table[i].var) {
+            return &only_table[i];
+        }
+    }
+    return 0;
+}
+
+static size_t text_length(const char *s)
+{
+    size_t n = 0;
+    while (s[n] != '\0') {
+        n++;
+    }
+    return n;
+}
+
+/* n bytes of a equal b's first n, and b ends there if whole is set. */
+static bool same_prefix(const char *a, size_t n, const char *b, bool whole)
+{
+    size_t i;
+    for (i = 0; i < n; i++) {
+        if (b[i] == '\0' || a[i] != b[i]) {
+            return false;
+        }
+    }
+    return !whole || b[n] == '\0';
+}
+
+/* Decimal digits without a leading zero (except "0"), at most 3; -1 else. */
+static int parse_index(const char *p, size_t n)
+{
+    int v = 0;
+    size_t i;
+    if (n == 0 || n > 3 || (n > 1 && p[0] == '0')) {
+        return -1;
+    }
+    for (i = 0; i < n; i++) {
+        if (p[i] < '0' || p[i] > '9') {
+            return -1;
+        }
+        v = v * 10 + (p[i] - '0');
+    }
+    return v;
+}
+
+int urrt_rtde_var_find(const char *name, size_t len)
+{
+    size_t i;
+    if (name == 0) {
+        return URRT_E_ARG;
+    }
+    for (i = 0; i < (size_t)URRT_RTDE_MAPPED_COUNT; i++) {
+        if (same_prefix(name, len, mapped_table[i].name, true)) {
+            return (int)i;
+        }
+    }
+    for (i = 0; i < ONLY_ROWS; i++) {
+        const only_row *r = &only_table[i];
+        size_t plen = text_length(r->name);
+        int index;
+        if (r->names == 1) {
+            if (same_prefix(name, len, r->name, true)) {
+                return r->var;
+            }
+            continue;
+        }
+        if (len <= plen || !same_prefix(name, plen, r->name, true)) {
+            continue;
+        }
+        index = parse_index(name + plen, len - plen);
+        if (index >= r->first && index < r->first + r->names) {
+            return r->var + index - r->first;
+        }
+    }
+    return URRT_RTDE_E_UNKNOWN_NAME;
+}
+
+/* Writes the name of var (no NUL) into out when out is not NULL; returns
+ * its length, or 0 for an id out of range. */
+static size_t put_name(int var, char *out)
+{
+    const only_row *r = only_row_of(var);
+    const char *base;
+    size_t n;
+    char digits[3];
+    unsigned index, d = 0;
+    if (var >= 0 && var < (int)URRT_RTDE_MAPPED_COUNT) {
+        base = mapped_table[var].name;
+    } else if (r != 0) {
+        base = r->name;
+    } else {
+        return 0;
+    }
+    for (n = 0; base[n] != '\0'; n++) {
+        if (out != 0) {
+            out[n] = base[n];
+        }
+    }
+    if (r == 0 || r->names == 1) {
+        return n;
+    }
+    index = (unsigned)r->first + (unsigned)(var - r->var);
+    do {
+        digits[d++] = (char)('0' + index % 10u);
+        index /= 10u;
+    } while (index != 0);
+    while (d > 0) {
+        char c = digits[--d];
+        if (out != 0) {
+            out[n] = c;
+        }
+        n++;
+    }
+    return n;
+}
+
+int urrt_rtde_var_name(int var, char *out, size_t cap)
+{
+    size_t n = put_name(var, 0);
+    if (out == 0 || n == 0) {
+        return URRT_E_ARG;
+    }
+    if (n + 1 > cap) {
+        return URRT_E_NO_SPACE;
+    }
+    put_name(var, out);
+    out[n] = '\0';
+    return (int)n;
+}
+
+urrt_rtde_type urrt_rtde_var_type(int var)
+{
+    const only_row *r = only_row_of(var);
+    if (var >= 0 && var < (int)URRT_RTDE_MAPPED_COUNT) {
+        return (urrt_rtde_type)mapped_table[var].type;
+    }
+    return r != 0 ? (urrt_rtde_type)r->type : URRT_RTDE_T_NONE;
+}
+
+int urrt_rtde_var_field(int var)
+{
+    return var >= 0 && var < (int)URRT_RTDE_MAPPED_COUNT ? (int)mapped_table[var].field : -1;
+}
+
+int urrt_rtde_var_of_field(urrt_field_id field)
+{
+    int i;
+    for (i = 0; i < (int)URRT_RTDE_MAPPED_COUNT; i++) {
+        if (mapped_table[i].field == (unsigned)field) {
+            return i;
+        }
+    }
+    return -1;
+}
+
+int urrt_rtde_var_available(int var, uint32_t major, uint32_t minor, uint32_t bugfix)
+{
+    const only_row *r = only_row_of(var);
+    const uint32_t *since;
+    uint32_t line, have, need;
+    if (var >= 0 && var < (int)URRT_RTDE_MAPPED_COUNT) {
+        since = mapped_table[var].since;
+    } else if (r != 0) {
+        since = var - r->var >= r->split ? r->since_hi : r->since;
+    } else {
+        return URRT_E_ARG;
+    }
+    if (major < 3) {
+        return 0;
+    }
+    line = major == 3 ? 0u : major < 10 ? 1u : 2u;
+    need = since[line];
+    if (need == URRT_RTDE_UNSTATED) {
+        return URRT_RTDE_UNKNOWN;
+    }
+    if (need == URRT_RTDE_NEVER) {
+        return 0;
+    }
+    have = URRT_RTDE_VER(major > 255 ? 255 : major, minor > 255 ? 255 : minor, bugfix > 255 ? 255 : bugfix);
+    return have >= need ? 1 : 0;
+}
+
+void urrt_rtde_values_clear(urrt_rtde_values *v)
+{
+    rtde_bits nan;
+    size_t i;
+    if (v == 0) {
+        return;
+    }
+    nan.u = RTDE_NAN_BITS;
+#define X_CLEAR(ID, member, name, TYPE, first, names, split, since, since_hi) \
+    for (i = 0; i < sizeof v->member / sizeof v->member[0]; i++) {           \
+        v->member[i] = (URRT_RTDE_CTYPE_##TYPE)(URRT_RTDE_T_##TYPE == URRT_RTDE_T_DOUBLE || \
+                       URRT_RTDE_T_##TYPE == URRT_RTDE_T_VECTOR3D ||          \
+                       URRT_RTDE_T_##TYPE == URRT_RTDE_T_VECTOR6D ? nan.d : 0.0); \
+    }
+    URRT_RTDE_ONLY(X_CLEAR)
+#undef X_CLEAR
+    for (i = 0; i < sizeof v->present; i++) {
+        v->present[i] = 0;
+    }
+}
+
+/* Where an RTDE-only variable sits in urrt_rtde_values: a family's values
+ * are back to back, each as big as on the wire (checked above). */
+static unsigned value_offset(const only_row *r, int var)
+{
+    return r->offset + (unsigned)(var - r->var) * type_table[r->type].size;
+}
+
+const void *urrt_rtde_value(const urrt_rtde_values *v, int var)
+{
+    const only_row *r = only_row_of(var);
+    if (v == 0 || r == 0) {
+        return 0;
+    }
+    return (const unsigned char *)v + value_offset(r, var);
+}
+
+/* ---- requests ---------------------------------------------------------- */
+
+static int write_header_only(uint8_t *out, size_t cap, uint8_t type)
+{
+    if (out == 0) {
+        return URRT_E_ARG;
+    }
+    if (cap < URRT_RTDE_HEADER_SIZE) {
+        return URRT_E_NO_SPACE;
+    }
+    store_be16(out, URRT_RTDE_HEADER_SIZE);
+    out[2] = type;
+    return URRT_RTDE_HEADER_SIZE;
+}
+
+int urrt_rtde_write_protocol_version(uint8_t *out, size_t cap, uint16_t version)
+{
+    if (out == 0) {
+        return URRT_E_ARG;
+    }
+    if (cap < 5) {
+        return URRT_E_NO_SPACE;
+    }
+    store_be16(out, 5);
+    out[2] = URRT_RTDE_TYPE_PROTOCOL_VERSION;
+    store_be16(out + 3, version);
+    return 5;
+}
+
+int urrt_rtde_write_controller_version(uint8_t *out, size_t cap)
+{
+    return write_header_only(out, cap, URRT_RTDE_TYPE_CONTROLLER_VERSION);
+}
+
+int urrt_rtde_write_start(uint8_t *out, size_t cap)
+{
+    return write_header_only(out, cap, URRT_RTDE_TYPE_START);
+}
+
+int urrt_rtde_write_pause(uint8_t *out, size_t cap)
+{
+    return write_header_only(out, cap, URRT_RTDE_TYPE_PAUSE);
+}
+
+/* Bytes of the comma-separated name list; 0 for an id out of range. */
+static size_t names_length(const uint16_t *vars, size_t count)
+{
+    size_t i, total = count - 1;
+    for (i = 0; i < count; i++) {
+        size_t n = put_name(vars[i], 0);
+        if (n == 0) {
+            return 0;
+        }
+        total += n;
+    }
+    return total;
+}
+
+int urrt_rtde_write_setup_outputs(uint8_t *out, size_t cap, unsigned protocol, double frequency,
+                                  const uint16_t *vars, size_t count)
+{
+    size_t names, size, at, i;
+    if (out == 0 || vars == 0 || count == 0 || count > URRT_RTDE_MAX_VARS ||
+        (protocol != 1 && protocol != 2) || !(frequency >= 0.0)) {
+        return URRT_E_ARG;
+    }
+    names = names_length(vars, count);
+    if (names == 0) {
+        return URRT_E_ARG;
+    }
+    if (names > URRT_RTDE_NAMES_MAX) {
+        return URRT_RTDE_E_NAMES_TOO_LONG;
+    }
+    size = URRT_RTDE_HEADER_SIZE + (protocol == 2 ? 8u : 0u) + names;
+    if (cap < size) {
+        return URRT_E_NO_SPACE;
+    }
+    store_be16(out, (unsigned)size);
+    out[2] = URRT_RTDE_TYPE_SETUP_OUTPUTS;
+    at = URRT_RTDE_HEADER_SIZE;
+    if (protocol == 2) {
+        rtde_bits f;
+        unsigned k;
+        f.d = frequency;
+        for (k = 0; k < 8; k++) {
+            out[at++] = (uint8_t)(f.u >> (56u - 8u * k));
+        }
+    }
+    for (i = 0; i < count; i++) {
+        if (i > 0) {
+            out[at++] = ',';
+        }
+        at += put_name(vars[i], (char *)(out + at));
+    }
+    return (int)size;
+}
+
+/* ---- the session ---------------------------------------------------------- */
+
+enum rtde_phase {
+    PH_IDLE = 0,    /* before begin, after finish */
+    PH_PROTOCOL,    /* waiting for the V reply */
+    PH_CONTROLLER,  /* waiting for the v reply */
+    PH_SETUP,       /* waiting for the O reply */
+    PH_START,       /* waiting for the S reply (a data package also starts) */
+    PH_STREAMING,
+    PH_PAUSE,       /* waiting for the P reply */
+    PH_PAUSED,
+    PH_ENDED        /* an error ended the session */
+};
+
+enum rtde_request { REQ_NONE = 0, REQ_PROTOCOL, REQ_CONTROLLER, REQ_SETUP, REQ_START, REQ_PAUSE };
+
+void urrt_rtde_init(urrt_rtde *s)
+{
+    unsigned char *p = (unsigned char *)s;
+    size_t i;
+    if (s == 0) {
+        return;
+    }
+    for (i = 0; i < sizeof *s; i++) {
+        p[i] = 0;
+    }
+}
+
+/* Checks the variables of a recipe and notes what they fill. */
+static int check_vars(urrt_rtde *s, const uint16_t *vars, size_t count)
+{
+    size_t i, j;
+    if (names_length(vars, count) > URRT_RTDE_NAMES_MAX) {
+        return URRT_RTDE_E_NAMES_TOO_LONG;
+    }
+    s->state_present = 0;
+    s->has_values = 0;
+    for (i = 0; i < count; i++) {
+        for (j = 0; j < i; j++) {
+            if (vars[j] == vars[i]) {
+                return URRT_RTDE_E_DUPLICATE;
+            }
+        }
+        if (vars[i] < URRT_RTDE_MAPPED_COUNT) {
+            s->state_present |= UINT64_C(1) << mapped_table[vars[i]].field;
+        } else {
+            s->has_values = 1;
+        }
+    }
+    return URRT_OK; /* its data package fits URRT_RTDE_PACKAGE_MAX: any recipe's does */
+}
+
+/* The spans of urrt_state fields no variable of the recipe fills, each
+ * field joined to the one before it where they touch. */
+static void find_absent(urrt_rtde *s)
+{
+    unsigned id, n = 0;
+    for (id = 0; id < (unsigned)URRT_FIELD_COUNT; id++) {
+        const state_field *f = &state_fields[id];
+        if (((s->state_present >> id) & 1u) != 0) {
+            continue;
+        }
+        if (n > 0 && s->absent[n - 1].offset + 8u * s->absent[n - 1].count == f->offset) {
+            s->absent[n - 1].count = (uint16_t)(s->absent[n - 1].count + f->count);
+        } else {
+            s->absent[n].offset = f->offset;
+            s->absent[n].count = f->count;
+            n++;
+        }
+    }
+    s->absent_count = (uint16_t)n;
+}
+
+int urrt_rtde_begin(urrt_rtde *s, const uint16_t *vars, size_t count, double frequency)
+{
+    size_t i;
+    int r;
+    if (s == 0) {
+        return URRT_E_ARG;
+    }
+    s->phase = PH_IDLE;
+    s->pending = REQ_NONE;
+    if (vars == 0 || count == 0 || count > URRT_RTDE_MAX_VARS || !(frequency >= 0.0 && frequency <= 1e6)) {
+        return URRT_E_ARG;
+    }
+    for (i = 0; i < count; i++) {
+        if (vars[i] >= URRT_RTDE_VAR_COUNT) {
+            return URRT_E_ARG;
+        }
+    }
+    r = check_vars(s, vars, count);
+    if (r < 0) {
+        return r;
+    }
+    find_absent(s);
+    for (i = 0; i < count; i++) {
+        s->vars[i] = vars[i];
+    }
+    for (i = 0; i < sizeof s->not_found; i++) {
+        s->not_found[i] = 0;
+    }
+    s->var_count = (uint16_t)count;
+    s->frequency = frequency;
+    s->data_size = 0;
+    s->have = 0;
+    s->need = 0;
+    s->error = 0;
+    s->up = 0;
+    s->recipe_id = 0;
+    s->protocol = URRT_RTDE_PROTOCOL;
+    s->protocol_accepted = 0;
+    for (i = 0; i < 4; i++) {
+        s->controller[i] = 0;
+    }
+    s->phase = PH_PROTOCOL;
+    s->pending = REQ_PROTOCOL;
+    return URRT_OK;
+}
+
+static double max_frequency(const urrt_rtde *s)
+{
+    return s->controller[0] < 5 ? URRT_RTDE_HZ_CB3 : URRT_RTDE_HZ_E_SERIES;
+}
+
+int urrt_rtde_output(urrt_rtde *s, uint8_t *out, size_t cap)
+{
+    int n;
+    if (s == 0 || out == 0) {
+        return URRT_E_ARG;
+    }
+    switch (s->pending) {
+    case REQ_PROTOCOL: n = urrt_rtde_write_protocol_version(out, cap, s->protocol); break;
+    case REQ_CONTROLLER: n = urrt_rtde_write_controller_version(out, cap); break;
+    case REQ_SETUP:
+        n = urrt_rtde_write_setup_outputs(out, cap, s->protocol_accepted,
+                                          s->frequency > 0.0 ? s->frequency : max_frequency(s), s->vars,
+                                          s->var_count);
+        break;
+    case REQ_START: n = urrt_rtde_write_start(out, cap); break;
+    case REQ_PAUSE: n = urrt_rtde_write_pause(out, cap); break;
+    default: return 0;
+    }
+    if (n > 0) {
+        s->pending = REQ_NONE;
+    }
+    return n;
+}
+
+int urrt_rtde_pause(urrt_rtde *s)
+{
+    if (s == 0 || s->phase != PH_STREAMING || s->pending != REQ_NONE) {
+        return URRT_E_ARG;
+    }
+    s->phase = PH_PAUSE;
+    s->pending = REQ_PAUSE;
+    return URRT_OK;
+}
+
+int urrt_rtde_start(urrt_rtde *s)
+{
+    if (s == 0 || s->phase != PH_PAUSED || s->pending != REQ_NONE) {
+        return URRT_E_ARG;
+    }
+    s->phase = PH_START;
+    s->pending = REQ_START;
+    return URRT_OK;
+}
+
+bool urrt_rtde_up(const urrt_rtde *s)
+{
+    return s != 0 && s->up != 0;
+}
+
+int urrt_rtde_not_found(const urrt_rtde *s, size_t i)
+{
+    size_t k;
+    if (s == 0) {
+        return -1;
+    }
+    for (k = 0; k < s->var_count; k++) {
+        if ((s->not_found[k / 8] >> (k % 8)) & 1u) {
+            if (i == 0) {
+                return s->vars[k];
+            }
+            i--;
+        }
+    }
+    return -1;
+}
+
+size_t urrt_rtde_finish(urrt_rtde *s)
+{
+    size_t dropped;
+    if (s == 0) {
+        return 0;
+    }
+    dropped = s->have;
+    s->have = 0;
+    s->need = 0;
+    s->phase = PH_IDLE;
+    s->pending = REQ_NONE;
+    return dropped;
+}
+
+/* ---- data packages ---------------------------------------------------------- */
+
+static int32_t to_int32(uint32_t u)
+{
+    return u >= UINT32_C(0x80000000) ? -(int32_t)(~u) - 1 : (int32_t)u;
+}
+
+/* One entry into urrt_state: every element as a double. */
+static void decode_to_state(const urrt_rtde_entry *e, const uint8_t *p, urrt_state *st)
+{
+    double *d = (double *)(void *)((unsigned char *)st + e->dest_offset);
+    unsigned k, count = e->count;
+    switch (e->type) {
+    case URRT_RTDE_T_DOUBLE:
+    case URRT_RTDE_T_VECTOR3D:
+    case URRT_RTDE_T_VECTOR6D:
+        for (k = 0; k < count; k++) {
+            d[k] = load_double(p + 8u * k);
+        }
+        break;
+    case URRT_RTDE_T_INT32:
+    case URRT_RTDE_T_VECTOR6INT32:
+        for (k = 0; k < count; k++) {
+            d[k] = (double)to_int32(load_be32(p + 4u * k));
+        }
+        break;
+    case URRT_RTDE_T_UINT32:
+    case URRT_RTDE_T_VECTOR6UINT32:
+        for (k = 0; k < count; k++) {
+            d[k] = (double)load_be32(p + 4u * k);
+        }
+        break;
+    case URRT_RTDE_T_UINT64: d[0] = (double)load_be64(p); break;
+    default: d[0] = (double)p[0]; break; /* BOOL, UINT8: no mapped variable has them */
+    }
+}
+
+/* One entry into urrt_rtde_values, in its own C type. */
+static void decode_to_values(const urrt_rtde_entry *e, const uint8_t *p, urrt_rtde_values *v)
+{
+    unsigned char *d = (unsigned char *)v + e->dest_offset;
+    unsigned k, count = e->count;
+    switch (e->type) {
+    case URRT_RTDE_T_BOOL: *d = (unsigned char)(p[0] != 0); break;
+    case URRT_RTDE_T_UINT8: *d = p[0]; break;
+    case URRT_RTDE_T_UINT64: *(uint64_t *)(void *)d = load_be64(p); break;
+    case URRT_RTDE_T_INT32:
+    case URRT_RTDE_T_VECTOR6INT32:
+        for (k = 0; k < count; k++) {
+            ((int32_t *)(void *)d)[k] = to_int32(load_be32(p + 4u * k));
+        }
+        break;
+    case URRT_RTDE_T_UINT32:
+    case URRT_RTDE_T_VECTOR6UINT32:
+        for (k = 0; k < count; k++) {
+            ((uint32_t *)(void *)d)[k] = load_be32(p + 4u * k);
+        }
+        break;
+    default: /* DOUBLE, VECTOR3D, VECTOR6D */
+        for (k = 0; k < count; k++) {
+            ((double *)(void *)d)[k] = load_double(p + 8u * k);
+        }
+        break;
+    }
+    v->present[e->present_bit / 8u] = (uint8_t)(v->present[e->present_bit / 8u] | 1u << (e->present_bit % 8u));
+}
+
+/* Everything of *st but the recipe's fields, which the walk writes: NaN in
+ * the spans of fields the recipe does not have (fewer stores than a whole
+ * clear, and loops as long as the fields allow). */
+static void state_begin(const urrt_rtde *s, urrt_state *st, size_t size)
+{
+    rtde_bits nan;
+    unsigned i, k;
+    nan.u = RTDE_NAN_BITS;
+    for (i = 0; i < s->absent_count; i++) {
+        double *d = (double *)(void *)((unsigned char *)st + s->absent[i].offset);
+        for (k = 0; k < s->absent[i].count; k++) {
+            d[k] = nan.d;
+        }
+    }
+    st->present = s->state_present;
+    st->length = (uint32_t)size;
+    st->doubles = 0;
+    st->extra_columns = 0;
+    st->generation = URRT_GEN_3X;
+}
+
+int urrt_rtde_decode(const urrt_rtde *s, const uint8_t *pkg, size_t size, urrt_state *st,
+                     urrt_rtde_values *vals)
+{
+    size_t i;
+    if (s == 0 || pkg == 0 || (s->state_present != 0 && st == 0) || (s->has_values && vals == 0)) {
+        return URRT_E_ARG;
+    }
+    if (s->data_size == 0) {
+        return URRT_RTDE_E_DATA_EARLY;
+    }
+    if (size != s->data_size || load_be16(pkg) != size || pkg[2] != URRT_RTDE_TYPE_DATA) {
+        return URRT_RTDE_E_DATA_SIZE;
+    }
+    if (s->protocol_accepted == 2 && pkg[3] != s->recipe_id) {
+        return URRT_RTDE_E_RECIPE_ID;
+    }
+    if (st != 0) {
+        state_begin(s, st, size);
+    }
+    if (vals != 0) {
+        urrt_rtde_values_clear(vals);
+    }
+    for (i = 0; i < s->entry_count; i++) {
+        const urrt_rtde_entry *e = &s->recipe[i];
+        if (e->to_state) {
+            decode_to_state(e, pkg + e->wire_offset, st);
+        } else {
+            decode_to_values(e, pkg + e->wire_offset, vals);
+        }
+    }
+    return (int)size;
+}
+
+/* ---- replies ------------------------------------------------------------- */
+
+/* Ends the session with an error: the event says which kind of drop. */
+static int end_session(urrt_rtde *s, urrt_rtde_event *ev, int error)
+{
+    s->phase = PH_ENDED;
+    s->pending = REQ_NONE;
+    s->error = error;
+    s->stats.errors++;
+    ev->kind = urrt_rtde_is_config_error(error) ? URRT_RTDE_EV_CONFIG : URRT_RTDE_EV_DROP;
+    ev->error = error;
+    return (int)ev->kind;
+}
+
+/* The accepted flag of a V, S or P reply (size 4): 0, 1, or an error. */
+static int accepted_flag(const urrt_rtde *s)
+{
+    if (s->need != 4) {
+        return URRT_RTDE_E_REPLY_LENGTH;
+    }
+    return s->buf[3] <= 1 ? s->buf[3] : URRT_RTDE_E_REPLY_VALUE;
+}
+
+static int on_protocol(urrt_rtde *s, urrt_rtde_event *ev)
+{
+    int ok = accepted_flag(s);
+    if (ok < 0) {
+        return end_session(s, ev, ok);
+    }
+    if (ok == 0) {
+        if (s->protocol == URRT_RTDE_PROTOCOL_FALLBACK) {
+            return end_session(s, ev, URRT_RTDE_E_PROTOCOL_REFUSED);
+        }
+        /* An event, so that the caller takes the request out before the
+         * next reply is read. */
+        s->protocol = URRT_RTDE_PROTOCOL_FALLBACK;
+        s->pending = REQ_PROTOCOL;
+        ev->kind = URRT_RTDE_EV_FALLBACK;
+        ev->protocol = s->protocol;
+        return (int)ev->kind;
+    }
+    s->protocol_accepted = s->protocol;
+    s->phase = PH_CONTROLLER;
+    s->pending = REQ_CONTROLLER;
+    ev->kind = URRT_RTDE_EV_PROTOCOL;
+    ev->protocol = s->protocol;
+    return (int)ev->kind;
+}
+
+static int on_controller(urrt_rtde *s, urrt_rtde_event *ev)
+{
+    unsigned i;
+    if (s->need != URRT_RTDE_HEADER_SIZE + 16) {
+        return end_session(s, ev, URRT_RTDE_E_REPLY_LENGTH);
+    }
+    for (i = 0; i < 4; i++) {
+        s->controller[i] = load_be32(s->buf + URRT_RTDE_HEADER_SIZE + 4u * i);
+        ev->version[i] = s->controller[i];
+    }
+    if ((s->controller[0] | s->controller[1] | s->controller[2] | s->controller[3]) == 0) {
+        return end_session(s, ev, URRT_RTDE_E_VERSION_ZERO);
+    }
+    if (s->protocol_accepted == 2 && s->frequency > max_frequency(s)) {
+        return end_session(s, ev, URRT_RTDE_E_FREQUENCY);
+    }
+    s->phase = PH_SETUP;
+    s->pending = REQ_SETUP;
+    ev->kind = URRT_RTDE_EV_CONTROLLER;
+    return (int)ev->kind;
+}
+
+/* The type a setup reply word names: a urrt_rtde_type, 0 for NOT_FOUND,
+ * -1 for a word that is no type. */
+static int type_of_word(const uint8_t *w, size_t n)
+{
+    unsigned t;
+    if (same_prefix((const char *)w, n, "NOT_FOUND", true)) {
+        return 0;
+    }
+    for (t = 1; t < (unsigned)URRT_RTDE_T_COUNT; t++) {
+        if (same_prefix((const char *)w, n, type_table[t].name, true)) {
+            return (int)t;
+        }
+    }
+    return -1;
+}
+
+static bool is_doubles(unsigned type)
+{
+    return type == URRT_RTDE_T_DOUBLE || type == URRT_RTDE_T_VECTOR3D || type == URRT_RTDE_T_VECTOR6D;
+}
+
+/* Whether entry e continues the run of doubles of the entry before it, on
+ * the wire and in urrt_state: then the walk copies both in one loop. */
+static bool continues_run(const urrt_rtde_entry *prev, const urrt_rtde_entry *e)
+{
+    return prev->to_state && e->to_state && is_doubles(prev->type) && is_doubles(e->type) &&
+           prev->wire_offset + 8u * prev->count == e->wire_offset &&
+           prev->dest_offset + 8u * prev->count == e->dest_offset;
+}
+
+/* Compiles the accepted recipe into the entry table. */
+static void compile_recipe(urrt_rtde *s)
+{
+    unsigned offset = URRT_RTDE_HEADER_SIZE + (s->protocol_accepted == 2 ? 1u : 0u), n = 0;
+    size_t i;
+    for (i = 0; i < s->var_count; i++) {
+        urrt_rtde_entry *e = &s->recipe[n];
+        int var = s->vars[i];
+        const only_row *r = only_row_of(var);
+        e->wire_offset = (uint16_t)offset;
+        e->type = (uint8_t)urrt_rtde_var_type(var);
+        e->count = type_table[e->type].count;
+        e->to_state = (uint8_t)(r == 0);
+        if (r == 0) {
+            e->dest_offset = mapped_table[var].offset;
+            e->present_bit = 0;
+        } else {
+            e->dest_offset = (uint16_t)value_offset(r, var);
+            e->present_bit = (uint16_t)(var - URRT_RTDE_MAPPED_COUNT);
+        }
+        offset += type_table[e->type].size;
+        if (n > 0 && continues_run(&s->recipe[n - 1], e)) {
+            s->recipe[n - 1].count = (uint16_t)(s->recipe[n - 1].count + e->count);
+            s->recipe[n - 1].type = URRT_RTDE_T_DOUBLE;
+        } else {
+            n++;
+        }
+    }
+    s->entry_count = (uint16_t)n;
+    s->data_size = (uint16_t)offset;
+}
+
+/* Checks each word of a setup reply against its name: a word that is no
+ * type is a protocol error, NOT_FOUND and a type urrt does not expect are
+ * configuration errors (NOT_FOUND reported per name). */
+static int check_types(urrt_rtde *s, urrt_rtde_event *ev, size_t at)
+{
+    size_t i, start, words = 1, not_found = 0;
+    int mismatch = -1;
+    for (i = at; i < s->need; i++) {
+        words += s->buf[i] == ',';
+    }
+    if (at == s->need || words != s->var_count) {
+        return end_session(s, ev, URRT_RTDE_E_TYPE_COUNT);
+    }
+    for (i = 0; i < s->var_count; i++, at++) {
+        int t;
+        start = at;
+        while (at < s->need && s->buf[at] != ',') {
+            at++;
+        }
+        t = type_of_word(s->buf + start, at - start);
+        if (t < 0) {
+            return end_session(s, ev, URRT_RTDE_E_TYPE_TOKEN);
+        }
+        if (t == 0) {
+            s->not_found[i / 8] = (uint8_t)(s->not_found[i / 8] | 1u << (i % 8));
+            not_found++;
+        } else if (t != (int)urrt_rtde_var_type(s->vars[i]) && mismatch < 0) {
+            mismatch = s->vars[i];
+        }
+    }
+    if (not_found > 0) {
+        ev->not_found = (uint16_t)not_found;
+        return end_session(s, ev, URRT_RTDE_E_NOT_FOUND);
+    }
+    if (mismatch >= 0) {
+        ev->var = mismatch;
+        return end_session(s, ev, URRT_RTDE_E_TYPE_MISMATCH);
+    }
+    return URRT_OK;
+}
+
+static int on_setup(urrt_rtde *s, urrt_rtde_event *ev)
+{
+    size_t at = URRT_RTDE_HEADER_SIZE + (s->protocol_accepted == 2 ? 1u : 0u);
+    int r;
+    if (s->need < at) {
+        return end_session(s, ev, URRT_RTDE_E_REPLY_LENGTH);
+    }
+    r = check_types(s, ev, at);
+    if (r != URRT_OK) {
+        return r;
+    }
+    s->recipe_id = s->protocol_accepted == 2 ? s->buf[URRT_RTDE_HEADER_SIZE] : 0;
+    compile_recipe(s);
+    s->phase = PH_START;
+    s->pending = REQ_START;
+    ev->kind = URRT_RTDE_EV_RECIPE;
+    ev->recipe_id = s->recipe_id;
+    return (int)ev->kind;
+}
+
+static int on_start(urrt_rtde *s, urrt_rtde_event *ev)
+{
+    int ok = accepted_flag(s);
+    if (ok < 0) {
+        return end_session(s, ev, ok);
+    }
+    if (ok == 0) {
+        return end_session(s, ev, URRT_RTDE_E_START_REFUSED);
+    }
+    s->phase = PH_STREAMING;
+    ev->kind = URRT_RTDE_EV_STARTED;
+    return (int)ev->kind;
+}
+
+static int on_pause(urrt_rtde *s, urrt_rtde_event *ev)
+{
+    int ok = accepted_flag(s);
+    if (ok < 0) {
+        return end_session(s, ev, ok);
+    }
+    if (ok == 0) {
+        return end_session(s, ev, URRT_RTDE_E_PAUSE_REFUSED);
+    }
+    s->phase = PH_PAUSED;
+    ev->kind = URRT_RTDE_EV_PAUSED;
+    return (int)ev->kind;
+}
+
+/* Protocol 2: uint8 length, text, uint8 length, source, uint8 level, filling
+ * the package exactly. Before protocol 2 is accepted, and in protocol 1:
+ * uint8 level, then text to the end. */
+static int on_text(urrt_rtde *s, urrt_rtde_event *ev)
+{
+    size_t at = URRT_RTDE_HEADER_SIZE, end = s->need;
+    const char *b = (const char *)s->buf;
+    if (s->protocol_accepted != 2) {
+        if (end < at + 1) {
+            return end_session(s, ev, URRT_RTDE_E_TEXT_LENGTH);
+        }
+        ev->level = s->buf[at];
+        ev->text = b + at + 1;
+        ev->text_len = (uint16_t)(end - at - 1);
+        ev->source = b + end;
+        ev->source_len = 0;
+    } else {
+        size_t text_len, source_len;
+        if (end < at + 3) {
+            return end_session(s, ev, URRT_RTDE_E_TEXT_LENGTH);
+        }
+        text_len = s->buf[at];
+        if (at + 3 + text_len > end) {
+            return end_session(s, ev, URRT_RTDE_E_TEXT_LENGTH);
+        }
+        source_len = s->buf[at + 1 + text_len];
+        if (at + 3 + text_len + source_len != end) {
+            return end_session(s, ev, URRT_RTDE_E_TEXT_LENGTH);
+        }
+        ev->text = b + at + 1;
+        ev->text_len = (uint16_t)text_len;
+        ev->source = b + at + 2 + text_len;
+        ev->source_len = (uint16_t)source_len;
+        ev->level = s->buf[end - 1];
+    }
+    s->stats.texts++;
+    ev->kind = URRT_RTDE_EV_TEXT;
+    return (int)ev->kind;
+}
+
+static int on_data(urrt_rtde *s, urrt_rtde_event *ev, urrt_state *st, urrt_rtde_values *vals)
+{
+    int r = urrt_rtde_decode(s, s->buf, s->need, st, vals);
+    if (r < 0) {
+        return end_session(s, ev, r);
+    }
+    if (s->phase == PH_START) {
+        s->phase = PH_STREAMING; /* data before the S reply: start succeeded */
+    }
+    s->stats.data++;
+    ev->kind = URRT_RTDE_EV_DATA;
+    ev->first = s->up == 0;
+    s->up = 1;
+    return (int)ev->kind;
+}
+
+/* Whether a reply of this type answers the request of the phase. (Not
+ * whether the request was taken out yet: a stream replayed at once holds the
+ * reply before the caller could take it.) */
+static int awaited(const urrt_rtde *s, uint8_t type)
+{
+    switch (type) {
+    case URRT_RTDE_TYPE_PROTOCOL_VERSION: return s->phase == PH_PROTOCOL;
+    case URRT_RTDE_TYPE_CONTROLLER_VERSION: return s->phase == PH_CONTROLLER;
+    case URRT_RTDE_TYPE_SETUP_OUTPUTS: return s->phase == PH_SETUP;
+    case URRT_RTDE_TYPE_START: return s->phase == PH_START;
+    case URRT_RTDE_TYPE_PAUSE: return s->phase == PH_PAUSE;
+    default: return 0;
+    }
+}
+
+static int on_package(urrt_rtde *s, urrt_rtde_event *ev, urrt_state *st, urrt_rtde_values *vals)
+{
+    uint8_t type = s->buf[2];
+    s->stats.packages++;
+    if (type == URRT_RTDE_TYPE_TEXT_MESSAGE) {
+        return on_text(s, ev);
+    }
+    if (type == URRT_RTDE_TYPE_DATA) {
+        return on_data(s, ev, st, vals);
+    }
+    if (!awaited(s, type)) {
+        s->stats.ignored++;
+        return URRT_RTDE_EV_NONE;
+    }
+    switch (type) {
+    case URRT_RTDE_TYPE_PROTOCOL_VERSION: return on_protocol(s, ev);
+    case URRT_RTDE_TYPE_CONTROLLER_VERSION: return on_controller(s, ev);
+    case URRT_RTDE_TYPE_SETUP_OUTPUTS: return on_setup(s, ev);
+    case URRT_RTDE_TYPE_START: return on_start(s, ev);
+    default: return on_pause(s, ev);
+    }
+}
+
+/* A complete header: the size bounds, and a data package's size against the
+ * recipe, before any of its body is taken. */
+static int check_header(const urrt_rtde *s)
+{
+    unsigned size = load_be16(s->buf);
+    if (size < URRT_RTDE_HEADER_SIZE) {
+        return URRT_RTDE_E_SIZE_SMALL;
+    }
+    if (size > URRT_RTDE_PACKAGE_MAX) {
+        return URRT_RTDE_E_SIZE_LARGE;
+    }
+    if (s->buf[2] == URRT_RTDE_TYPE_DATA) {
+        if (s->data_size == 0) {
+            return URRT_RTDE_E_DATA_EARLY;
+        }
+        if (size != s->data_size) {
+            return URRT_RTDE_E_DATA_SIZE;
+        }
+    }
+    return URRT_OK;
+}
+
+static void clear_event(urrt_rtde_event *ev)
+{
+    ev->kind = URRT_RTDE_EV_NONE;
+    ev->error = 0;
+    ev->protocol = 0;
+    ev->recipe_id = 0;
+    ev->level = 0;
+    ev->first = false;
+    ev->version[0] = ev->version[1] = ev->version[2] = ev->version[3] = 0;
+    ev->text = 0;
+    ev->source = 0;
+    ev->text_len = 0;
+    ev->source_len = 0;
+    ev->not_found = 0;
+    ev->var = -1;
+}
+
+int urrt_rtde_feed(urrt_rtde *s, const uint8_t *data, size_t len, size_t *used, urrt_rtde_event *ev,
+                   urrt_state *st, urrt_rtde_values *vals)
+{
+    size_t i = 0;
+    if (used != 0) {
+        *used = 0;
+    }
+    if (s == 0 || used == 0 || ev == 0 || (data == 0 && len > 0) || (s->has_values && vals == 0) ||
+        (s->state_present != 0 && st == 0)) {
+        return URRT_E_ARG;
+    }
+    clear_event(ev);
+    if (s->phase == PH_IDLE || s->phase == PH_ENDED) {
+        return URRT_RTDE_E_ENDED;
+    }
+    while (i < len) {
+        if (s->need == 0) {
+            s->buf[s->have++] = data[i++];
+            if (s->have == URRT_RTDE_HEADER_SIZE) {
+                int r = check_header(s);
+                if (r < 0) {
+                    *used = i;
+                    s->stats.bytes += i;
+                    return end_session(s, ev, r);
+                }
+                s->need = load_be16(s->buf);
+            }
+        } else {
+            size_t n = len - i < (size_t)(s->need - s->have) ? len - i : (size_t)(s->need - s->have);
+            size_t k;
+            for (k = 0; k < n; k++) {
+                s->buf[s->have + k] = data[i + k];
+            }
+            s->have = (uint16_t)(s->have + n);
+            i += n;
+        }
+        if (s->need != 0 && s->have == s->need) {
+            int k = on_package(s, ev, st, vals);
+            s->have = 0;
+            s->need = 0;
+            if (k != URRT_RTDE_EV_NONE) {
+                *used = i;
+                s->stats.bytes += i;
+                return k;
+            }
+        }
+    }
+    *used = len;
+    s->stats.bytes += len;
+    return URRT_RTDE_EV_NONE;
+}

@@ -1,0 +1,51 @@
+# SPDX-License-Identifier: MIT
+# tests/lib/rtde.mk: the RTDE client (lib/urrt_rtde), on its own.
+#   check-rtde       tests/lib/test_rtde.c on the sessions tests/ref/rtde_ref.py writes (it plays
+#                    the controller: every type, protocol 1 and 2, every error), fed whole, byte
+#                    by byte and in 7-byte reads; every split point of each session; every byte
+#                    written is a V, v, O, S or P request; the name and version tables
+#   check-rtde-san   the same under ASan + UBSan, lib/ compiled with them
+#   check-fuzz-rtde  the libFuzzer harness tests/lib/fuzz_rtde.c, briefly (FUZZ_RTDE_SECONDS, 20)
+#   fuzz-rtde        the same for FUZZ_SECONDS; the corpus grows in $(RTT)/fuzz
+
+RTT := $(BUILD)/tests/rtde
+RTDE_VECTORS := $(RTT)/vectors.txt
+RTDE_CORPUS := $(RTT)/seeds
+FUZZ_RTDE_SECONDS ?= 20
+
+CHECKS += check-rtde check-rtde-san check-fuzz-rtde
+.PHONY: check-rtde check-rtde-san check-fuzz-rtde fuzz-rtde
+
+$(RTDE_VECTORS): tests/ref/rtde_ref.py
+	@mkdir -p $(@D)
+	rm -rf $(RTDE_CORPUS)
+	$(PYTHON) tests/ref/rtde_ref.py --out $@ --corpus $(RTDE_CORPUS)
+
+$(RTT)/test_rtde: tests/lib/test_rtde.c tests/check.h $(LIBURRT) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LIB_TEST_CFLAGS) $(OPT) $< $(LIBURRT) -lm -o $@
+
+$(RTT)/test_rtde_san: tests/lib/test_rtde.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LIB_TEST_CFLAGS) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $< $(LIB_SRCS) -lm -o $@
+
+check-rtde: $(RTT)/test_rtde $(RTDE_VECTORS)
+	$(call suite,check-rtde,$(RTT)/test_rtde $(RTDE_VECTORS))
+
+check-rtde-san: $(RTT)/test_rtde_san $(RTDE_VECTORS)
+	$(call suite,check-rtde-san,ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	  $(RTT)/test_rtde_san $(RTDE_VECTORS))
+
+$(RTT)/fuzz_rtde: tests/lib/fuzz_rtde.c $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) -std=c99 -Wall -Wextra -Werror -g -O1 -fsanitize=fuzzer,address,undefined \
+	  -fno-sanitize-recover=all $(CPPFLAGS) $< $(LIB_SRCS) -o $@
+
+# The seeds are the reference's controller streams (its vectors' rule writes them).
+check-fuzz-rtde: $(RTT)/fuzz_rtde $(RTDE_VECTORS)
+	$(call suite,$@,sh tests/lib/fuzz.sh $(RTT)/fuzz_rtde $(RTDE_CORPUS) $(RTT)/fuzz-check $(FUZZ_RTDE_SECONDS) --check)
+
+fuzz-rtde: $(RTT)/fuzz_rtde $(RTDE_VECTORS)
+	sh tests/lib/fuzz.sh $(RTT)/fuzz_rtde $(RTDE_CORPUS) $(RTT)/fuzz $(FUZZ_SECONDS)
+
+fuzz: fuzz-rtde

@@ -1,0 +1,645 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * check-rtde: the RTDE client (lib/urrt_rtde) against the sessions of the
+ * independent reference (tests/ref/rtde_ref.py plays the controller and says
+ * what the client must send and decode), fed whole and in small chunks; every
+ * split point of each session gives the same events; every byte the client
+ * writes is a V, v, O, S or P request; and the tables against the version
+ * facts of docs/rtde.md.
+ *   test_rtde VECTORS
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "urrt_rtde.h"
+
+#define LINE_MAX_CHARS 140000
+#define IN_MAX 65536
+#define TRANSCRIPT_MAX 65536
+
+typedef struct named {
+    const char *name;
+    int value;
+} named;
+
+static const named errors[] = {
+    {"SIZE_SMALL", URRT_RTDE_E_SIZE_SMALL}, {"SIZE_LARGE", URRT_RTDE_E_SIZE_LARGE},
+    {"REPLY_LENGTH", URRT_RTDE_E_REPLY_LENGTH}, {"REPLY_VALUE", URRT_RTDE_E_REPLY_VALUE},
+    {"VERSION_ZERO", URRT_RTDE_E_VERSION_ZERO}, {"DATA_EARLY", URRT_RTDE_E_DATA_EARLY},
+    {"RECIPE_ID", URRT_RTDE_E_RECIPE_ID}, {"DATA_SIZE", URRT_RTDE_E_DATA_SIZE},
+    {"TYPE_TOKEN", URRT_RTDE_E_TYPE_TOKEN}, {"TYPE_COUNT", URRT_RTDE_E_TYPE_COUNT},
+    {"TEXT_LENGTH", URRT_RTDE_E_TEXT_LENGTH}, {"PAUSE_REFUSED", URRT_RTDE_E_PAUSE_REFUSED},
+    {"NOT_FOUND", URRT_RTDE_E_NOT_FOUND}, {"TYPE_MISMATCH", URRT_RTDE_E_TYPE_MISMATCH},
+    {"PROTOCOL_REFUSED", URRT_RTDE_E_PROTOCOL_REFUSED}, {"START_REFUSED", URRT_RTDE_E_START_REFUSED},
+    {"FREQUENCY", URRT_RTDE_E_FREQUENCY}, {"NAMES_TOO_LONG", URRT_RTDE_E_NAMES_TOO_LONG},
+    {"DUPLICATE", URRT_RTDE_E_DUPLICATE},
+};
+
+static const named kinds[] = {
+    {"protocol", URRT_RTDE_EV_PROTOCOL}, {"fallback", URRT_RTDE_EV_FALLBACK}, {"controller", URRT_RTDE_EV_CONTROLLER},
+    {"recipe", URRT_RTDE_EV_RECIPE}, {"started", URRT_RTDE_EV_STARTED}, {"paused", URRT_RTDE_EV_PAUSED},
+    {"text", URRT_RTDE_EV_TEXT}, {"data", URRT_RTDE_EV_DATA}, {"drop", URRT_RTDE_EV_DROP},
+    {"config", URRT_RTDE_EV_CONFIG},
+};
+
+static int lookup(const named *t, size_t n, const char *name)
+{
+    for (size_t i = 0; i < n; i++) {
+        if (strcmp(t[i].name, name) == 0) {
+            return t[i].value;
+        }
+    }
+    CHECK(0, "unknown word %s in the vectors", name);
+    return 0;
+}
+#define LOOKUP(t, name) lookup(t, sizeof t / sizeof t[0], name)
+
+static size_t unhex(const char *h, uint8_t *out, size_t cap)
+{
+    size_t n = 0;
+    if (strcmp(h, "-") == 0) {
+        return 0;
+    }
+    while (h[0] != '\0' && h[1] != '\0' && n < cap) {
+        unsigned b;
+        sscanf(h, "%2x", &b);
+        out[n++] = (uint8_t)b;
+        h += 2;
+    }
+    return n;
+}
+
+/* Every request the client writes: a whole package of one of the five
+ * types a read-only client has, its size field its length. */
+static void check_request(const uint8_t *p, int n)
+{
+    CHECK(n >= 3 && (p[0] << 8 | p[1]) == n, "request of %d bytes declares %d", n, n >= 2 ? p[0] << 8 | p[1] : -1);
+    CHECK(n >= 3 && strchr("VvOSP", p[2]) != NULL && p[2] != 0, "client wrote a package of type %c", n >= 3 ? p[2] : '?');
+}
+
+/* ---- the vector runner ----------------------------------------------------- */
+
+static struct runner {
+    urrt_rtde s;
+    urrt_state st;
+    urrt_rtde_values vals;
+    urrt_rtde_event ev;
+    uint8_t in[IN_MAX];
+    size_t in_len, in_pos, chunk;
+    uint16_t vars[URRT_RTDE_MAX_VARS];
+    size_t var_count;
+    double freq;
+    int begun;
+    char session[64];
+} R;
+
+/* Feeds pending input in chunks of R.chunk until an event. */
+static int next_event(void)
+{
+    while (R.in_pos < R.in_len) {
+        size_t n = R.in_len - R.in_pos < R.chunk ? R.in_len - R.in_pos : R.chunk;
+        size_t used = 99999;
+        int k = urrt_rtde_feed(&R.s, R.in + R.in_pos, n, &used, &R.ev, &R.st, &R.vals);
+        CHECK(used <= n, "%s: used %zu of %zu", R.session, used, n);
+        R.in_pos += used;
+        if (k != URRT_RTDE_EV_NONE) {
+            return k;
+        }
+        CHECK(used == n, "%s: no event but %zu of %zu used", R.session, used, n);
+    }
+    return URRT_RTDE_EV_NONE;
+}
+
+static void do_begin(const char *err)
+{
+    int r = urrt_rtde_begin(&R.s, R.vars, R.var_count, R.freq);
+    if (err == NULL) {
+        CHECK(r == URRT_OK, "%s: begin: %s", R.session, urrt_rtde_strerror(r));
+    } else {
+        CHECK_EQ_INT(r, LOOKUP(errors, err));
+    }
+    R.begun = 1;
+}
+
+static void parse_vars(char *list)
+{
+    R.var_count = 0;
+    for (char *name = strtok(list, ","); name != NULL; name = strtok(NULL, ",")) {
+        int var = urrt_rtde_var_find(name, strlen(name));
+        CHECK(var >= 0, "%s: urrt_rtde_var_find(%s) = %d", R.session, name, var);
+        if (R.var_count < URRT_RTDE_MAX_VARS) {
+            R.vars[R.var_count++] = (uint16_t)(var < 0 ? 0 : var);
+        }
+    }
+}
+
+static void do_send(const char *hex)
+{
+    static uint8_t want[URRT_RTDE_REQUEST_MAX], got[URRT_RTDE_REQUEST_MAX];
+    size_t n = unhex(hex, want, sizeof want);
+    CHECK_EQ_INT(urrt_rtde_output(&R.s, got, n - 1), URRT_E_NO_SPACE); /* one byte short: stays due */
+    int k = urrt_rtde_output(&R.s, got, sizeof got);
+    CHECK(k == (int)n && memcmp(got, want, n) == 0, "%s: sent %d bytes, expected %zu (%s)", R.session, k, n, hex);
+    if (k > 0) {
+        check_request(got, k);
+    }
+    CHECK_EQ_INT(urrt_rtde_output(&R.s, got, sizeof got), 0);
+}
+
+static void check_text(const char *hex, const char *got, size_t len)
+{
+    static uint8_t want[600];
+    size_t n = unhex(hex, want, sizeof want);
+    CHECK(n == len && (n == 0 || memcmp(got, want, n) == 0), "%s: text of %zu bytes, expected %zu", R.session, len, n);
+}
+
+/* After a data package: exactly the recipe's fields present in urrt_state,
+ * every element of every other field NaN (nothing stale), and the same for
+ * the RTDE-only values' present bits. */
+static void check_state_fields(void)
+{
+    for (int f = 0; f < URRT_FIELD_COUNT; f++) {
+        int var = urrt_rtde_var_of_field((urrt_field_id)f), in_recipe = 0;
+        for (size_t i = 0; i < R.var_count; i++) {
+            in_recipe |= var >= 0 && R.vars[i] == var;
+        }
+        CHECK((int)urrt_has(&R.st, f) == in_recipe, "%s: field %d present %d", R.session, f, (int)urrt_has(&R.st, f));
+        const double *d = urrt_field_values(&R.st, (urrt_field_id)f);
+        for (unsigned k = 0; !in_recipe && k < urrt_field((urrt_field_id)f)->count; k++) {
+            CHECK(isnan(d[k]), "%s: absent %s[%u] is not NaN", R.session, urrt_field((urrt_field_id)f)->name, k);
+        }
+    }
+    CHECK(R.st.length == R.s.data_size && R.st.generation == URRT_GEN_3X, "%s: length %u", R.session, R.st.length);
+    for (int var = URRT_RTDE_MAPPED_COUNT; var < URRT_RTDE_VAR_COUNT; var++) {
+        int in_recipe = 0;
+        for (size_t i = 0; i < R.var_count; i++) {
+            in_recipe |= R.vars[i] == var;
+        }
+        CHECK((int)urrt_rtde_has(&R.vals, var) == in_recipe, "%s: var %d present", R.session, var);
+    }
+}
+
+static void check_event(char *args)
+{
+    char *kind = strtok(args, " ");
+    int want = LOOKUP(kinds, kind);
+    int k = next_event();
+    CHECK(k == want, "%s: event %d (error %s), expected %s", R.session, k, urrt_rtde_strerror(R.ev.error), kind);
+    if (k != want) {
+        return;
+    }
+    char *a1 = strtok(NULL, " "), *a2 = strtok(NULL, " "), *a3 = strtok(NULL, " "), *a4 = strtok(NULL, " ");
+    switch (want) {
+    case URRT_RTDE_EV_PROTOCOL:
+    case URRT_RTDE_EV_FALLBACK: CHECK_EQ_INT(R.ev.protocol, atoi(a1)); break;
+    case URRT_RTDE_EV_CONTROLLER:
+        CHECK(R.ev.version[0] == strtoul(a1, NULL, 10) && R.ev.version[1] == strtoul(a2, NULL, 10) &&
+                  R.ev.version[2] == strtoul(a3, NULL, 10) && R.ev.version[3] == strtoul(a4, NULL, 10),
+              "%s: controller %u.%u.%u.%u", R.session, R.ev.version[0], R.ev.version[1], R.ev.version[2],
+              R.ev.version[3]);
+        break;
+    case URRT_RTDE_EV_RECIPE: CHECK_EQ_INT(R.ev.recipe_id, atoi(a1)); break;
+    case URRT_RTDE_EV_TEXT:
+        CHECK_EQ_INT(R.ev.level, atoi(a1));
+        check_text(a2, R.ev.text, R.ev.text_len);
+        check_text(a3, R.ev.source, R.ev.source_len);
+        break;
+    case URRT_RTDE_EV_DATA:
+        CHECK_EQ_INT(R.ev.first, atoi(a1));
+        CHECK(urrt_rtde_up(&R.s), "%s: not up after a data package", R.session);
+        check_state_fields();
+        break;
+    case URRT_RTDE_EV_DROP:
+    case URRT_RTDE_EV_CONFIG:
+        CHECK(R.ev.error == LOOKUP(errors, a1), "%s: %s, expected %s", R.session, urrt_rtde_strerror(R.ev.error), a1);
+        CHECK(urrt_rtde_is_config_error(R.ev.error) == (want == URRT_RTDE_EV_CONFIG), "%s: error kind", R.session);
+        if (R.ev.error == URRT_RTDE_E_NOT_FOUND) {
+            char *names[URRT_RTDE_MAX_VARS] = {a2, a3, a4};
+            size_t n = 0;
+            while (n < 3 && names[n] != NULL) {
+                n++;
+            }
+            while (n >= 3 && n < URRT_RTDE_MAX_VARS && (names[n] = strtok(NULL, " ")) != NULL) {
+                n++;
+            }
+            for (size_t i = 0; i < n; i++) {
+                CHECK_EQ_INT(urrt_rtde_not_found(&R.s, i), urrt_rtde_var_find(names[i], strlen(names[i])));
+            }
+            CHECK_EQ_INT(R.ev.not_found, n);
+            CHECK_EQ_INT(urrt_rtde_not_found(&R.s, n), -1);
+        }
+        break;
+    default: break;
+    }
+}
+
+static uint64_t raw_value(int var, unsigned elem, int *width)
+{
+    const void *p = urrt_rtde_value(&R.vals, var);
+    switch (urrt_rtde_var_type(var)) {
+    case URRT_RTDE_T_BOOL:
+    case URRT_RTDE_T_UINT8: *width = 2; return ((const uint8_t *)p)[elem];
+    case URRT_RTDE_T_INT32:
+    case URRT_RTDE_T_VECTOR6INT32: *width = 8; return (uint32_t)((const int32_t *)p)[elem];
+    case URRT_RTDE_T_UINT32:
+    case URRT_RTDE_T_VECTOR6UINT32: *width = 8; return ((const uint32_t *)p)[elem];
+    case URRT_RTDE_T_UINT64: *width = 16; return ((const uint64_t *)p)[elem];
+    default: {
+        uint64_t u;
+        memcpy(&u, (const double *)p + elem, 8);
+        *width = 16;
+        return u;
+    }
+    }
+}
+
+static void check_value(char *args)
+{
+    char *name = strtok(args, " ");
+    unsigned elem = (unsigned)atoi(strtok(NULL, " "));
+    const char *hex = strtok(NULL, " ");
+    uint64_t want = strtoull(hex, NULL, 16), got;
+    int var = urrt_rtde_var_find(name, strlen(name)), field = urrt_rtde_var_field(var), width = 16;
+    if (field >= 0) {
+        const double *d = urrt_field_values(&R.st, (urrt_field_id)field);
+        CHECK(urrt_has(&R.st, field), "%s: %s not present", R.session, name);
+        memcpy(&got, d + elem, 8);
+    } else {
+        CHECK(urrt_rtde_has(&R.vals, var), "%s: %s not present", R.session, name);
+        got = raw_value(var, elem, &width);
+    }
+    CHECK(got == want && (int)strlen(hex) == width, "%s: %s[%u] = %0*llx, expected %s", R.session, name, elem, width,
+          (unsigned long long)got, hex);
+}
+
+static void check_absent(const char *name)
+{
+    int var = urrt_rtde_var_find(name, strlen(name)), field = urrt_rtde_var_field(var);
+    if (field >= 0) {
+        const urrt_field_info *f = urrt_field((urrt_field_id)field);
+        const double *d = urrt_field_values(&R.st, (urrt_field_id)field);
+        CHECK(!urrt_has(&R.st, field), "%s: %s present", R.session, name);
+        for (unsigned i = 0; i < f->count; i++) {
+            CHECK(isnan(d[i]), "%s: absent %s[%u] is not NaN", R.session, name, i);
+        }
+    } else {
+        CHECK(!urrt_rtde_has(&R.vals, var), "%s: %s present", R.session, name);
+    }
+}
+
+static void directive(char *line)
+{
+    char *sp = strchr(line, ' ');
+    char *arg = sp != NULL ? sp + 1 : line + strlen(line);
+    if (sp != NULL) {
+        *sp = '\0';
+    }
+    if (strcmp(line, "session") == 0) {
+        snprintf(R.session, sizeof R.session, "%.40s/%s%u", arg, R.chunk == SIZE_MAX ? "whole" : "chunk ",
+                 R.chunk == SIZE_MAX ? 0u : (unsigned)R.chunk);
+        urrt_rtde_init(&R.s);
+        R.in_len = R.in_pos = 0;
+        R.begun = 0;
+        return;
+    }
+    if (strcmp(line, "vars") == 0) {
+        parse_vars(arg);
+        return;
+    }
+    if (strcmp(line, "freq") == 0) {
+        R.freq = strtod(arg, NULL);
+        return;
+    }
+    if (!R.begun) {
+        do_begin(strcmp(line, "begin_error") == 0 ? arg : NULL);
+    }
+    if (strcmp(line, "send") == 0) {
+        do_send(arg);
+    } else if (strcmp(line, "recv") == 0) {
+        R.in_len += unhex(arg, R.in + R.in_len, IN_MAX - R.in_len);
+    } else if (strcmp(line, "event") == 0) {
+        check_event(arg);
+    } else if (strcmp(line, "idle") == 0) {
+        CHECK_EQ_INT(next_event(), URRT_RTDE_EV_NONE);
+    } else if (strcmp(line, "value") == 0) {
+        check_value(arg);
+    } else if (strcmp(line, "absent") == 0) {
+        check_absent(arg);
+    } else if (strcmp(line, "pause") == 0) {
+        CHECK_EQ_INT(urrt_rtde_pause(&R.s), URRT_OK);
+    } else if (strcmp(line, "start") == 0) {
+        CHECK_EQ_INT(urrt_rtde_start(&R.s), URRT_OK);
+    } else if (strcmp(line, "finish") == 0) {
+        CHECK_EQ_INT(urrt_rtde_finish(&R.s), atoi(arg));
+    } else if (strcmp(line, "ended") == 0) {
+        uint8_t out[URRT_RTDE_REQUEST_MAX];
+        size_t used = 1;
+        if (R.in_pos == R.in_len) { /* the error was at the last byte: feed one more package */
+            R.in_len += unhex("000356", R.in + R.in_len, 3);
+        }
+        CHECK_EQ_INT(urrt_rtde_feed(&R.s, R.in + R.in_pos, R.in_len - R.in_pos, &used, &R.ev, &R.st, &R.vals),
+                     URRT_RTDE_E_ENDED);
+        CHECK_EQ_INT(used, 0);
+        R.in_pos = R.in_len;
+        CHECK_EQ_INT(urrt_rtde_output(&R.s, out, sizeof out), 0);
+    } else if (strcmp(line, "end") == 0) {
+        CHECK(R.in_pos == R.in_len, "%s: %zu bytes never fed", R.session, R.in_len - R.in_pos);
+    } else if (strcmp(line, "begin_error") != 0) {
+        CHECK(0, "unknown directive %s", line);
+    }
+}
+
+static int run_vectors(const char *path, size_t chunk)
+{
+    static char line[LINE_MAX_CHARS];
+    FILE *f = fopen(path, "r");
+    int sessions = 0;
+    if (f == NULL) {
+        CHECK(0, "cannot open %s (run tests/ref/rtde_ref.py)", path);
+        return 0;
+    }
+    R.chunk = chunk;
+    while (fgets(line, sizeof line, f) != NULL) {
+        line[strcspn(line, "\n")] = '\0';
+        sessions += strncmp(line, "session ", 8) == 0;
+        directive(line);
+    }
+    fclose(f);
+    return sessions;
+}
+
+/* ---- every split point ---------------------------------------------------------- */
+
+/* A session's controller stream and recipe, for replays. */
+typedef struct replay {
+    uint16_t vars[URRT_RTDE_MAX_VARS];
+    size_t var_count;
+    double freq;
+    uint8_t stream[IN_MAX];
+    size_t len;
+} replay;
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const uint8_t *b = p;
+    for (size_t i = 0; i < n; i++) {
+        h = (h ^ b[i]) * UINT64_C(0x100000001b3);
+    }
+    return h;
+}
+
+/* Appends what an event says to a transcript (data as a hash of what was
+ * decoded; nothing for no event), and the client's output after it. */
+static void note_event(char *t, size_t *at, int k, const urrt_rtde_event *ev, const urrt_state *st,
+                       const urrt_rtde_values *vals, urrt_rtde *s)
+{
+    uint64_t h = 0xcbf29ce484222325u;
+    if (k == URRT_RTDE_EV_DATA) {
+        h = fnv(fnv(h, st, sizeof *st), vals, sizeof *vals);
+    } else if (k == URRT_RTDE_EV_TEXT) {
+        h = fnv(fnv(h, ev->text, ev->text_len), ev->source, ev->source_len);
+    }
+    if (k != URRT_RTDE_EV_NONE) {
+        *at += (size_t)snprintf(t + *at, TRANSCRIPT_MAX - *at, "%d %d %u %u %u %u %d %d %llx\n", k, ev->error,
+                                ev->protocol, ev->recipe_id, ev->level, ev->version[0], ev->first, ev->not_found,
+                                (unsigned long long)h);
+    }
+    uint8_t out[URRT_RTDE_REQUEST_MAX];
+    int n;
+    while ((n = urrt_rtde_output(s, out, sizeof out)) > 0) {
+        check_request(out, n);
+        *at += (size_t)snprintf(t + *at, TRANSCRIPT_MAX - *at, "out %d %c\n", n, out[2]);
+    }
+}
+
+/* Feeds the stream cut at each point of cuts[] (ascending), the output taken
+ * after every call; returns the transcript's length. */
+static size_t transcript(const replay *r, const size_t *cuts, size_t ncuts, char *t)
+{
+    static urrt_rtde s;
+    static urrt_state st;
+    static urrt_rtde_values vals;
+    urrt_rtde_event ev;
+    size_t at = 0, pos = 0;
+    urrt_rtde_init(&s);
+    CHECK_EQ_INT(urrt_rtde_begin(&s, r->vars, r->var_count, r->freq), URRT_OK);
+    note_event(t, &at, URRT_RTDE_EV_NONE, &(urrt_rtde_event){0}, &st, &vals, &s);
+    for (size_t c = 0; c <= ncuts; c++) {
+        size_t end = c < ncuts ? cuts[c] : r->len;
+        while (pos < end) {
+            size_t used;
+            memset(&st, 0, sizeof st); /* padding too: the hash covers every byte */
+            memset(&vals, 0, sizeof vals);
+            int k = urrt_rtde_feed(&s, r->stream + pos, end - pos, &used, &ev, &st, &vals);
+            pos += used;
+            if (k < 0) {
+                at += (size_t)snprintf(t + at, TRANSCRIPT_MAX - at, "ended %d\n", k);
+                return at;
+            }
+            /* the output after every read, event or not, as a poll loop takes it */
+            note_event(t, &at, k, &ev, &st, &vals, &s);
+        }
+    }
+    return at;
+}
+
+static void check_splits(const replay *r, const char *name)
+{
+    static char whole[TRANSCRIPT_MAX], cut[TRANSCRIPT_MAX];
+    size_t n = transcript(r, NULL, 0, whole), bad = 0;
+    for (size_t k = 0; k <= r->len; k++) {
+        size_t m = transcript(r, &k, 1, cut);
+        bad += m != n || memcmp(whole, cut, n) != 0;
+    }
+    CHECK(bad == 0, "%s: %zu of %zu split points give other events", name, bad, r->len + 1);
+    /* and one byte at a time */
+    static size_t every[IN_MAX];
+    for (size_t k = 0; k < r->len; k++) {
+        every[k] = k;
+    }
+    size_t m = transcript(r, every, r->len, cut);
+    CHECK(m == n && memcmp(whole, cut, n) == 0, "%s: byte by byte gives other events", name);
+}
+
+/* Every session of the vectors without caller actions in its middle. */
+static void run_splits(const char *path)
+{
+    static char line[LINE_MAX_CHARS], name[64];
+    static replay r;
+    FILE *f = fopen(path, "r");
+    int usable = 0, checked = 0;
+    if (f == NULL) {
+        return;
+    }
+    while (fgets(line, sizeof line, f) != NULL) {
+        line[strcspn(line, "\n")] = '\0';
+        char *arg = strchr(line, ' ');
+        arg = arg != NULL ? arg + 1 : line;
+        if (strncmp(line, "session ", 8) == 0) {
+            snprintf(name, sizeof name, "split %.40s", arg);
+            r.len = 0;
+            usable = 1;
+        } else if (strncmp(line, "vars ", 5) == 0) {
+            r.var_count = 0;
+            for (char *v = strtok(arg, ","); v != NULL && r.var_count < URRT_RTDE_MAX_VARS; v = strtok(NULL, ",")) {
+                r.vars[r.var_count++] = (uint16_t)urrt_rtde_var_find(v, strlen(v));
+            }
+        } else if (strncmp(line, "freq ", 5) == 0) {
+            r.freq = strtod(arg, NULL);
+        } else if (strncmp(line, "recv ", 5) == 0) {
+            r.len += unhex(arg, r.stream + r.len, IN_MAX - r.len);
+        } else if (!strncmp(line, "pause", 5) || !strncmp(line, "start", 5) || !strncmp(line, "finish", 6) ||
+                   !strncmp(line, "begin_error", 11)) {
+            usable = 0;
+        } else if (strcmp(line, "end") == 0 && usable && r.len > 0) {
+            check_splits(&r, name);
+            checked++;
+        }
+    }
+    fclose(f);
+    CHECK(checked >= 30, "only %d sessions replayed at every split point", checked);
+}
+
+/* ---- the tables and the API without a controller ---------------------------------- */
+
+static void test_names(void)
+{
+    char name[URRT_RTDE_NAME_MAX];
+    for (int var = 0; var < URRT_RTDE_VAR_COUNT; var++) {
+        int n = urrt_rtde_var_name(var, name, sizeof name);
+        CHECK(n > 0 && urrt_rtde_var_find(name, (size_t)n) == var, "var %d: name %s does not find it", var, name);
+        CHECK(urrt_rtde_var_type(var) != URRT_RTDE_T_NONE, "var %d has no type", var);
+    }
+    CHECK_EQ_INT(urrt_rtde_var_name(URRT_RTDE_VAR_COUNT, name, sizeof name), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_var_name(-1, name, sizeof name), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_var_name(URRT_RTDE_V_ACTUAL_Q, name, 8), URRT_E_NO_SPACE);
+    CHECK_EQ_INT(urrt_rtde_var_name(URRT_RTDE_V_ACTUAL_Q, name, 9), 8);
+    const char *bad[] = {"actual_Q", "output_int_register_48", "output_int_register_05", "output_bit_register_63",
+                         "output_bit_register_128", "output_int_register_", "output_bit_register_0", "actual_q ",
+                         "standard_analog_input2", "", "output_int_register_1x"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        CHECK(urrt_rtde_var_find(bad[i], strlen(bad[i])) == URRT_RTDE_E_UNKNOWN_NAME, "found \"%s\"", bad[i]);
+    }
+    CHECK_EQ_INT(urrt_rtde_var_find("output_bit_register_64", 22), URRT_RTDE_V_OUTPUT_BIT_REGISTER);
+    CHECK_EQ_INT(urrt_rtde_var_find("output_int_register_47", 22), URRT_RTDE_V_OUTPUT_INT_REGISTER + 47);
+    CHECK_EQ_INT(urrt_rtde_var_find("actual_q", 6), URRT_RTDE_E_UNKNOWN_NAME); /* "actual" */
+    /* The RealTime field each name fills, as docs/rtde.md's table says. */
+    CHECK_EQ_INT(urrt_rtde_var_field(urrt_rtde_var_find("actual_TCP_pose", 15)), URRT_F_TOOL_VECTOR_ACTUAL);
+    CHECK_EQ_INT(urrt_rtde_var_field(urrt_rtde_var_find("payload", 7)), URRT_F_PAYLOAD_MASS);
+    CHECK_EQ_INT(urrt_rtde_var_of_field(URRT_F_Q_ACTUAL), URRT_RTDE_V_ACTUAL_Q);
+    CHECK_EQ_INT(urrt_rtde_var_of_field(URRT_F_TEST_VALUE), -1);
+    CHECK_EQ_INT(urrt_rtde_var_field(URRT_RTDE_V_ROBOT_STATUS_BITS), -1);
+    CHECK_EQ_STR(urrt_rtde_type_name(URRT_RTDE_T_VECTOR6UINT32), "VECTOR6UINT32");
+    CHECK_EQ_INT(urrt_rtde_type_size(URRT_RTDE_T_VECTOR6INT32), 24);
+}
+
+static int avail(const char *name, unsigned a, unsigned b, unsigned c)
+{
+    return urrt_rtde_var_available(urrt_rtde_var_find(name, strlen(name)), a, b, c);
+}
+
+/* Versions as docs/rtde.md lists them. */
+static void test_versions(void)
+{
+    CHECK_EQ_INT(avail("actual_q", 3, 4, 0), 1);
+    CHECK_EQ_INT(avail("actual_q", 2, 0, 0), 0);
+    CHECK_EQ_INT(avail("payload", 5, 5, 0), 0);
+    CHECK_EQ_INT(avail("payload", 5, 5, 1), 1);
+    CHECK_EQ_INT(avail("payload", 3, 10, 9), 0);
+    CHECK_EQ_INT(avail("payload", 3, 11, 0), 1);
+    CHECK_EQ_INT(avail("payload_inertia", 5, 10, 99), 0);
+    CHECK_EQ_INT(avail("output_int_register_23", 3, 4, 0), 1);
+    CHECK_EQ_INT(avail("output_int_register_23", 3, 3, 9), 0);
+    CHECK_EQ_INT(avail("output_int_register_24", 3, 8, 0), 0);
+    CHECK_EQ_INT(avail("output_int_register_24", 3, 9, 0), 1);
+    CHECK_EQ_INT(avail("output_double_register_47", 5, 2, 0), 0);
+    CHECK_EQ_INT(avail("output_double_register_47", 5, 3, 0), 1);
+    CHECK_EQ_INT(avail("output_double_register_0", 5, 0, 0), 1);
+    CHECK_EQ_INT(avail("output_bit_register_64", 5, 2, 9), 0);
+    CHECK_EQ_INT(avail("ft_raw_wrench", 3, 15, 0), 0);
+    CHECK_EQ_INT(avail("ft_raw_wrench", 5, 9, 0), 1);
+    CHECK_EQ_INT(avail("ft_raw_wrench", 10, 0, 0), 1);
+    CHECK_EQ_INT(avail("target_gravity", 10, 11, 0), 0);
+    CHECK_EQ_INT(avail("target_gravity", 10, 12, 0), 1);
+    CHECK_EQ_INT(avail("target_gravity", 5, 26, 0), 1);
+    CHECK_EQ_INT(avail("safety_status", 3, 10, 0), 1);
+    CHECK_EQ_INT(avail("safety_status", 5, 3, 0), 0);
+    CHECK_EQ_INT(avail("tcp_offset", 5, 20, 0), URRT_RTDE_UNKNOWN);
+    CHECK_EQ_INT(avail("time_scale_source", 3, 15, 0), 0);
+    CHECK_EQ_INT(urrt_rtde_var_available(URRT_RTDE_VAR_COUNT, 5, 0, 0), URRT_E_ARG);
+}
+
+/* No recipe can overflow the buffer: the URRT_RTDE_MAX_VARS largest
+ * variables' data package fits URRT_RTDE_PACKAGE_MAX. */
+static void test_largest_recipe(void)
+{
+    unsigned sizes[URRT_RTDE_VAR_COUNT], total = 4;
+    for (int var = 0; var < URRT_RTDE_VAR_COUNT; var++) {
+        sizes[var] = urrt_rtde_type_size(urrt_rtde_var_type(var));
+    }
+    for (int k = 0; k < URRT_RTDE_MAX_VARS; k++) {
+        int best = 0;
+        for (int var = 1; var < URRT_RTDE_VAR_COUNT; var++) {
+            best = sizes[var] > sizes[best] ? var : best;
+        }
+        total += sizes[best];
+        sizes[best] = 0;
+    }
+    CHECK(total <= URRT_RTDE_PACKAGE_MAX, "largest recipe %u bytes", total);
+}
+
+static void test_api_errors(void)
+{
+    static urrt_rtde s;
+    static urrt_state st;
+    urrt_rtde_event ev;
+    uint8_t out[8];
+    size_t used;
+    uint16_t vars[] = {URRT_RTDE_V_ACTUAL_Q, URRT_RTDE_V_OUTPUT_INT_REGISTER};
+    urrt_rtde_init(&s);
+    CHECK_EQ_INT(urrt_rtde_feed(&s, out, 1, &used, &ev, &st, NULL), URRT_RTDE_E_ENDED); /* before begin */
+    CHECK_EQ_INT(urrt_rtde_begin(&s, vars, 0, 0.0), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_begin(&s, vars, URRT_RTDE_MAX_VARS + 1, 0.0), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_begin(&s, vars, 2, -1.0), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_begin(&s, vars, 2, NAN), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_output(&s, out, sizeof out), 0); /* a refused begin queues nothing */
+    uint16_t unknown[] = {URRT_RTDE_VAR_COUNT};
+    CHECK_EQ_INT(urrt_rtde_begin(&s, unknown, 1, 0.0), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_begin(&s, vars, 2, 0.0), URRT_OK);
+    /* the recipe has an RTDE-only variable: values are required */
+    CHECK_EQ_INT(urrt_rtde_feed(&s, out, 1, &used, &ev, &st, NULL), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_pause(&s), URRT_E_ARG); /* not streaming */
+    CHECK_EQ_INT(urrt_rtde_start(&s), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_output(&s, out, 4), URRT_E_NO_SPACE);
+    CHECK_EQ_INT(urrt_rtde_output(&s, out, 5), 5);
+    CHECK_EQ_INT(urrt_rtde_write_start(out, 2), URRT_E_NO_SPACE);
+    CHECK_EQ_INT(urrt_rtde_write_pause(out, 3), 3);
+    CHECK(out[0] == 0 && out[1] == 3 && out[2] == 'P', "pause request");
+    CHECK_EQ_INT(urrt_rtde_write_setup_outputs(out, sizeof out, 3, 0.0, vars, 1), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_write_setup_outputs(out, sizeof out, 1, 0.0, vars, 1), URRT_E_NO_SPACE);
+    CHECK_EQ_INT(urrt_rtde_decode(&s, out, 3, &st, NULL), URRT_E_ARG);
+    CHECK(strcmp(urrt_rtde_strerror(URRT_RTDE_E_NOT_FOUND), "ok") != 0, "strerror");
+    CHECK_EQ_STR(urrt_rtde_strerror(URRT_E_NO_SPACE), urrt_strerror(URRT_E_NO_SPACE));
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 2) {
+        fprintf(stderr, "usage: %s VECTORS (from tests/ref/rtde_ref.py)\n", argv[0]);
+        return 2;
+    }
+    test_names();
+    test_versions();
+    test_largest_recipe();
+    test_api_errors();
+    int sessions = run_vectors(argv[1], SIZE_MAX);
+    CHECK(sessions >= 40, "only %d sessions in %s", sessions, argv[1]);
+    run_vectors(argv[1], 1);
+    run_vectors(argv[1], 7);
+    run_splits(argv[1]);
+    return check_report();
+}

@@ -1,0 +1,281 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The RTDE client (lib/urrt_rtde) on the emulated Cortex-M cores, without a
+ * C library: the reference's sessions (tests/ref/rtde_ref.py, as C data by
+ * tests/target/rtde_vectors_c.py) fed whole, byte by byte and in 7-byte
+ * reads, the client's output taken after every read as a poll loop does:
+ * every request byte for byte, every event, every value bit for bit (what
+ * tests/lib/test_rtde.c checks on the host from the same sessions). Built by
+ * tests/target/target.mk as NAME/rtde.elf; RAM: one session, its values and
+ * state (about 9 KiB: fits the Cortex-M0 board's 16 KiB).
+ *
+ * It also prints the stack high-water mark of every public urrt_rtde
+ * function ("stack: NAME BYTES", as tests/target/stack_target.h does for the
+ * rest of lib/), worst over the first pass, whose reads take every path:
+ * tests/target/stack.py holds them to -fstack-usage and docs/footprint.md.
+ */
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../check.h"
+#include "rtde_vectors.h"
+#include "urrt_rtde.h"
+
+static urrt_rtde s;
+static urrt_state st;
+static urrt_rtde_values vals;
+static uint8_t out[URRT_RTDE_REQUEST_MAX];
+
+/* ---- stack marks ---------------------------------------------------------- */
+
+static struct {
+    const char *name;
+    unsigned bytes;
+} marks[32];
+static unsigned mark_count;
+static bool measuring;
+
+static void note(const char *fn, uintptr_t sp, uintptr_t lowest)
+{
+    unsigned i;
+    CHECK(lowest > target_stack_limit(), "%s reached the stack's limit", fn);
+    for (i = 0; i < mark_count && !CHECK_SAME_TEXT(marks[i].name, fn); i++) {
+    }
+    if (i == mark_count) {
+        CHECK(i < sizeof marks / sizeof marks[0], "more than %u functions", i);
+        if (i == sizeof marks / sizeof marks[0]) {
+            return;
+        }
+        marks[mark_count].name = fn;
+        marks[mark_count++].bytes = 0;
+    }
+    if (sp - lowest > marks[i].bytes) {
+        marks[i].bytes = (unsigned)(sp - lowest);
+    }
+}
+
+/* The call, its stack painted and measured while measuring: result = fn
+ * args, or for functions without a result MEASURED_VOID(fn, args). */
+#define MEASURED_CALL(call, fn)                                     \
+    do {                                                            \
+        uintptr_t sp_ = target_sp();                                \
+        if (measuring) {                                            \
+            target_stack_paint(sp_);                                \
+        }                                                           \
+        call;                                                       \
+        if (measuring) {                                            \
+            note(#fn, sp_, target_stack_lowest_used(sp_));          \
+        }                                                           \
+    } while (0)
+#define MEASURED(result, fn, args) MEASURED_CALL(result = fn args, fn)
+#define MEASURED_VOID(fn, args) MEASURED_CALL(fn args, fn)
+
+static size_t text_len(const char *t)
+{
+    size_t n = 0;
+    while (t[n] != '\0') {
+        n++;
+    }
+    return n;
+}
+
+static int var_of(const char *name)
+{
+    return urrt_rtde_var_find(name, text_len(name));
+}
+
+typedef struct named {
+    const char *name;
+    int value;
+} named;
+
+static const named kinds[] = {
+    {"protocol", URRT_RTDE_EV_PROTOCOL}, {"fallback", URRT_RTDE_EV_FALLBACK},
+    {"controller", URRT_RTDE_EV_CONTROLLER}, {"recipe", URRT_RTDE_EV_RECIPE},
+    {"started", URRT_RTDE_EV_STARTED}, {"paused", URRT_RTDE_EV_PAUSED}, {"text", URRT_RTDE_EV_TEXT},
+    {"data", URRT_RTDE_EV_DATA}, {"drop", URRT_RTDE_EV_DROP}, {"config", URRT_RTDE_EV_CONFIG},
+};
+
+static const named errors[] = {
+    {"SIZE_SMALL", URRT_RTDE_E_SIZE_SMALL}, {"SIZE_LARGE", URRT_RTDE_E_SIZE_LARGE},
+    {"REPLY_LENGTH", URRT_RTDE_E_REPLY_LENGTH}, {"REPLY_VALUE", URRT_RTDE_E_REPLY_VALUE},
+    {"VERSION_ZERO", URRT_RTDE_E_VERSION_ZERO}, {"DATA_EARLY", URRT_RTDE_E_DATA_EARLY},
+    {"RECIPE_ID", URRT_RTDE_E_RECIPE_ID}, {"DATA_SIZE", URRT_RTDE_E_DATA_SIZE},
+    {"TYPE_TOKEN", URRT_RTDE_E_TYPE_TOKEN}, {"TYPE_COUNT", URRT_RTDE_E_TYPE_COUNT},
+    {"TEXT_LENGTH", URRT_RTDE_E_TEXT_LENGTH}, {"NOT_FOUND", URRT_RTDE_E_NOT_FOUND},
+    {"TYPE_MISMATCH", URRT_RTDE_E_TYPE_MISMATCH}, {"PROTOCOL_REFUSED", URRT_RTDE_E_PROTOCOL_REFUSED},
+    {"START_REFUSED", URRT_RTDE_E_START_REFUSED}, {"FREQUENCY", URRT_RTDE_E_FREQUENCY},
+};
+
+static int lookup(const named *t, size_t n, const char *name)
+{
+    for (size_t i = 0; i < n; i++) {
+        if (CHECK_SAME_TEXT(t[i].name, name)) {
+            return t[i].value;
+        }
+    }
+    CHECK(0, "unknown name %s", name);
+    return 0;
+}
+
+static uint64_t raw_of(const rtv_value *v)
+{
+    int var = var_of(v->name), field = urrt_rtde_var_field(var);
+    uint64_t u = 0;
+    if (field >= 0) {
+        CHECK(urrt_has(&st, field), "%s not present", v->name);
+        memcpy(&u, urrt_field_values(&st, (urrt_field_id)field) + v->elem, 8);
+        return u;
+    }
+    CHECK(urrt_rtde_has(&vals, var), "%s not present", v->name);
+    const void *p = urrt_rtde_value(&vals, var);
+    switch (v->hex_digits) {
+    case 2: return ((const uint8_t *)p)[v->elem];
+    case 8: return ((const uint32_t *)p)[v->elem];
+    default: memcpy(&u, (const uint64_t *)p + v->elem, 8); return u;
+    }
+}
+
+static void check_event(const rtv_session *t, unsigned e, int k, const urrt_rtde_event *ev)
+{
+    const rtv_event *want = &t->events[e];
+    CHECK(k == lookup(kinds, sizeof kinds / sizeof kinds[0], want->kind), "%s: event %u is %d, not %s", t->name,
+          e, k, want->kind);
+    if (want->error != NULL) {
+        CHECK(ev->error == lookup(errors, sizeof errors / sizeof errors[0], want->error), "%s: error %d, not %s",
+              t->name, ev->error, want->error);
+    } else if (k == URRT_RTDE_EV_TEXT) {
+        CHECK(ev->level == want->arg && ev->text_len == want->text_len && ev->source_len == want->source_len &&
+                  memcmp(ev->text, want->text, want->text_len) == 0 &&
+                  memcmp(ev->source, want->source, want->source_len) == 0,
+              "%s: text event %u", t->name, e);
+    } else if (k == URRT_RTDE_EV_DATA) {
+        CHECK_EQ_INT(ev->first, want->arg);
+        for (unsigned i = 0; i < t->value_count; i++) {
+            const rtv_value *v = &t->values[i];
+            if (v->event == e) {
+                uint64_t got = raw_of(v);
+                CHECK(got == v->raw, "%s: %s[%u] = %llx, expected %llx", t->name, v->name, v->elem,
+                      (unsigned long long)got, (unsigned long long)v->raw);
+            }
+        }
+    } else if (k == URRT_RTDE_EV_PROTOCOL || k == URRT_RTDE_EV_FALLBACK) {
+        CHECK_EQ_INT(ev->protocol, want->arg);
+    } else if (k == URRT_RTDE_EV_RECIPE) {
+        CHECK_EQ_INT(ev->recipe_id, want->arg);
+    }
+}
+
+/* Every request the client has due: the next bytes of t->sent. */
+static void take_output(const rtv_session *t, size_t *sent)
+{
+    int n;
+    for (;;) {
+        MEASURED(n, urrt_rtde_output, (&s, out, sizeof out));
+        if (n <= 0) {
+            break;
+        }
+        CHECK(*sent + (size_t)n <= t->sent_len && memcmp(out, t->sent + *sent, (size_t)n) == 0,
+              "%s: request %c of %d bytes at %u is not the reference's", t->name, out[2], n, (unsigned)*sent);
+        *sent += (size_t)n;
+    }
+}
+
+static void run(const rtv_session *t, size_t chunk)
+{
+    uint16_t vars[URRT_RTDE_MAX_VARS];
+    size_t pos = 0, sent = 0;
+    unsigned e = 0;
+    int r;
+    for (unsigned i = 0; i < t->var_count; i++) {
+        MEASURED(r, urrt_rtde_var_find, (t->vars[i], text_len(t->vars[i])));
+        vars[i] = (uint16_t)r;
+    }
+    MEASURED_VOID(urrt_rtde_init, (&s));
+    MEASURED(r, urrt_rtde_begin, (&s, vars, t->var_count, t->freq));
+    CHECK_EQ_INT(r, URRT_OK);
+    take_output(t, &sent);
+    while (pos < t->stream_len) {
+        size_t n = t->stream_len - pos < chunk ? t->stream_len - pos : chunk, used;
+        urrt_rtde_event ev;
+        int k;
+        MEASURED(k, urrt_rtde_feed, (&s, t->stream + pos, n, &used, &ev, &st, &vals));
+        pos += used;
+        if (k < 0) {
+            break; /* ended by an earlier drop; the rest is refused */
+        }
+        if (k != URRT_RTDE_EV_NONE) {
+            CHECK(e < t->event_count, "%s: more events than the reference's", t->name);
+            if (e < t->event_count) {
+                check_event(t, e, k, &ev);
+            }
+            if (k == URRT_RTDE_EV_DATA) { /* the package is still in the buffer */
+                MEASURED(r, urrt_rtde_decode, (&s, s.buf, s.data_size, &st, &vals));
+                CHECK_EQ_INT(r, s.data_size);
+            }
+            e++;
+        }
+        take_output(t, &sent);
+    }
+    CHECK(e == t->event_count && sent == t->sent_len, "%s (reads of %u): %u of %u events, %u of %u request bytes",
+          t->name, (unsigned)chunk, e, t->event_count, (unsigned)sent, (unsigned)t->sent_len);
+}
+
+/* The functions a session's reads do not call, on the state the last
+ * session left (streaming, or ended), and the tables, each on its deepest
+ * path (a family's name has digits to write, a version its column). */
+static void measure_rest(void)
+{
+    static const uint16_t family[] = {URRT_RTDE_V_OUTPUT_DOUBLE_REGISTER + 47, URRT_RTDE_V_INPUT_BIT_REGISTER + 63};
+    char name[URRT_RTDE_NAME_MAX];
+    const void *p;
+    const char *text;
+    unsigned u;
+    int r;
+    bool b;
+    MEASURED(r, urrt_rtde_pause, (&s));
+    MEASURED(r, urrt_rtde_start, (&s));
+    MEASURED(b, urrt_rtde_up, (&s));
+    MEASURED(r, urrt_rtde_not_found, (&s, 3));
+    MEASURED(u, urrt_rtde_finish, (&s));
+    MEASURED(text, urrt_rtde_strerror, (URRT_E_NO_SPACE));
+    MEASURED(b, urrt_rtde_is_config_error, (URRT_RTDE_E_NOT_FOUND));
+    MEASURED(text, urrt_rtde_type_name, (URRT_RTDE_T_VECTOR6D));
+    MEASURED(u, urrt_rtde_type_size, (URRT_RTDE_T_VECTOR6D));
+    MEASURED_VOID(urrt_rtde_values_clear, (&vals));
+    MEASURED(p, urrt_rtde_value, (&vals, family[1]));
+    MEASURED(r, urrt_rtde_var_name, (family[0], name, sizeof name));
+    CHECK(r == 25 && CHECK_SAME_TEXT(name, "output_double_register_47"), "urrt_rtde_var_name: %s", name);
+    MEASURED(r, urrt_rtde_var_type, (family[1]));
+    MEASURED(r, urrt_rtde_var_field, (URRT_RTDE_V_ACTUAL_Q));
+    MEASURED(r, urrt_rtde_var_of_field, (URRT_F_PAYLOAD_INERTIA));
+    MEASURED(r, urrt_rtde_var_available, (family[0], 3, 8, 0));
+    MEASURED(r, urrt_rtde_write_protocol_version, (out, sizeof out, 2));
+    MEASURED(r, urrt_rtde_write_controller_version, (out, sizeof out));
+    MEASURED(r, urrt_rtde_write_setup_outputs, (out, sizeof out, 2, 500.0, family, 2));
+    MEASURED(r, urrt_rtde_write_start, (out, sizeof out));
+    MEASURED(r, urrt_rtde_write_pause, (out, sizeof out));
+    (void)p;
+    (void)u;
+    (void)text;
+    (void)b;
+}
+
+int main(void)
+{
+    static const size_t chunks[] = {SIZE_MAX, 1, 7};
+    CHECK(rtv_session_count >= 10, "only %u sessions", rtv_session_count);
+    for (unsigned c = 0; c < sizeof chunks / sizeof chunks[0]; c++) {
+        measuring = c == 0;
+        for (unsigned i = 0; i < rtv_session_count; i++) {
+            run(&rtv_sessions[i], chunks[c]);
+        }
+    }
+    measuring = true;
+    measure_rest();
+    for (unsigned i = 0; i < mark_count; i++) {
+        check_printf("stack: %s %u\n", marks[i].name, marks[i].bytes);
+    }
+    return check_report();
+}
