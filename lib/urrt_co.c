@@ -783,7 +783,7 @@ static size_t sync_received(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emi
     return sent;
 }
 
-/* ---- the object dictionary: the communication objects' table ---------------------------- */
+/* ---- the object dictionary: the communication objects ---------------------------------- */
 
 /* A number: its size is its row's type's (urrt_co_comm_read). */
 static uint32_t value_of(urrt_co_value *v, uint32_t value)
@@ -801,13 +801,6 @@ static uint32_t text_of(urrt_co_value *v, const char *text)
     return 0;
 }
 
-static uint32_t read_device_type(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
-{
-    (void)n;
-    (void)sub;
-    return value_of(v, co->desc->device_type);
-}
-
 static uint32_t read_error_register(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
 {
     (void)n;
@@ -815,17 +808,14 @@ static uint32_t read_error_register(const urrt_co *co, size_t n, uint8_t sub, ur
     return value_of(v, urrt_co_error_register(co));
 }
 
-/* 0x1003: sub 0 the count, sub 1.. the codes, newest first. */
+/* 0x1003 sub 1..: the codes, newest first. */
 static uint32_t read_errors(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
 {
     (void)n;
-    if (sub == 0u) {
-        return value_of(v, co->error_count);
-    }
     return sub > co->error_count ? URRT_CO_ABORT_NO_DATA : value_of(v, co->errors[sub - 1u]);
 }
 
-/* Only 0 clears the history (CiA 301). */
+/* 0x1003 sub 0: only 0 clears the history (CiA 301). */
 static uint32_t write_errors(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
 {
     (void)n;
@@ -836,13 +826,6 @@ static uint32_t write_errors(urrt_co *co, size_t n, uint8_t sub, uint32_t value,
     }
     co->error_count = 0;
     return 0;
-}
-
-static uint32_t read_sync(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
-{
-    (void)n;
-    (void)sub;
-    return value_of(v, co->sync_cob_id);
 }
 
 /* SYNC consumer only: bit 30 (generate) and 29-bit ids are refused. */
@@ -858,34 +841,6 @@ static uint32_t write_sync(urrt_co *co, size_t n, uint8_t sub, uint32_t value, u
     return 0;
 }
 
-static uint32_t read_device_name(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
-{
-    (void)n;
-    (void)sub;
-    return text_of(v, co->desc->device_name);
-}
-
-static uint32_t read_hardware_version(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
-{
-    (void)n;
-    (void)sub;
-    return text_of(v, co->desc->hardware_version);
-}
-
-static uint32_t read_software_version(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
-{
-    (void)n;
-    (void)sub;
-    return text_of(v, co->desc->software_version);
-}
-
-static uint32_t read_emcy(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
-{
-    (void)n;
-    (void)sub;
-    return value_of(v, co->emcy_cob_id);
-}
-
 static uint32_t write_emcy(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
 {
     uint32_t abort_code = cob_check(co->emcy_cob_id, value, 0);
@@ -894,13 +849,6 @@ static uint32_t write_emcy(urrt_co *co, size_t n, uint8_t sub, uint32_t value, u
     (void)now_us;
     co->emcy_cob_id = abort_code != 0u ? co->emcy_cob_id : value;
     return abort_code;
-}
-
-static uint32_t read_emcy_inhibit(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
-{
-    (void)n;
-    (void)sub;
-    return value_of(v, co->emcy_inhibit_100us);
 }
 
 static uint32_t write_emcy_inhibit(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
@@ -912,13 +860,6 @@ static uint32_t write_emcy_inhibit(urrt_co *co, size_t n, uint8_t sub, uint32_t 
     return 0;
 }
 
-static uint32_t read_heartbeat(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
-{
-    (void)n;
-    (void)sub;
-    return value_of(v, co->heartbeat_ms);
-}
-
 static uint32_t write_heartbeat(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
 {
     (void)n;
@@ -926,27 +867,6 @@ static uint32_t write_heartbeat(urrt_co *co, size_t n, uint8_t sub, uint32_t val
     co->heartbeat_ms = (uint16_t)value;
     heartbeat_restart(co, now_us);
     return 0;
-}
-
-static uint32_t read_identity(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
-{
-    const urrt_co_desc *d = co->desc;
-    const uint32_t ids[IDENTITY_SUBS] = {d->vendor_id, d->product_code, d->revision, d->serial};
-    (void)n;
-    return value_of(v, sub == 0u ? IDENTITY_SUBS : ids[sub - 1u]);
-}
-
-/* 0x1800+n: sub 0 the highest sub-index (4 is reserved, 6 unsupported). */
-static uint32_t read_tpdo_comm(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
-{
-    const urrt_co_tpdo_state *t = &co->tpdos[n];
-    switch (sub) {
-    case 0: return value_of(v, TPDO_COMM_SUBS);
-    case 1: return value_of(v, t->cob_id);
-    case 2: return value_of(v, t->type);
-    case 3: return value_of(v, t->inhibit_100us);
-    default: return value_of(v, t->event_ms);
-    }
 }
 
 /* 0x1A00+n: the description's mapping, read-only. */
@@ -959,63 +879,173 @@ static uint32_t read_tpdo_map(const urrt_co *co, size_t n, uint8_t sub, urrt_co_
     return sub > p->mapping_count ? URRT_CO_ABORT_NO_SUB : value_of(v, p->mapping[sub - 1u]);
 }
 
+/*
+ * The communication objects, one line each, written once and expanded three
+ * times (nanopb's X-macros): into urrt_co_comm_table, the node's; into
+ * comm_names, which only urrt_co_comm_name reads (an array of its own, so that
+ * a firmware that writes no EDS links no names: --gc-sections drops it); and
+ * into comm_limits, for the rows with limits.
+ *   HEAD(index, object, flags, name)  an ARRAY or RECORD; the rows of its index follow
+ *   ROW(index, sub, subs, object, type, in, what, write, flags, name)
+ *       in FN: `what` is the read function; NODE, DESC, TPDO: `what` is the
+ *       member of urrt_co, urrt_co_desc or TPDO n's urrt_co_tpdo_state that
+ *       holds the value (read as the type); CONST: `what` is the value
+ *   LIMITED(the ROW's columns, low, high)  a ROW whose writes outside low..high are refused
+ */
+#define COMM_LIST(HEAD, ROW, LIMITED)                                                                         \
+    ROW(0x1000, 0, 1, VAR, U32, DESC, device_type, NULL, 0, "Device type")                                    \
+    ROW(0x1001, 0, 1, VAR, U8, FN, read_error_register, NULL, 0, "Error register")                            \
+    HEAD(0x1003, ARRAY, 0, "Pre-defined error field")                                                         \
+    ROW(0x1003, 0, 1, SUB, U8, NODE, error_count, write_errors, 0, "Number of errors")                        \
+    ROW(0x1003, 1, URRT_CO_HISTORY, SUB, U32, FN, read_errors, NULL, 0, "Standard error field")               \
+    ROW(0x1005, 0, 1, VAR, U32, NODE, sync_cob_id, write_sync, 0, "COB-ID SYNC")                              \
+    ROW(0x1008, 0, 1, VAR, TEXT, DESC, device_name, NULL, 0, "Manufacturer device name")                      \
+    ROW(0x1009, 0, 1, VAR, TEXT, DESC, hardware_version, NULL, 0, "Manufacturer hardware version")            \
+    ROW(0x100A, 0, 1, VAR, TEXT, DESC, software_version, NULL, 0, "Manufacturer software version")            \
+    ROW(0x1014, 0, 1, VAR, U32, NODE, emcy_cob_id, write_emcy, NODE_ID, "COB-ID EMCY")                        \
+    ROW(0x1015, 0, 1, VAR, U16, NODE, emcy_inhibit_100us, write_emcy_inhibit, 0, "Inhibit time EMCY")         \
+    ROW(0x1017, 0, 1, VAR, U16, NODE, heartbeat_ms, write_heartbeat, 0, "Producer heartbeat time")            \
+    HEAD(0x1018, RECORD, 0, "Identity object")                                                                \
+    ROW(0x1018, 0, 1, SUB, U8, CONST, IDENTITY_SUBS, NULL, 0, "Highest sub-index supported")                  \
+    ROW(0x1018, 1, 1, SUB, U32, DESC, vendor_id, NULL, 0, "Vendor-ID")                                        \
+    ROW(0x1018, 2, 1, SUB, U32, DESC, product_code, NULL, 0, "Product code")                                  \
+    ROW(0x1018, 3, 1, SUB, U32, DESC, revision, NULL, 0, "Revision number")                                   \
+    ROW(0x1018, 4, 1, SUB, U32, DESC, serial, NULL, 0, "Serial number")                                       \
+    HEAD(TPDO_COMM, RECORD, PER_TPDO, "TPDO communication parameter")                                         \
+    ROW(TPDO_COMM, 0, 1, SUB, U8, CONST, TPDO_COMM_SUBS, NULL, PER_TPDO, "Highest sub-index supported")       \
+    ROW(TPDO_COMM, 1, 1, SUB, U32, TPDO, cob_id, tpdo_write, PER_TPDO | NODE_ID, "COB-ID used by TPDO")       \
+    /* 1..240 (every nth SYNC), 254, 255; 241..253 are refused by tpdo_write */                               \
+    LIMITED(TPDO_COMM, 2, 1, SUB, U8, TPDO, type, tpdo_write, PER_TPDO, "Transmission type", 1, 0xFF)         \
+    ROW(TPDO_COMM, 3, 1, SUB, U16, TPDO, inhibit_100us, tpdo_write, PER_TPDO, "Inhibit time")                 \
+    ROW(TPDO_COMM, 5, 1, SUB, U16, TPDO, event_ms, tpdo_write, PER_TPDO, "Event timer")                       \
+    HEAD(TPDO_MAP, RECORD, PER_TPDO, "TPDO mapping parameter")                                                \
+    ROW(TPDO_MAP, 0, 1, SUB, U8, FN, read_tpdo_map, NULL, PER_TPDO, "Number of mapped objects")               \
+    ROW(TPDO_MAP, 1, URRT_CO_MAX_MAPPED, SUB, U32, FN, read_tpdo_map, NULL, PER_TPDO, "Mapped object")
+
 #define U8 URRT_CO_UNSIGNED8
 #define U16 URRT_CO_UNSIGNED16
 #define U32 URRT_CO_UNSIGNED32
 #define TEXT URRT_CO_VISIBLE_STRING
 #define VAR URRT_CO_OBJ_VAR
 #define SUB URRT_CO_OBJ_SUB
-#define HEADER(index_, object_, name_, flags_) {(name_), NULL, NULL, 0, 0, (index_), 0, 0, (object_), 0, (flags_)}
-#define ROW(index_, sub_, subs_, object_, type_, name_, read_, write_, flags_) \
-    {(name_), (read_), (write_), 0, 0, (index_), (sub_), (subs_), (object_), (type_), (flags_)}
+#define ARRAY URRT_CO_OBJ_ARRAY
+#define RECORD URRT_CO_OBJ_RECORD
+#define PER_TPDO URRT_CO_PER_TPDO
+#define NODE_ID URRT_CO_NODE_ID
 
-const urrt_co_comm urrt_co_comm_table[] = {
-    ROW(0x1000, 0, 1, VAR, U32, "Device type", read_device_type, NULL, 0),
-    ROW(0x1001, 0, 1, VAR, U8, "Error register", read_error_register, NULL, 0),
-    HEADER(0x1003, URRT_CO_OBJ_ARRAY, "Pre-defined error field", 0),
-    ROW(0x1003, 0, 1, SUB, U8, "Number of errors", read_errors, write_errors, 0),
-    ROW(0x1003, 1, URRT_CO_HISTORY, SUB, U32, "Standard error field", read_errors, NULL, 0),
-    ROW(0x1005, 0, 1, VAR, U32, "COB-ID SYNC", read_sync, write_sync, 0),
-    ROW(0x1008, 0, 1, VAR, TEXT, "Manufacturer device name", read_device_name, NULL, 0),
-    ROW(0x1009, 0, 1, VAR, TEXT, "Manufacturer hardware version", read_hardware_version, NULL, 0),
-    ROW(0x100A, 0, 1, VAR, TEXT, "Manufacturer software version", read_software_version, NULL, 0),
-    ROW(0x1014, 0, 1, VAR, U32, "COB-ID EMCY", read_emcy, write_emcy, URRT_CO_NODE_ID),
-    ROW(0x1015, 0, 1, VAR, U16, "Inhibit time EMCY", read_emcy_inhibit, write_emcy_inhibit, 0),
-    ROW(0x1017, 0, 1, VAR, U16, "Producer heartbeat time", read_heartbeat, write_heartbeat, 0),
-    HEADER(0x1018, URRT_CO_OBJ_RECORD, "Identity object", 0),
-    ROW(0x1018, 0, 1, SUB, U8, "Highest sub-index supported", read_identity, NULL, 0),
-    ROW(0x1018, 1, 1, SUB, U32, "Vendor-ID", read_identity, NULL, 0),
-    ROW(0x1018, 2, 1, SUB, U32, "Product code", read_identity, NULL, 0),
-    ROW(0x1018, 3, 1, SUB, U32, "Revision number", read_identity, NULL, 0),
-    ROW(0x1018, 4, 1, SUB, U32, "Serial number", read_identity, NULL, 0),
-    HEADER(TPDO_COMM, URRT_CO_OBJ_RECORD, "TPDO communication parameter", URRT_CO_PER_TPDO),
-    ROW(TPDO_COMM, 0, 1, SUB, U8, "Highest sub-index supported", read_tpdo_comm, NULL, URRT_CO_PER_TPDO),
-    ROW(TPDO_COMM, 1, 1, SUB, U32, "COB-ID used by TPDO", read_tpdo_comm, tpdo_write,
-        URRT_CO_PER_TPDO | URRT_CO_NODE_ID),
-    /* 1..240 (every nth SYNC), 254, 255; 241..253 are refused by tpdo_write */
-    {"Transmission type", read_tpdo_comm, tpdo_write, 1, 0xFF, TPDO_COMM, 2, 1, SUB, U8,
-     URRT_CO_PER_TPDO | URRT_CO_LIMITS},
-    ROW(TPDO_COMM, 3, 1, SUB, U16, "Inhibit time", read_tpdo_comm, tpdo_write, URRT_CO_PER_TPDO),
-    ROW(TPDO_COMM, 5, 1, SUB, U16, "Event timer", read_tpdo_comm, tpdo_write, URRT_CO_PER_TPDO),
-    HEADER(TPDO_MAP, URRT_CO_OBJ_RECORD, "TPDO mapping parameter", URRT_CO_PER_TPDO),
-    ROW(TPDO_MAP, 0, 1, SUB, U8, "Number of mapped objects", read_tpdo_map, NULL, URRT_CO_PER_TPDO),
-    ROW(TPDO_MAP, 1, URRT_CO_MAX_MAPPED, SUB, U32, "Mapped object", read_tpdo_map, NULL, URRT_CO_PER_TPDO),
-};
+/* A ROW's `in`, `what` as the table's read, flags and at. A member's offset
+ * must fit `at` (a uint8_t: -Woverflow) and its size be the type's (a
+ * negative array size otherwise), so that read_plain reads it whole. */
+#define READ_FN(f) (f)
+#define READ_NODE(m) NULL
+#define READ_DESC(m) NULL
+#define READ_TPDO(m) NULL
+#define READ_CONST(value) NULL
+#define IN_FN 0u
+#define IN_NODE URRT_CO_IN_NODE
+#define IN_DESC URRT_CO_IN_DESC
+#define IN_TPDO URRT_CO_IN_TPDO
+#define IN_CONST URRT_CO_IN_CONST
+#define TYPE_BYTES(type_) ((type_) == TEXT ? sizeof(const char *) : (type_) == U32 ? 4u : (type_) == U16 ? 2u : 1u)
+#define MEMBER_AT(struct_, m, type_) \
+    (offsetof(struct_, m) + 0u * sizeof(char[sizeof(((struct_ *)0)->m) == TYPE_BYTES(type_) ? 1 : -1]))
+#define AT_FN(f, type_) 0u
+#define AT_NODE(m, type_) MEMBER_AT(urrt_co, m, type_)
+#define AT_DESC(m, type_) MEMBER_AT(urrt_co_desc, m, type_)
+#define AT_TPDO(m, type_) MEMBER_AT(urrt_co_tpdo_state, m, type_)
+#define AT_CONST(value, type_) (value)
+
+#define TABLE_HEAD(index_, object_, flags_, name_) {NULL, NULL, (index_), 0, 0, (object_), 0, (flags_), 0},
+#define TABLE_ROW(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_)                     \
+    {READ_##in_(what_), (write_), (index_), (sub_), (subs_), (object_), (type_), (flags_) | IN_##in_,     \
+     AT_##in_(what_, type_)},
+#define TABLE_LIMITED(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_, low_, high_) \
+    TABLE_ROW(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_)
+
+const urrt_co_comm urrt_co_comm_table[] = {COMM_LIST(TABLE_HEAD, TABLE_ROW, TABLE_LIMITED)};
 const size_t urrt_co_comm_count = sizeof urrt_co_comm_table / sizeof urrt_co_comm_table[0];
+
+/* The names, each ended by its NUL, in the table's order. */
+#define NAME_HEAD(index_, object_, flags_, name_) name_ "\0"
+#define NAME_ROW(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_) name_ "\0"
+#define NAME_LIMITED(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_, low_, high_) name_ "\0"
+static const char comm_names[] = COMM_LIST(NAME_HEAD, NAME_ROW, NAME_LIMITED);
+
+const char *urrt_co_comm_name(const urrt_co_comm *row)
+{
+    const char *name = comm_names;
+    size_t i;
+    for (i = 0; i < (size_t)(row - urrt_co_comm_table); i++) {
+        name += text_len(name) + 1u;
+    }
+    return name;
+}
+
+typedef struct comm_limit {
+    uint32_t low, high;
+    uint16_t index;
+    uint8_t sub;
+} comm_limit;
+#define NO_LIMITS(...)
+#define LIMITS_OF(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_, low_, high_) \
+    {(low_), (high_), (index_), (sub_)},
+static const comm_limit comm_limits[] = {COMM_LIST(NO_LIMITS, NO_LIMITS, LIMITS_OF)};
+
+/* Where in comm_limits a row that holds sub-indices has its limits, or NONE. */
+static size_t limits_at(const urrt_co_comm *row)
+{
+    size_t i;
+    for (i = 0; i < sizeof comm_limits / sizeof comm_limits[0]; i++) {
+        if (comm_limits[i].index == row->index && comm_limits[i].sub == row->sub && row->subs != 0u) {
+            return i;
+        }
+    }
+    return NONE;
+}
+
+bool urrt_co_comm_limits(const urrt_co_comm *row, uint32_t *low, uint32_t *high)
+{
+    size_t i = limits_at(row);
+    if (i != NONE) {
+        *low = comm_limits[i].low;
+        *high = comm_limits[i].high;
+    }
+    return i != NONE;
+}
 
 size_t urrt_co_comm_instances(const urrt_co *co, const urrt_co_comm *row)
 {
     return (row->flags & URRT_CO_PER_TPDO) != 0u ? co->desc->tpdo_count : 1u;
 }
 
+/* A row without a read function: the member `at` bytes into the node, its
+ * description or TPDO n's state, read as the row's type; or `at` itself. */
+static uint32_t read_plain(const urrt_co *co, const urrt_co_comm *row, size_t n, urrt_co_value *v)
+{
+    const unsigned char *base;
+    switch (row->flags & URRT_CO_IN_MASK) {
+    case URRT_CO_IN_NODE: base = (const unsigned char *)co; break;
+    case URRT_CO_IN_DESC: base = (const unsigned char *)co->desc; break;
+    case URRT_CO_IN_TPDO: base = (const unsigned char *)&co->tpdos[n]; break;
+    default: return value_of(v, row->at);
+    }
+    base += row->at;
+    switch (row->type) {
+    case TEXT: return text_of(v, *(const char *const *)(const void *)base);
+    case U8: return value_of(v, *base);
+    case U16: return value_of(v, *(const uint16_t *)(const void *)base);
+    default: return value_of(v, *(const uint32_t *)(const void *)base);
+    }
+}
+
 uint32_t urrt_co_comm_read(const urrt_co *co, const urrt_co_comm *row, size_t n, uint8_t sub, urrt_co_value *v)
 {
     uint32_t abort_code;
     v->text = NULL;
-    if (row->read == NULL || sub < row->sub || sub - row->sub >= row->subs || n >= urrt_co_comm_instances(co, row)) {
-        return URRT_CO_ABORT_NO_SUB;
+    if (sub < row->sub || sub - row->sub >= row->subs || n >= urrt_co_comm_instances(co, row)) {
+        return URRT_CO_ABORT_NO_SUB; /* a header row holds no sub-index */
     }
-    abort_code = row->read(co, n, sub, v);
+    abort_code = row->read != NULL ? row->read(co, n, sub, v) : read_plain(co, row, n, v);
     v->size = v->text != NULL ? v->size : type_size(row->type);
     return abort_code;
 }
@@ -1123,6 +1153,13 @@ static uint32_t range_check(uint32_t value, uint8_t type, uint32_t low, uint32_t
     return key > order_key(high, type) ? URRT_CO_ABORT_TOO_HIGH : 0u;
 }
 
+/* A value outside a row's limits: why; else 0. */
+static uint32_t limits_check(const urrt_co_comm *row, uint32_t value)
+{
+    size_t i = limits_at(row);
+    return i != NONE ? range_check(value, row->type, comm_limits[i].low, comm_limits[i].high) : 0u;
+}
+
 /* A write the entry's access and size allow: its value's rules. */
 static uint32_t od_write(urrt_co *co, uint8_t sub, const od_entry *e, uint32_t value, uint64_t now_us)
 {
@@ -1133,7 +1170,7 @@ static uint32_t od_write(urrt_co *co, uint8_t sub, const od_entry *e, uint32_t v
         co->vars[e->object->item] = abort_code != 0u ? co->vars[e->object->item] : value;
         return abort_code;
     }
-    abort_code = (row->flags & URRT_CO_LIMITS) != 0u ? range_check(value, row->type, row->low, row->high) : 0u;
+    abort_code = limits_check(row, value);
     return abort_code != 0u ? abort_code : row->write(co, e->n, sub, value, now_us);
 }
 

@@ -245,7 +245,11 @@ typedef struct urrt_co {
  * sub-indices; per-TPDO rows stand for index + n, n < tpdo_count. A row's
  * default is the value it reads right after urrt_co_start (or a reset).
  * A write is checked in one order for every object (CiA 301): exists, access,
- * size, then value (the row's limits, then its write hook's own rules). */
+ * size, then value (the row's limits, then its write hook's own rules).
+ * The rows, their names and their limits are written once in urrt_co.c, as
+ * one list; the names are an array of their own, which only
+ * urrt_co_comm_name reads: a firmware that writes no EDS links none of them
+ * (with -fdata-sections and --gc-sections). */
 
 #define URRT_CO_OBJ_SUB 0x0u      /* a sub-index of the ARRAY or RECORD a header row opened */
 #define URRT_CO_OBJ_VAR 0x7u      /* object codes as CiA 306 numbers them */
@@ -255,7 +259,14 @@ typedef struct urrt_co {
 /* urrt_co_comm.flags */
 #define URRT_CO_PER_TPDO 0x01u    /* one object per TPDO: index + n */
 #define URRT_CO_NODE_ID 0x02u     /* a COB-ID counted from the node id (an EDS's $NODEID) */
-#define URRT_CO_LIMITS 0x04u      /* low..high: a write outside is refused (0x06090032, 0x06090031) */
+/* A row without a read function (bits 4-5 of flags): its value is the
+ * member `at` bytes into the urrt_co, its urrt_co_desc or TPDO n's
+ * urrt_co_tpdo_state, read as the row's type; or `at` itself. */
+#define URRT_CO_IN_CONST 0x00u
+#define URRT_CO_IN_NODE 0x10u
+#define URRT_CO_IN_DESC 0x20u
+#define URRT_CO_IN_TPDO 0x30u
+#define URRT_CO_IN_MASK 0x30u
 
 /* A value as the SDO server sends it. */
 typedef struct urrt_co_value {
@@ -271,20 +282,26 @@ typedef uint32_t (*urrt_co_read_fn)(const struct urrt_co *co, size_t n, uint8_t 
 typedef uint32_t (*urrt_co_write_fn)(struct urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us);
 
 typedef struct urrt_co_comm {
-    const char *name;         /* an EDS's ParameterName */
-    urrt_co_read_fn read;     /* NULL for a header row */
+    urrt_co_read_fn read;     /* NULL: a header row, or a value where flags' URRT_CO_IN_* and `at` say */
     urrt_co_write_fn write;   /* NULL: read-only ("ro"), else "rw" */
-    uint32_t low, high;       /* with URRT_CO_LIMITS */
     uint16_t index;
     uint8_t sub;              /* its first sub-index */
     uint8_t subs;             /* sub-indices from `sub` on (0: a header row, which holds none) */
     uint8_t object;           /* URRT_CO_OBJ_* */
     uint8_t type;             /* URRT_CO_UNSIGNED8 .. URRT_CO_VISIBLE_STRING */
-    uint8_t flags;            /* URRT_CO_PER_TPDO, _NODE_ID, _LIMITS */
+    uint8_t flags;            /* URRT_CO_PER_TPDO, _NODE_ID, URRT_CO_IN_* */
+    uint8_t at;               /* read NULL: a member's offset, or the value (URRT_CO_IN_CONST) */
 } urrt_co_comm;
 
 extern const urrt_co_comm urrt_co_comm_table[];
 extern const size_t urrt_co_comm_count;
+
+/* A row of urrt_co_comm_table's name: an EDS's ParameterName. */
+const char *urrt_co_comm_name(const urrt_co_comm *row);
+
+/* Whether a row (not a header) has limits: then a write outside low..high
+ * is refused (URRT_CO_ABORT_TOO_LOW, URRT_CO_ABORT_TOO_HIGH). */
+bool urrt_co_comm_limits(const urrt_co_comm *row, uint32_t *low, uint32_t *high);
 
 /* The row's objects on this node: 1, or the TPDO count for a per-TPDO row. */
 size_t urrt_co_comm_instances(const struct urrt_co *co, const urrt_co_comm *row);

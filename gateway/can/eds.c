@@ -279,16 +279,17 @@ static void put_comm_row(FILE *out, const urrt_co *node, const urrt_co_comm *row
 {
     unsigned index = row->index + (unsigned)n;
     urrt_co_value v;
+    uint32_t lowest = 0, highest = 0;
+    bool limits = urrt_co_comm_limits(row, &lowest, &highest);
     for (unsigned s = row->sub; s < row->sub + row->subs; s++) {
         char name[64], def[64], low[16], high[16];
-        bool limits = (row->flags & URRT_CO_LIMITS) != 0u;
         if (urrt_co_comm_read(node, row, n, (uint8_t)s, &v) == URRT_CO_ABORT_NO_SUB) {
             continue;
         }
-        snprintf(name, sizeof name, row->subs > 1u ? "%s %u" : "%s", row->name, s);
+        snprintf(name, sizeof name, row->subs > 1u ? "%s %u" : "%s", urrt_co_comm_name(row), s);
         default_text(node, row, n, (uint8_t)s, def, sizeof def);
-        snprintf(low, sizeof low, "0x%X", (unsigned)row->low);
-        snprintf(high, sizeof high, "0x%X", (unsigned)row->high);
+        snprintf(low, sizeof low, "0x%X", (unsigned)lowest);
+        snprintf(high, sizeof high, "0x%X", (unsigned)highest);
         put_var(out, &(struct eds_var){index, row->object == URRT_CO_OBJ_VAR ? -1 : (int)s, name, row->type,
                                        row->write != NULL ? ACCESS_RW : ACCESS_RO, def, false,
                                        limits ? low : NULL, limits ? high : NULL});
@@ -308,7 +309,7 @@ static void put_communication(FILE *out, const urrt_co *node)
         }
         for (size_t n = 0; n < urrt_co_comm_instances(node, first); n++) {
             if (is_header(first)) {
-                put_record(out, first->index + (unsigned)n, first->name, first->object,
+                put_record(out, first->index + (unsigned)n, urrt_co_comm_name(first), first->object,
                            subs_present(node, first, count, n));
             }
             for (size_t k = is_header(first) ? 1u : 0u; k < count; k++) {

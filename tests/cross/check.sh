@@ -171,6 +171,24 @@ check "image (framer + decode + random access) links with -nostdlib" \
 roots=$(${CROSS}nm -g --defined-only $objs | awk 'NF == 3 && $2 ~ /[TDRB]/ { printf " -Wl,-u,%s", $3 }')
 check "image (every lib/ function) links with -nostdlib -lgcc" \
   ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $roots -lgcc -o "$out/image-all.elf"
+# The CANopen node as a firmware links it: every urrt_co_ function but
+# urrt_co_comm_name, which only an EDS writer calls; and with it. The object
+# names are an array of their own that --gc-sections must drop without it.
+co_roots=$(${CROSS}nm -g --defined-only "$out/urrt_co.o" |
+  awk 'NF == 3 && $2 ~ /[TDR]/ && $3 != "urrt_co_comm_name" { printf " -Wl,-u,%s", $3 }')
+check "image (the CANopen node, no EDS writer) links with -nostdlib -lgcc" \
+  ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $co_roots -lgcc -o "$out/image-co.elf"
+check "image (the CANopen node and urrt_co_comm_name) links with -nostdlib -lgcc" \
+  ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $co_roots -Wl,-u,urrt_co_comm_name -lgcc -o "$out/image-co-eds.elf"
+co_name="Producer heartbeat time" # 0x1017's name
+if [ -f "$out/image-co.elf" ] && [ -f "$out/image-co-eds.elf" ]; then
+  if grep -q "$co_name" "$out/image-co.elf"; then
+    fail "the CANopen node's image without urrt_co_comm_name holds the object names (\"$co_name\"): keep them out of urrt_co_comm_table"
+  else
+    ok "the CANopen node's image without urrt_co_comm_name holds no object names"
+  fi
+  check "the image with urrt_co_comm_name holds the object names (\"$co_name\")" grep -q "$co_name" "$out/image-co-eds.elf"
+fi
 
 # Footprint.
 row() { # name text data bss
@@ -197,11 +215,13 @@ while IFS='|' read -r core cc flags; do
 done <<EOF_CORES
 $CORES
 EOF_CORES
-for img in min all; do
+for img in min co co-eds all; do
   [ -f "$out/image-$img.elf" ] || continue
   set -- $(${CROSS}size "$out/image-$img.elf" | awk 'NR == 2 { print $1, $2, $3 }')
   case $img in
     min) name="image: framer + decode + random access (tests/cross)" ;;
+    co) name="image: the CANopen node, no EDS writer (tests/cross)" ;;
+    co-eds) name="image: the CANopen node and urrt_co_comm_name (tests/cross)" ;;
     all) name="image: every lib/ function (tests/cross)" ;;
   esac
   row "$name" "$1" "$2" "$3" >> "$measured"

@@ -803,6 +803,61 @@ static void test_abort_order(void)
     ABORT(1000000, 0x06010002, 0x23, 0x03, 0x10, 0x02, 0, 0, 0, 0);
 }
 
+/* ---- the communication objects' table: names and limits ---------------------------- */
+
+/* The row of (index, sub): a header row when header, else the row holding sub. */
+static const urrt_co_comm *comm_row(uint16_t index, uint8_t sub, bool header)
+{
+    size_t i;
+    for (i = 0; i < urrt_co_comm_count; i++) {
+        const urrt_co_comm *r = &urrt_co_comm_table[i];
+        if (r->index == index && (header ? r->subs == 0u : sub >= r->sub && sub - r->sub < r->subs)) {
+            return r;
+        }
+    }
+    return NULL;
+}
+
+static void expect_name(int line, uint16_t index, uint8_t sub, bool header, const char *want)
+{
+    const urrt_co_comm *r = comm_row(index, sub, header);
+    CHECK(r != NULL, "line %d: no row for 0x%04X sub %u", line, (unsigned)index, (unsigned)sub);
+    if (r != NULL) {
+        CHECK(CHECK_SAME_TEXT(urrt_co_comm_name(r), want), "line %d: 0x%04X sub %u is \"%s\", want \"%s\"", line,
+              (unsigned)index, (unsigned)sub, urrt_co_comm_name(r), want);
+    }
+}
+#define NAME(index, sub, header, want) expect_name(__LINE__, (index), (sub), (header), (want))
+
+/* Names as CiA 301 gives its objects (an EDS's ParameterName), read for
+ * rows at the start, middle and end of the table; and the one row with
+ * limits, the transmission type (CiA 301: 0 and 241..253 are not values
+ * this node takes; 1..255 is the range a write is held to first). */
+static void test_comm_table(void)
+{
+    uint32_t low = 0, high = 0;
+    size_t i;
+    NAME(0x1000, 0, false, "Device type");
+    NAME(0x1003, 0, true, "Pre-defined error field");
+    NAME(0x1003, 0, false, "Number of errors");
+    NAME(0x1003, 8, false, "Standard error field");
+    NAME(0x1017, 0, false, "Producer heartbeat time");
+    NAME(0x1018, 0, true, "Identity object");
+    NAME(0x1018, 1, false, "Vendor-ID");
+    NAME(0x1018, 4, false, "Serial number");
+    NAME(0x1800, 2, false, "Transmission type");
+    NAME(0x1A00, 0, true, "TPDO mapping parameter");
+    NAME(0x1A00, 64, false, "Mapped object");
+    for (i = 0; i < urrt_co_comm_count; i++) {
+        CHECK(urrt_co_comm_name(&urrt_co_comm_table[i])[0] != '\0', "row %zu has a name", i);
+    }
+    CHECK(urrt_co_comm_limits(comm_row(0x1800, 2, false), &low, &high) && low == 1u && high == 0xFFu,
+          "0x1800 sub 2's limits: %u..%u, want 1..255", (unsigned)low, (unsigned)high);
+    CHECK(!urrt_co_comm_limits(comm_row(0x1800, 1, false), &low, &high), "0x1800 sub 1 has no limits");
+    CHECK(!urrt_co_comm_limits(comm_row(0x1800, 0, true), &low, &high), "0x1800's header has no limits");
+    CHECK(!urrt_co_comm_limits(comm_row(0x1017, 0, false), &low, &high), "0x1017 has no limits");
+}
+
 /* ---- EMCY ------------------------------------------------------------------------- */
 
 static void read_errors(uint64_t t, uint8_t reg, uint8_t count)
@@ -1018,6 +1073,7 @@ int main(void)
     test_event_timer_zero();
     test_cob_move();
     test_abort_order();
+    test_comm_table();
     test_emcy();
     test_lengths();
     test_random();
