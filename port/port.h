@@ -311,9 +311,9 @@ void urrt_link_drop(urrt_link *link, urrt_link_drop_kind kind, const char *reaso
  * blocking). The reader sees whole lines only: a line it has no room for
  * is dropped and counted (dropped, busy), and one it took in part is
  * finished before any other (at the next send, and every retry_interval_ms:
- * pending is 1 meanwhile). A log file, and a stdout that
- * is a regular file, is written with write(2), which the kernel may make
- * wait briefly on the filesystem.
+ * pending is 1 meanwhile). A log file, a stdout that is a regular file,
+ * and stdout with log_caller_clock (a replay wants every line) are written
+ * with write(2), which may wait (on the filesystem, on the reader).
  */
 typedef struct urrt_canlink_config {
     const char *interface;     /* "can0", or "log:PATH[,ifname=NAME]" ("log:-" is stdout) */

@@ -20,10 +20,13 @@ DIST := $(BUILD)/dist
 # Java policy: a versioned jar and an unversioned link to it.
 TYPES_JAR := urrt-lcmtypes-$(URRT_VERSION).jar
 
-DOCS := README.md $(sort $(wildcard docs/*.md))
-DOC_IMAGES := $(sort $(wildcard docs/img/*.png))
+# The documents go into DOCDIR flat (docs/can.md is DOCDIR/can.md, docs/img/ is DOCDIR/img/), the
+# paths the man pages name; the README's links into docs/ are rewritten to match ($(DIST)/README.md).
+# Every relative link in the installed documents resolves: check-deb follows them all.
+DOCS := $(sort $(wildcard docs/*.md))
+DOC_IMAGES := $(sort $(wildcard docs/img/*))
 EXAMPLES := $(sort $(wildcard docs/examples/*.ini))
-DIST_FILES := $(DIST)/urrt-spy $(DIST)/urrt-gateway.service $(DIST)/urrt-gateway@.service $(DIST)/urrt.pc \
+DIST_FILES := $(DIST)/README.md $(DIST)/urrt-spy $(DIST)/urrt-gateway.service $(DIST)/urrt-gateway@.service $(DIST)/urrt.pc \
               $(DIST)/gateway.ini $(DIST)/$(TYPES_JAR)
 
 INSTALL_ITEMS = $(foreach f,$(PROGRAMS) $(DIST)/urrt-spy,$(f):$(BINDIR):0755) \
@@ -32,7 +35,7 @@ INSTALL_ITEMS = $(foreach f,$(PROGRAMS) $(DIST)/urrt-spy,$(f):$(BINDIR):0755) \
   gateway/install/urrt-gateway.example.ini:$(DATADIR)/urrt:0644 \
   $(foreach f,$(LCMTYPES),$(f):$(DATADIR)/urrt/lcmtypes:0644) \
   $(foreach f,$(MAN_PAGES),$(f):$(MANDIR)/man$(subst .,,$(suffix $(f))):0644) \
-  $(foreach f,$(DOCS) LICENSE,$(f):$(DOCDIR):0644) \
+  $(foreach f,$(DIST)/README.md $(DOCS) LICENSE,$(f):$(DOCDIR):0644) \
   $(foreach f,$(DOC_IMAGES),$(f):$(DOCDIR)/img:0644) \
   $(foreach f,$(EXAMPLES),$(f):$(DOCDIR)/examples:0644) \
   lib/urrt.h:$(INCLUDEDIR):0644 lib/urrt_can.h:$(INCLUDEDIR):0644 lib/urrt_cantx.h:$(INCLUDEDIR):0644 \
@@ -73,6 +76,12 @@ $(DIST)/urrt-gateway@.service: $(DIST)/urrt-gateway.service
 	  { echo "$@: the plain unit's ExecStart= or LogsDirectory= changed: update this rule"; rm -f $@; exit 1; }
 # check-man holds both units' Documentation= to the man page.
 check-man: $(DIST)/urrt-gateway@.service
+
+# Links to docs/X (inline, reference definitions, and their text) become X: the
+# documents sit beside it.
+$(DIST)/README.md: README.md
+	@mkdir -p $(@D)
+	sed -e 's|](docs/|](|g; s|\[docs/|[|g; s|^\( \{0,3\}\[[^]]*\]: *\)docs/|\1|' $< > $@
 
 $(DIST)/urrt-spy: gateway/install/urrt-spy
 	@mkdir -p $(@D)

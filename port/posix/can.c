@@ -23,6 +23,10 @@
  * - The interface going down reaches the socket as a pending error
  *   (ENETDOWN; ENODEV when it is removed) that makes poll() return POLLERR,
  *   so the loop notices even when it sends nothing.
+ * - A log: link to stdout never waits for its reader (see open_stdout),
+ *   and the reader sees whole candump lines only: a line it has no room
+ *   for is dropped and counted like a frame the driver refused, and one it
+ *   took in part (a terminal does that) is finished before any other.
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -34,6 +38,7 @@
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/time.h>
 #include <unistd.h>
 
@@ -57,6 +62,8 @@
  * babbling bus cannot starve the loop. Data frames handed on are bounded
  * further by URRT_CANLINK_RX_BURST. */
 #define MAX_READS_PER_SERVICE 64
+/* The longest candump line: "(" 10 "." 6 ") " IFNAMSIZ " " 8 "##" 1 128 "\n". */
+#define LOG_LINE_MAX (32 + IFNAMSIZ + 16 + 2 * URRT_CAN_MAX_LEN)
 
 /* Outage reasons: compared by address to log a change of reason once. */
 static const char REASON_DOWN[] = "interface went down";
@@ -76,7 +83,9 @@ struct urrt_canlink {
     char ifname[IFNAMSIZ];       /* SocketCAN interface, or the log's IFNAME column */
     char *log_path;              /* NULL for a socket link */
     int fd;                      /* socket or log file; -1 when closed */
-    bool log_is_stdout;
+    bool log_is_socket;          /* log:- to a socket: written with send(MSG_DONTWAIT) */
+    char line[LOG_LINE_MAX];     /* the log line being written: line_done < line_len while */
+    size_t line_len, line_done;  /* its tail waits for the reader (a partial write) */
     urrt_canlink_state state;
     bool reported_down;          /* the current outage has been logged */
     const char *down_reason;     /* last reason logged, to log a change once */
@@ -166,32 +175,92 @@ static size_t format_log_line(char *out, size_t size, const char *ifname, uint64
     return pos;
 }
 
-static int log_write(urrt_canlink *can, const urrt_can_frame *f, uint64_t now_us)
+/* Writes what it can of the current line. 1: all of it is out; 0: the
+ * reader has no room now (EAGAIN: only a non-blocking stdout says so);
+ * -1: an error (errno). */
+static int log_put(urrt_canlink *can)
 {
-    /* "(" 10 "." 6 ") " IFNAMSIZ " " 8 "##" 1 128 "\n" */
-    char line[32 + IFNAMSIZ + 16 + 2 * URRT_CAN_MAX_LEN];
-    uint64_t line_us = can->cfg.log_caller_clock ? now_us : urrt_port_realtime_us();
-    size_t len = format_log_line(line, sizeof(line), can->ifname, line_us, f, can->cfg.fd_brs);
-    size_t done = 0;
-    while (done < len) {
-        ssize_t w = write(can->fd, line + done, len - done);
-        if (w < 0) {
-            if (errno == EINTR)
-                continue;
-            can->stats.send_errors++;
-            if (errno != can->last_send_errno)
-                urrt_log(URRT_LOG_ERR, "CAN log %s: write failed: %s; frames are lost until it works again",
-                         can->log_path, strerror(errno));
-            can->last_send_errno = errno;
+    while (can->line_done < can->line_len) {
+        const char *p = can->line + can->line_done;
+        size_t n = can->line_len - can->line_done;
+        ssize_t w = can->log_is_socket ? send(can->fd, p, n, MSG_DONTWAIT) : write(can->fd, p, n);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w < 0 && (errno == EAGAIN || errno == EWOULDBLOCK))
             return 0;
-        }
-        done += (size_t)w;
+        if (w <= 0)
+            return w == 0 ? 0 : -1;
+        can->line_done += (size_t)w;
     }
+    return 1;
+}
+
+/* The reader took no byte of a line: the frame is dropped, as one the
+ * driver refused would be (the first of a spell is logged). */
+static void log_refused(urrt_canlink *can)
+{
+    can->stats.busy++;
+    can->stats.dropped++;
+    if (can->busy)
+        return;
+    urrt_log(URRT_LOG_WARNING,
+             "CAN log %s: the reader is not keeping up (stdout full); dropping whole lines, counting drops",
+             can->log_path);
+    can->busy = true;
+    can->dropped_at_busy = can->stats.dropped - 1;
+}
+
+/* Writes the line in hand (line_len > 0). 1: it is out; 0: the reader
+ * took none of it (the line is dropped) or only a part (its tail waits in
+ * hand, and goes before any other line); -1: an error, logged, the line
+ * lost. So a line in hand has always begun: the stream never holds half a
+ * line followed by another. */
+static int log_finish(urrt_canlink *can, uint64_t now_us)
+{
+    int r = log_put(can);
+    if (r < 0) {
+        can->stats.send_errors++;
+        if (errno != can->last_send_errno)
+            urrt_log(URRT_LOG_ERR, "CAN log %s: write failed: %s; frames are lost until it works again",
+                     can->log_path, strerror(errno));
+        can->last_send_errno = errno;
+        can->line_len = can->line_done = 0;
+        return -1;
+    }
+    if (r == 0) {
+        if (can->line_done == 0) {
+            log_refused(can);
+            can->line_len = 0;
+        }
+        can->retry_at_us = now_us + (uint64_t)can->cfg.retry_interval_ms * 1000u;
+        can->stats.pending = can->line_len > 0;
+        return 0;
+    }
+    can->line_len = can->line_done = 0;
+    can->stats.pending = 0;
+    can->stats.sent++;
     if (can->last_send_errno != 0)
         urrt_log(URRT_LOG_NOTICE, "CAN log %s: writing again", can->log_path);
     can->last_send_errno = 0;
-    can->stats.sent++;
+    if (can->busy)
+        urrt_log(URRT_LOG_NOTICE, "CAN log %s: the reader takes lines again; %llu dropped meanwhile",
+                 can->log_path, (unsigned long long)(can->stats.dropped - can->dropped_at_busy));
+    can->busy = false;
     return 1;
+}
+
+/* 1: the frame's line is out; 0: dropped (no room for it, or the tail of
+ * the line before still waits), lost to an error, or its own tail waits. */
+static int log_write(urrt_canlink *can, const urrt_can_frame *f, uint64_t now_us)
+{
+    if (can->line_len > 0 && log_finish(can, now_us) == 0) {
+        log_refused(can);
+        return 0;
+    }
+    uint64_t line_us = can->cfg.log_caller_clock ? now_us : urrt_port_realtime_us();
+    can->line_len = format_log_line(can->line, sizeof(can->line), can->ifname, line_us, f, can->cfg.fd_brs);
+    can->line_done = 0;
+    return log_finish(can, now_us) > 0 ? 1 : 0;
 }
 
 /* "log:PATH[,ifname=NAME]" */
@@ -219,11 +288,53 @@ static bool parse_log_interface(urrt_canlink *can, const char *spec)
     return can->log_path != NULL;
 }
 
+/*
+ * "log:-". Its reader may stop reading (a pager, a script that hangs, a
+ * terminal held with Ctrl-S), and a blocking write would then stop the
+ * whole loop. But O_NONBLOCK on descriptor 1 itself would be set on the
+ * open file description it shares with the shell and the rest of the
+ * pipeline, which expect blocking writes and reads (the next program on a
+ * terminal left non-blocking may fail with EAGAIN), and it would outlive
+ * us if we crashed. So, by what stdout is:
+ * - a pipe, FIFO or character device (a terminal, /dev/null) is opened
+ *   again through /proc/self/fd/1: a new open file description of the same
+ *   pipe or terminal that is ours alone, made non-blocking (libuv does the
+ *   same for terminals); O_NOCTTY: a terminal never becomes ours to control;
+ * - a socket (systemd's StandardOutput=journal) is written with
+ *   send(MSG_DONTWAIT), non-blocking per call, nothing shared changed;
+ * - a regular file is written like log:FILE, and so is stdout when it
+ *   cannot be opened again (no /proc): said once, since a stalled reader
+ *   then stalls the loop;
+ * - with log_caller_clock (urrt-gateway --replay: no live loop to keep
+ *   going, and its point is every frame) stdout is written as it is too,
+ *   waiting for the reader (`--replay ... | less` shows every line).
+ */
+static void open_stdout(urrt_canlink *can)
+{
+    struct stat st;
+    can->fd = STDOUT_FILENO;
+    if (can->cfg.log_caller_clock || fstat(STDOUT_FILENO, &st) != 0 || S_ISREG(st.st_mode) ||
+        S_ISBLK(st.st_mode))
+        return;
+    if (S_ISSOCK(st.st_mode)) {
+        can->log_is_socket = true;
+        return;
+    }
+    int fd = open("/proc/self/fd/1", O_WRONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+    if (fd < 0) {
+        urrt_log(URRT_LOG_WARNING,
+                 "CAN log -: cannot open stdout again to write it without blocking (/proc/self/fd/1: %s); "
+                 "writing it as it is: a reader that stops reading stops the gateway (mount /proc, or "
+                 "use log:FILE)", strerror(errno));
+        return;
+    }
+    can->fd = fd;
+}
+
 static bool open_log(urrt_canlink *can)
 {
     if (strcmp(can->log_path, "-") == 0) {
-        can->fd = STDOUT_FILENO;
-        can->log_is_stdout = true;
+        open_stdout(can);
     } else {
         can->fd = open(can->log_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
         if (can->fd < 0) {
@@ -817,7 +928,10 @@ void urrt_canlink_free(urrt_canlink *can)
     if (can == NULL)
         return;
     if (can->log_path != NULL) {
-        if (!can->log_is_stdout && can->fd >= 0)
+        if (can->line_len > 0 && log_finish(can, urrt_port_monotonic_us()) == 0)
+            urrt_log(URRT_LOG_WARNING, "CAN log %s: closed with its last line incomplete: the reader did not "
+                     "take it", can->log_path);
+        if (can->fd >= 0 && can->fd != STDOUT_FILENO)
             close(can->fd);
     } else {
         close_socket(can);
@@ -884,8 +998,10 @@ int urrt_canlink_poll_fd(const urrt_canlink *can, short *events)
 
 uint64_t urrt_canlink_deadline(const urrt_canlink *can)
 {
-    if (can == NULL || can->log_path != NULL)
+    if (can == NULL)
         return UINT64_MAX;
+    if (can->log_path != NULL)
+        return can->line_len > 0 ? can->retry_at_us : UINT64_MAX; /* a tail waits for the reader */
     if (can->state != URRT_CANLINK_UP)
         return can->reopen_at_us;
     if (can->rx_more)
@@ -904,8 +1020,13 @@ uint64_t urrt_canlink_deadline(const urrt_canlink *can)
 
 void urrt_canlink_service(urrt_canlink *can, uint64_t now_us)
 {
-    if (can == NULL || can->log_path != NULL)
+    if (can == NULL)
         return;
+    if (can->log_path != NULL) {
+        if (can->line_len > 0 && now_us >= can->retry_at_us)
+            log_finish(can, now_us);
+        return;
+    }
     if (can->state != URRT_CANLINK_UP) {
         if (now_us >= can->reopen_at_us)
             reopen(can, now_us);

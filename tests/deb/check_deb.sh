@@ -4,6 +4,8 @@
 #  - make deb builds it; lintian finds no error and no warning (debian/ overrides justify any)
 #  - its contents: programs, unit and template unit (neither enabled), conffile, man pages, docs,
 #    examples, .lcm, jar, C header, library and pkg-config file
+#  - every relative link in the installed README and documents resolves in the unpacked package
+#    (tests/deb/doc_links.py), and the README keeps all the links it has in the tree
 #  - dpkg installs it into a scratch root (a bootstrap of busybox and a dpkg database holding its
 #    dependencies as the host has them: no container, no root of the host touched), the programs
 #    run from there, the shipped example passes --check-config, the unedited /etc/urrt/gateway.ini
@@ -40,7 +42,8 @@ for f in /usr/bin/urrt-gateway /usr/bin/urrt-dump /usr/bin/urrt-sim /usr/bin/urr
          /lib/systemd/system/urrt-gateway.service /lib/systemd/system/urrt-gateway@.service /etc/urrt/gateway.ini \
          /usr/share/man/man8/urrt-gateway.8.gz /usr/share/man/man5/urrt-gateway.ini.5.gz \
          /usr/share/man/man1/urrt-dump.1.gz /usr/share/man/man1/urrt-sim.1.gz /usr/share/man/man1/urrt-spy.1.gz \
-         /usr/share/doc/urrt/copyright /usr/share/doc/urrt/gateway.md.gz /usr/share/doc/urrt/examples/canopen.ini \
+         /usr/share/doc/urrt/copyright /usr/share/doc/urrt/README.md /usr/share/doc/urrt/gateway.md \
+         /usr/share/doc/urrt/examples/canopen.ini \
          /usr/share/urrt/urrt-gateway.example.ini /usr/share/urrt/lcmtypes/state_t.lcm \
          /usr/share/java/urrt-lcmtypes.jar /usr/include/urrt.h /usr/include/urrt_can.h /usr/include/urrt_cantx.h \
          /usr/include/urrt_co.h; do
@@ -48,6 +51,19 @@ for f in /usr/bin/urrt-gateway /usr/bin/urrt-dump /usr/bin/urrt-sim /usr/bin/urr
 done
 check "contents: liburrt.a and urrt.pc under /usr/lib/<multiarch>" \
   sh -c "grep -q '^/usr/lib/[^/]*/liburrt.a$' '$T/contents' && grep -q '^/usr/lib/[^/]*/pkgconfig/urrt.pc$' '$T/contents'"
+# The documents as a reader of /usr/share/doc/urrt gets them: every link followed.
+dpkg-deb -x "$deb" "$T/pkg"
+doc=$T/pkg/usr/share/doc/urrt
+/usr/bin/python3 tests/deb/doc_links.py "$T/pkg" "$doc"/*.md > "$T/links" 2>&1; rc=$?
+sed 's/^/links: /' "$T/links"
+check "every relative link in the installed README and docs resolves (files, directories, #anchors)" \
+  sh -c "[ $rc = 0 ] && grep -q '^usr/share/doc/urrt/README.md: ' '$T/links'"
+tree=$(/usr/bin/python3 tests/deb/doc_links.py . README.md | sed -n 's/^README.md: \([0-9]*\) links.*/\1/p')
+installed=$(sed -n 's|^usr/share/doc/urrt/README.md: \([0-9]*\) links.*|\1|p' "$T/links")
+check "the installed README keeps the tree's ${tree:-?} relative links (has ${installed:-?})" \
+  sh -c "[ -n '$tree' ] && [ '$tree' = '$installed' ]"
+check "no document compressed (links name .md files)" sh -c "! grep -q '^/usr/share/doc/urrt/.*\.md\.gz$' '$T/contents'"
+
 dpkg-deb --ctrl-tarfile "$deb" | tar -x -C "$T" ./conffiles ./postinst 2>/dev/null
 check "conffiles: /etc/urrt/gateway.ini alone" sh -c "[ \"\$(cat '$T/conffiles')\" = /etc/urrt/gateway.ini ]"
 check "the unit is not enabled on install (only if it was enabled before)" \

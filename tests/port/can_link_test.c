@@ -5,7 +5,10 @@
  *   can_link_test log DIR      the candump-log output (no CAN needed): writes
  *                              DIR/log-fd.log, DIR/log-classic.log,
  *                              DIR/log-stdout.log and DIR/log-expect.txt for
- *                              an independent reader (python-can, canplayer)
+ *                              an independent reader (python-can, canplayer);
+ *                              and log:- to a pipe, a socket and a terminal
+ *                              whose reader stalls, and under a replay's
+ *                              clock (it waits for a slow reader)
  *   can_link_test frames DIR   sends a known set of frames through SocketCAN
  *                              links on vcan0 (FD MTU) and vcan1 (classic
  *                              MTU), checks them with its own receiving
@@ -30,14 +33,18 @@
 #include <inttypes.h>
 #include <net/if.h>
 #include <poll.h>
+#include <pthread.h>
+#include <signal.h>
 #include <spawn.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <linux/can.h>
@@ -65,13 +72,18 @@ static long voluntary_switches(void)
 /* ---- captured log messages ----------------------------------------------------- */
 
 static char messages[16384];
+/* Set while calls are measured for sleeping: stderr may be a pipe to a
+ * slow reader (make's tee), and a write to it must not count against the
+ * link. The messages are printed afterwards from messages[]. */
+static bool capture_quiet;
 
 static void capture(void *ctx, urrt_log_level level, const char *message)
 {
     (void)ctx;
     size_t used = strlen(messages);
     snprintf(messages + used, sizeof(messages) - used, "%s\n", message);
-    fprintf(stderr, "  [link %s] %s\n", urrt_log_level_name(level), message);
+    if (!capture_quiet)
+        fprintf(stderr, "  [link %s] %s\n", urrt_log_level_name(level), message);
 }
 
 static void messages_clear(void)
@@ -419,6 +431,366 @@ static urrt_can_frame case_frame(const log_case *c)
     return f;
 }
 
+/* ---- log:- with a reader that stalls --------------------------------------------- */
+
+/* A call that blocked on the stalled reader would never return (nothing
+ * reads then): the alarm turns that hang into a failure. */
+static void stall_alarm(int sig)
+{
+    (void)sig;
+    static const char msg[] = "FAIL: a log:- test did not end in 30 s: a call blocked on its stalled reader?\n";
+    ssize_t ignored = write(STDERR_FILENO, msg, sizeof(msg) - 1);
+    (void)ignored;
+    _exit(1);
+}
+
+/* Reads what the reader's end (a pipe, a socket) holds: the writes before
+ * were synchronous, so poll with no timeout sees all of it. Returns the
+ * length read. */
+static size_t drain_now(int rd, char *buf, size_t size)
+{
+    size_t n = 0;
+    struct pollfd p = { .fd = rd, .events = POLLIN };
+    while (n < size - 1 && poll(&p, 1, 0) == 1 && (p.revents & POLLIN)) {
+        ssize_t r = read(rd, buf + n, size - 1 - n);
+        if (r <= 0)
+            break;
+        n += (size_t)r;
+    }
+    buf[n] = '\0';
+    return n;
+}
+
+/* The counters of the lines in text, which must all be whole candump lines
+ * "(SEC.USEC) can1 123#CCCCCCCC"; false at the first that is not. */
+static bool stall_lines(char *text, size_t len, uint32_t *seq, size_t max, size_t *n, uint64_t lo, uint64_t hi)
+{
+    *n = 0;
+    if (len > 0 && text[len - 1] != '\n') {
+        CHECK(false, "the stream ends inside a line: ...%s", len > 40 ? text + len - 40 : text);
+        return false;
+    }
+    for (char *save = NULL, *line = strtok_r(text, "\n", &save); line != NULL; line = strtok_r(NULL, "\n", &save)) {
+        const char *rest = strip_stamp(line, lo, hi);
+        unsigned v;
+        int end = 0;
+        if (rest == NULL || strncmp(rest, "can1 123#", 9) != 0 || strlen(rest) != 17 ||
+            sscanf(rest + 9, "%8X%n", &v, &end) != 1 || end != 8 || *n == max) {
+            CHECK(false, "not a whole candump line of the test: \"%s\"", line);
+            return false;
+        }
+        seq[(*n)++] = v;
+    }
+    return true;
+}
+
+static urrt_can_frame seq_frame(uint32_t i)
+{
+    urrt_can_frame f = make_frame(0x123, false, false, 4, 0);
+    f.data[0] = (uint8_t)(i >> 24);
+    f.data[1] = (uint8_t)(i >> 16);
+    f.data[2] = (uint8_t)(i >> 8);
+    f.data[3] = (uint8_t)i;
+    return f;
+}
+
+/* log:- into a pipe whose reader stops reading (a pager, a hung script),
+ * or a stream socket (systemd's StandardOutput=journal, socat): every call
+ * returns at once, frames it has no room for are dropped and counted, the
+ * reader then finds only whole lines, exactly those of the frames the link
+ * took, and writing resumes when it drains. stdout's own open file
+ * description stays blocking: the shell shares it. */
+static void test_log_stall(bool socket_out)
+{
+    enum { TAKEN_MAX = 8192, STALLED_SENDS = 500, RESUMED = 20 };
+    static uint32_t taken[TAKEN_MAX], got[TAKEN_MAX];
+    static char text[TAKEN_MAX * 40];
+    size_t n_taken = 0, n_got = 0;
+    const char *kind = socket_out ? "socket" : "pipe";
+    int p[2];
+    CHECK((socket_out ? socketpair(AF_UNIX, SOCK_STREAM, 0, p) : pipe(p)) == 0, "%s: %s", kind, strerror(errno));
+    fflush(stdout);
+    int saved = dup(STDOUT_FILENO);
+    dup2(p[1], STDOUT_FILENO);
+    close(p[1]);
+    signal(SIGALRM, stall_alarm);
+    alarm(30);
+    uint64_t lo = urrt_port_realtime_us();
+
+    messages_clear();
+    urrt_canlink *so = open_link("log:-,ifname=can1", false, false);
+    int stdout_flags = fcntl(STDOUT_FILENO, F_GETFL);
+    uint64_t longest = 0;
+    long slept = 0;
+    uint32_t i = 0, refused = 0, taken_before = 0;
+    capture_quiet = true;
+    for (; so != NULL && refused < STALLED_SENDS && i < 4 * TAKEN_MAX; i++) {
+        urrt_can_frame f = seq_frame(i);
+        long switches0 = voluntary_switches();
+        uint64_t t0 = now_us();
+        int r = urrt_canlink_send(so, &f, t0);
+        uint64_t dt = now_us() - t0;
+        slept += voluntary_switches() - switches0;
+        longest = dt > longest ? dt : longest;
+        if (r == 1 && n_taken < TAKEN_MAX)
+            taken[n_taken++] = i;
+        refused += r == 0;
+        if (r == 0 && taken_before == 0)
+            taken_before = (uint32_t)n_taken;
+    }
+    capture_quiet = false;
+    fprintf(stderr, "%s", messages);
+    CHECK(so != NULL, "log:- link on a %s", kind);
+    if (so == NULL)
+        goto out;
+    fprintf(stderr, "  stalled %s: %u sends, %zu taken before it was full, %u refused; longest call %" PRIu64
+            " us\n", kind, i, n_taken, refused, longest);
+    CHECK(stdout_flags >= 0 && !(stdout_flags & O_NONBLOCK), "stdout's shared description stays blocking");
+    CHECK(slept == 0, "%ld calls slept on the stalled reader", slept);
+    /* A blocked write would wait for ever (nothing reads): any bound tells,
+     * and one second holds on a loaded host. */
+    CHECK(longest < 1000000, "longest call %" PRIu64 " us", longest);
+    CHECK_EQ_INT(refused, STALLED_SENDS);
+    CHECK(n_taken > 100 && taken_before == n_taken, "the %s took %zu lines, all before the first refusal", kind,
+          n_taken);
+    const urrt_canlink_stats *st = urrt_canlink_get_stats(so);
+    CHECK_EQ_INT(st->sent, n_taken);
+    CHECK_EQ_INT(st->dropped, STALLED_SENDS);
+    CHECK_EQ_INT(st->busy, STALLED_SENDS);
+    CHECK_EQ_INT(st->send_errors, 0);
+    CHECK_EQ_INT(st->pending, 0); /* both take a short line whole or not at all */
+    CHECK_EQ_INT(count_substr(messages, "not keeping up"), 1);
+
+    /* The reader comes back: whole lines, exactly the frames taken. */
+    size_t len = drain_now(p[0], text, sizeof(text));
+    uint64_t hi = urrt_port_realtime_us();
+    if (stall_lines(text, len, got, TAKEN_MAX, &n_got, lo, hi)) {
+        CHECK_EQ_INT(n_got, n_taken);
+        CHECK(n_got == n_taken && memcmp(got, taken, n_got * sizeof(got[0])) == 0,
+              "the lines read are the frames taken, in order");
+    }
+
+    /* Drained: every frame goes out again, and the recovery is said. */
+    messages_clear();
+    for (uint32_t k = 0; k < RESUMED; k++) {
+        urrt_can_frame f = seq_frame(i + k);
+        CHECK_EQ_INT(urrt_canlink_send(so, &f, now_us()), 1);
+    }
+    char said[64];
+    snprintf(said, sizeof(said), "takes lines again; %d dropped meanwhile", STALLED_SENDS);
+    CHECK(strstr(messages, said) != NULL, "logged: %s", messages);
+    CHECK_EQ_INT(st->sent, n_taken + RESUMED);
+    CHECK_EQ_INT(st->dropped, STALLED_SENDS);
+    len = drain_now(p[0], text, sizeof(text));
+    if (stall_lines(text, len, got, TAKEN_MAX, &n_got, lo, urrt_port_realtime_us())) {
+        CHECK_EQ_INT(n_got, RESUMED);
+        CHECK(n_got == RESUMED && got[0] == i && got[RESUMED - 1] == i + RESUMED - 1, "the resumed lines");
+    }
+    urrt_canlink_free(so);
+out:
+    alarm(0);
+    CHECK(fcntl(STDOUT_FILENO, F_GETFD) >= 0, "stdout stays open after urrt_canlink_free");
+    dup2(saved, STDOUT_FILENO);
+    close(saved);
+    close(p[0]);
+}
+
+/* A pty's master end, its slave in raw mode (bytes as written: no "\n" to
+ * "\r\n") in *slave; -1 when there is none. */
+static int open_raw_pty(int *slave)
+{
+    int master = posix_openpt(O_RDWR | O_NOCTTY);
+    *slave = -1;
+    if (master >= 0 && grantpt(master) == 0 && unlockpt(master) == 0)
+        *slave = open(ptsname(master), O_RDWR | O_NOCTTY);
+    if (*slave < 0) {
+        if (master >= 0)
+            close(master);
+        return -1;
+    }
+    struct termios raw;
+    tcgetattr(*slave, &raw);
+    cfmakeraw(&raw);
+    tcsetattr(*slave, TCSANOW, &raw);
+    return master;
+}
+
+/* What a test's reader has read so far. */
+typedef struct stream_reader {
+    int fd;
+    size_t len, lines;
+    char text[8192 * 40];
+} stream_reader;
+
+/* Reads at most max bytes of what arrives within timeout_ms. */
+static void read_some(stream_reader *rd, size_t max, int timeout_ms)
+{
+    struct pollfd p = { .fd = rd->fd, .events = POLLIN };
+    size_t room = sizeof(rd->text) - 1 - rd->len;
+    if (room == 0 || poll(&p, 1, timeout_ms) != 1)
+        return;
+    ssize_t r = read(rd->fd, rd->text + rd->len, max < room ? max : room);
+    for (ssize_t k = 0; k < r; k++)
+        rd->lines += rd->text[rd->len + (size_t)k] == '\n';
+    rd->len += r > 0 ? (size_t)r : 0;
+    rd->text[rd->len] = '\0';
+}
+
+/* Sends frames numbered from *next until one goes to the terminal in part
+ * (pending 1), recording those taken whole. Where the terminal's room runs
+ * out is the kernel's affair: when a line is refused whole, the reader
+ * frees a little and the writer fills again. Returns the calls that slept. */
+static long fill_until_part(urrt_canlink *so, stream_reader *rd, int slave, uint32_t *next, uint32_t *taken,
+                            size_t max, size_t *n_taken)
+{
+    const urrt_canlink_stats *st = urrt_canlink_get_stats(so);
+    long slept = 0;
+    for (int round = 0; round < 40 && st->pending == 0; round++) {
+        while (st->pending == 0 && *n_taken < max) {
+            urrt_can_frame f = seq_frame(*next);
+            long switches0 = voluntary_switches();
+            int r = urrt_canlink_send(so, &f, now_us());
+            slept += voluntary_switches() - switches0;
+            if (r == 1)
+                taken[(*n_taken)++] = *next;
+            (*next)++;
+            if (r == 0 && st->pending == 0)
+                break; /* refused whole */
+        }
+        if (st->pending != 0)
+            break;
+        read_some(rd, 100, 1000);
+        struct pollfd p = { .fd = slave, .events = POLLOUT };
+        poll(&p, 1, 200); /* room comes when the kernel moves on what the reader left */
+    }
+    return slept;
+}
+
+/* log:- to a terminal whose reader stalls. Unlike a pipe, a terminal takes
+ * part of a line when it has room for only part: the link keeps the tail
+ * (pending 1), drops what comes meanwhile, and finishes the tail before any
+ * other line, so the reader still sees whole lines only. */
+static void test_log_tty(void)
+{
+    enum { MAX_LINES = 8192 };
+    static uint32_t taken[MAX_LINES], got[MAX_LINES];
+    static stream_reader rd;
+    size_t n_taken = 0, n_got = 0;
+    int slave;
+    rd.fd = open_raw_pty(&slave);
+    CHECK(rd.fd >= 0, "a pty: %s", strerror(errno));
+    if (rd.fd < 0)
+        return;
+    fflush(stdout);
+    int saved = dup(STDOUT_FILENO);
+    dup2(slave, STDOUT_FILENO);
+    signal(SIGALRM, stall_alarm);
+    alarm(30);
+    uint64_t lo = urrt_port_realtime_us();
+    messages_clear();
+    urrt_canlink *so = open_link("log:-,ifname=can1", false, false);
+    CHECK(so != NULL, "log:- link on a terminal");
+    if (so == NULL)
+        goto out;
+    const urrt_canlink_stats *st = urrt_canlink_get_stats(so);
+    uint32_t next = 0;
+    capture_quiet = true;
+    long slept = fill_until_part(so, &rd, slave, &next, taken, MAX_LINES - 1, &n_taken);
+    uint32_t in_part = next - 1;
+    fprintf(stderr, "  terminal: %zu lines taken whole, line %u went in part\n", n_taken, (unsigned)in_part);
+    CHECK(st->pending == 1, "a line went to the terminal in part");
+    /* While the tail waits, new frames are dropped, and no call sleeps. */
+    uint64_t dropped0 = st->dropped;
+    for (uint32_t k = 0; k < 3; k++) {
+        urrt_can_frame f = seq_frame(next++);
+        long switches0 = voluntary_switches();
+        CHECK_EQ_INT(urrt_canlink_send(so, &f, now_us()), 0);
+        slept += voluntary_switches() - switches0;
+    }
+    capture_quiet = false;
+    fprintf(stderr, "%s", messages);
+    CHECK_EQ_INT(st->dropped, dropped0 + 3);
+    CHECK_EQ_INT(slept, 0);
+    CHECK(urrt_canlink_deadline(so) != UINT64_MAX, "a waiting tail is due for a retry");
+    /* The reader drains; the link finishes the tail when its retry is due. */
+    for (int waited = 0; st->pending != 0 && waited < 5000; waited += 10) {
+        read_some(&rd, SIZE_MAX, 10);
+        if (now_us() >= urrt_canlink_deadline(so))
+            urrt_canlink_service(so, now_us());
+    }
+    CHECK_EQ_INT(st->pending, 0);
+    taken[n_taken++] = in_part;
+    CHECK_EQ_INT(st->sent, n_taken);
+    /* The rest, as the kernel passes it on: a line for each frame taken. */
+    for (int waited = 0; rd.lines < n_taken && waited < 5000; waited += 10)
+        read_some(&rd, SIZE_MAX, 10);
+    if (stall_lines(rd.text, rd.len, got, MAX_LINES, &n_got, lo, urrt_port_realtime_us())) {
+        CHECK_EQ_INT(n_got, n_taken);
+        CHECK(n_got == n_taken && memcmp(got, taken, n_got * sizeof(got[0])) == 0,
+              "the lines read are the frames taken, the one written in part among them, in order");
+    }
+    urrt_canlink_free(so);
+out:
+    alarm(0);
+    dup2(saved, STDOUT_FILENO);
+    close(saved);
+    close(slave);
+    close(rd.fd);
+}
+
+/* A reader that takes one byte per read: far slower than the link writes. */
+static void *slow_reader(void *arg)
+{
+    int rd = *(int *)arg;
+    static char text[8192 * 40];
+    size_t n = 0;
+    ssize_t r;
+    while (n < sizeof(text) - 1 && (r = read(rd, text + n, 1)) > 0)
+        n += (size_t)r;
+    text[n] = '\0';
+    return text;
+}
+
+/* With log_caller_clock (urrt-gateway --replay) log:- waits for its reader:
+ * a replay's point is every frame, and it has no live loop to keep going.
+ * A reader far slower than the link still gets every line. */
+static void test_log_replay_waits(void)
+{
+    enum { N = 4000 };
+    static uint32_t got[N];
+    size_t n_got = 0;
+    int p[2];
+    CHECK(pipe(p) == 0, "pipe: %s", strerror(errno));
+    fflush(stdout);
+    int saved = dup(STDOUT_FILENO);
+    dup2(p[1], STDOUT_FILENO);
+    close(p[1]);
+    urrt_canlink_config cfg;
+    urrt_canlink_config_defaults(&cfg);
+    cfg.interface = "log:-,ifname=can1";
+    cfg.log_caller_clock = true;
+    urrt_canlink *so = urrt_canlink_new(&cfg);
+    pthread_t reader;
+    pthread_create(&reader, NULL, slow_reader, &p[0]);
+    int taken = 0;
+    for (uint32_t i = 0; so != NULL && i < N; i++) {
+        urrt_can_frame f = seq_frame(i);
+        taken += urrt_canlink_send(so, &f, 1000000u + i) == 1;
+    }
+    urrt_canlink_free(so);
+    dup2(saved, STDOUT_FILENO); /* the pipe's last writer gone: the reader sees its end */
+    close(saved);
+    void *text;
+    pthread_join(reader, &text);
+    close(p[0]);
+    CHECK(so != NULL, "log:- link with the caller's clock");
+    CHECK_EQ_INT(taken, N);
+    if (stall_lines(text, strlen(text), got, N, &n_got, 1000000u, 1000000u + N)) {
+        CHECK_EQ_INT(n_got, N);
+        CHECK(n_got == N && got[0] == 0 && got[N - 1] == N - 1, "every line, in order");
+    }
+}
+
 static int test_log(const char *dir)
 {
     char path_fd[512], path_cc[512], path_out[512], path_expect[512], spec[600];
@@ -521,6 +893,10 @@ static int test_log(const char *dir)
     snprintf(spec, sizeof(spec), "log:%s/x.log,ifname=averyveryverylongname", dir);
     CHECK(open_link(spec, false, false) == NULL, "long ifname");
     CHECK(strstr(messages, "ifname") != NULL, "reason: %s", messages);
+    test_log_stall(false);
+    test_log_stall(true);
+    test_log_tty();
+    test_log_replay_waits();
     /* Only files were written here: said, not held to "never sleeps" (see call_ended). */
     printf("log writes that waited on the filesystem: %u (longest call %" PRIu64 " us)\n", file_waits, max_call_us);
     return check_report();

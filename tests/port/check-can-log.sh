@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: MIT
 # make check-can-log: the CAN link's candump-log output, on the host (no CAN
 # needed): exact lines from can_link_test, then python-can's candump-log
-# reader (an independent parser) on the same files.
+# reader (an independent parser) on the same files; and log:- into a pipe,
+# a socket and a terminal whose reader stalls (can_link_test log).
 #   tests/port/check-can-log.sh DIR (where can_link_test and can_link_test_san are)
 bin=$1
 . tests/lib.sh

@@ -6,7 +6,8 @@
 #                  first (handshake, partial writes, drops); and gateway/common/cli.c's
 #                  host:port parsing
 #   check-can-log  the CAN link's candump-log output (port/posix/can.c) on the host, no CAN
-#                  needed: exact lines from can_link_test, then python-can's candump-log reader
+#                  needed: exact lines from can_link_test, then python-can's candump-log reader;
+#                  log:- into a pipe, a socket and a terminal whose reader stalls
 #   (check-vm)     the CAN link on a real kernel's vcan: tests/port/can-link.sh runs
 #                  can_link_test in the VM of tests/vm/vm.mk (frames, candump/canplayer
 #                  agreement, full queue, down/up, error frames)
