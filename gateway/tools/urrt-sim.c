@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * urrt-sim: a robot controller's RealTime stream, served here.
+ * urrt-sim: a robot controller's RealTime stream, and on request its RTDE
+ * port (gateway/tools/sim_rtde.c) from the same arm, served here.
  *
  * One packet per period on an absolute monotonic schedule, to every
  * connected client, from a deterministic model of a moving UR5e-like arm
@@ -31,6 +32,7 @@
 #include "cli.h"
 #include "port.h"
 #include "sim_model.h"
+#include "sim_rtde.h"
 #include "urrt.h"
 
 #define PROGRAM "urrt-sim"
@@ -69,6 +71,10 @@ typedef struct fault_config {
     uint64_t freeze_after;    /* freeze the whole stream after N packets ... */
     uint64_t freeze_every;    /* ... or after every N packets ... */
     uint64_t freeze_ms;       /* ... for this long (0: for good) */
+    /* RTDE only. */
+    sim_rtde_faults rtde;
+    uint32_t rtde_backlog;    /* disconnect a reader this many bytes behind */
+    bool rtde_given;          /* an rtde-* fault was given */
 } fault_config;
 
 /* What the packets' time column counts. */
@@ -82,6 +88,11 @@ typedef struct options {
     char listen_host[256];
     uint16_t listen_port;
     const char *port_file;
+    bool rtde;                /* serve RTDE too */
+    char rtde_host[256];
+    uint16_t rtde_port;
+    const char *rtde_port_file;
+    sim_rtde_controller rtde_controller;
     sim_clock clock;
     uint32_t length;
     double rate_hz;
@@ -104,6 +115,7 @@ typedef struct options {
 typedef struct command_line {
     options opt;
     const char *listen_arg;
+    const char *rtde_arg;      /* --rtde HOST:PORT */
     const char *version_arg;   /* --controller V, or --version V */
     bool length_given;
     int argc;                  /* for --version, which may take the next word */
@@ -147,11 +159,13 @@ typedef struct client {
     bool reset_when_drained;
     bool recording;
     uint64_t received;       /* bytes the client sent us (ignored) */
+    sim_rtde_session *rtde;  /* an RTDE client: its session (NULL: RealTime) */
 } client;
 
 typedef struct sim {
     options opt;
     int listen_fd;
+    int rtde_fd;              /* the RTDE listener, -1 without --rtde */
     client clients[MAX_CLIENTS_LIMIT];
     size_t nclients;
     uint64_t next_client_id;
@@ -163,12 +177,14 @@ typedef struct sim {
     sim_model model;
     replay rp;
     bool replaying;
+    urrt_state state;         /* the model's state at the current packet */
     uint8_t packet[URRT_PACKET_MAX];
     uint8_t odd_packet[URRT_PACKET_MAX];
     FILE *record;
     bool record_taken;        /* the first client has been assigned the recording */
     uint64_t garbage_sent;
     uint64_t slow_drops;
+    uint64_t rtde_behind;     /* RTDE readers disconnected for falling behind */
     uint64_t packets_out;     /* packets emitted by the schedule */
     uint64_t frozen_until_ns; /* freeze fault: nothing is emitted before this (0: not frozen) */
     uint64_t freezes;
@@ -225,13 +241,21 @@ static void usage(FILE *out)
 "      --max-clients N      refuse clients past N at once (default 16)\n"
 "      --rt-priority N      run under SCHED_FIFO at priority N (1-99; needs\n"
 "                           CAP_SYS_NICE): less jitter on a busy machine\n"
-"  -w, --record PATH        write the exact bytes sent to the first client\n"
-"                           (a raw capture for urrt-dump --file and --replay)\n"
+"  -w, --record PATH        write the exact bytes sent to the first RealTime\n"
+"                           client (a raw capture for urrt-dump --file and\n"
+"                           --replay)\n"
 "      --replay PATH        send a raw capture (e.g. `nc robot 30003 > PATH`),\n"
 "                           paced by its time column; bytes between packets\n"
 "                           are sent as they are, a partial packet at the end\n"
 "                           is not; it starts when the first client connects\n"
 "      --loop               replay again and again (default: exit at the end)\n"
+"\n"
+"RTDE (the Real-Time Data Exchange of TCP port 30004, from the same arm):\n"
+"      --rtde HOST:PORT     serve RTDE there too (port 0: any free port), as the\n"
+"                           controller version of --controller (default 3.10)\n"
+"                           does: its variables, 125 Hz before 5.0 and 500 Hz\n"
+"                           from 5.0, protocol 1 only before 3.4\n"
+"      --rtde-port-file FILE  once listening, write the RTDE port to FILE\n"
 "\n"
 "Faults (repeat --fault to combine them; N counts packets per client):\n"
 "  -f, --fault close-after=N          close the connection after N packets\n"
@@ -256,6 +280,19 @@ static void usage(FILE *out)
 "                                     every client gets the stream again, the\n"
 "                                     packets of the frozen period skipped\n"
 "      --fault freeze-every=N,for=MS  the same freeze after every N packets\n"
+"  RTDE clients get the faults above but garbage-every and odd-length, N\n"
+"  counting data packages, and these:\n"
+"      --fault rtde-refuse-v2         refuse protocol 2 (V), accept 1\n"
+"      --fault rtde-text-handshake    a text message before every reply\n"
+"      --fault rtde-text-every=N[,level=L]  a text message (level 0-3, default\n"
+"                                     2 warning) before data packages N+1,\n"
+"                                     2N+1, ...\n"
+"      --fault rtde-bad-package=N[,kind=size|type|recipe|header]  every Nth data\n"
+"                                     package bad: a byte short (default), an\n"
+"                                     unknown type, a wrong recipe id, a size\n"
+"                                     field below the header\n"
+"      --fault rtde-backlog=B         disconnect a reader more than B bytes\n"
+"                                     behind (default 65536)\n"
 "\n"
 "Other:\n"
 "  -v, --verbose            log every client (twice: debug)\n"
@@ -276,7 +313,9 @@ static void usage(FILE *out)
 "  " PROGRAM " -l [::1]:30013 --fault close-after=500 --fault garbage-every=100\n"
 "  " PROGRAM " --start-on-connect -n 1000 -w capture.bin --clients 1\n"
 "  " PROGRAM " -l 127.0.0.1:0 --port-file sim.port --fault freeze-every=2500,for=1500\n"
-"  " PROGRAM " --replay capture.bin --loop\n",
+"  " PROGRAM " --replay capture.bin --loop\n"
+"  " PROGRAM " -c 5.12.3.1234 -l 127.0.0.1:0 --port-file rt.port \\\n"
+"           --rtde 127.0.0.1:0 --rtde-port-file rtde.port --fault rtde-text-every=500\n",
             URRT_PACKET_MAX, DEFAULT_LENGTH);
 }
 
@@ -320,6 +359,38 @@ static uint64_t fault_value(const char *name, const char *value, uint64_t min, u
     return v;
 }
 
+/* A kind that takes no value. */
+static void no_value(const char *kind, const char *value)
+{
+    if (value != NULL) {
+        cli_usage_error(PROGRAM, "fault %s takes no value (drop \"=%s\")", kind, value);
+    }
+}
+
+/* The RTDE-only kinds; false for a kind that is not one of them. */
+static bool parse_rtde_fault_kind(const char *kind, const char *value, fault_config *f)
+{
+    if (strcmp(kind, "rtde-refuse-v2") == 0) {
+        no_value(kind, value);
+        f->rtde.refuse_v2 = true;
+    } else if (strcmp(kind, "rtde-text-handshake") == 0) {
+        no_value(kind, value);
+        f->rtde.text_handshake = true;
+    } else if (strcmp(kind, "rtde-text-every") == 0) {
+        f->rtde.text_every = fault_value(kind, value, 1, UINT64_MAX);
+        f->rtde.text_level = 2;
+    } else if (strcmp(kind, "rtde-bad-package") == 0) {
+        f->rtde.bad_every = fault_value(kind, value, 1, UINT64_MAX);
+        f->rtde.bad_kind = SIM_RTDE_BAD_SIZE;
+    } else if (strcmp(kind, "rtde-backlog") == 0) {
+        f->rtde_backlog = (uint32_t)fault_value(kind, value, 1, 1u << 30);
+    } else {
+        return false;
+    }
+    f->rtde_given = true;
+    return true;
+}
+
 /* The first part of a --fault: the kind and its count. */
 static void parse_fault_kind(const char *kind, const char *value, fault_config *f)
 {
@@ -345,9 +416,11 @@ static void parse_fault_kind(const char *kind, const char *value, fault_config *
         f->freeze_after = fault_value(kind, value, 1, UINT64_MAX);
     } else if (strcmp(kind, "freeze-every") == 0) {
         f->freeze_every = fault_value(kind, value, 1, UINT64_MAX);
-    } else {
+    } else if (!parse_rtde_fault_kind(kind, value, f)) {
         cli_usage_error(PROGRAM, "unknown fault \"%s\": use close-after, reset-after, truncate-after, "
-                        "garbage-every, tiny-writes, coalesce, stall-after, odd-length, freeze-after or freeze-every",
+                        "garbage-every, tiny-writes, coalesce, stall-after, odd-length, freeze-after, freeze-every, "
+                        "or for RTDE rtde-refuse-v2, rtde-text-handshake, rtde-text-every, rtde-bad-package or "
+                        "rtde-backlog",
                         kind);
     }
 }
@@ -363,6 +436,18 @@ static void parse_fault_param(const char *spec, const char *kind, const char *ke
     } else if ((strcmp(kind, "freeze-after") == 0 || strcmp(kind, "freeze-every") == 0) &&
                strcmp(key, "for") == 0) {
         f->freeze_ms = fault_value(key, value, 1, 86400000);
+    } else if (strcmp(kind, "rtde-text-every") == 0 && strcmp(key, "level") == 0) {
+        f->rtde.text_level = (uint8_t)fault_value(key, value, 0, 3);
+    } else if (strcmp(kind, "rtde-bad-package") == 0 && strcmp(key, "kind") == 0) {
+        static const char *const kinds[] = {"size", "type", "recipe", "header"}; /* sim_rtde_bad's order */
+        size_t k = 0;
+        while (k < 4 && (value == NULL || strcmp(value, kinds[k]) != 0)) {
+            k++;
+        }
+        if (k == 4) {
+            cli_usage_error(PROGRAM, "fault \"%s\": kind is size, type, recipe or header", spec);
+        }
+        f->rtde.bad_kind = (sim_rtde_bad)k;
     } else if (strcmp(kind, "odd-length") == 0 && strcmp(key, "length") == 0) {
         f->odd_length = (uint32_t)fault_value(key, value, URRT_PACKET_MIN, URRT_PACKET_MAX);
         if ((f->odd_length - URRT_HEADER_SIZE) % 8 != 0) {
@@ -462,6 +547,8 @@ _Static_assert(sizeof(sim_clock) == sizeof(int), "CLI_WORD stores an int");
 static const cli_option option_table[] = {
     {"listen", 'l', required_argument, CLI_TEXT, AT(listen_arg), 0, 0, NULL, NULL, NULL},
     {"port-file", 0, required_argument, CLI_TEXT, AT(opt.port_file), 0, 0, NULL, NULL, NULL},
+    {"rtde", 0, required_argument, CLI_TEXT, AT(rtde_arg), 0, 0, NULL, NULL, NULL},
+    {"rtde-port-file", 0, required_argument, CLI_TEXT, AT(opt.rtde_port_file), 0, 0, NULL, NULL, NULL},
     {"clock", 0, required_argument, CLI_WORD, AT(opt.clock), 0, 0, NULL, clock_words, NULL},
     {"version", 'V', optional_argument, CLI_FN, 0, 0, 0, NULL, NULL, version_or_controller},
     {"controller", 'c', required_argument, CLI_TEXT, AT(version_arg), 0, 0, NULL, NULL, NULL},
@@ -526,6 +613,41 @@ static void check_combinations(command_line *cl)
     }
 }
 
+/* --rtde: where, and the controller version whose RTDE to serve. */
+static void resolve_rtde(command_line *cl)
+{
+    options *o = &cl->opt;
+    const char *why, *version = cl->version_arg != NULL ? cl->version_arg : "3.10";
+    if (cl->rtde_arg == NULL) {
+        if (o->rtde_port_file != NULL || o->fault.rtde_given) {
+            cli_usage_error(PROGRAM, "%s goes with --rtde HOST:PORT",
+                            o->rtde_port_file != NULL ? "--rtde-port-file" : "an rtde-* fault");
+        }
+        return;
+    }
+    if (o->replay_path != NULL) {
+        cli_usage_error(PROGRAM, "--rtde serves the simulated arm, not a capture: drop --replay or --rtde");
+    }
+    if (cl->length_given) {
+        cli_usage_error(PROGRAM, "--rtde serves a controller version's variables: give --controller V, not --length");
+    }
+    if ((why = sim_rtde_controller_parse(version, &o->rtde_controller)) != NULL) {
+        cli_usage_error(PROGRAM, "--rtde as controller %s: %s", version, why);
+    }
+    if (o->rate_hz != (double)o->rtde_controller.rate_hz) {
+        cli_usage_error(PROGRAM, "--rtde: controller %s runs at %u Hz on both ports: drop --rate", version,
+                        (unsigned)o->rtde_controller.rate_hz);
+    }
+    if ((why = cli_parse_listen_address(cl->rtde_arg, SIM_RTDE_PORT, o->rtde_host, sizeof o->rtde_host,
+                                        &o->rtde_port)) != NULL) {
+        cli_usage_error(PROGRAM, "--rtde %s: %s", cl->rtde_arg, why);
+    }
+    if (o->fault.rtde_backlog == 0) {
+        o->fault.rtde_backlog = SIM_RTDE_BACKLOG_DEFAULT;
+    }
+    o->rtde = true;
+}
+
 static void parse_options(int argc, char **argv, options *o)
 {
     static const cli_options set = {PROGRAM, option_table, sizeof option_table / sizeof option_table[0], usage,
@@ -546,6 +668,7 @@ static void parse_options(int argc, char **argv, options *o)
         resolve_controller(&cl);
     }
     check_combinations(&cl);
+    resolve_rtde(&cl);
     *o = cl.opt;
 }
 
@@ -678,10 +801,11 @@ static const uint8_t *packet_bytes(sim *s, uint64_t k, uint64_t due, size_t *len
         *len = s->rp.end[i] - start;
         return s->rp.data + start;
     }
-    urrt_state st;
-    sim_model_state(&s->model, k, urrt_generation_of(s->opt.length) == URRT_GEN_1X ? URRT_GEN_1X : URRT_GEN_3X, &st);
-    st.time[0] = clock_column(s, k, due);
-    int n = urrt_encode(&st, s->opt.length, s->packet, sizeof s->packet);
+    /* Kept for the RTDE clients: one state, the same values on both ports. */
+    urrt_state *st = &s->state;
+    sim_model_state(&s->model, k, urrt_generation_of(s->opt.length) == URRT_GEN_1X ? URRT_GEN_1X : URRT_GEN_3X, st);
+    st->time[0] = clock_column(s, k, due);
+    int n = urrt_encode(st, s->opt.length, s->packet, sizeof s->packet);
     *len = n > 0 ? (size_t)n : 0;
     return s->packet;
 }
@@ -727,17 +851,42 @@ static void drop_client(sim *s, size_t i, urrt_log_level level, const char *why)
         s->record = NULL;
     }
     free(c->queue);
+    free(c->rtde);
     s->clients[i] = s->clients[--s->nclients];
+    if (i < s->nclients && s->clients[i].rtde != NULL) {
+        s->clients[i].rtde->emit_ctx = &s->clients[i]; /* it moved */
+    }
     s->clients_done++;
 }
 
-static void accept_clients(sim *s, uint64_t now)
+/* An RTDE session's replies and packages go into its client's queue, to be
+ * written at once. */
+static bool rtde_emit(void *ctx, const uint8_t *bytes, size_t len)
+{
+    client *c = ctx;
+    return queue_bytes(c, bytes, len);
+}
+
+/* A new client of the RTDE port: its session. */
+static bool rtde_attach(sim *s, client *c)
+{
+    c->rtde = malloc(sizeof *c->rtde);
+    if (c->rtde == NULL) {
+        urrt_log(URRT_LOG_WARNING, "refusing RTDE client %s: out of memory", c->peer);
+        return false;
+    }
+    sim_rtde_session_init(c->rtde, &s->opt.rtde_controller, &s->opt.fault.rtde, rtde_emit, c, c->peer);
+    return true;
+}
+
+/* New clients of a listener: the RealTime one, or the RTDE one (rtde). */
+static void accept_clients(sim *s, int listen_fd, bool rtde, uint64_t now)
 {
     for (;;) {
         struct sockaddr_storage ss;
         socklen_t sl = sizeof ss;
         char host[64], serv[8];
-        int fd = accept4(s->listen_fd, (struct sockaddr *)&ss, &sl, SOCK_NONBLOCK | SOCK_CLOEXEC);
+        int fd = accept4(listen_fd, (struct sockaddr *)&ss, &sl, SOCK_NONBLOCK | SOCK_CLOEXEC);
         client *c;
         int on = 1, sndbuf = CLIENT_SNDBUF;
 
@@ -767,7 +916,12 @@ static void accept_clients(sim *s, uint64_t now)
         c->fd = fd;
         c->id = ++s->next_client_id;
         snprintf(c->peer, sizeof c->peer, strchr(host, ':') ? "[%s]:%s" : "%s:%s", host, serv);
-        if (s->opt.record_path != NULL && !s->record_taken) {
+        if (rtde && !rtde_attach(s, c)) {
+            close(fd);
+            s->nclients--;
+            continue;
+        }
+        if (s->opt.record_path != NULL && !s->record_taken && !rtde) {
             s->record_taken = true;
             c->recording = true;
         }
@@ -776,8 +930,69 @@ static void accept_clients(sim *s, uint64_t now)
             s->t0_ns = now;
             s->next = 0;
         }
-        urrt_log(URRT_LOG_INFO, "client %s connected%s", c->peer, c->recording ? " (recorded)" : "");
+        urrt_log(URRT_LOG_INFO, "%sclient %s connected%s", rtde ? "RTDE " : "", c->peer,
+                 c->recording ? " (recorded)" : "");
     }
+}
+
+/* Whether a client takes a packet now: not closing, not in a stall. */
+static bool client_takes(client *c, uint64_t now)
+{
+    if (c->close_when_drained) {
+        return false;
+    }
+    if (c->stalled) {
+        if (now < c->stall_until_ns) {
+            return false;
+        }
+        c->stalled = false;
+        urrt_log(URRT_LOG_INFO, "client %s: stall over, sending again", c->peer);
+    }
+    return true;
+}
+
+/* The faults that act once packet n went into the queue (from byte before):
+ * the ends of the connection, the stall, what may be written. */
+static void after_packet(sim *s, client *c, uint64_t n, size_t before, uint64_t now)
+{
+    const fault_config *f = &s->opt.fault;
+    if (f->truncate_after != 0 && n == f->truncate_after) {
+        c->len = before + (c->len - before) / 2;
+        c->close_when_drained = true;
+    }
+    if ((f->close_after != 0 && n == f->close_after) || (s->opt.count != 0 && n == s->opt.count)) {
+        c->close_when_drained = true;
+    }
+    if (f->reset_after != 0 && n == f->reset_after) {
+        c->close_when_drained = true;
+        c->reset_when_drained = true;
+    }
+    if (f->stall_after != 0 && n == f->stall_after) {
+        c->stalled = true;
+        c->stall_until_ns = f->stall_ms ? now + f->stall_ms * 1000000ull : UINT64_MAX;
+        urrt_log(URRT_LOG_INFO, "client %s: stalling after %" PRIu64 " packet%s", c->peer, n, plural(n));
+    }
+    if (f->coalesce == 0 || n % f->coalesce == 0 || c->close_when_drained) {
+        c->releasable = c->len;
+    }
+}
+
+/* An RTDE client's data package of control cycle k, when its recipe's
+ * rate has one in this cycle; the same faults as on the RealTime port. */
+static void rtde_to_client(sim *s, client *c, uint64_t k, uint64_t now)
+{
+    size_t before = c->len;
+    uint64_t n;
+    if (!sim_rtde_due(c->rtde, k) || !client_takes(c, now)) {
+        return;
+    }
+    n = ++c->packets;
+    if (!sim_rtde_send_data(c->rtde, k, &s->state)) {
+        c->close_when_drained = true;
+        c->len = 0;
+        return;
+    }
+    after_packet(s, c, n, before, now);
 }
 
 /* Packet n (1-based, per client) goes into the client's queue, shaped by
@@ -786,17 +1001,11 @@ static void emit_to_client(sim *s, client *c, const uint8_t *pkt, size_t len, ui
 {
     const fault_config *f = &s->opt.fault;
     uint64_t n;
+    size_t before;
     bool ok = true;
 
-    if (c->close_when_drained) {
+    if (!client_takes(c, now)) {
         return;
-    }
-    if (c->stalled) {
-        if (now < c->stall_until_ns) {
-            return;
-        }
-        c->stalled = false;
-        urrt_log(URRT_LOG_INFO, "client %s: stall over, sending again", c->peer);
     }
     n = ++c->packets;
     if (f->garbage_every != 0 && n > 1 && (n - 1) % f->garbage_every == 0) {
@@ -829,31 +1038,14 @@ static void emit_to_client(sim *s, client *c, const uint8_t *pkt, size_t len, ui
         pkt = s->odd_packet;
         len = odd;
     }
-    if (f->truncate_after != 0 && n == f->truncate_after) {
-        len /= 2;
-        c->close_when_drained = true;
-    }
+    before = c->len;
     ok = ok && queue_bytes(c, pkt, len);
     if (!ok) {
         c->close_when_drained = true;
         c->len = 0;
         return;
     }
-    if ((f->close_after != 0 && n == f->close_after) || (s->opt.count != 0 && n == s->opt.count)) {
-        c->close_when_drained = true;
-    }
-    if (f->reset_after != 0 && n == f->reset_after) {
-        c->close_when_drained = true;
-        c->reset_when_drained = true;
-    }
-    if (f->stall_after != 0 && n == f->stall_after) {
-        c->stalled = true;
-        c->stall_until_ns = f->stall_ms ? now + f->stall_ms * 1000000ull : UINT64_MAX;
-        urrt_log(URRT_LOG_INFO, "client %s: stalling after %" PRIu64 " packet%s", c->peer, n, plural(n));
-    }
-    if (f->coalesce == 0 || n % f->coalesce == 0 || c->close_when_drained) {
-        c->releasable = c->len;
-    }
+    after_packet(s, c, n, before, now);
 }
 
 /* Writes what may be written now. Returns false when the client is gone. */
@@ -901,6 +1093,10 @@ static bool flush_client(sim *s, size_t i, uint64_t now)
              * the pieces that are due, each in its own write. */
             uint64_t per_packet = s->replaying ? s->rp.span_ns / s->rp.count : s->period_ns;
             size_t plen = s->replaying ? s->rp.end[s->rp.count - 1] / s->rp.count : s->opt.length;
+            if (c->rtde != NULL) {
+                per_packet = s->period_ns * c->rtde->divisor;
+                plen = c->rtde->data_size + 4;
+            }
             uint64_t interval = per_packet * tiny / (2 * plen);
             uint64_t from = c->next_write_ns + per_packet > now ? c->next_write_ns : now;
             c->next_write_ns = from + interval;
@@ -916,7 +1112,15 @@ static bool flush_client(sim *s, size_t i, uint64_t now)
                     : "closed");
         return false;
     }
-    if ((c->full_since_ns != 0 && now - c->full_since_ns > SLOW_CLIENT_NS) || c->len > CLIENT_QUEUE_MAX) {
+    if (c->rtde != NULL && c->len > s->opt.fault.rtde_backlog) {
+        /* A controller closes an RTDE reader whose unread data overflows its
+         * buffer: no throttling, no dropping of packages. */
+        s->rtde_behind++;
+        drop_client(s, i, URRT_LOG_WARNING, "disconnected: fell behind (its backlog passed the RTDE limit)");
+        return false;
+    }
+    if (c->rtde == NULL &&
+        ((c->full_since_ns != 0 && now - c->full_since_ns > SLOW_CLIENT_NS) || c->len > CLIENT_QUEUE_MAX)) {
         s->slow_drops++;
         drop_client(s, i, URRT_LOG_WARNING, "dropped: too slow (its socket stayed full)");
         return false;
@@ -924,14 +1128,24 @@ static bool flush_client(sim *s, size_t i, uint64_t now)
     return true;
 }
 
-/* Reads and discards what a client sends: a controller would run it as
- * URScript, a simulator only says so. Returns false when the client left. */
+/* Reads what a client sends: an RTDE client's requests go to its session;
+ * a RealTime client's bytes are discarded (a controller would run them as
+ * URScript, a simulator only says so). Returns false when the client left. */
 static bool read_client(sim *s, size_t i)
 {
     client *c = &s->clients[i];
     uint8_t buf[4096];
     for (;;) {
         ssize_t n = recv(c->fd, buf, sizeof buf, MSG_DONTWAIT);
+        if (n > 0 && c->rtde != NULL) {
+            c->received += (uint64_t)n;
+            if (!sim_rtde_feed(c->rtde, buf, (size_t)n)) {
+                drop_client(s, i, URRT_LOG_INFO, "disconnected (unframable package)");
+                return false;
+            }
+            c->releasable = c->len; /* replies go at once */
+            continue;
+        }
         if (n > 0) {
             if (c->received == 0) {
                 urrt_log(URRT_LOG_WARNING, "client %s sends data: ignored (a controller on port 30003 would run it as URScript)",
@@ -1042,7 +1256,11 @@ static void run_schedule(sim *s, uint64_t now)
             note_lateness(&s->lat, now - due, period ? period : 1);
             pkt = packet_bytes(s, s->next, due, &len);
             for (size_t i = 0; i < s->nclients; i++) {
-                emit_to_client(s, &s->clients[i], pkt, len, now);
+                if (s->clients[i].rtde != NULL) {
+                    rtde_to_client(s, &s->clients[i], s->next, now);
+                } else {
+                    emit_to_client(s, &s->clients[i], pkt, len, now);
+                }
             }
             s->packets_out++;
             maybe_freeze(s, due);
@@ -1060,20 +1278,21 @@ static void run_schedule(sim *s, uint64_t now)
     }
 }
 
-static int open_listener(const options *o)
+/* A listener on host:port, which option gave (named in the errors). */
+static int open_listener(const char *host, uint16_t port, const char *option)
 {
     struct addrinfo hints, *res = NULL, *ai;
     char service[8];
     int fd = -1, rc, on = 1;
     char where[300];
 
-    cli_format_host_port(o->listen_host, o->listen_port, where, sizeof where);
+    cli_format_host_port(host, port, where, sizeof where);
     memset(&hints, 0, sizeof hints);
     hints.ai_family = AF_UNSPEC;
     hints.ai_socktype = SOCK_STREAM;
     hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
-    snprintf(service, sizeof service, "%u", (unsigned)o->listen_port);
-    rc = getaddrinfo(o->listen_host, service, &hints, &res);
+    snprintf(service, sizeof service, "%u", (unsigned)port);
+    rc = getaddrinfo(host, service, &hints, &res);
     if (rc != 0) {
         urrt_log(URRT_LOG_ERR, "cannot listen on %s: %s (give an address of this machine, e.g. 127.0.0.1 or 0.0.0.0)",
                  where, gai_strerror(rc));
@@ -1094,12 +1313,14 @@ static int open_listener(const options *o)
         errno = rc;
     }
     if (fd < 0) {
-        urrt_log(URRT_LOG_ERR, "cannot listen on %s: %s%s", where, strerror(errno),
-                 errno == EADDRINUSE      ? " (another simulator or program has the port: pick another with --listen)"
+        urrt_log(URRT_LOG_ERR, "cannot listen on %s: %s%s%s%s", where, strerror(errno),
+                 errno == EADDRINUSE      ? " (another simulator or program has the port: pick another with "
                  : errno == EADDRNOTAVAIL ? " (not an address of this machine: use 127.0.0.1, 0.0.0.0 or one that "
-                                            "`ip addr` lists)"
-                 : errno == EACCES        ? " (ports below 1024 need root: pick another with --listen)"
-                                          : "");
+                                            "`ip addr` lists in "
+                 : errno == EACCES        ? " (ports below 1024 need root: pick another with "
+                                          : "",
+                 errno == EADDRINUSE || errno == EADDRNOTAVAIL || errno == EACCES ? option : "",
+                 errno == EADDRINUSE || errno == EADDRNOTAVAIL || errno == EACCES ? ")" : "");
     }
     freeaddrinfo(res);
     return fd;
@@ -1149,11 +1370,12 @@ static void log_summary(const sim *s, uint64_t now)
     urrt_log(URRT_LOG_NOTICE,
              "%" PRIu64 " packet%s in %.3f s; late (a period or more behind) %" PRIu64 ", skipped %" PRIu64
              "; lateness mean %.1f us, p99 <= %.0f us, max %.1f us; clients %" PRIu64 ", dropped as slow %" PRIu64
-             "; garbage bytes %" PRIu64 "; freezes %" PRIu64 " (%" PRIu64 " packet%s not sent)",
+             "; garbage bytes %" PRIu64 "; freezes %" PRIu64 " (%" PRIu64 " packet%s not sent)"
+             "; RTDE readers disconnected as behind %" PRIu64,
              s->packets_out, plural(s->packets_out), secs, lat->late, lat->skipped,
              lat->samples ? (double)lat->sum_ns / (double)lat->samples / 1e3 : 0.0,
              (double)percentile_ns(lat, 0.99) / 1e3, (double)lat->max_ns / 1e3, s->next_client_id, s->slow_drops,
-             s->garbage_sent, s->freezes, s->frozen_packets, plural(s->frozen_packets));
+             s->garbage_sent, s->freezes, s->frozen_packets, plural(s->frozen_packets), s->rtde_behind);
 }
 
 /* Real-time priority on request; a normal one with a warning if refused. */
@@ -1181,6 +1403,13 @@ static void log_serving(const sim *s)
         urrt_log(URRT_LOG_NOTICE, "serving %" PRIu32 "-byte packets (%s) at %g Hz on %s, seed %" PRIu64,
                  s->opt.length, v ? v : "no controller sends this length", s->opt.rate_hz, where, s->opt.seed);
     }
+    if (s->opt.rtde) {
+        const sim_rtde_controller *c = &s->opt.rtde_controller;
+        cli_format_host_port(s->opt.rtde_host, s->opt.rtde_port, where, sizeof where);
+        urrt_log(URRT_LOG_NOTICE, "serving RTDE as controller %" PRIu32 ".%" PRIu32 ".%" PRIu32 ".%" PRIu32
+                 " (%" PRIu32 " Hz, protocol %s) on %s", c->major, c->minor, c->bugfix, c->build, c->rate_hz,
+                 c->major == 3 && c->minor < 4 ? "1" : "1 and 2", where);
+    }
 }
 
 /* The source of packets, the recording, the listener; false (logged) if
@@ -1204,14 +1433,25 @@ static bool sim_start(sim *s)
             return false;
         }
     }
-    s->listen_fd = open_listener(&s->opt);
+    s->listen_fd = open_listener(s->opt.listen_host, s->opt.listen_port, "--listen");
+    s->rtde_fd = -1;
     if (s->listen_fd < 0) {
         return false;
     }
     s->opt.listen_port = bound_port(s->listen_fd);
+    if (s->opt.rtde) {
+        s->rtde_fd = open_listener(s->opt.rtde_host, s->opt.rtde_port, "--rtde");
+        if (s->rtde_fd < 0) {
+            return false;
+        }
+        s->opt.rtde_port = bound_port(s->rtde_fd);
+    }
     log_serving(s);
     /* After the log line, so that a reader woken by the file finds it too. */
     if (s->opt.port_file != NULL && !write_port_file(s->opt.port_file, s->opt.listen_port)) {
+        return false;
+    }
+    if (s->opt.rtde_port_file != NULL && !write_port_file(s->opt.rtde_port_file, s->opt.rtde_port)) {
         return false;
     }
     /* A capture starts from its first packet for the first client. */
@@ -1228,13 +1468,14 @@ static bool sim_finished(const sim *s)
            (s->replay_done && s->nclients == 0);
 }
 
-/* The descriptors to wait on (the listener first, then each client) and,
+/* The descriptors to wait on (the listeners first, then each client) and,
  * in *wake, the time of the next packet, paced write or slow-client verdict. */
 static size_t poll_set(const sim *s, uint64_t now, struct pollfd *pfds, uint64_t *wake)
 {
     size_t nfds = 0;
     *wake = s->started && !s->replay_done ? s->t0_ns + due_offset(s, s->next) : UINT64_MAX;
     pfds[nfds++] = (struct pollfd){.fd = s->listen_fd, .events = POLLIN};
+    pfds[nfds++] = (struct pollfd){.fd = s->rtde_fd, .events = POLLIN}; /* -1: ignored */
     for (size_t i = 0; i < s->nclients; i++) {
         const client *c = &s->clients[i];
         short ev = POLLIN;
@@ -1245,7 +1486,7 @@ static size_t poll_set(const sim *s, uint64_t now, struct pollfd *pfds, uint64_t
                 ev |= POLLOUT;
             }
         }
-        if (c->full_since_ns != 0) {
+        if (c->full_since_ns != 0 && c->rtde == NULL) {
             uint64_t give_up = c->full_since_ns + SLOW_CLIENT_NS + 1;
             *wake = give_up < *wake ? give_up : *wake;
         }
@@ -1270,7 +1511,7 @@ static int wait_until(struct pollfd *pfds, size_t nfds, uint64_t wake, uint64_t 
 static void serve_ready(sim *s, const struct pollfd *pfds, size_t nfds, uint64_t now)
 {
     /* Clients by descriptor: dropping one reorders the array. */
-    for (size_t k = nfds; k-- > 1;) {
+    for (size_t k = nfds; k-- > 2;) {
         if (pfds[k].revents == 0) {
             continue;
         }
@@ -1288,14 +1529,17 @@ static void serve_ready(sim *s, const struct pollfd *pfds, size_t nfds, uint64_t
         }
     }
     if (pfds[0].revents & POLLIN) {
-        accept_clients(s, now);
+        accept_clients(s, s->listen_fd, false, now);
+    }
+    if (pfds[1].revents & POLLIN) {
+        accept_clients(s, s->rtde_fd, true, now);
     }
 }
 
 /* The loop: send what is due, wait, serve. Returns the exit status. */
 static int serve(sim *s)
 {
-    static struct pollfd pfds[MAX_CLIENTS_LIMIT + 1];
+    static struct pollfd pfds[MAX_CLIENTS_LIMIT + 2];
     while (running) {
         uint64_t now = now_ns();
         uint64_t wake;
@@ -1337,6 +1581,9 @@ static int sim_stop(sim *s, int status)
         status = CLI_EXIT_RUNTIME;
     }
     close(s->listen_fd);
+    if (s->rtde_fd >= 0) {
+        close(s->rtde_fd);
+    }
     return status;
 }
 

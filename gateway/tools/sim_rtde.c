@@ -1,0 +1,832 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * sim_rtde.c: see sim_rtde.h. The wire format, big-endian throughout: a
+ * package is uint16 size (header included), uint8 type letter, payload.
+ * docs/tools.md ("RTDE") states what the simulator does where UR's
+ * documentation is silent.
+ */
+#include "sim_rtde.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "port.h"
+
+/* Package types. */
+#define RTDE_V_PROTOCOL 'V'
+#define RTDE_V_URCONTROL 'v'
+#define RTDE_TEXT 'M'
+#define RTDE_DATA 'U'
+#define RTDE_SETUP_OUTPUTS 'O'
+#define RTDE_SETUP_INPUTS 'I'
+#define RTDE_START 'S'
+#define RTDE_PAUSE 'P'
+#define RTDE_HEADER 3
+#define RTDE_SIZE_MAX 65535u
+#define RTDE_OUTPUT_RECIPE_ID 1
+#define LEVEL_ERROR 1
+
+/* A version as one number: 5.5.1 is 50501. */
+#define VER(major, minor, bugfix) ((major) * 10000u + (minor) * 100u + (bugfix))
+#define NEVER 0u            /* not on this line of controllers */
+#define BASE3 VER(3, 3, 0)  /* RTDE's first CB3 version */
+#define BASE5 VER(5, 0, 0)
+#define REG3 VER(3, 4, 0)   /* the fieldbus range of registers, 0..23 */
+#define UPPER3 VER(3, 9, 0) /* the range for RTDE clients, 24..47 and bits 64..127 */
+#define UPPER5 VER(5, 3, 0)
+
+typedef enum wire_type { W_BOOL, W_UINT8, W_UINT32, W_UINT64, W_INT32, W_DOUBLE, W_VECTOR3D, W_VECTOR6D, W_VECTOR6INT32 } wire_type;
+
+static const struct {
+    const char *token;
+    uint8_t count;  /* elements */
+    uint8_t size;   /* bytes of one element */
+} wire[] = {
+    [W_BOOL] = {"BOOL", 1, 1},       [W_UINT8] = {"UINT8", 1, 1},       [W_UINT32] = {"UINT32", 1, 4},
+    [W_UINT64] = {"UINT64", 1, 8},   [W_INT32] = {"INT32", 1, 4},       [W_DOUBLE] = {"DOUBLE", 1, 8},
+    [W_VECTOR3D] = {"VECTOR3D", 3, 8}, [W_VECTOR6D] = {"VECTOR6D", 6, 8}, [W_VECTOR6INT32] = {"VECTOR6INT32", 6, 4},
+};
+
+/* One cycle's values, every one as doubles (integers up to 2^53 exactly);
+ * a recipe field points at its first element. */
+typedef struct values {
+    double timestamp, target_q[6], target_qd[6], target_qdd[6], target_current[6], target_moment[6];
+    double actual_q[6], actual_qd[6], actual_current[6], joint_control_output[6];
+    double actual_tcp_pose[6], actual_tcp_speed[6], actual_tcp_force[6], target_tcp_pose[6], target_tcp_speed[6];
+    double din, din_conf, dout, dout_conf, joint_temperatures[6], execution_time;
+    double robot_mode, joint_mode[6], safety_mode, safety_status, accelerometer[3], speed_scaling;
+    double speed_fraction, momentum, main_voltage, robot_voltage, robot_current, joint_voltage[6];
+    double runtime_state, elbow_position[3], elbow_velocity[3], robot_status_bits, safety_status_bits;
+    double payload, payload_cog[3], payload_inertia[6], time_scale_source, control_step;
+    double tool_output_voltage, ft_raw_wrench[6];
+    double out_bits[2], out_bit[64], out_int[48], out_double[48];
+    double in_bits[2], in_bit[64], in_int[48], in_double[48];
+    double zero[6];   /* every variable the model does not move */
+} values;
+
+#define VALUES_COUNT (sizeof(values) / sizeof(double))
+#define AT(member) ((uint16_t)(offsetof(values, member) / sizeof(double)))
+
+typedef struct variable {
+    const char *name;
+    uint8_t type;
+    uint32_t since3, since5;   /* first CB3 and e-Series versions, NEVER if none */
+    uint16_t value;
+} variable;
+
+/* UR's output variables and the first versions that have them. Where UR
+ * gives no version the simulator serves the variable on every version. */
+static const variable outputs[] = {
+    {"timestamp", W_DOUBLE, BASE3, BASE5, AT(timestamp)},
+    {"target_q", W_VECTOR6D, BASE3, BASE5, AT(target_q)},
+    {"target_qd", W_VECTOR6D, BASE3, BASE5, AT(target_qd)},
+    {"target_qdd", W_VECTOR6D, BASE3, BASE5, AT(target_qdd)},
+    {"target_current", W_VECTOR6D, BASE3, BASE5, AT(target_current)},
+    {"target_moment", W_VECTOR6D, BASE3, BASE5, AT(target_moment)},
+    {"actual_q", W_VECTOR6D, BASE3, BASE5, AT(actual_q)},
+    {"actual_qd", W_VECTOR6D, BASE3, BASE5, AT(actual_qd)},
+    {"actual_current", W_VECTOR6D, BASE3, BASE5, AT(actual_current)},
+    {"actual_current_window", W_VECTOR6D, BASE3, BASE5, AT(zero)},
+    {"actual_current_as_torque", W_VECTOR6D, NEVER, VER(5, 23, 0), AT(zero)},
+    {"joint_control_output", W_VECTOR6D, BASE3, BASE5, AT(joint_control_output)},
+    {"actual_TCP_pose", W_VECTOR6D, BASE3, BASE5, AT(actual_tcp_pose)},
+    {"actual_TCP_speed", W_VECTOR6D, BASE3, BASE5, AT(actual_tcp_speed)},
+    {"actual_TCP_force", W_VECTOR6D, BASE3, BASE5, AT(actual_tcp_force)},
+    {"target_TCP_pose", W_VECTOR6D, BASE3, BASE5, AT(target_tcp_pose)},
+    {"target_TCP_speed", W_VECTOR6D, BASE3, BASE5, AT(target_tcp_speed)},
+    {"tcp_offset", W_VECTOR6D, BASE3, BASE5, AT(zero)},
+    {"actual_TCP_acceleration", W_VECTOR6D, BASE3, BASE5, AT(zero)},
+    {"target_TCP_acceleration", W_VECTOR6D, BASE3, BASE5, AT(zero)},
+    {"actual_digital_input_bits", W_UINT64, BASE3, BASE5, AT(din)},
+    {"actual_configurable_digital_input_bits", W_UINT64, BASE3, BASE5, AT(din_conf)},
+    {"joint_temperatures", W_VECTOR6D, BASE3, BASE5, AT(joint_temperatures)},
+    {"actual_execution_time", W_DOUBLE, BASE3, BASE5, AT(execution_time)},
+    {"target_execution_time", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"robot_mode", W_INT32, BASE3, BASE5, AT(robot_mode)},
+    {"joint_mode", W_VECTOR6INT32, BASE3, BASE5, AT(joint_mode)},
+    {"safety_mode", W_INT32, BASE3, BASE5, AT(safety_mode)},
+    {"safety_status", W_INT32, VER(3, 10, 0), VER(5, 4, 0), AT(safety_status)},
+    {"actual_tool_accelerometer", W_VECTOR3D, BASE3, BASE5, AT(accelerometer)},
+    {"speed_scaling", W_DOUBLE, BASE3, BASE5, AT(speed_scaling)},
+    {"target_speed_fraction", W_DOUBLE, BASE3, BASE5, AT(speed_fraction)},
+    {"actual_momentum", W_DOUBLE, BASE3, BASE5, AT(momentum)},
+    {"actual_main_voltage", W_DOUBLE, BASE3, BASE5, AT(main_voltage)},
+    {"actual_robot_voltage", W_DOUBLE, BASE3, BASE5, AT(robot_voltage)},
+    {"actual_robot_current", W_DOUBLE, BASE3, BASE5, AT(robot_current)},
+    {"actual_joint_voltage", W_VECTOR6D, BASE3, BASE5, AT(joint_voltage)},
+    {"actual_digital_output_bits", W_UINT64, BASE3, BASE5, AT(dout)},
+    {"actual_configurable_digital_output_bits", W_UINT64, BASE3, BASE5, AT(dout_conf)},
+    {"runtime_state", W_UINT32, BASE3, BASE5, AT(runtime_state)},
+    {"elbow_position", W_VECTOR3D, VER(3, 5, 0), BASE5, AT(elbow_position)},
+    {"elbow_velocity", W_VECTOR3D, VER(3, 5, 0), BASE5, AT(elbow_velocity)},
+    {"robot_status_bits", W_UINT32, BASE3, BASE5, AT(robot_status_bits)},
+    {"safety_status_bits", W_UINT32, BASE3, BASE5, AT(safety_status_bits)},
+    {"analog_io_types", W_UINT32, BASE3, BASE5, AT(zero)},
+    {"standard_analog_input0", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"standard_analog_input1", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"standard_analog_output0", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"standard_analog_output1", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"io_current", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"output_bit_registers0_to_31", W_UINT32, BASE3, BASE5, AT(out_bits[0])},
+    {"output_bit_registers32_to_63", W_UINT32, BASE3, BASE5, AT(out_bits[1])},
+    {"input_bit_registers0_to_31", W_UINT32, REG3, BASE5, AT(in_bits[0])},
+    {"input_bit_registers32_to_63", W_UINT32, REG3, BASE5, AT(in_bits[1])},
+    {"actual_robot_energy_consumed", W_DOUBLE, NEVER, VER(5, 23, 0), AT(zero)},
+    {"actual_robot_braking_energy_dissipated", W_DOUBLE, NEVER, VER(5, 23, 0), AT(zero)},
+    {"encoder0_raw", W_INT32, BASE3, BASE5, AT(zero)},
+    {"encoder1_raw", W_INT32, BASE3, BASE5, AT(zero)},
+    {"euromap67_input_bits", W_UINT32, BASE3, BASE5, AT(zero)},
+    {"euromap67_output_bits", W_UINT32, BASE3, BASE5, AT(zero)},
+    {"euromap67_24V_voltage", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"euromap67_24V_current", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"tool_mode", W_UINT32, BASE3, BASE5, AT(zero)},
+    {"tool_analog_input_types", W_UINT32, BASE3, BASE5, AT(zero)},
+    {"tool_analog_input0", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"tool_analog_input1", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"tool_output_voltage", W_INT32, BASE3, BASE5, AT(tool_output_voltage)},
+    {"tool_output_current", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"tool_temperature", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"tool_output_mode", W_UINT8, BASE3, BASE5, AT(zero)},
+    {"tool_digital_output0_mode", W_UINT8, BASE3, BASE5, AT(zero)},
+    {"tool_digital_output1_mode", W_UINT8, BASE3, BASE5, AT(zero)},
+    {"tcp_force_scalar", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"joint_position_deviation_ratio", W_DOUBLE, BASE3, BASE5, AT(zero)},
+    {"collision_detection_ratio", W_DOUBLE, NEVER, VER(5, 15, 0), AT(zero)},
+    {"ft_raw_wrench", W_VECTOR6D, NEVER, VER(5, 9, 0), AT(ft_raw_wrench)},
+    {"wrench_calc_from_currents", W_VECTOR6D, BASE3, BASE5, AT(zero)},
+    {"payload", W_DOUBLE, VER(3, 11, 0), VER(5, 5, 1), AT(payload)},
+    {"payload_cog", W_VECTOR3D, VER(3, 11, 0), VER(5, 5, 1), AT(payload_cog)},
+    {"payload_inertia", W_VECTOR6D, VER(3, 15, 0), VER(5, 11, 0), AT(payload_inertia)},
+    {"script_control_line", W_UINT32, VER(3, 14, 0), VER(5, 9, 0), AT(zero)},
+    {"time_scale_source", W_INT32, NEVER, VER(5, 17, 0), AT(time_scale_source)},
+    {"target_gravity", W_VECTOR3D, NEVER, VER(5, 26, 0), AT(zero)},
+    {"target_base_acceleration", W_VECTOR6D, NEVER, VER(5, 26, 0), AT(zero)},
+    {"control_step", W_UINT64, NEVER, VER(5, 26, 0), AT(control_step)},
+    {"target_base_wrench", W_VECTOR6D, NEVER, VER(5, 26, 0), AT(zero)},
+};
+
+/* Inputs (RTDE_CONTROL_PACKAGE_SETUP_INPUTS) other than the registers. */
+static const variable inputs[] = {
+    {"speed_slider_mask", W_UINT32, BASE3, BASE5, 0},
+    {"speed_slider_fraction", W_DOUBLE, BASE3, BASE5, 0},
+    {"standard_digital_output_mask", W_UINT8, BASE3, BASE5, 0},
+    {"standard_digital_output", W_UINT8, BASE3, BASE5, 0},
+    {"configurable_digital_output_mask", W_UINT8, BASE3, BASE5, 0},
+    {"configurable_digital_output", W_UINT8, BASE3, BASE5, 0},
+    {"tool_digital_output_mask", W_UINT8, BASE3, BASE5, 0},
+    {"tool_digital_output", W_UINT8, BASE3, BASE5, 0},
+    {"standard_analog_output_mask", W_UINT8, BASE3, BASE5, 0},
+    {"standard_analog_output_type", W_UINT8, BASE3, BASE5, 0},
+    {"standard_analog_output_0", W_DOUBLE, BASE3, BASE5, 0},
+    {"standard_analog_output_1", W_DOUBLE, BASE3, BASE5, 0},
+    {"input_bit_registers0_to_31", W_UINT32, REG3, BASE5, 0},
+    {"input_bit_registers32_to_63", W_UINT32, REG3, BASE5, 0},
+    {"external_force_torque", W_VECTOR6D, BASE3, BASE5, 0},
+};
+
+/* The numbered registers: PREFIX + index, a version per range. */
+typedef struct register_bank {
+    const char *prefix;
+    uint8_t type;
+    unsigned first, last;       /* indices that exist */
+    unsigned upper;             /* from here on: the 3.9 / 5.3 range */
+    uint16_t out_value, in_value;
+} register_bank;
+
+static const register_bank output_banks[] = {
+    {"output_int_register_", W_INT32, 0, 47, 24, AT(out_int), 0},
+    {"output_double_register_", W_DOUBLE, 0, 47, 24, AT(out_double), 0},
+    {"output_bit_register_", W_BOOL, 64, 127, 64, AT(out_bit), 0},
+    {"input_int_register_", W_INT32, 0, 47, 24, AT(in_int), 0},
+    {"input_double_register_", W_DOUBLE, 0, 47, 24, AT(in_double), 0},
+    {"input_bit_register_", W_BOOL, 64, 127, 64, AT(in_bit), 0},
+};
+static const register_bank input_banks[] = {
+    {"input_int_register_", W_INT32, 0, 47, 24, 0, 0},
+    {"input_double_register_", W_DOUBLE, 0, 47, 24, 0, 0},
+    {"input_bit_register_", W_BOOL, 64, 127, 64, 0, 0},
+};
+
+#define COUNT(a) (sizeof(a) / sizeof((a)[0]))
+
+static uint32_t version_number(const sim_rtde_controller *c)
+{
+    uint32_t minor = c->minor < 99 ? c->minor : 99, bugfix = c->bugfix < 99 ? c->bugfix : 99;
+    return VER(c->major, minor, bugfix);
+}
+
+/* Whether the controller has a variable introduced at since3 / since5. */
+static bool has_version(const sim_rtde_controller *c, uint32_t since3, uint32_t since5)
+{
+    uint32_t since = c->major >= 5 ? since5 : since3;
+    return since != NEVER && version_number(c) >= since;
+}
+
+static bool parse_u32(const char **p, uint32_t *out)
+{
+    const char *s = *p;
+    uint64_t v = 0;
+    if (*s < '0' || *s > '9') {
+        return false;
+    }
+    while (*s >= '0' && *s <= '9') {
+        v = v * 10u + (uint64_t)(*s++ - '0');
+        if (v > UINT32_MAX) {
+            return false;
+        }
+    }
+    *out = (uint32_t)v;
+    *p = s;
+    return true;
+}
+
+const char *sim_rtde_controller_parse(const char *text, sim_rtde_controller *c)
+{
+    uint32_t *parts[4] = {&c->major, &c->minor, &c->bugfix, &c->build};
+    const char *p = text;
+    size_t n = 0;
+    memset(c, 0, sizeof *c);
+    while (n < 4 && parse_u32(&p, parts[n])) {
+        n++;
+        if (*p != '.') {
+            break;
+        }
+        p++;
+    }
+    if (n < 2 || *p != '\0') {
+        return "not a version: MAJOR.MINOR[.BUGFIX[.BUILD]]";
+    }
+    if (version_number(c) < BASE3 || (c->major != 3 && c->major != 5)) {
+        return "no RTDE on this version (CB3 from 3.3, and e-Series 5.x)";
+    }
+    c->rate_hz = c->major >= 5 ? 500u : 125u;
+    return NULL;
+}
+
+/* ---- sending --------------------------------------------------------------- */
+
+static void put_u16(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)(v >> 8);
+    p[1] = (uint8_t)v;
+}
+
+static void put_u32(uint8_t *p, uint32_t v)
+{
+    for (int i = 0; i < 4; i++) {
+        p[i] = (uint8_t)(v >> (24 - 8 * i));
+    }
+}
+
+static void put_u64(uint8_t *p, uint64_t v)
+{
+    for (int i = 0; i < 8; i++) {
+        p[i] = (uint8_t)(v >> (56 - 8 * i));
+    }
+}
+
+/* One package: header and payload (len bytes). */
+static bool send_package(sim_rtde_session *s, uint8_t type, const uint8_t *payload, size_t len)
+{
+    static uint8_t pkg[RTDE_SIZE_MAX];
+    if (len > RTDE_SIZE_MAX - RTDE_HEADER) {
+        return false;
+    }
+    put_u16(pkg, (uint32_t)(len + RTDE_HEADER));
+    pkg[2] = type;
+    if (len > 0) {
+        memcpy(pkg + RTDE_HEADER, payload, len);
+    }
+    return s->emit(s->emit_ctx, pkg, len + RTDE_HEADER);
+}
+
+/* A text message in the layout of the protocol in force: v2 length-prefixed
+ * message and source and a level; v1 (controller to client) the level and
+ * the message to the end of the package. */
+static bool send_text(sim_rtde_session *s, uint8_t level, const char *msg)
+{
+    static const char source[] = "urrt-sim";
+    uint8_t p[600];
+    size_t n = 0, mlen = strlen(msg);
+    mlen = mlen > 255 ? 255 : mlen;
+    if (s->protocol >= 2) {
+        p[n++] = (uint8_t)mlen;
+        memcpy(p + n, msg, mlen);
+        n += mlen;
+        p[n++] = (uint8_t)(sizeof source - 1);
+        memcpy(p + n, source, sizeof source - 1);
+        n += sizeof source - 1;
+        p[n++] = level;
+    } else {
+        p[n++] = level;
+        memcpy(p + n, msg, mlen);
+        n += mlen;
+    }
+    s->texts_sent++;
+    return send_package(s, RTDE_TEXT, p, n);
+}
+
+/* A protocol problem, told the client as the controller does (an error
+ * text message) and logged here. */
+static bool complain(sim_rtde_session *s, const char *msg)
+{
+    urrt_log(URRT_LOG_INFO, "RTDE client %s: %s", s->peer, msg);
+    return send_text(s, LEVEL_ERROR, msg);
+}
+
+/* A reply, after a text message when the fault asks for one. */
+static bool reply(sim_rtde_session *s, uint8_t type, const uint8_t *payload, size_t len)
+{
+    if (s->faults->text_handshake) {
+        char msg[64];
+        snprintf(msg, sizeof msg, "urrt-sim: before the reply to '%c' (fault rtde-text-handshake)", type);
+        if (!send_text(s, 3, msg)) {
+            return false;
+        }
+    }
+    return send_package(s, type, payload, len);
+}
+
+static bool reply_byte(sim_rtde_session *s, uint8_t type, uint8_t value)
+{
+    return reply(s, type, &value, 1);
+}
+
+/* ---- requests ---------------------------------------------------------------- */
+
+static bool on_protocol_version(sim_rtde_session *s, const uint8_t *p, size_t len)
+{
+    unsigned asked;
+    bool accept;
+    if (len != 2) {
+        return complain(s, "RTDE_REQUEST_PROTOCOL_VERSION takes a uint16 version") &&
+               reply_byte(s, RTDE_V_PROTOCOL, 0);
+    }
+    asked = (unsigned)p[0] << 8 | p[1];
+    /* Protocol 2 came with 3.4; before it only 1. */
+    accept = asked == 1 || (asked == 2 && version_number(s->ctl) >= VER(3, 4, 0) && !s->faults->refuse_v2);
+    urrt_log(URRT_LOG_INFO, "RTDE client %s asks for protocol %u: %s", s->peer, asked, accept ? "accepted" : "refused");
+    /* The reply in the layout of the protocol in force before it. */
+    if (!reply_byte(s, RTDE_V_PROTOCOL, accept ? 1 : 0)) {
+        return false;
+    }
+    if (accept) {
+        s->protocol = asked;
+    }
+    return true;
+}
+
+static bool on_urcontrol_version(sim_rtde_session *s)
+{
+    uint8_t p[16];
+    put_u32(p, s->ctl->major);
+    put_u32(p + 4, s->ctl->minor);
+    put_u32(p + 8, s->ctl->bugfix);
+    put_u32(p + 12, s->ctl->build);
+    return reply(s, RTDE_V_URCONTROL, p, sizeof p);
+}
+
+/* A register name: the bank's prefix, then an index written plainly. */
+static bool find_register(const sim_rtde_controller *c, const register_bank *banks, size_t nbanks, const char *name,
+                          size_t len, bool as_input, sim_rtde_field *f)
+{
+    for (size_t b = 0; b < nbanks; b++) {
+        const register_bank *bk = &banks[b];
+        size_t plen = strlen(bk->prefix);
+        unsigned index = 0;
+        if (len <= plen || len > plen + 3 || memcmp(name, bk->prefix, plen) != 0 ||
+            (name[plen] == '0' && len > plen + 1)) {
+            continue;
+        }
+        for (size_t i = plen; i < len; i++) {
+            if (name[i] < '0' || name[i] > '9') {
+                return false;
+            }
+            index = index * 10u + (unsigned)(name[i] - '0');
+        }
+        if (index < bk->first || index > bk->last) {
+            return false;
+        }
+        if (!(index >= bk->upper ? has_version(c, UPPER3, UPPER5) : has_version(c, REG3, BASE5))) {
+            return false;
+        }
+        f->type = bk->type;
+        f->value = (uint16_t)((as_input ? bk->in_value : bk->out_value) + index - bk->first);
+        return true;
+    }
+    return false;
+}
+
+/* A name (len bytes, not terminated) of the list, as this controller
+ * version knows it: false for NOT_FOUND. */
+static bool find_variable(const sim_rtde_controller *c, const char *name, size_t len, bool input, sim_rtde_field *f)
+{
+    const variable *table = input ? inputs : outputs;
+    size_t n = input ? COUNT(inputs) : COUNT(outputs);
+    for (size_t i = 0; i < n; i++) {
+        if (strlen(table[i].name) == len && memcmp(table[i].name, name, len) == 0) {
+            if (!has_version(c, table[i].since3, table[i].since5)) {
+                return false;
+            }
+            f->type = table[i].type;
+            f->value = table[i].value;
+            return true;
+        }
+    }
+    return input ? find_register(c, input_banks, COUNT(input_banks), name, len, true, f)
+                 : find_register(c, output_banks, COUNT(output_banks), name, len, false, f);
+}
+
+/* The names of a setup, one by one: the type list of the reply, the
+ * fields in out (up to max, NULL to drop them). Returns the number of
+ * names, *found the number known; the types go to types (NUL-terminated). */
+static size_t resolve_names(const sim_rtde_session *s, const uint8_t *names, size_t len, bool input,
+                            sim_rtde_field *out, size_t max, size_t *found, char *types, size_t types_cap)
+{
+    size_t count = 0, tlen = 0, start = 0;
+    *found = 0;
+    types[0] = '\0';
+    for (size_t i = 0; i <= len; i++) {
+        sim_rtde_field f;
+        const char *token;
+        if (i < len && names[i] != ',') {
+            continue;
+        }
+        if (find_variable(s->ctl, (const char *)names + start, i - start, input, &f)) {
+            token = wire[f.type].token;
+            if (out != NULL && *found < max) {
+                out[*found] = f;
+            }
+            (*found)++;
+        } else {
+            token = "NOT_FOUND";
+        }
+        tlen += (size_t)snprintf(types + tlen, types_cap - tlen, "%s%s", count ? "," : "", token);
+        tlen = tlen < types_cap ? tlen : types_cap - 1;
+        count++;
+        start = i + 1;
+    }
+    return count;
+}
+
+/* Why a v2 frequency is refused, or NULL: 1 Hz <= f <= the controller's rate. */
+static const char *frequency_problem(const sim_rtde_session *s, double f)
+{
+    if (!(f >= 1.0)) {
+        return "the output frequency must be 1 Hz or more";
+    }
+    if (f > (double)s->ctl->rate_hz) {
+        return s->ctl->rate_hz == 125 ? "the output frequency is above this controller's 125 Hz"
+                                      : "the output frequency is above this controller's 500 Hz";
+    }
+    return NULL;
+}
+
+static double get_double(const uint8_t *p)
+{
+    uint64_t bits = 0;
+    double d;
+    for (int i = 0; i < 8; i++) {
+        bits = bits << 8 | p[i];
+    }
+    memcpy(&d, &bits, sizeof d);
+    return d;
+}
+
+static bool on_setup_outputs(sim_rtde_session *s, const uint8_t *p, size_t len)
+{
+    static char types[SIM_RTDE_NAMES_MAX * 13 + 2];
+    uint8_t out[sizeof types + 1];
+    double freq = (double)s->ctl->rate_hz;
+    const char *problem = NULL;
+    size_t names, found, off = 0, tlen;
+
+    if (s->protocol >= 2) {
+        if (len < 8) {
+            return complain(s, "RTDE_CONTROL_PACKAGE_SETUP_OUTPUTS takes a double frequency, then the names") &&
+                   reply_byte(s, RTDE_SETUP_OUTPUTS, 0);
+        }
+        freq = get_double(p);
+        p += 8;
+        len -= 8;
+        problem = frequency_problem(s, freq);
+    }
+    if (len > SIM_RTDE_NAMES_MAX) {
+        problem = "the variable names are longer than 2048 bytes";
+    }
+    names = resolve_names(s, p, len, false, s->fields, SIM_RTDE_RECIPE_MAX, &found, types, sizeof types);
+    if (problem == NULL && found > SIM_RTDE_RECIPE_MAX) {
+        problem = "more variables than the simulator holds in a recipe (512)";
+    }
+    s->recipe_valid = problem == NULL && found == names;
+    s->started = s->started && s->recipe_valid;
+    s->nfields = s->recipe_valid ? found : 0;
+    s->data_size = 0;
+    for (size_t i = 0; i < s->nfields; i++) {
+        s->data_size += (size_t)wire[s->fields[i].type].count * wire[s->fields[i].type].size;
+    }
+    /* Every divisor-th cycle: a rate that does not divide the controller's
+     * rounds up to the next one that does. */
+    s->divisor = problem == NULL ? (uint32_t)floor((double)s->ctl->rate_hz / freq) : 1;
+    s->divisor = s->divisor ? s->divisor : 1;
+    urrt_log(URRT_LOG_INFO, "RTDE client %s: output recipe of %zu variable%s%s, %s", s->peer, names,
+             names == 1 ? "" : "s", found == names ? "" : " (some NOT_FOUND)",
+             problem ? problem : s->recipe_valid ? "valid" : "invalid");
+    if (problem != NULL && !complain(s, problem)) {
+        return false;
+    }
+    if (s->protocol >= 2) {
+        /* Recipe id 0: no valid recipe. */
+        out[off++] = s->recipe_valid ? RTDE_OUTPUT_RECIPE_ID : 0;
+    }
+    tlen = strlen(types);
+    memcpy(out + off, types, tlen);
+    return reply(s, RTDE_SETUP_OUTPUTS, out, off + tlen);
+}
+
+static bool on_setup_inputs(sim_rtde_session *s, const uint8_t *p, size_t len)
+{
+    static char types[SIM_RTDE_NAMES_MAX * 13 + 2];
+    static sim_rtde_field fields[SIM_RTDE_RECIPE_MAX];
+    uint8_t out[sizeof types + 1];
+    size_t names, found, size = 0, tlen;
+    bool valid;
+
+    names = resolve_names(s, p, len, true, fields, SIM_RTDE_RECIPE_MAX, &found, types, sizeof types);
+    valid = found == names && found <= SIM_RTDE_RECIPE_MAX && len <= SIM_RTDE_NAMES_MAX &&
+            s->ninputs < SIM_RTDE_INPUT_RECIPES;
+    if (valid) {
+        for (size_t i = 0; i < found; i++) {
+            size += (size_t)wire[fields[i].type].count * wire[fields[i].type].size;
+        }
+        s->input_size[++s->ninputs] = size;
+    }
+    urrt_log(URRT_LOG_INFO, "RTDE client %s: input recipe of %zu variable%s, %s (the simulator applies no input)",
+             s->peer, names, names == 1 ? "" : "s", valid ? "valid" : "invalid");
+    out[0] = valid ? (uint8_t)s->ninputs : 0;
+    tlen = strlen(types);
+    memcpy(out + 1, types, tlen);
+    return reply(s, RTDE_SETUP_INPUTS, out, 1 + tlen);
+}
+
+static bool on_start(sim_rtde_session *s)
+{
+    /* No valid output recipe: nothing to synchronise, start refused. */
+    s->started = s->recipe_valid;
+    urrt_log(URRT_LOG_INFO, "RTDE client %s: start %s", s->peer, s->started ? "accepted" : "refused (no valid output recipe)");
+    return reply_byte(s, RTDE_START, s->started ? 1 : 0);
+}
+
+/* Input data from the client: checked against its input recipe, not applied. */
+static bool on_input_data(sim_rtde_session *s, const uint8_t *p, size_t len)
+{
+    size_t id = s->ninputs;
+    if (s->protocol >= 2) {
+        id = len > 0 ? p[0] : 0;
+        len = len > 0 ? len - 1 : 0;
+    }
+    if (id == 0 || id > s->ninputs || s->input_size[id] != len) {
+        return complain(s, "RTDE_DATA_PACKAGE from the client matches no input recipe");
+    }
+    return true;
+}
+
+/* A text message from the client goes to the log, as a controller's would. */
+static void on_text(sim_rtde_session *s, const uint8_t *p, size_t len)
+{
+    size_t mlen = len > 0 ? p[0] : 0;
+    if (len < 1 + mlen) {
+        mlen = len > 0 ? len - 1 : 0;
+    }
+    urrt_log(URRT_LOG_NOTICE, "RTDE client %s says: %.*s", s->peer, (int)mlen, (const char *)p + 1);
+}
+
+/* One whole package from the client. */
+static bool on_package(sim_rtde_session *s, uint8_t type, const uint8_t *p, size_t len)
+{
+    char msg[64];
+    switch (type) {
+    case RTDE_V_PROTOCOL: return on_protocol_version(s, p, len);
+    case RTDE_V_URCONTROL: return on_urcontrol_version(s);
+    case RTDE_SETUP_OUTPUTS: return on_setup_outputs(s, p, len);
+    case RTDE_SETUP_INPUTS: return on_setup_inputs(s, p, len);
+    case RTDE_START: return on_start(s);
+    case RTDE_PAUSE:
+        /* Always accepted. */
+        s->started = false;
+        return reply_byte(s, RTDE_PAUSE, 1);
+    case RTDE_DATA: return on_input_data(s, p, len);
+    case RTDE_TEXT: on_text(s, p, len); return true;
+    default:
+        snprintf(msg, sizeof msg, "unknown package type %u", (unsigned)type);
+        return complain(s, msg);
+    }
+}
+
+void sim_rtde_session_init(sim_rtde_session *s, const sim_rtde_controller *ctl, const sim_rtde_faults *faults,
+                           sim_rtde_emit emit, void *emit_ctx, const char *peer)
+{
+    memset(s, 0, sizeof *s);
+    s->ctl = ctl;
+    s->faults = faults;
+    s->emit = emit;
+    s->emit_ctx = emit_ctx;
+    s->protocol = 1;
+    s->divisor = 1;
+    snprintf(s->peer, sizeof s->peer, "%s", peer);
+}
+
+bool sim_rtde_feed(sim_rtde_session *s, const uint8_t *data, size_t len)
+{
+    while (len > 0 && !s->broken) {
+        /* The size field first, then the rest of the package it announces. */
+        size_t want = s->in_len < 2 ? 2 : (size_t)s->in[0] << 8 | s->in[1];
+        size_t take = want - s->in_len < len ? want - s->in_len : len;
+        memcpy(s->in + s->in_len, data, take);
+        s->in_len += take;
+        data += take;
+        len -= take;
+        if (s->in_len < 2) {
+            break;
+        }
+        want = (size_t)s->in[0] << 8 | s->in[1];
+        if (want < RTDE_HEADER) {
+            urrt_log(URRT_LOG_WARNING, "RTDE client %s sent a package of size %zu, below its 3-byte header: "
+                     "disconnected", s->peer, want);
+            s->broken = true;
+            return false;
+        }
+        if (s->in_len == want) {
+            s->in_len = 0;
+            if (!on_package(s, s->in[2], s->in + RTDE_HEADER, want - RTDE_HEADER)) {
+                return false;
+            }
+        }
+    }
+    return !s->broken;
+}
+
+/* ---- data ---------------------------------------------------------------------- */
+
+bool sim_rtde_due(const sim_rtde_session *s, uint64_t k)
+{
+    return s->started && k % s->divisor == 0;
+}
+
+static void copy_doubles(double *to, const double *from, size_t n)
+{
+    memcpy(to, from, n * sizeof *to);
+}
+
+/* Cycle k's values: the RealTime ones from the state, the RTDE-only ones
+ * by the rules of docs/tools.md. */
+static void cycle_values(uint64_t k, const urrt_state *st, values *v)
+{
+    memset(v, 0, sizeof *v);
+    v->timestamp = st->time[0];
+    copy_doubles(v->target_q, st->q_target, 6);
+    copy_doubles(v->target_qd, st->qd_target, 6);
+    copy_doubles(v->target_qdd, st->qdd_target, 6);
+    copy_doubles(v->target_current, st->i_target, 6);
+    copy_doubles(v->target_moment, st->m_target, 6);
+    copy_doubles(v->actual_q, st->q_actual, 6);
+    copy_doubles(v->actual_qd, st->qd_actual, 6);
+    copy_doubles(v->actual_current, st->i_actual, 6);
+    copy_doubles(v->joint_control_output, st->i_control, 6);
+    copy_doubles(v->actual_tcp_pose, st->tool_vector_actual, 6);
+    copy_doubles(v->actual_tcp_speed, st->tcp_speed_actual, 6);
+    copy_doubles(v->actual_tcp_force, st->tcp_force, 6);
+    copy_doubles(v->ft_raw_wrench, st->tcp_force, 6);
+    copy_doubles(v->target_tcp_pose, st->tool_vector_target, 6);
+    copy_doubles(v->target_tcp_speed, st->tcp_speed_target, 6);
+    copy_doubles(v->joint_temperatures, st->motor_temperatures, 6);
+    copy_doubles(v->joint_mode, st->joint_modes, 6);
+    copy_doubles(v->joint_voltage, st->v_actual, 6);
+    copy_doubles(v->accelerometer, st->tool_accelerometer, 3);
+    copy_doubles(v->elbow_position, st->elbow_position, 3);
+    copy_doubles(v->elbow_velocity, st->elbow_velocity, 3);
+    copy_doubles(v->payload_cog, st->payload_cog, 3);
+    copy_doubles(v->payload_inertia, st->payload_inertia, 6);
+    v->din = st->digital_input_bits[0];
+    v->dout = st->digital_outputs[0];
+    /* Bits 8-15 are the configurable ones, counted from 0 there. */
+    v->din_conf = (double)(((uint64_t)v->din >> 8) & 0xffu);
+    v->dout_conf = (double)(((uint64_t)v->dout >> 8) & 0xffu);
+    v->execution_time = st->controller_timer[0];
+    v->robot_mode = st->robot_mode[0];
+    v->safety_mode = st->safety_mode[0];
+    v->safety_status = st->safety_status[0];
+    v->speed_scaling = st->speed_scaling[0];
+    v->speed_fraction = 1.0;
+    v->momentum = st->linear_momentum_norm[0];
+    v->main_voltage = st->v_main[0];
+    v->robot_voltage = st->v_robot[0];
+    v->robot_current = st->i_robot[0];
+    v->runtime_state = st->program_state[0];
+    v->payload = st->payload_mass[0];
+    /* Power on from POWER_ON (4) up; program running while PLAYING (2). */
+    v->robot_status_bits = (v->robot_mode >= 4.0 ? 1.0 : 0.0) + (v->runtime_state == 2.0 ? 2.0 : 0.0);
+    /* Bit (safety mode - 1): NORMAL is bit 0, REDUCED bit 1, ... */
+    v->safety_status_bits = v->safety_mode >= 1.0 && v->safety_mode <= 11.0 ? ldexp(1.0, (int)v->safety_mode - 1) : 0.0;
+    v->time_scale_source = v->runtime_state == 2.0 && v->speed_scaling == 1.0 ? 1.0 : 0.0;
+    v->control_step = (double)k;
+    v->tool_output_voltage = 24.0;
+    /* The general-purpose output registers, as a robot program writing
+     * them every cycle would: ints count cycles, doubles count seconds of
+     * the stream, bits count in binary. */
+    v->out_bits[0] = (double)(uint32_t)k;
+    v->out_bits[1] = (double)(uint32_t)~(uint32_t)k;
+    for (unsigned n = 0; n < 48; n++) {
+        v->out_int[n] = (double)(int32_t)(uint32_t)(k + n);
+        v->out_double[n] = (double)n + (double)k / 1000.0;
+    }
+    for (unsigned n = 64; n < 128; n++) {
+        v->out_bit[n - 64] = (double)((k >> (n % 32)) & 1u);
+    }
+}
+
+/* A field's wire bytes. */
+static size_t put_field(uint8_t *p, const sim_rtde_field *f, const double *vals)
+{
+    const double *x = vals + f->value;
+    size_t n = 0;
+    for (unsigned e = 0; e < wire[f->type].count; e++) {
+        uint64_t bits;
+        switch (f->type) {
+        case W_BOOL: p[n++] = x[e] != 0.0 ? 1 : 0; break;
+        case W_UINT8: p[n++] = (uint8_t)x[e]; break;
+        case W_UINT32: put_u32(p + n, (uint32_t)x[e]); n += 4; break;
+        case W_INT32:
+        case W_VECTOR6INT32: put_u32(p + n, (uint32_t)(int32_t)x[e]); n += 4; break;
+        case W_UINT64: put_u64(p + n, (uint64_t)x[e]); n += 8; break;
+        default:
+            memcpy(&bits, &x[e], 8);
+            put_u64(p + n, bits);
+            n += 8;
+            break;
+        }
+    }
+    return n;
+}
+
+/* The package for data package n (1-based) of the session, bad if the
+ * fault says so: returns its type letter, the payload in p, *len. */
+static uint8_t data_package(sim_rtde_session *s, uint64_t n, const values *v, uint8_t *p, size_t *len)
+{
+    const sim_rtde_faults *f = s->faults;
+    bool bad = f->bad_every != 0 && n % f->bad_every == 0;
+    size_t off = 0;
+    if (s->protocol >= 2) {
+        p[off++] = bad && f->bad_kind == SIM_RTDE_BAD_RECIPE ? RTDE_OUTPUT_RECIPE_ID + 1 : RTDE_OUTPUT_RECIPE_ID;
+    }
+    for (size_t i = 0; i < s->nfields; i++) {
+        off += put_field(p + off, &s->fields[i], (const double *)v);
+    }
+    *len = off;
+    if (!bad) {
+        return RTDE_DATA;
+    }
+    switch (f->bad_kind) {
+    case SIM_RTDE_BAD_TYPE: return 'X';
+    case SIM_RTDE_BAD_RECIPE:
+        if (s->protocol >= 2) {
+            return RTDE_DATA;
+        }
+        /* v1 packages carry no recipe id: one byte short instead. */
+        *len = off - 1;
+        return RTDE_DATA;
+    case SIM_RTDE_BAD_HEADER: *len = 0; return RTDE_DATA;
+    case SIM_RTDE_BAD_SIZE: *len = off - 1; return RTDE_DATA;
+    }
+    return RTDE_DATA;
+}
+
+bool sim_rtde_send_data(sim_rtde_session *s, uint64_t k, const urrt_state *st)
+{
+    static values v;
+    static uint8_t payload[RTDE_SIZE_MAX];
+    const sim_rtde_faults *f = s->faults;
+    uint64_t n = ++s->data_sent;
+    size_t len;
+    uint8_t type;
+
+    _Static_assert(sizeof(values) == VALUES_COUNT * sizeof(double), "values is an array of doubles");
+    if (f->text_every != 0 && n > 1 && (n - 1) % f->text_every == 0) {
+        char msg[96];
+        snprintf(msg, sizeof msg, "urrt-sim: text message %" PRIu64 " (fault rtde-text-every)", s->texts_sent + 1);
+        if (!send_text(s, f->text_level, msg)) {
+            return false;
+        }
+    }
+    cycle_values(k, st, &v);
+    type = data_package(s, n, &v, payload, &len);
+    if (f->bad_every != 0 && n % f->bad_every == 0 && f->bad_kind == SIM_RTDE_BAD_HEADER) {
+        /* Size 2: below the header itself, so no reader can frame what follows. */
+        static const uint8_t broken[3] = {0x00, 0x02, RTDE_DATA};
+        return s->emit(s->emit_ctx, broken, sizeof broken);
+    }
+    return send_package(s, type, payload, len);
+}

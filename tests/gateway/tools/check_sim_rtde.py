@@ -1,0 +1,575 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: MIT
+"""check-sim-rtde: urrt-sim's RTDE port against an RTDE client written from
+the protocol's description (rtde_peer.py), and against its own RealTime port.
+
+Every simulator takes its ports from the system (port 0, port files); every
+wait is for an event (a port file, a package, a log line, the end of a
+connection) with a bound, never a sleep for something to have happened.
+
+  check_sim_rtde.py BUILD
+"""
+import os
+import socket
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import rt  # noqa: E402  the RealTime reference: column table
+from rtde_peer import Peer, Closed, Unframable, M, U  # noqa: E402
+
+BUILD = sys.argv[1] if len(sys.argv) > 1 else 'build'
+SIM = os.path.join(BUILD, 'bin', 'urrt-sim')
+TMP = tempfile.mkdtemp(prefix='urrt-sim-rtde.')
+PASSED = FAILED = 0
+START_TIME = 1000.0  # controller time of cycle 0 (docs/tools.md)
+
+
+def check(ok, what, detail=''):
+    global PASSED, FAILED
+    if ok:
+        PASSED += 1
+        print('ok: ' + what)
+    else:
+        FAILED += 1
+        print('FAIL: %s%s' % (what, (': ' + str(detail)) if detail else ''), file=sys.stderr)
+    return ok
+
+
+def wait_for(what, cond, proc=None, timeout=10.0):
+    """Until cond() holds (polled), or fails at once when proc has ended."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if cond():
+            return True
+        if proc is not None and proc.poll() is not None:
+            return cond()
+        time.sleep(0.02)
+    print('waited in vain for ' + what, file=sys.stderr)
+    return False
+
+
+class Sim:
+    count = 0
+
+    def __init__(self, *args):
+        Sim.count += 1
+        base = os.path.join(TMP, 'sim%d' % Sim.count)
+        self.log_path, self.rt_pf, self.rtde_pf = base + '.log', base + '.rt', base + '.rtde'
+        with open(self.log_path, 'w') as log:
+            self.proc = subprocess.Popen(['timeout', '-k', '3', '60', SIM, '-l', '127.0.0.1:0', '--port-file', self.rt_pf,
+                                          '--rtde', '127.0.0.1:0', '--rtde-port-file', self.rtde_pf, '-v'] + list(args),
+                                         stderr=log)
+        if not wait_for('the simulator\'s port files', lambda: os.path.exists(self.rtde_pf), self.proc):
+            raise RuntimeError('simulator did not start: ' + self.log())
+        self.rt_port = int(open(self.rt_pf).read())
+        self.port = int(open(self.rtde_pf).read())
+
+    def log(self):
+        return open(self.log_path).read()
+
+    def stop(self):
+        self.proc.terminate()
+        self.proc.wait(timeout=10)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.stop()
+
+
+def cycle(ts, rate):
+    """The control cycle of a timestamp (--clock start)."""
+    return round((ts - START_TIME) * rate)
+
+
+def steps_of(pk, rate):
+    """Cycles between consecutive data packages, by their timestamps."""
+    return [cycle(b[0], rate) - cycle(a[0], rate) for a, b in zip(pk, pk[1:])]
+
+
+def regular(steps, d):
+    """Every d-th cycle: each step d, or a multiple of it where a loaded
+    machine held the simulator past its catch-up limit (it then skips whole
+    cycles, never sends them late), at most one step in ten."""
+    return bool(steps) and all(x > 0 and x % d == 0 for x in steps) and steps.count(d) >= 0.9 * len(steps)
+
+
+# ---- usage -------------------------------------------------------------------------
+def usage_errors():
+    cases = [
+        (['--rtde', '127.0.0.1:0', '--replay', '/dev/null'], 'drop --replay or --rtde'),
+        (['--rtde', '127.0.0.1:0', '--length', '1116'], 'give --controller V, not --length'),
+        (['--rtde', '127.0.0.1:0', '-c', '3.2'], 'no RTDE on this version'),
+        (['--rtde', '127.0.0.1:0', '-c', '5.10', '--rate', '125'], 'runs at 500 Hz on both ports: drop --rate'),
+        (['--fault', 'rtde-refuse-v2'], 'an rtde-* fault goes with --rtde'),
+        (['--rtde-port-file', 'x'], '--rtde-port-file goes with --rtde'),
+        (['--rtde', '127.0.0.1:0', '--fault', 'rtde-bad-package=3,kind=odd'], 'kind is size, type, recipe or header'),
+        (['--rtde', '127.0.0.1:0', '--fault', 'rtde-text-every=3,level=4'], 'from 0 to 3'),
+        (['--rtde', '127.0.0.1:0', '--fault', 'rtde-refuse-v2=1'], 'takes no value'),
+        (['--rtde', '127.0.0.1:99999'], '--rtde 127.0.0.1:99999'),
+    ]
+    for args, text in cases:
+        r = subprocess.run([SIM] + args, capture_output=True, text=True, timeout=10)
+        check(r.returncode == 2 and text in r.stderr, 'usage error: %s' % ' '.join(args), r.stderr.strip())
+
+
+# ---- handshakes, versions, variables -------------------------------------------------
+RECIPE = ['timestamp', 'actual_q', 'robot_mode', 'joint_mode', 'actual_digital_input_bits', 'runtime_state',
+          'speed_scaling', 'robot_status_bits', 'output_bit_registers0_to_31']
+RECIPE_TYPES = ['DOUBLE', 'VECTOR6D', 'INT32', 'VECTOR6INT32', 'UINT64', 'UINT32', 'DOUBLE', 'UINT32', 'UINT32']
+# Variables newer than some versions, with their first CB3 / e-Series versions (UR's guide).
+NEWER = {'elbow_position': ((3, 5), (5, 0)), 'safety_status': ((3, 10), (5, 4)), 'payload': ((3, 11), (5, 5, 1)),
+         'output_int_register_24': ((3, 9), (5, 3)), 'output_bit_register_64': ((3, 9), (5, 3)),
+         'payload_inertia': ((3, 15), (5, 11)), 'ft_raw_wrench': (None, (5, 9)),
+         'time_scale_source': (None, (5, 17)), 'control_step': (None, (5, 26))}
+NEWER_TYPES = {'elbow_position': 'VECTOR3D', 'safety_status': 'INT32', 'payload': 'DOUBLE',
+               'output_int_register_24': 'INT32', 'output_bit_register_64': 'BOOL', 'payload_inertia': 'VECTOR6D',
+               'ft_raw_wrench': 'VECTOR6D', 'time_scale_source': 'INT32', 'control_step': 'UINT64'}
+
+
+def has(version, name):
+    since = NEWER[name][0 if version[0] == 3 else 1]
+    return since is not None and tuple(version) >= since
+
+
+def handshake_v2(version_text, version, rate):
+    with Sim('-c', version_text) as sim:
+        p = Peer(sim.port)
+        check(p.protocol_version(2) == 1, '%s: protocol 2 accepted' % version_text)
+        got = p.controller_version()
+        want = tuple(version) + (0,) * (4 - len(version))
+        check(got == want, '%s: v gives all four numbers %s' % (version_text, want), got)
+        rid, types = p.setup_outputs(RECIPE, rate)
+        check(rid == 1 and types == RECIPE_TYPES, '%s: recipe id 1 and the types UR gives' % version_text, (rid, types))
+        names = sorted(NEWER)
+        rid2, types2 = p.setup_outputs(names, rate)
+        want2 = [NEWER_TYPES[n] if has(version, n) else 'NOT_FOUND' for n in names]
+        check(types2 == want2, '%s: NOT_FOUND exactly for the variables newer than it' % version_text,
+              list(zip(names, types2)))
+        check(rid2 == (1 if 'NOT_FOUND' not in want2 else 0), '%s: recipe id 0 when a name is NOT_FOUND' % version_text)
+        if 'NOT_FOUND' in want2:
+            check(p.start() == 0, '%s: start refused without a valid recipe' % version_text)
+        p.setup_outputs(RECIPE, rate)
+        check(p.start() == 1, '%s: start accepted' % version_text)
+        pk = p.data(int(rate) // 2)
+        steps = steps_of(pk, rate)
+        check(regular(steps, 1), '%s: %d Hz, every cycle (by the timestamps)' % (version_text, rate), set(steps))
+        ok = all(x[2] == 7 and x[3] == (253,) * 6 and x[5] == 2 and x[7] == 3 and x[8] == cycle(x[0], rate) % 2**32
+                 for x in pk)
+        check(ok, '%s: modes RUNNING, PLAYING, status bits power on + program running, bit registers count cycles'
+              % version_text, pk[0])
+        p.close()
+
+
+def handshake_v1(version_text, rate):
+    with Sim('-c', version_text) as sim:
+        p = Peer(sim.port)
+        check(p.protocol_version(1) == 1, '%s: protocol 1 accepted' % version_text)
+        rid, types = p.setup_outputs(['timestamp', 'actual_q', 'robot_mode'])
+        check(rid is None and types == ['DOUBLE', 'VECTOR6D', 'INT32'], '%s v1: types without a recipe id' % version_text,
+              types)
+        check(p.start() == 1, '%s v1: start accepted' % version_text)
+        kind, payload = p.package()
+        while kind != U:
+            kind, payload = p.package()
+        check(len(payload) == 8 + 48 + 4, '%s v1: data packages carry no recipe id (60 bytes)' % version_text,
+              len(payload))
+        pk = [p.decode(payload)] + p.data(50)
+        steps = steps_of(pk, rate)
+        check(regular(steps, 1), '%s v1: always the controller\'s %d Hz' % (version_text, rate), set(steps))
+        p.close()
+
+
+def old_protocol():
+    with Sim('-c', '3.3') as sim:
+        p = Peer(sim.port)
+        check(p.protocol_version(2) == 0, '3.3: protocol 2 refused')
+        check(p.protocol_version(1) == 1, '3.3: then protocol 1 accepted on the same connection')
+        rid, types = p.setup_outputs(['timestamp', 'output_int_register_0', 'elbow_position'])
+        check(types == ['DOUBLE', 'NOT_FOUND', 'NOT_FOUND'], '3.3: registers (3.4) and elbow (3.5) NOT_FOUND', types)
+        p.close()
+
+
+def inputs_and_misc():
+    with Sim('-c', '5.4') as sim:
+        p = Peer(sim.port)
+        p.protocol_version(2)
+        rid, types = p.setup_inputs(['input_int_register_24', 'input_double_register_0', 'speed_slider_fraction'])
+        check(rid == 1 and types == ['INT32', 'DOUBLE', 'DOUBLE'], 'inputs: recipe id and types', (rid, types))
+        rid, types = p.setup_inputs(['input_int_register_48'])
+        check(rid == 0 and types == ['NOT_FOUND'], 'inputs: register 48 NOT_FOUND, id 0', (rid, types))
+        p.send(b'Z')
+        kind, payload = p.package()
+        check(kind == M and p.texts[-1][0] == 1 and 'unknown package type 90' in p.texts[-1][1],
+              'an unknown package type: an error text message', p.texts[-1:])
+        p.setup_outputs(['timestamp'], 500.0)
+        p.start()
+        p.data(5)
+        check(p.pause() == 1, 'pause accepted')
+        try:
+            p.package(0.3)
+            quiet = False
+        except TimeoutError:
+            quiet = True
+        check(quiet, 'after the pause reply no data package')
+        check(p.start() == 1, 'start again after a pause')
+        check(len(p.data(5)) == 5, 'data again after the second start')
+        long_names = ['actual_q'] * 230  # 2069 bytes of names
+        rid, _ = p.setup_outputs(long_names, 500.0)
+        check(rid == 0 and 'longer than 2048 bytes' in p.texts[-1][1], 'a name list past 2048 bytes refused, said why',
+              p.texts[-1:])
+        p.close()
+        # A package below its own header ends the connection.
+        q = Peer(sim.port)
+        q.send_raw(b'\x00\x02V')
+        try:
+            q.package(5)
+            ended = False
+        except Closed:
+            ended = True
+        except ConnectionResetError:
+            ended = True
+        check(ended, 'a package of size 2 from the client: disconnected')
+        check(wait_for('the log line', lambda: 'below its 3-byte header' in sim.log()), 'and the log says why')
+        q.close()
+
+
+def frequencies():
+    cases = [('5.10', 500, 125.0, 4), ('5.10', 500, 200.0, 2), ('5.10', 500, 499.0, 1), ('3.10', 125, 25.0, 5),
+             ('3.10', 125, 1.0, 125)]
+    for version, rate, asked, divisor in cases:
+        with Sim('-c', version) as sim:
+            p = Peer(sim.port)
+            p.protocol_version(2)
+            p.setup_outputs(['timestamp', 'output_int_register_24'], asked)
+            p.start()
+            n = 3 if asked < 5 else 40
+            pk = p.data(n, timeout=5)
+            steps = steps_of(pk, rate)
+            check(regular(steps, divisor) and all(cycle(x[0], rate) % divisor == 0 for x in pk),
+                  '%s at %g Hz: every %d%s cycle by the timestamp (%g Hz)' %
+                  (version, asked, divisor, {1: 'st', 2: 'nd'}.get(divisor, 'th'), rate / divisor), steps)
+            check(all(x[1] == cycle(x[0], rate) + 24 for x in pk),
+                  '%s at %g Hz: output_int_register_24 = cycle + 24' % (version, asked), pk[:2])
+            p.close()
+    for version, asked in (('5.10', 501.0), ('3.10', 126.0), ('5.10', 0.5)):
+        with Sim('-c', version) as sim:
+            p = Peer(sim.port)
+            p.protocol_version(2)
+            rid, types = p.setup_outputs(['timestamp'], asked)
+            check(rid == 0 and types == ['DOUBLE'] and p.texts and p.texts[-1][0] == 1,
+                  '%s: %g Hz refused (recipe id 0, an error text)' % (version, asked), (rid, types, p.texts))
+            check(p.start() == 0, '%s: %g Hz: start refused' % (version, asked))
+            p.close()
+
+
+# ---- the same arm on both ports ------------------------------------------------------------
+PAIRS = [('actual_q', 'q_actual', 6), ('target_q', 'q_target', 6), ('target_qd', 'qd_target', 6),
+         ('actual_qd', 'qd_actual', 6), ('actual_current', 'i_actual', 6), ('actual_TCP_pose', 'tool_vector_actual', 6),
+         ('actual_TCP_speed', 'tcp_speed_actual', 6), ('actual_TCP_force', 'tcp_force', 6),
+         ('target_TCP_pose', 'tool_vector_target', 6), ('joint_temperatures', 'motor_temperatures', 6),
+         ('actual_tool_accelerometer', 'tool_accelerometer', 3), ('speed_scaling', 'speed_scaling', 1),
+         ('elbow_position', 'elbow_position', 3), ('actual_digital_input_bits', 'digital_input_bits', 1),
+         ('actual_digital_output_bits', 'digital_outputs', 1), ('robot_mode', 'robot_mode', 1),
+         ('joint_mode', 'joint_modes', 6), ('safety_mode', 'safety_mode', 1), ('safety_status', 'safety_status', 1),
+         ('runtime_state', 'program_state', 1)]
+EXTRA_COLS = {'safety_mode': 102}
+
+
+def rt_packets(sock, until, deadline):
+    """RealTime packets (size, then doubles) up to the one timed until."""
+    data, out = b'', []
+    while (not out or out[-1][0] < until) and time.monotonic() < deadline:
+        chunk = sock.recv(65536)
+        if not chunk:
+            break
+        data += chunk
+        while len(data) >= 4:
+            size = struct.unpack_from('>i', data)[0]
+            if len(data) < size:
+                break
+            out.append(struct.unpack('>%dd' % ((size - 4) // 8), data[4:size]))
+            data = data[size:]
+    return out
+
+
+def rt_value(vals, name, n):
+    col = rt.COL3.get(name) or EXTRA_COLS[name]
+    got = vals[col - 1:col - 1 + n]
+    return got if n > 1 else got[0]
+
+
+def same_arm(version, rate, clock):
+    """RealTime first (its packets queue while RTDE is read), then RTDE; then
+    RealTime is read up to the last RTDE timestamp: they overlap wholly."""
+    with Sim('-c', version, '--clock', clock) as sim:
+        s = socket.create_connection(('127.0.0.1', sim.rt_port), timeout=5)
+        p = Peer(sim.port)
+        p.protocol_version(2)
+        p.setup_outputs(['timestamp'] + [a for a, _, _ in PAIRS], float(rate))
+        p.start()
+        rtde = p.data(rate // 5)
+        p.close()
+        rtp = rt_packets(s, rtde[-1][0], time.monotonic() + 10)
+        s.close()
+    by_time = {x[0]: x for x in rtde}
+    common = [r for r in rtp if r[0] in by_time]
+    check(len(common) >= len(rtde) * 0.9, '%s --clock %s: RealTime and RTDE overlap in controller time (%d of %d)'
+          % (version, clock, len(common), len(rtde)), (len(rtp), len(rtde)))
+    bad = []
+    for r in common:
+        x = by_time[r[0]]
+        for i, (a, b, n) in enumerate(PAIRS):
+            want = rt_value(r, b, n)
+            got = x[i + 1]
+            if isinstance(got, tuple):
+                same = len(got) == len(want) and all(struct.pack('>d', float(g)) == struct.pack('>d', w)
+                                                     for g, w in zip(got, want))
+            else:
+                same = struct.pack('>d', float(got)) == struct.pack('>d', want)
+            if not same:
+                bad.append((r[0], a, got, want))
+    check(common and not bad, '%s --clock %s: every value the same on both ports at the same timestamp, bit for bit'
+          % (version, clock), bad[:3])
+
+
+def rtde_only_model():
+    with Sim('-c', '5.26') as sim:
+        p = Peer(sim.port)
+        p.protocol_version(2)
+        names = ['timestamp', 'control_step', 'output_int_register_47', 'output_double_register_30',
+                 'output_bit_registers0_to_31', 'output_bit_registers32_to_63', 'output_bit_register_65',
+                 'output_bit_register_100', 'robot_status_bits', 'safety_status_bits', 'target_speed_fraction',
+                 'tcp_offset', 'payload', 'payload_cog', 'time_scale_source', 'tool_output_voltage',
+                 'input_int_register_30', 'actual_configurable_digital_input_bits']
+        p.setup_outputs(names, 500.0)
+        p.start()
+        pk = p.data(300)
+        p.close()
+    bad = []
+    for x in pk:
+        k = cycle(x[0], 500)
+        want = [x[0], k, k + 47, 30 + k / 1000.0, k % 2**32, ~k % 2**32, (k >> 1) & 1, (k >> 4) & 1, 3, 1, 1.0,
+                (0.0,) * 6, 1.0, (0.0, 0.0, 0.05), 1, 24, 0, 0]
+        for name, g, w in zip(names, x, want):
+            if w is not None and g != w:
+                bad.append((k, name, g, w))
+    # The model's inputs use bits 0-4 and 16: no configurable one (8-15) is on.
+    check(not bad, '5.26: the RTDE-only values follow docs/tools.md (registers count cycles, status bits, ...)', bad[:3])
+
+
+# ---- faults --------------------------------------------------------------------------------
+def session(sim, names=('timestamp', 'actual_q'), rate=500.0, protocol=2, rcvbuf=None):
+    p = Peer(sim.port, rcvbuf=rcvbuf)
+    if protocol == 2:
+        p.protocol_version(2)
+        p.setup_outputs(list(names), rate)
+    else:
+        p.setup_outputs(list(names))
+    p.start()
+    return p
+
+
+def read_until_end(p, limit=100000):
+    """Data packages until the connection ends: (packages, how it ended)."""
+    pk = []
+    try:
+        while len(pk) < limit:
+            kind, payload = p.package()
+            if kind == U:
+                pk.append(p.decode(payload))
+    except Closed:
+        return pk, 'closed'
+    except ConnectionResetError:
+        return pk, 'reset'
+    except TimeoutError:
+        return pk, 'timeout'
+    return pk, 'limit'
+
+
+def faults_refuse_and_text():
+    with Sim('-c', '5.10', '--fault', 'rtde-refuse-v2') as sim:
+        p = Peer(sim.port)
+        check(p.protocol_version(2) == 0, 'rtde-refuse-v2: V(2) answered 0')
+        check(p.protocol_version(1) == 1, 'rtde-refuse-v2: V(1) accepted on the same connection')
+        p.setup_outputs(['timestamp'])
+        p.start()
+        check(len(p.data(20)) == 20, 'rtde-refuse-v2: data in protocol 1')
+        p.close()
+    with Sim('-c', '5.10', '--fault', 'rtde-text-handshake') as sim:
+        p = Peer(sim.port)
+        p.protocol_version(2)
+        p.controller_version()
+        p.setup_outputs(['timestamp'], 500.0)
+        p.start()
+        layouts = [t[2] for t in p.texts]
+        check(len(p.texts) == 4 and layouts[0] is None and all(s == 'urrt-sim' for s in layouts[1:]),
+              'rtde-text-handshake: a text before each of 4 replies, before V in the v1 layout, then v2', p.texts)
+        check(all(k == M for k, _ in p.foreign), 'rtde-text-handshake: the client skipped them to find its replies')
+        p.close()
+    with Sim('-c', '5.10', '--fault', 'rtde-text-every=10,level=1') as sim:
+        p = session(sim)
+        pk = p.data(45)
+        steps = steps_of(pk, 500)
+        check([t[0] for t in p.texts] == [1, 1, 1, 1] and regular(steps, 1),
+              'rtde-text-every=10,level=1: 4 error texts among 45 data packages, none missing', (p.texts, steps))
+        p.close()
+    with Sim('-c', '3.10', '--fault', 'rtde-text-every=5') as sim:
+        p = session(sim, rate=125.0, protocol=1)
+        p.data(11)
+        check(len(p.texts) == 2 and p.texts[0][0] == 2 and p.texts[0][2] is None and 'text message 1' in p.texts[0][1],
+              'rtde-text-every in protocol 1: level then message, warning by default', p.texts)
+        p.close()
+
+
+def faults_bad_package():
+    for kind in ('size', 'type', 'recipe'):
+        with Sim('-c', '5.10', '--fault', 'rtde-bad-package=5,kind=' + kind) as sim:
+            p = session(sim)
+            good, bad = [], []
+            while len(good) + len(bad) < 15:
+                k, payload = p.package()
+                if k == M:
+                    continue
+                try:
+                    if k != U:
+                        raise ValueError('type %r' % k)
+                    good.append(p.decode(payload))
+                except ValueError as e:
+                    bad.append(str(e))
+            steps = [cycle(b[0], 500) - cycle(a[0], 500) for a, b in zip(good, good[1:])]
+            check(len(bad) == 3 and sorted(set(steps)) == [1, 2],
+                  'rtde-bad-package=5,kind=%s: every 5th package bad, framing intact' % kind, (bad, steps))
+            p.close()
+    with Sim('-c', '5.10', '--fault', 'rtde-bad-package=5,kind=header') as sim:
+        p = session(sim)
+        try:
+            p.data(10)
+            got = 'no error'
+        except Unframable as e:
+            got = str(e)
+        check(got == 'size field 2', 'rtde-bad-package kind=header: an unframable size field after 4 packages', got)
+        p.close()
+
+
+def faults_connection():
+    with Sim('-c', '5.10', '--fault', 'close-after=30') as sim:
+        pk, how = read_until_end(session(sim))
+        check(len(pk) == 30 and how == 'closed', 'close-after=30: 30 data packages, then an orderly close', (len(pk), how))
+    with Sim('-c', '5.10', '--fault', 'reset-after=30') as sim:
+        pk, how = read_until_end(session(sim))
+        check(len(pk) == 30 and how == 'reset', 'reset-after=30: 30 data packages, then a reset', (len(pk), how))
+    with Sim('-c', '5.10', '--fault', 'truncate-after=10') as sim:
+        p = session(sim)
+        pk, how = read_until_end(p)
+        check(len(pk) == 10 and how == 'closed' and len(p.buf) == (3 + 1 + 56) // 2,
+              'truncate-after=10: 10 packages, half of the next, a close', (len(pk), how, len(p.buf)))
+    with Sim('-c', '5.10', '-n', '25') as sim:
+        pk, how = read_until_end(session(sim))
+        check(len(pk) == 25 and how == 'closed', '--count 25: 25 data packages', (len(pk), how))
+    with Sim('-c', '5.10', '--fault', 'stall-after=20,for=300') as sim:
+        p = session(sim)
+        pk = p.data(60)
+        steps = [cycle(b[0], 500) - cycle(a[0], 500) for a, b in zip(pk, pk[1:])]
+        gaps = [s for s in steps if s != 1]
+        check(len(gaps) == 1 and 140 <= gaps[0] <= 400 and steps.index(gaps[0]) == 19,
+              'stall-after=20,for=300: 20 packages, a gap of about 150 cycles in controller time, then one per cycle '
+              '(no burst)', gaps)
+        p.close()
+    with Sim('-c', '5.10', '--start-on-connect', '--fault', 'freeze-after=250,for=300') as sim:
+        p = session(sim)
+        pk = p.data(400)
+        steps = [cycle(b[0], 500) - cycle(a[0], 500) for a, b in zip(pk, pk[1:])]
+        gaps = [s for s in steps if s != 1]
+        # From cycle 250 on (later only if the schedule skipped cycles), 300 ms of them.
+        check(len(gaps) == 1 and 140 <= gaps[0] <= 170 and cycle(pk[0][0], 500) + steps.index(gaps[0]) >= 249,
+              'freeze-after=250,for=300: the controller\'s cycles 250 to ~400 skipped for RTDE too', gaps)
+        p.close()
+    with Sim('-c', '5.10', '--fault', 'tiny-writes=5') as sim:
+        p = session(sim, names=['timestamp'], rate=50.0)
+        pk = p.data(40)
+        steps = steps_of(pk, 500)
+        check(regular(steps, 10), 'tiny-writes=5: packages in 5-byte writes arrive whole, at the rate', set(steps))
+        p.close()
+    with Sim('-c', '5.10', '--fault', 'coalesce=8') as sim:
+        p = session(sim)
+        pk = p.data(64)
+        steps = steps_of(pk, 500)
+        check(regular(steps, 1), 'coalesce=8: every package, 8 to a write', set(steps))
+        p.close()
+
+
+def slow_reader(extra, bound, what):
+    """A reader that stops reading is disconnected once the backlog the
+    simulator holds for it passes the bound; one that reads is not."""
+    names = ['timestamp', 'target_q', 'actual_q', 'actual_qd', 'actual_current', 'actual_TCP_pose']
+    with Sim('-c', '5.10', *extra) as sim:
+        slow = session(sim, names=names, rcvbuf=4096)
+        fast = session(sim, names=['timestamp'])
+        before = len(fast.data(10))
+        ok = wait_for('the slow reader\'s disconnection', lambda: 'fell behind' in sim.log(), sim.proc, timeout=20)
+        check(ok, '%s: a reader that does not read is disconnected' % what, sim.log()[-400:])
+        pk, how = read_until_end(slow, limit=10**6)
+        size = 3 + slow.size_of()
+        check(how == 'closed', '%s: with an orderly close (EOF after what was sent)' % what, how)
+        # The log: "... fell behind (...) after N packets (B bytes)": N packages
+        # queued, B bytes written; the reader got those bytes, and what the
+        # simulator dropped is the backlog: just past the bound.
+        line = [l for l in sim.log().splitlines() if 'fell behind' in l][0]
+        queued, written = [int(w.strip('(')) for w in line.split(' after ')[1].split()[0:3:2]]
+        backlog = (queued - len(pk)) * size
+        check(written == slow.received and bound < backlog <= bound + size,
+              '%s: the reader got all that was written (%d bytes), the backlog dropped was just past %d bytes (%d)'
+              % (what, written, bound, backlog), (written, slow.received, line))
+        more = fast.data(50)
+        steps = steps_of(more, 500)
+        check(before == 10 and regular(steps, 1), '%s: the reader that reads is not disturbed' % what, set(steps))
+        slow.close()
+        fast.close()
+        sim.stop()
+        check('RTDE readers disconnected as behind 1' in sim.log(), '%s: the summary counts it' % what,
+              sim.log()[-300:])
+
+
+def run(group, *args):
+    """One group of checks; an exception (a reply that never came, a package
+    that does not parse) fails the group instead of ending the suite."""
+    try:
+        group(*args)
+    except Exception as e:  # noqa: BLE001  any of them is a failure to report
+        check(False, '%s%s raised %s' % (group.__name__, args, type(e).__name__), e)
+
+
+def main():
+    run(usage_errors)
+    run(handshake_v2, '3.4', (3, 4), 125)
+    run(handshake_v2, '3.10', (3, 10), 125)
+    run(handshake_v2, '5.12.3.1234', (5, 12, 3, 1234), 500)
+    run(handshake_v2, '5.5.1', (5, 5, 1), 500)
+    run(handshake_v1, '3.10', 125)
+    run(handshake_v1, '5.10', 500)
+    run(old_protocol)
+    run(inputs_and_misc)
+    run(frequencies)
+    run(same_arm, '5.10', 500, 'start')
+    run(same_arm, '3.15', 125, 'monotonic')
+    run(rtde_only_model)
+    run(faults_refuse_and_text)
+    run(faults_bad_package)
+    run(faults_connection)
+    run(slow_reader, [], 65536, 'default backlog')
+    run(slow_reader, ['--fault', 'rtde-backlog=2048'], 2048, 'rtde-backlog=2048')
+    print('%d passed, %d failed' % (PASSED, FAILED))
+    return 1 if FAILED else 0
+
+
+if __name__ == '__main__':
+    try:
+        sys.exit(main())
+    finally:
+        subprocess.run(['rm', '-rf', TMP])
