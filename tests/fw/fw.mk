@@ -2,43 +2,66 @@
 # tests/fw/fw.mk: a firmware gateway built from lib/ alone against urrt-gateway.
 #   check-fw-gateway  the same capture (tests/fw/make_capture.py: 500 packets with a stall,
 #                     clamped and NaN values, garbage between packets) through
-#                     (a) urrt-gateway --replay with a docs/examples/ configuration, interface = log:PATH
+#                     (a) urrt-gateway --replay with the configuration, interface = log:PATH
 #                     (b) tests/fw/fw_gateway.c with lib/ and the tables urrt-gateway --print-c-tables
 #                         wrote for the same file, bare metal on qemu's Cortex-M4 (mps2-an386), no C
 #                         library, the capture read through semihosting in 1460-byte chunks
 #                     both clocked by the packets' controller time: the frames (id, flags, payload,
 #                     order) must be identical. For canopen.ini (classic, a CANopen node: the
-#                     image runs lib/urrt_co too, built with -DFW_CANOPEN, and both are fed the
-#                     same manager's frames, tests/fw/master_frames.py: NMT, SYNC, SDO with
-#                     segmented upload and aborts, via --replay-rx), fd.ini (CAN FD) and
-#                     j1939.ini (29-bit ids); prints the canopen image's footprint.
+#                     image runs lib/urrt_co too, built with -DFW_CANOPEN, no manager), fd.ini
+#                     (CAN FD), j1939.ini (29-bit ids) and canopen-vm: tests/canopen/canopen.ini
+#                     fed what make check-canopen's VM run recorded, the robot's stream
+#                     (tests/fw/vm-capture.bin.xz) and the frames tests/canopen/master.py sent on
+#                     its clock (tests/fw/vm-master.log: NMT, SYNC, SDO; via --replay-rx and the
+#                     image's receive table), whose SDO answers must be the live node's
+#                     (tests/fw/vm-node.log); prints the canopen image's footprint.
+#   record-fw-master  make check-canopen, then that recording from its run (tests/fw/record_master.py)
 # The rules use target.mk's toolchain variables in recipes only (it is included after this file).
 
 FW := $(BUILD)/tests/fw
-FW_CONFIGS := canopen fd j1939
-FW_CANOPEN := canopen
+FW_CONFIGS := canopen canopen-vm fd j1939
+FW_CANOPEN := canopen canopen-vm
 FW_LIB_OBJS = $(LIB_SRCS:lib/%.c=$(FW)/lib/%.o)
 
 CHECKS += check-fw-gateway
-.PHONY: check-fw-gateway
+.PHONY: check-fw-gateway record-fw-master
 
 $(FW)/capture.bin: tests/fw/make_capture.py tests/ref/urrt_ref.py
 	@mkdir -p $(@D)
 	$(PYTHON) tests/fw/make_capture.py $@
 
-# The manager's frames, for --replay-rx (rx.log) and the image (rx.c): one script writes both.
-$(FW)/%/rx.log $(FW)/%/rx.c: tests/fw/master_frames.py
+# The manager's frames, for --replay-rx (rx.log) and the image (rx.c): canopen-vm's were
+# recorded; a node with no manager gets none.
+$(FW)/canopen-vm/rx.log: tests/fw/vm-master.log
 	@mkdir -p $(@D)
-	$(PYTHON) tests/fw/master_frames.py $(FW)/$*/rx.log $(FW)/$*/rx.c
+	cp $< $@
+$(FW)/%/rx.log:
+	@mkdir -p $(@D)
+	: > $@
+$(FW)/%/rx.c: $(FW)/%/rx.log tests/fw/rx_table.py
+	$(PYTHON) tests/fw/rx_table.py $< $@
+
+$(FW)/canopen-vm/capture.bin: tests/fw/vm-capture.bin.xz
+	@mkdir -p $(@D)
+	xz -dc $< > $@
+# The live node's SDO answers, which the replay's must equal.
+$(FW)/canopen-vm/node.log: tests/fw/vm-node.log
+	@mkdir -p $(@D)
+	cp $< $@
 
 $(FW)/%/rx.o: $(FW)/%/rx.c tests/fw/fw_rx.h
 	$(TGT_CM) $(TGT_M4) -Os $(TGT_LIB_FLAGS) -Itests/fw -c $< -o $@
 
-# The example configuration with its CAN frames logged to a file.
-$(FW)/%/gateway.ini: docs/examples/%.ini
+# The configuration with its CAN frames logged to a file: an example, or check-canopen's.
+define fw_log_ini
 	@mkdir -p $(@D)
 	sed 's|^interface = .*|interface = log:$(@D)/gateway.log|' $< > $@
 	@grep -q '^interface = log:' $@ || { echo "$@: no interface line in $<"; exit 1; }
+endef
+$(FW)/%/gateway.ini: docs/examples/%.ini
+	$(fw_log_ini)
+$(FW)/canopen-vm/gateway.ini: tests/canopen/canopen.ini
+	$(fw_log_ini)
 
 $(FW)/%/tables.c: $(FW)/%/gateway.ini $(BUILD)/bin/urrt-gateway
 	$(BUILD)/bin/urrt-gateway --print-c-tables -o $@ $<
@@ -64,5 +87,9 @@ $(FW)/%/fw_gateway.elf: tests/fw/fw_gateway.c tests/fw/fw_rx.h tests/target/cm.c
 	  $(if $(filter $*,$(FW_CANOPEN)),$(FW)/$*/rx.o) $(FW_LIB_OBJS) -T tests/target/an386.ld $(TGT_LINK) -o $@
 
 check-fw-gateway: $(foreach c,$(FW_CONFIGS),$(FW)/$(c)/fw_gateway.elf $(FW)/$(c)/gateway.ini) $(FW)/capture.bin \
-  tests/fw/run.sh tests/fw/compare.sh
+  $(FW)/canopen-vm/capture.bin $(FW)/canopen-vm/node.log tests/fw/run.sh tests/fw/compare.sh
 	$(call suite,check-fw-gateway,sh tests/fw/run.sh $(BUILD) $(FW) $(FW_CONFIGS))
+
+# Writes tests/fw/vm-capture.bin.xz, vm-master.log and vm-node.log from a passing check-canopen run.
+record-fw-master: check-canopen
+	$(PYTHON) tests/fw/record_master.py $(BUILD)/vm/check-canopen/out tests/fw

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* The frames a CANopen manager sent the firmware's node in check-fw-gateway
- * (tests/fw/master_frames.py writes them, timed on the capture's clock): what
- * a board's CAN receive interrupt would hand over. */
+ * (tests/fw/rx_table.py writes them from a candump -l log timed on the
+ * capture's clock, recorded from check-canopen's master): what a board's CAN
+ * receive interrupt would hand over. */
 #ifndef URRT_TEST_FW_RX_H
 #define URRT_TEST_FW_RX_H
 
