@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: MIT
 # tests/soak/soak.mk: make soak SOAK_MINUTES=N (default 10). urrt-sim cycles through
-# every fault mode against one long-running urrt-gateway with an LCM and a CAN
-# log output; an independent checker judges every message's and frame's data
-# age, and the gateway's RSS and descriptors. Not part of `make check`.
+# every fault mode against two long-running urrt-gateways, one with an LCM and
+# a CAN log output, one a CANopen node with its own log; an independent
+# checker judges every message's and frame's data age, the node's EMCYs and
+# heartbeats, and both gateways' RSS and descriptors. Not part of `make check`.
 SOAK_MINUTES ?= 10
 # Seconds per fault phase: 12 phases make one pass.
 SOAK_PHASE_SECONDS ?= 10

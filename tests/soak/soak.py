@@ -1,9 +1,10 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: MIT
-"""make soak: one urrt-gateway, many urrt-sim fault modes, an independent judge.
+"""make soak: two urrt-gateways, many urrt-sim fault modes, an independent judge.
 
 One gateway runs for the whole soak with an LCM output and a CAN output to a
-candump log. urrt-sim serves it on one port, restarted for each phase with
+candump log, another as a CANopen node (self-starting) to a log of its own.
+urrt-sim serves both on one port, restarted for each phase with
 the next fault mode (and, in the restart phase, killed and restarted every
 couple of seconds). Every packet carries the wall clock at its scheduled send
 instant (--clock realtime), so each message's and frame's data age is known
@@ -16,6 +17,9 @@ without asking the gateway:
   write); age = the line's stamp - the simulator's time recovered from the
   payload (0x181: the time column as a float64, exact; 0x182 and 0x183: ms
   since the soak's start, 32 bits, +-0.5 ms).
+- CANopen: the same for the node's TPDOs (validity bits), and its EMCYs
+  (0xFF01 link down, 0xFF02 stale) and heartbeats judged against the data
+  its TPDO1 carries and the fault schedule.
 
 Usage: soak.py --build DIR [--minutes N] [--phase-seconds S] [--result FILE]
 """
@@ -67,6 +71,27 @@ RESTART_UP_S, RESTART_DOWN_S = 2.0, 0.3
 
 CAN_EVERY, CAN_FAST, CAN_INVALID, CAN_HEARTBEAT = 0x181, 0x182, 0x183, 0x701
 CAN_BOUND_MS = {CAN_EVERY: BOUND_MS, CAN_FAST: FAST_BOUND_MS, CAN_INVALID: BOUND_MS}
+
+# The CANopen gateway: node 9, self-starting, to its own log. TPDO1 keeps its
+# period while stale with valid = 0; TPDO2 stops. Both carry ms since the
+# soak's start (bytes 0-3), as 0x182 does.
+CO_NODE = 9
+CO_TPDO_INVALID, CO_TPDO_STOP = 0x180 + CO_NODE, 0x280 + CO_NODE
+CO_EMCY, CO_HEARTBEAT = 0x80 + CO_NODE, 0x700 + CO_NODE
+CO_ALIVE_BYTE = 4                                           # TPDO1's alive counter
+CO_VALID_BYTE = {CO_TPDO_INVALID: 5, CO_TPDO_STOP: 4}       # each TPDO's validity bit (bit 0)
+CO_HB_MS = 100
+# Between the freezes: freeze-every's 700 ms raises 0xFF02 (stale) and resets
+# it on fresh data; the 1500 ms stalls and freeze raise 0xFF02, then 0xFF01 as
+# the link drops (0xFF02's reset hands over to it), and a frozen simulator
+# keeps 0xFF01 set through the reconnection until data flows.
+CO_SILENCE_MS = 1000
+EMCY_LINK, EMCY_STALE = 0xFF01, 0xFF02
+# The EMCYs each phase must raise once data has flowed in it (the stop and
+# start between phases drops the link in every phase: that one is not counted).
+EXPECTED_EMCY = {"close": (EMCY_LINK,), "reset": (EMCY_LINK,), "truncate": (EMCY_LINK,), "restart": (EMCY_LINK,),
+                 "stall": (EMCY_STALE, EMCY_LINK), "freeze-after": (EMCY_STALE, EMCY_LINK),
+                 "freeze-every": (EMCY_STALE,)}
 
 PASSED = 0
 FAILED = 0
@@ -150,6 +175,53 @@ validity_bit = 63
            fast=CAN_FAST, fast_bound=FAST_BOUND_MS, t0=t0, inv=CAN_INVALID)
 
 
+def co_config(port, url, log, t0):
+    """The CANopen gateway: the same robot, its own log, no LCM messages."""
+    return """[lcm]
+url = {url}
+state_rate = off
+joints_rate = off
+tool_rate = off
+status_rate = off
+gateway_rate = off
+
+[robot {name}co]
+host = 127.0.0.1
+port = {port}
+version = 5.10
+silence_timeout = {silence} ms
+backoff_initial = 20 ms
+backoff_max = 200 ms
+
+[can]
+interface = log:{log}
+stale_after_ms = {bound}
+bitrate = 1000000
+
+[canopen]
+node_id = {node}
+nmt_start = operational
+heartbeat_ms = {hb}
+
+# TPDO1: keeps its period while stale, with valid = 0.
+[frame co_invalid]
+period_ms = 10
+stale_policy = invalid
+signal = time @0|32 intel unsigned factor=0.001 offset={t0} name=time_ms
+alive_counter = {alive_bit}
+validity_bit = {valid1_bit}
+
+# TPDO2: stops while stale.
+[frame co_stop]
+period_ms = 20
+stale_policy = stop
+signal = time @0|32 intel unsigned factor=0.001 offset={t0} name=time_ms
+validity_bit = {valid2_bit}
+""".format(url=url, name=NAME, port=port, silence=CO_SILENCE_MS, log=log, bound=BOUND_MS, node=CO_NODE, hb=CO_HB_MS,
+           t0=t0, alive_bit=CO_ALIVE_BYTE * 8, valid1_bit=CO_VALID_BYTE[CO_TPDO_INVALID] * 8,
+           valid2_bit=CO_VALID_BYTE[CO_TPDO_STOP] * 8)
+
+
 NAME = "soak%d" % os.getpid()
 
 
@@ -163,23 +235,18 @@ class PhaseStats:
         self.hb_lies = 0
 
 
-class CanLog:
-    """Reads the candump log as it grows and judges each line."""
+class CandumpLog:
+    """Reads a candump log as it grows and hands each frame to _frame()."""
 
-    def __init__(self, path, t0):
-        self.path, self.t0 = path, t0
+    def __init__(self, path, t0, stats):
+        self.path, self.t0, self.stats = path, t0, stats
         self.offset = 0
-        self.newest_stamp_us = 0       # newest simulator time carried by a data frame so far
-        self.last_hb_us = None
-        self.max_hb_gap_us = 0
-        self.alive = None              # 0x182's last alive counter
-        self.alive_breaks = 0
         self.bad_lines = 0
         self.reported = 0
         self.phases = []
 
     def phase(self, name, start_us):
-        self.phases.append(PhaseStats(name, start_us))
+        self.phases.append(self.stats(name, start_us))
 
     def _phase_at(self, t_us):
         for p in reversed(self.phases):
@@ -201,7 +268,7 @@ class CanLog:
 
     def _report(self, text):
         if self.reported < 20:
-            print("can: " + text)
+            print(self.prefix + text)
         self.reported += 1
 
     def _line(self, line):
@@ -217,14 +284,33 @@ class CanLog:
             return
         p = self._phase_at(t_us)
         p.frames[ident] = p.frames.get(ident, 0) + 1
+        self._frame(p, t_us, ident, data)
+
+    def ms_since_t0(self, data):
+        """The simulator's time (us) from a 32-bit 'ms since the soak's start' signal at byte 0."""
+        return self.t0 * 1000000 + struct.unpack("<I", data[:4])[0] * 1000
+
+
+class CanLog(CandumpLog):
+    """Judges the [can] gateway's frames as they are read."""
+    prefix = "can: "
+
+    def __init__(self, path, t0):
+        CandumpLog.__init__(self, path, t0, PhaseStats)
+        self.newest_stamp_us = 0       # newest simulator time carried by a data frame so far
+        self.last_hb_us = None
+        self.max_hb_gap_us = 0
+        self.alive = None              # 0x182's last alive counter
+        self.alive_breaks = 0
+
+    def _frame(self, p, t_us, ident, data):
         if ident == CAN_HEARTBEAT:
             self._heartbeat(p, t_us, data)
             return
         if ident == CAN_EVERY:
             sim_us = round(struct.unpack("<d", data)[0] * 1e6)
         elif ident in (CAN_FAST, CAN_INVALID):
-            raw = struct.unpack("<I", data[:4])[0]
-            sim_us = self.t0 * 1000000 + raw * 1000
+            sim_us = self.ms_since_t0(data)
             if ident == CAN_FAST:
                 alive = data[6] & 0xF
                 if self.alive is not None and alive != (self.alive + 1) % 16:
@@ -254,6 +340,158 @@ class CanLog:
             p.hb_lies += 1
             self._report("heartbeat OK at %d while the newest data sent is %.1f ms old (%s)" %
                          (t_us, (t_us - self.newest_stamp_us) / 1e3, p.name))
+
+
+
+class CoPhaseStats:
+    def __init__(self, name, start_us):
+        self.name, self.start_us = name, start_us
+        self.frames = {}         # id -> count
+        self.invalid = {}        # TPDO id -> frames with valid = 0
+        self.oldest_us = {}      # TPDO id -> oldest data age of a frame with valid = 1
+        self.first_data_us = None  # the first TPDO with valid = 1 of this phase
+        self.end_us = None       # the simulator's stop at the phase's end
+        self.raised = {}         # EMCY code -> raised after first_data_us, before end_us
+        self.resets = {}         # EMCY code -> reset
+
+
+class CoLog(CandumpLog):
+    """Judges the CANopen node's frames as they are read. TPDO1 (invalid policy,
+    10 ms) carries the newest data the node has at every period, whatever its
+    age: it is the reference the EMCYs are judged against."""
+    prefix = "canopen: "
+
+    def __init__(self, path, t0):
+        CandumpLog.__init__(self, path, t0, CoPhaseStats)
+        self.violations = {}     # rule -> count
+        self.data_seen = False   # a TPDO with valid = 1 was seen (before: the startup, no data)
+        self.before_data = 0
+        self.newest_us = 0       # newest simulator time sent in TPDO1
+        self.active = {}         # EMCY code raised -> its time
+        self.pending = []        # (code, reset time, raise time): judged by the next TPDO1
+        self.alive = None
+        self.hb_count = 0
+        self.hb_boot = 0
+        self.last_hb_us = None
+        self.max_hb_gap_us = 0
+
+    def _violate(self, rule, t_us, text):
+        self.violations[rule] = self.violations.get(rule, 0) + 1
+        self._report("%s at %d (%s)" % (text, t_us, self._phase_at(t_us).name))
+
+    def _frame(self, p, t_us, ident, data):
+        if ident == CO_HEARTBEAT:
+            self._heartbeat(t_us, data)
+        elif ident in CO_VALID_BYTE:
+            self._tpdo(p, t_us, ident, data)
+        elif ident == CO_EMCY:
+            self._emcy(p, t_us, data)
+        else:
+            self._violate("unexpected", t_us, "unexpected frame 0x%X#%s" % (ident, data.hex().upper()))
+
+    def _tpdo(self, p, t_us, ident, data):
+        if len(data) <= max(CO_VALID_BYTE[ident], CO_ALIVE_BYTE):
+            self._violate("unexpected", t_us, "TPDO 0x%X#%s too short" % (ident, data.hex().upper()))
+            return
+        valid = data[CO_VALID_BYTE[ident]] & 1
+        if not valid and not self.data_seen:
+            self.before_data += 1
+            return
+        self.data_seen = True
+        sim_us = self.ms_since_t0(data)
+        age = t_us - sim_us
+        if valid:
+            p.oldest_us[ident] = max(p.oldest_us.get(ident, age), age)
+            if p.first_data_us is None:
+                p.first_data_us = t_us
+            if age > (BOUND_MS + MARGIN_MS) * 1000:
+                self._violate("valid_stale_%X" % ident, t_us, "0x%X#%s has its validity bit set on data %.1f ms old" %
+                              (ident, data.hex().upper(), age / 1e3))
+        else:
+            p.invalid[ident] = p.invalid.get(ident, 0) + 1
+        if ident != CO_TPDO_INVALID:
+            return
+        alive = data[CO_ALIVE_BYTE] & 0xF
+        if self.alive is not None and alive != (self.alive + 1) % 16:
+            self._violate("alive", t_us, "0x%X's alive counter went from %d to %d" % (ident, self.alive, alive))
+        self.alive = alive
+        self._settle(t_us, sim_us)
+        if age > (BOUND_MS + MARGIN_MS) * 1000 and not self.active:
+            self._violate("stale_silent", t_us, "data %.1f ms old and neither EMCY 0xFF01 nor 0xFF02 set" %
+                          (age / 1e3))
+        self.newest_us = max(self.newest_us, sim_us)
+
+    def _settle(self, t_us, sim_us):
+        """Judges the resets since the last TPDO1 by the data this one carries."""
+        for code, reset_us, raise_us in self.pending:
+            if code == EMCY_LINK and sim_us < raise_us - MARGIN_MS * 1000:
+                self._violate("reset_early", reset_us, "EMCY 0xFF01 reset before data flowed again (the next "
+                              "TPDO1's data is %.1f ms older than the link's loss)" % ((raise_us - sim_us) / 1e3))
+            elif code == EMCY_STALE and reset_us - sim_us > (BOUND_MS + MARGIN_MS) * 1000:
+                self._violate("reset_early", reset_us, "EMCY 0xFF02 reset while the data is %.1f ms old" %
+                              ((reset_us - sim_us) / 1e3))
+        self.pending = []
+
+    def _emcy(self, p, t_us, data):
+        if len(data) != 8:
+            self._violate("emcy", t_us, "EMCY of %d bytes %s" % (len(data), data.hex().upper()))
+            return
+        code, register = struct.unpack("<H", data[:2])[0], data[2]
+        if code == 0:
+            self._emcy_reset(p, t_us, struct.unpack("<H", data[3:5])[0])
+            return
+        if code not in (EMCY_LINK, EMCY_STALE) or register != 0x81:
+            self._violate("emcy", t_us, "unexpected EMCY %s" % data.hex().upper())
+            return
+        if code in self.active:
+            self._violate("emcy", t_us, "EMCY 0x%04X raised twice" % code)
+        if code == EMCY_STALE and t_us - self.newest_us <= (BOUND_MS - MARGIN_MS) * 1000:
+            self._violate("raise_early", t_us, "EMCY 0xFF02 raised while the newest data sent is %.1f ms old" %
+                          ((t_us - self.newest_us) / 1e3))
+        if code == EMCY_LINK:
+            # The link's loss ends staleness: 0xFF02's reset in the same run is the handover.
+            self.pending = [x for x in self.pending if not (x[0] == EMCY_STALE and x[1] >= t_us - MARGIN_MS * 1000)]
+        self.active[code] = t_us
+        if p.first_data_us is not None and (p.end_us is None or t_us < p.end_us):
+            p.raised[code] = p.raised.get(code, 0) + 1
+
+    def _emcy_reset(self, p, t_us, code):
+        if code not in self.active:
+            self._violate("emcy", t_us, "EMCY reset of 0x%04X, which is not set" % code)
+            return
+        raise_us = self.active.pop(code)
+        p.resets[code] = p.resets.get(code, 0) + 1
+        if code == EMCY_LINK or EMCY_LINK not in self.active:
+            self.pending.append((code, t_us, raise_us))
+
+    def _heartbeat(self, t_us, data):
+        state = data[0] if len(data) == 1 else -1
+        if self.hb_count == 0 and state == 0:
+            self.hb_boot += 1
+        elif state != 5:
+            self._violate("hb_state", t_us, "heartbeat 0x%X#%s: not OPERATIONAL (05)%s" %
+                          (CO_HEARTBEAT, data.hex().upper(), "" if self.hb_count else ", nor a first boot-up (00)"))
+        if self.last_hb_us is not None:
+            gap = t_us - self.last_hb_us
+            self.max_hb_gap_us = max(self.max_hb_gap_us, gap)
+            if gap > CO_HB_MS * 1500:
+                self._violate("hb_gap", t_us, "heartbeat %.1f ms after the last" % (gap / 1e3))
+        self.last_hb_us = t_us
+        self.hb_count += 1
+
+    def end_phase(self, t_us):
+        """The simulator stops now: its stop drops the link, in every phase; the
+        EMCYs that follow are not the phase's fault."""
+        self.phases[-1].end_us = t_us
+
+    def finish(self, end_us):
+        """After the last read: what was raised before the simulator's final stop is reset."""
+        for code, raise_us in self.active.items():
+            if raise_us < end_us:
+                self._violate("never_reset", raise_us, "EMCY 0x%04X raised and never reset" % code)
+        for code, reset_us, _ in self.pending:
+            if reset_us < end_us:
+                self._violate("reset_early", reset_us, "EMCY 0x%04X reset and no TPDO1 after it" % code)
 
 
 def proc_sample(pid):
@@ -334,6 +572,7 @@ def run(args):
     t0 = int(time.time())
     log = s.path("can.log")
     can = CanLog(log, t0)
+    co = CoLog(s.path("co.log"), t0)
     url = "udpm://239.255.76.67:%d?ttl=0" % free_udp_port()
     deadline = time.monotonic() + args.minutes * 60
     cycle_s = len(PHASES) * args.phase_seconds
@@ -343,8 +582,8 @@ def run(args):
     warm_phases = len(PHASES) if args.minutes * 60 >= 2 * cycle_s else 1
     print("soak: %.1f min, %d phases of %d s (%d s per pass, %d passes), bound %d ms (+%d ms margin), dir %s" %
           (args.minutes, len(PHASES), args.phase_seconds, cycle_s, cycles, BOUND_MS, MARGIN_MS, s.dir))
-    samples = []
-    gw = checker = None
+    samples = {"can": [], "canopen": []}
+    gw = co_gw = checker = None
     try:
         s.start_sim(PHASES[0][1])
         ready = s.path("lcm.ready")
@@ -356,27 +595,34 @@ def run(args):
             raise RuntimeError("soak_lcm did not start: %s" % open(s.path("lcm.err")).read())
         with open(s.path("gw.ini"), "w") as f:
             f.write(config(s.port, url, log, t0))
+        with open(s.path("co.ini"), "w") as f:
+            # Nobody listens to its LCM group; all its messages are off anyway.
+            f.write(co_config(s.port, "udpm://239.255.76.67:%d?ttl=0" % free_udp_port(), co.path, t0))
 
         def begin(name):
             start = now_us()
             can.phase(name, start)
+            co.phase(name, start)
             checker.stdin.write("phase %s %d\n" % (name, start))
             checker.stdin.flush()
 
         begin(PHASES[0][0])
         gw = s.start([args.gateway, s.path("gw.ini")], "gw.log")
+        co_gw = s.start([args.gateway, s.path("co.ini")], "co-gw.log")
         n = 0
         while time.monotonic() < deadline:
             name, extra = PHASES[n % len(PHASES)]
             if n > 0:
+                co.end_phase(now_us())
                 s.stop_sim()
                 begin(name)
                 s.start_sim(extra)
             end = min(time.monotonic() + args.phase_seconds, deadline)
             next_kill = time.monotonic() + RESTART_UP_S
             while time.monotonic() < end:
-                if gw.poll() is not None:
-                    raise RuntimeError("urrt-gateway exited (%s) in phase %s" % (gw.returncode, name))
+                for g, what in ((gw, "urrt-gateway"), (co_gw, "the CANopen urrt-gateway")):
+                    if g.poll() is not None:
+                        raise RuntimeError("%s exited (%s) in phase %s" % (what, g.returncode, name))
                 if name == "restart" and time.monotonic() >= next_kill:
                     s.stop_sim(signal.SIGKILL)
                     s.sim_kills += 1
@@ -384,31 +630,39 @@ def run(args):
                     s.start_sim([])
                     next_kill = time.monotonic() + RESTART_UP_S
                 can.read()
+                co.read()
                 time.sleep(0.05)
             n += 1
-            rss, fds = proc_sample(gw.pid)
-            samples.append((n, name, rss, fds))
-            if n % len(PHASES) == 0 or n == warm_phases:
-                print("soak: after phase %d (%s, pass %d): gateway RSS %d KiB, %d fds" %
-                      (n, name, (n - 1) // len(PHASES) + 1, rss, fds))
-                sys.stdout.flush()
+            for key, g in (("can", gw), ("canopen", co_gw)):
+                rss, fds = proc_sample(g.pid)
+                samples[key].append((n, name, rss, fds))
+                if n % len(PHASES) == 0 or n == warm_phases:
+                    print("soak: after phase %d (%s, pass %d): %s gateway RSS %d KiB, %d fds" %
+                          (n, name, (n - 1) // len(PHASES) + 1, key, rss, fds))
+            sys.stdout.flush()
+        end_us = now_us()
+        co.end_phase(end_us)
         s.stop_sim()
         checker.stdin.write("end %d\n" % now_us())
         checker.stdin.flush()
         checker.wait(timeout=WAIT)
-        alive = gw.poll() is None
-        gw.send_signal(signal.SIGTERM)
-        gw_rc = gw.wait(timeout=WAIT)
+        exits = {}
+        for key, g in (("can", gw), ("canopen", co_gw)):
+            alive = g.poll() is None
+            g.send_signal(signal.SIGTERM)
+            exits[key] = (alive, g.wait(timeout=WAIT))
         can.read()
+        co.read()
+        co.finish(end_us)
     finally:
         s.stop_all()
-    if report(s, can, samples, warm_phases, alive, gw_rc):
+    if report(s, can, co, samples, warm_phases, exits):
         subprocess.run(["rm", "-rf", s.dir])
     else:
         print("soak: files kept in %s" % s.dir)
 
 
-def report(s, can, samples, warm_phases, alive, gw_rc):
+def report(s, can, co, samples, warm_phases, exits):
     lcm_out = open(s.path("lcm.out")).read().splitlines()
     for line in lcm_out:
         if line.startswith(("stale ", "lie ", "undecodable ")):
@@ -459,7 +713,8 @@ def report(s, can, samples, warm_phases, alive, gw_rc):
             print("gateway's final report (for reference, not judged): " + line[7:])
     print("simulator: %d starts, %d killed, %d binds retried" % (s.sim_starts, s.sim_kills, s.bind_retries))
     print()
-    check(alive and gw_rc == 0, "the gateway ran through every phase and exited 0 on SIGTERM (rc %s)" % gw_rc)
+    for key, (alive, rc) in sorted(exits.items()):
+        check(alive and rc == 0, "the %s gateway ran through every phase and exited 0 on SIGTERM (rc %s)" % (key, rc))
     data_names = [n for n in order]
     check(set(n for n, _ in PHASES) <= set(data_names) and
           all(by_name[n]["state"] > 0 and by_name[n]["frames"].get(CAN_EVERY, 0) > 0 for n in data_names),
@@ -493,19 +748,86 @@ def report(s, can, samples, warm_phases, alive, gw_rc):
     check(can.alive_breaks == 0 and can.bad_lines == 0,
           "CAN log: every line parses, 0x182's alive counter steps by 1 (%d breaks, %d bad lines)" %
           (can.alive_breaks, can.bad_lines))
-    if len(samples) > warm_phases:
-        _, wname, rss0, fd0 = samples[warm_phases - 1]
-        _, _, rss1, fd1 = samples[-1]
-        peak = max(x[2] for x in samples[warm_phases - 1:])
-        print("gateway RSS: start %d KiB (after phase %d, %s), end %d KiB, peak %d KiB; fds: start %d, end %d" %
-              (rss0, warm_phases, wname, rss1, peak, fd0, fd1))
-        check(rss1 <= rss0 + RSS_ALLOWANCE_KIB, "gateway RSS does not grow: start %d KiB, end %d KiB "
-              "(allowed +%d KiB)" % (rss0, rss1, RSS_ALLOWANCE_KIB))
-        check(fd1 <= fd0 + FD_ALLOWANCE, "gateway fds do not grow: start %d, end %d (allowed +%d)" %
-              (fd0, fd1, FD_ALLOWANCE))
-    else:
-        check(False, "RSS and fds: the soak was too short to sample after the warm-up")
+    report_canopen(co)
+    for key in ("can", "canopen"):
+        check_growth(key, samples[key], warm_phases)
     return FAILED == 0
+
+
+def report_canopen(co):
+    """The CANopen node's table and judgements."""
+    print("\nCANopen node %d, per fault phase (summed over passes): frames; EMCYs raised from the phase's "
+          "first data to its end / reset; oldest data age with valid = 1 (ms)" % CO_NODE)
+    print("%-13s %3s %7s %6s %6s %5s %4s %9s %9s %7s %7s" % ("phase", "n", "0x%X" % CO_TPDO_INVALID, "inv",
+          "0x%X" % CO_TPDO_STOP, "emcy", "hb", "FF01", "FF02", "old%X" % CO_TPDO_INVALID, "old%X" % CO_TPDO_STOP))
+    order = []
+    for p in co.phases:
+        if p.name not in order:
+            order.append(p.name)
+    for name in order:
+        runs = [p for p in co.phases if p.name == name]
+
+        def total(attr, key):
+            return sum(getattr(p, attr).get(key, 0) for p in runs)
+
+        def oldest(ident):
+            return max((p.oldest_us.get(ident, 0) for p in runs), default=0) / 1e3
+        print("%-13s %3d %7d %6d %6d %5d %4d %4d/%-4d %4d/%-4d %7.1f %7.1f" %
+              (name, len(runs), total("frames", CO_TPDO_INVALID), total("invalid", CO_TPDO_INVALID),
+               total("frames", CO_TPDO_STOP), total("frames", CO_EMCY), total("frames", CO_HEARTBEAT),
+               total("raised", EMCY_LINK), total("resets", EMCY_LINK), total("raised", EMCY_STALE),
+               total("resets", EMCY_STALE), oldest(CO_TPDO_INVALID), oldest(CO_TPDO_STOP)))
+    print("(%d TPDOs before the first data, not judged)\n" % co.before_data)
+    v = co.violations
+    check(all(p.first_data_us is not None for p in co.phases),
+          "CANopen: TPDOs with valid = 1 in every phase run (%d of %d)" %
+          (sum(p.first_data_us is not None for p in co.phases), len(co.phases)))
+    for ident in (CO_TPDO_INVALID, CO_TPDO_STOP):
+        n = sum(p.frames.get(ident, 0) - p.invalid.get(ident, 0) for p in co.phases)
+        old = max((p.oldest_us.get(ident, 0) for p in co.phases), default=0)
+        check(n > 0 and v.get("valid_stale_%X" % ident, 0) == 0 and (ident != CO_TPDO_INVALID or v.get("alive", 0) == 0),
+              "CANopen TPDO 0x%X: none of %d frames with valid = 1 older than %d ms + %d ms (%d frames with "
+              "valid = 0; oldest valid %.1f ms%s)" %
+              (ident, n, BOUND_MS, MARGIN_MS, sum(p.invalid.get(ident, 0) for p in co.phases), old / 1e3,
+               "; alive counter breaks %d" % v.get("alive", 0) if ident == CO_TPDO_INVALID else ""))
+    missing = ["%s (pass %d) 0x%04X" % (p.name, i // len(PHASES) + 1, code) for i, p in enumerate(co.phases)
+               for code in EXPECTED_EMCY.get(p.name, ()) if p.raised.get(code, 0) == 0]
+    check(not missing, "CANopen EMCY: each stall and freeze raises 0xFF02, each drop of the link 0xFF01, between the "
+          "phase's first data and its end (%d raised; missing: %s)" %
+          (sum(sum(p.raised.values()) for p in co.phases), ", ".join(missing) or "none"))
+    raised = sum(p.frames.get(CO_EMCY, 0) for p in co.phases)
+    check(raised > 0 and all(v.get(r, 0) == 0 for r in ("emcy", "raise_early", "never_reset", "unexpected")),
+          "CANopen EMCY: only 0xFF01/0xFF02, each raised once and reset after, 0xFF02 only on data older than "
+          "%d ms - %d ms (%d EMCY frames; %d malformed or doubled, %d early, %d never reset, %d other frames)" %
+          (BOUND_MS, MARGIN_MS, raised, v.get("emcy", 0), v.get("raise_early", 0), v.get("never_reset", 0),
+           v.get("unexpected", 0)))
+    check(v.get("reset_early", 0) == 0,
+          "CANopen EMCY: 0xFF01 reset only once new data flows (the next TPDO1 carries data newer than the link's "
+          "loss), 0xFF02 only on fresh data or handed over to 0xFF01 (%d are not)" % v.get("reset_early", 0))
+    check(v.get("stale_silent", 0) == 0, "CANopen EMCY: 0xFF01 or 0xFF02 set whenever TPDO1's data is older than "
+          "%d ms + %d ms (%d TPDO1s without)" % (BOUND_MS, MARGIN_MS, v.get("stale_silent", 0)))
+    check(co.hb_boot == 1 and co.hb_count > 1 and v.get("hb_state", 0) == 0 and v.get("hb_gap", 0) == 0 and
+          co.bad_lines == 0,
+          "CANopen heartbeat 0x%X: boot-up then OPERATIONAL (05) every %d ms, no gap over %d ms (%d beats, %d "
+          "boot-up, %d in another state, longest gap %.1f ms; %d bad lines)" %
+          (CO_HEARTBEAT, CO_HB_MS, CO_HB_MS * 3 // 2, co.hb_count, co.hb_boot, v.get("hb_state", 0),
+           co.max_hb_gap_us / 1e3, co.bad_lines))
+
+
+def check_growth(key, samples, warm_phases):
+    """The gateway's RSS and descriptors from after the warm-up to the end."""
+    if len(samples) <= warm_phases:
+        check(False, "%s gateway's RSS and fds: the soak was too short to sample after the warm-up" % key)
+        return
+    _, wname, rss0, fd0 = samples[warm_phases - 1]
+    _, _, rss1, fd1 = samples[-1]
+    peak = max(x[2] for x in samples[warm_phases - 1:])
+    print("%s gateway RSS: start %d KiB (after phase %d, %s), end %d KiB, peak %d KiB; fds: start %d, end %d" %
+          (key, rss0, warm_phases, wname, rss1, peak, fd0, fd1))
+    check(rss1 <= rss0 + RSS_ALLOWANCE_KIB, "%s gateway RSS does not grow: start %d KiB, end %d KiB "
+          "(allowed +%d KiB)" % (key, rss0, rss1, RSS_ALLOWANCE_KIB))
+    check(fd1 <= fd0 + FD_ALLOWANCE, "%s gateway fds do not grow: start %d, end %d (allowed +%d)" %
+          (key, fd0, fd1, FD_ALLOWANCE))
 
 
 def main():
