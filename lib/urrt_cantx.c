@@ -36,6 +36,30 @@ static double nan_value(void)
     return b.d;
 }
 
+double urrt_cantx_mask_value(uint64_t mask)
+{
+    union {
+        uint64_t u;
+        double d;
+    } b;
+    b.u = mask;
+    return b.d;
+}
+
+/* The bits a URRT_CANTX_FILLED_MASK signal carries of the mask in value
+ * (urrt_cantx_mask_value's): integer work only, every bit exact. */
+static uint64_t mask_raw(const urrt_can_signal *sig, double value)
+{
+    union {
+        uint64_t u;
+        double d;
+    } b;
+    unsigned first = URRT_CAN_SIG_MASK_FIRST(sig->flags);
+    uint64_t keep = sig->length >= 64u ? UINT64_MAX : (UINT64_C(1) << sig->length) - 1u;
+    b.d = value;
+    return first < 64u ? (b.u >> first) & keep : 0u;
+}
+
 static bool takes_field(uint8_t kind)
 {
     return kind == (uint8_t)URRT_CANTX_FIELD || kind == (uint8_t)URRT_CANTX_FIELD_MASK;
@@ -82,6 +106,7 @@ static int check_sources(const urrt_cantx_frame *f, size_t *bad_signal)
             ok = ++valid == 1u && sig->type == (uint8_t)URRT_CAN_UNSIGNED && sig->length == 1u;
             break;
         case URRT_CANTX_FILLED: ok = f->fill != NULL; break;
+        case URRT_CANTX_FILLED_MASK: ok = f->fill != NULL && (sig->flags & URRT_CAN_SIG_BITMASK) != 0u; break;
         default: ok = false; break;
         }
         if (!ok) {
@@ -332,26 +357,52 @@ static void pack_fields(urrt_cantx *tx, size_t index)
     fs->outcome = (int8_t)worst;
 }
 
-/* The frame as it goes out at now_us, in fs->frame: the packed fields,
- * then the filled values, the alive counter and the validity bit. */
-static const urrt_can_frame *build(urrt_cantx *tx, size_t index, uint64_t now_us, bool fresh, bool sending)
+/* The filled values into the frame: the worst outcome of their packing (a
+ * mask's is always OK: its bits go as they are), counted in tx->clamped
+ * when the frame is sent. */
+static int pack_filled(urrt_cantx *tx, size_t index, uint64_t now_us, bool sending)
 {
     const urrt_cantx_frame *f = &tx->tables->frames[index];
     urrt_cantx_frame_state *fs = &tx->frames[index];
     double *values = tx->values + fs->first_value;
-    bool valid;
+    int worst = URRT_CAN_PACK_OK;
+    size_t i;
+    if (f->fill == NULL) {
+        return worst;
+    }
+    f->fill(tx, index, now_us, sending, values);
+    for (i = 0; i < f->signal_count; i++) {
+        const urrt_can_signal *sig = &f->signals[i];
+        int outcome = URRT_CAN_PACK_OK;
+        if (f->sources[i].kind == (uint8_t)URRT_CANTX_FILLED) {
+            outcome = pack_signal(tx, fs->first_value + i, sig, values[i], fs->frame.data);
+        } else if (f->sources[i].kind == (uint8_t)URRT_CANTX_FILLED_MASK) {
+            urrt_can_put_raw_checked(sig, mask_raw(sig, values[i]), fs->frame.data);
+        }
+        if (outcome != URRT_CAN_PACK_OK) {
+            tx->clamped += sending ? 1u : 0u;
+            worst = outcome > worst ? outcome : worst;
+        }
+    }
+    return worst;
+}
+
+/* The frame as it goes out at now_us, in fs->frame: the packed fields,
+ * then the filled values, the alive counter and the validity bit (1: fresh,
+ * and every field and filled value packed as it is), also in *valid. */
+static const urrt_can_frame *build(urrt_cantx *tx, size_t index, uint64_t now_us, bool fresh, bool sending,
+                                   bool *valid)
+{
+    const urrt_cantx_frame *f = &tx->tables->frames[index];
+    urrt_cantx_frame_state *fs = &tx->frames[index];
     size_t i;
     pack_fields(tx, index);
-    valid = fresh && fs->outcome == URRT_CAN_PACK_OK;
-    if (f->fill != NULL) {
-        f->fill(tx, index, now_us, sending, values);
-    }
+    *valid = pack_filled(tx, index, now_us, sending) == URRT_CAN_PACK_OK && fresh && fs->outcome == URRT_CAN_PACK_OK;
     for (i = 0; i < f->signal_count; i++) {
         const urrt_can_signal *sig = &f->signals[i];
         switch ((urrt_cantx_kind)f->sources[i].kind) {
         case URRT_CANTX_ALIVE: urrt_can_put_raw_checked(sig, fs->alive, fs->frame.data); break;
-        case URRT_CANTX_VALID: urrt_can_put_raw_checked(sig, valid ? 1u : 0u, fs->frame.data); break;
-        case URRT_CANTX_FILLED: (void)pack_signal(tx, fs->first_value + i, sig, values[i], fs->frame.data); break;
+        case URRT_CANTX_VALID: urrt_can_put_raw_checked(sig, *valid ? 1u : 0u, fs->frame.data); break;
         default: break;
         }
     }
@@ -361,10 +412,11 @@ static const urrt_can_frame *build(urrt_cantx *tx, size_t index, uint64_t now_us
 static void send_frame(urrt_cantx *tx, size_t index, uint64_t now_us, bool fresh, urrt_cantx_emit_fn emit, void *ctx)
 {
     urrt_cantx_frame_state *fs = &tx->frames[index];
-    const urrt_can_frame *out = build(tx, index, now_us, fresh, true);
+    bool valid;
+    const urrt_can_frame *out = build(tx, index, now_us, fresh, true, &valid);
     fs->alive++;
     fs->sent++;
-    fs->sent_invalid += !(fresh && fs->outcome == URRT_CAN_PACK_OK);
+    fs->sent_invalid += valid ? 0u : 1u;
     if (emit != NULL) {
         emit(ctx, out, now_us);
     }
@@ -386,12 +438,14 @@ static void frame_copy(urrt_can_frame *to, const urrt_can_frame *from)
 void urrt_cantx_peek(urrt_cantx *tx, size_t frame, uint64_t now_us, urrt_can_frame *out)
 {
     const urrt_cantx_frame *f;
+    bool valid;
     if (tx == NULL || out == NULL || frame >= tx->tables->frame_count) {
         return;
     }
     f = &tx->tables->frames[frame];
     /* What build writes beyond the packed fields, the next send writes again. */
-    frame_copy(out, build(tx, frame, now_us, urrt_cantx_fresh(tx, f->robot, now_us, f->stale_after_us), false));
+    frame_copy(out, build(tx, frame, now_us, urrt_cantx_fresh(tx, f->robot, now_us, f->stale_after_us), false,
+                          &valid));
 }
 
 /* ---- the schedule ------------------------------------------------------------- */

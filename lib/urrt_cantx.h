@@ -75,10 +75,18 @@ typedef enum urrt_cantx_kind {
     URRT_CANTX_ALIVE,         /* the frame's alive counter: 0, 1, ... with each frame sent,
                                  modulo 2^length (unsigned, length 1..8; one per frame) */
     URRT_CANTX_VALID,         /* the frame's validity bit (unsigned, length 1; one per frame):
-                                 1 when the robot's data is fresh and every field value was
-                                 packed as it is (URRT_CAN_PACK_OK) */
-    URRT_CANTX_FILLED         /* the value the frame's fill function gives */
+                                 1 when the robot's data is fresh and every field and
+                                 filled value was packed as it is (URRT_CAN_PACK_OK) */
+    URRT_CANTX_FILLED,        /* the value the frame's fill function gives */
+    URRT_CANTX_FILLED_MASK    /* a bit mask the fill function gives as its 64 bits, by
+                                 urrt_cantx_mask_value (its signal a URRT_CAN_SIG_BITMASK
+                                 descriptor): exact up to bit 63, where a double holding
+                                 the integer loses bits past 2^53 */
 } urrt_cantx_kind;
+
+/* A 64-bit mask as a fill function gives it to a URRT_CANTX_FILLED_MASK
+ * signal: its bits in the double's place, not its value. */
+double urrt_cantx_mask_value(uint64_t mask);
 
 /* What signal i of a frame carries: sources[i] beside signals[i]. */
 typedef struct urrt_cantx_source {

@@ -14,8 +14,25 @@ static void put_double(FILE *out, double v)
 static const char *const kind_names[] = {
     [URRT_CANTX_FIELD] = "URRT_CANTX_FIELD",   [URRT_CANTX_FIELD_MASK] = "URRT_CANTX_FIELD_MASK",
     [URRT_CANTX_ALIVE] = "URRT_CANTX_ALIVE",   [URRT_CANTX_VALID] = "URRT_CANTX_VALID",
-    [URRT_CANTX_FILLED] = "URRT_CANTX_FILLED",
+    [URRT_CANTX_FILLED] = "URRT_CANTX_FILLED", [URRT_CANTX_FILLED_MASK] = "URRT_CANTX_FILLED_MASK",
 };
+
+/* A firmware reads RealTime, which has no RTDE-only value: a table that
+ * names one would not build (its frame has no fill function there), so the
+ * source says why instead, where the compiler stops. */
+static void put_rtde_refusal(FILE *out, const struct can_map *map)
+{
+    for (size_t i = 0; i < map->frame_count; i++) {
+        for (size_t k = 0; k < map->frames[i].count; k++) {
+            const struct can_map_signal *m = &map->frames[i].meta[k];
+            if (m->role == CAN_MAP_ROLE_RTDE) {
+                fprintf(out, "#error \"[frame %s] signal %s (line %d) is an RTDE-only value: a firmware reads "
+                             "RealTime, which has none; leave this frame to urrt-gateway or map RealTime fields\"\n",
+                        map->frames[i].name, m->name, m->loc.line);
+            }
+        }
+    }
+}
 
 static const char *const stale_names[] = {
     [URRT_CANTX_STALE_STOP] = "URRT_CANTX_STALE_STOP",
@@ -232,6 +249,7 @@ int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run,
     }
     fprintf(out, ".\n */\n#include <stddef.h>\n#include <stdint.h>\n\n#include \"%s\"\n\n",
             node != NULL ? "urrt_co.h" : "urrt_cantx.h");
+    put_rtde_refusal(out, map);
     for (size_t i = 0; i < map->frame_count; i++) {
         put_frame_tables(out, &map->frames[i], &t->frames[i]);
     }

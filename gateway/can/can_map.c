@@ -12,6 +12,9 @@
 #include <string.h>
 #include <strings.h>
 
+#include "can_rtde.h"
+#include "urrt_rtde.h"
+
 /* ---- reporting ------------------------------------------------------------------- */
 
 /* Reports a problem: to the map's reporter if one is set, and as
@@ -399,14 +402,13 @@ static int split_words(char *line, char **words)
 
 /* Unit of element elem of a field: the table writes "m, rad" for a pose,
  * i.e. the first three elements in m and the last three in rad. */
-static void field_unit(const urrt_field_info *info, unsigned elem, char *out, size_t size)
+static void field_unit(const char *unit, unsigned count, unsigned elem, char *out, size_t size)
 {
-    const char *unit = info->unit;
     const char *comma = strstr(unit, ", ");
     if (strcmp(unit, "enum") == 0 || strcmp(unit, "bits") == 0) {
         unit = "";
     }
-    if (comma != NULL && info->count == 6) {
+    if (comma != NULL && count == 6) {
         if (elem < 3) {
             snprintf(out, size, "%.*s", (int)(comma - unit), unit);
         } else {
@@ -421,7 +423,10 @@ static void field_unit(const urrt_field_info *info, unsigned elem, char *out, si
 struct signal_parse {
     urrt_can_signal sig;
     struct can_map_signal meta;
-    const urrt_field_info *info;
+    const char *value;      /* the field's or the RTDE-only value's name */
+    unsigned count;         /* its elements */
+    const char *unit;       /* its unit as the tables write it ("m, rad", "bits") */
+    char rtde_name[URRT_RTDE_NAME_MAX];
     int order;              /* URRT_CAN_INTEL/MOTOROLA, -1: not given */
     int type;               /* URRT_CAN_UNSIGNED..., -1: not given */
     bool have_min, have_max, have_name, have_unit, have_invalid, have_factor, have_offset, have_bits;
@@ -434,20 +439,48 @@ struct signal_parse {
     "signal = FIELD[ELEM] @START|LENGTH intel|motorola unsigned|signed|float32|float64 " \
     "[factor=F] [offset=O] [min=A] [max=B] [unit=U] [name=N] [invalid=RAW] [bits=FIRST-LAST]"
 
+/* What FIELD names: a robot field (by its RealTime or RTDE name: actual_q
+ * is q_actual), or an RTDE-only value, which its robot's RTDE session reads
+ * (config.c refuses it on a realtime robot). */
+static bool signal_value(struct signal_parse *s, const char *word, size_t name_len, char *why, size_t n)
+{
+    int fid = urrt_field_find(word, name_len);
+    int var = fid < 0 ? urrt_rtde_var_find(word, name_len) : -1;
+    if (fid < 0 && var >= 0 && urrt_rtde_var_field(var) >= 0) {
+        fid = urrt_rtde_var_field(var);
+    }
+    if (fid >= 0) {
+        const urrt_field_info *info = urrt_field((urrt_field_id)fid);
+        s->meta.field = fid;
+        s->value = info->name;
+        s->count = info->count;
+        s->unit = info->unit;
+    } else if (can_rtde_only(var)) {
+        s->meta.role = CAN_MAP_ROLE_RTDE;
+        s->meta.field = -1;
+        s->meta.var = var;
+        (void)urrt_rtde_var_name(var, s->rtde_name, sizeof s->rtde_name);
+        s->value = s->rtde_name;
+        s->count = can_rtde_elements(var);
+        s->unit = can_rtde_unit(var);
+    } else {
+        return conf_fail(why, n, "signal: no field '%.*s' (field names as in docs/protocol.md: q_actual, tcp_force, "
+                   "robot_mode, ...; RTDE-only values by their RTDE names: output_int_register_24, ...)",
+                   (int)name_len, word);
+    }
+    s->meta.bitmask = strcmp(s->unit, "bits") == 0;
+    return true;
+}
+
 /* FIELD or FIELD[ELEM] */
 static bool signal_field(struct signal_parse *s, const char *word, char *why, size_t n)
 {
     const char *bracket = strchr(word, '[');
     size_t name_len = bracket ? (size_t)(bracket - word) : strlen(word);
-    int fid = urrt_field_find(word, name_len);
     char reason[CONF_WHY_MAX];
-    if (fid < 0) {
-        return conf_fail(why, n, "signal: no field '%.*s' (field names as in docs/protocol.md: q_actual, tcp_force, "
-                   "robot_mode, ...)", (int)name_len, word);
+    if (!signal_value(s, word, name_len, why, n)) {
+        return false;
     }
-    s->info = urrt_field((urrt_field_id)fid);
-    s->meta.field = fid;
-    s->meta.bitmask = strcmp(s->info->unit, "bits") == 0;
     if (bracket != NULL) {
         size_t blen = strlen(bracket);
         char num[16];
@@ -459,15 +492,14 @@ static bool signal_field(struct signal_parse *s, const char *word, char *why, si
         if (!conf_u32(num, 0, UINT32_MAX, &e, reason, sizeof reason)) {
             return conf_fail(why, n, "signal: '%s': the element is a number: %s", word, reason);
         }
-        if (e >= s->info->count) {
-            return conf_fail(why, n, "signal: %s has %u element%s: %s[%u] is out of range (0..%u)", s->info->name,
-                       (unsigned)s->info->count, s->info->count == 1 ? "" : "s", s->info->name, (unsigned)e,
-                       (unsigned)s->info->count - 1);
+        if (e >= s->count) {
+            return conf_fail(why, n, "signal: %s has %u element%s: %s[%u] is out of range (0..%u)", s->value,
+                       s->count, s->count == 1 ? "" : "s", s->value, (unsigned)e, s->count - 1);
         }
         s->meta.elem = e;
-    } else if (s->info->count > 1) {
-        return conf_fail(why, n, "signal: %s has %u elements: write %s[0] .. %s[%u]", s->info->name,
-                   (unsigned)s->info->count, s->info->name, s->info->name, (unsigned)s->info->count - 1);
+    } else if (s->count > 1) {
+        return conf_fail(why, n, "signal: %s has %u elements: write %s[0] .. %s[%u]", s->value, s->count, s->value,
+                   s->value, s->count - 1);
     }
     return true;
 }
@@ -663,7 +695,7 @@ static bool signal_invalid(struct signal_parse *s, char *why, size_t n)
 static bool signal_mask(struct signal_parse *s, char *why, size_t n)
 {
     static const char *const types[] = {"unsigned", "signed", "float32", "float64"};
-    const char *field = s->info->name;
+    const char *field = s->value;
     unsigned first = s->have_bits ? s->first_bit : 0;
     if (!s->meta.bitmask) {
         return !s->have_bits ||
@@ -752,14 +784,20 @@ static bool frame_signal(void *obj, const struct conf_key *key, const char *valu
         return false;
     }
     if (!s.have_unit) {
-        field_unit(s.info, s.meta.elem, s.meta.unit, sizeof s.meta.unit);
+        field_unit(s.unit, s.count, s.meta.elem, s.meta.unit, sizeof s.meta.unit);
     }
     if (!s.have_name) {
-        if (s.info->count > 1) {
-            snprintf(s.meta.name, sizeof s.meta.name, "%s_%u", s.info->name, s.meta.elem);
+        char name[URRT_RTDE_NAME_MAX + 8];
+        if (s.count > 1) {
+            snprintf(name, sizeof name, "%s_%u", s.value, s.meta.elem);
         } else {
-            snprintf(s.meta.name, sizeof s.meta.name, "%s", s.info->name);
+            snprintf(name, sizeof name, "%s", s.value);
         }
+        if (strlen(name) > CAN_MAP_NAME_MAX) {
+            return conf_fail(why, n, "signal: its name '%s' is longer than a DBC name's %d characters: add name=N",
+                             name, CAN_MAP_NAME_MAX);
+        }
+        memcpy(s.meta.name, name, strlen(name) + 1); /* fits: checked just above */
     }
     other = signal_named(f, s.meta.name);
     if (other >= 0) {
@@ -1119,7 +1157,7 @@ static void check_frame(struct finish *fin, struct can_map_frame *f)
     check_frame_length(fin, f, what);
     check_frame_timing(fin, f, what);
     for (size_t i = 0; i < f->count; i++) {
-        fields += f->meta[i].role == CAN_MAP_ROLE_FIELD;
+        fields += f->meta[i].role == CAN_MAP_ROLE_FIELD || f->meta[i].role == CAN_MAP_ROLE_RTDE;
     }
     if (fields == 0) {
         problem(fin, f->loc, "%s has no signal (signal = FIELD[ELEM] @START|LENGTH ...)", what);
@@ -1280,8 +1318,9 @@ static void check_load(struct finish *fin, struct can_map_loc can_loc)
  * What the bits of each bit-mask field mean: the one place the gateway keeps
  * them (docs/protocol.md; the RealTime interface and RTDE give digital inputs
  * and outputs the same layout). A mask field without rows here has no defined
- * bits to miss. RTDE's masks (robot_status_bits, safety_status_bits, the bit
- * registers) add their rows when they join lib's field table.
+ * bits to miss. RTDE-only masks (robot_status_bits, safety_status_bits, the bit
+ * registers: CAN_MAP_ROLE_RTDE signals) have no rows yet, so no notice names
+ * their bits a signal leaves out.
  */
 static const struct mask_group {
     urrt_field_id field;

@@ -51,7 +51,9 @@ struct can_map_loc {
 enum can_map_role {
     CAN_MAP_ROLE_FIELD = 0,  /* a robot field element */
     CAN_MAP_ROLE_ALIVE,      /* the frame's alive counter */
-    CAN_MAP_ROLE_VALID       /* the frame's validity bit (1 = valid) */
+    CAN_MAP_ROLE_VALID,      /* the frame's validity bit (1 = valid) */
+    CAN_MAP_ROLE_RTDE        /* an element of an RTDE-only value (output_int_register_24, ...):
+                                its robot has source = rtde, its value the package's (can_rtde.h) */
 };
 
 /* What a signal of the table carries; sigs[i] and meta[i] go together. */
@@ -60,6 +62,7 @@ struct can_map_signal {
     char unit[CAN_MAP_UNIT_MAX + 1];
     enum can_map_role role;
     int field;               /* urrt_field_id for CAN_MAP_ROLE_FIELD */
+    int var;                 /* urrt_rtde_var for CAN_MAP_ROLE_RTDE */
     unsigned elem;
     bool bitmask;            /* field coded as a bit mask (unit "bits"): its bits sent as they are,
                                 never scaled or clamped (sigs[i] has URRT_CAN_SIG_MASK(first)) */

@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "can_rtde.h"
+
 struct can_run {
     urrt_cantx tx;
     urrt_cantx_tables tables;
@@ -16,6 +18,8 @@ struct can_run {
     urrt_cantx_robot *robots;
     double *values;
     urrt_can_scale *scales;          /* one per value: packing without a division (urrt_cantx_prepare) */
+    const struct can_map *map;       /* what the RTDE-only signals carry (fill_rtde) */
+    urrt_rtde_values *rtde;          /* per robot: its latest package's RTDE-only values */
 };
 
 void can_run_free(struct can_run *run)
@@ -32,6 +36,7 @@ void can_run_free(struct can_run *run)
     free(run->robots);
     free(run->values);
     free(run->scales);
+    free(run->rtde);
     free(run);
 }
 
@@ -41,6 +46,11 @@ static urrt_cantx_source source_of(const struct can_map_signal *m)
     switch (m->role) {
     case CAN_MAP_ROLE_ALIVE: src.kind = URRT_CANTX_ALIVE; break;
     case CAN_MAP_ROLE_VALID: src.kind = URRT_CANTX_VALID; break;
+    case CAN_MAP_ROLE_RTDE:
+        /* A mask as its 64 bits: a double holding it would lose bits past 2^53. */
+        src.kind = m->bitmask ? URRT_CANTX_FILLED_MASK : URRT_CANTX_FILLED;
+        src.elem = (uint8_t)m->elem;
+        break;
     default:
         src.kind = m->bitmask ? URRT_CANTX_FIELD_MASK : URRT_CANTX_FIELD;
         src.field = (uint8_t)m->field;
@@ -48,6 +58,34 @@ static urrt_cantx_source source_of(const struct can_map_signal *m)
         break;
     }
     return src;
+}
+
+/* The RTDE-only values of frame `frame`, from its robot's latest package: as
+ * old as that package, whose time the frame's freshness already judges. */
+static void fill_rtde(urrt_cantx *tx, size_t frame, uint64_t now_us, bool sending, double *values)
+{
+    const struct can_run *run = tx->user;
+    const struct can_map_frame *f = &run->map->frames[frame];
+    const urrt_rtde_values *v = &run->rtde[f->robot_index];
+    (void)now_us;
+    (void)sending;
+    for (size_t k = 0; k < f->count; k++) {
+        const struct can_map_signal *m = &f->meta[k];
+        if (m->role == CAN_MAP_ROLE_RTDE) {
+            values[k] = m->bitmask ? urrt_cantx_mask_value(can_rtde_mask(v, m->var))
+                                   : can_rtde_element(v, m->var, m->elem);
+        }
+    }
+}
+
+static bool has_rtde(const struct can_map_frame *f)
+{
+    for (size_t k = 0; k < f->count; k++) {
+        if (f->meta[k].role == CAN_MAP_ROLE_RTDE) {
+            return true;
+        }
+    }
+    return false;
 }
 
 static urrt_cantx_frame frame_of(const struct can_map_frame *f, const urrt_cantx_source *sources)
@@ -63,7 +101,7 @@ static urrt_cantx_frame frame_of(const struct can_map_frame *f, const urrt_cantx
         .stale_after_us = f->stale_after_ms * 1000u,
         .stale = f->stale_policy == CAN_MAP_STALE_INVALID ? URRT_CANTX_STALE_INVALID : URRT_CANTX_STALE_STOP,
         .robot = (uint8_t)f->robot_index,
-        .fill = NULL,
+        .fill = has_rtde(f) ? fill_rtde : NULL,
     };
     return out;
 }
@@ -92,7 +130,12 @@ static bool alloc_run(struct can_run *run, size_t frames, size_t robots)
     run->sources = calloc(frames, sizeof *run->sources);
     run->states = calloc(frames, sizeof *run->states);
     run->robots = calloc(robots, sizeof *run->robots);
-    return run->frames != NULL && run->sources != NULL && run->states != NULL && run->robots != NULL;
+    run->rtde = calloc(robots, sizeof *run->rtde);
+    for (size_t i = 0; run->rtde != NULL && i < robots; i++) {
+        urrt_rtde_values_clear(&run->rtde[i]);
+    }
+    return run->frames != NULL && run->sources != NULL && run->states != NULL && run->robots != NULL &&
+           run->rtde != NULL;
 }
 
 static int init_core(struct can_run *run, const struct can_map *map, char *err, size_t errlen)
@@ -121,6 +164,7 @@ static int init_core(struct can_run *run, const struct can_map *map, char *err, 
     }
     /* Cannot fail: the tables were just accepted and scales[] holds count. */
     (void)urrt_cantx_prepare(&run->tx, run->scales, count);
+    run->tx.user = run;
     return 0;
 }
 
@@ -148,6 +192,7 @@ struct can_run *can_run_build(const struct can_map *map, char *err, size_t errle
     struct can_run *run = calloc(1, sizeof *run);
     if (run != NULL) {
         run->frame_count = map->frame_count;
+        run->map = map;
     }
     if (run == NULL || !alloc_run(run, map->frame_count + 1, robots) || !fill_frames(run, map)) {
         can_run_free(run);
@@ -160,6 +205,13 @@ struct can_run *can_run_build(const struct can_map *map, char *err, size_t errle
         return NULL;
     }
     return run;
+}
+
+void can_run_rtde(struct can_run *run, size_t robot, const urrt_rtde_values *values)
+{
+    if (values != NULL && robot < run->tables.robot_count) {
+        run->rtde[robot] = *values;
+    }
 }
 
 urrt_cantx *can_run_tx(struct can_run *run)

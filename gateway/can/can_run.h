@@ -22,6 +22,7 @@
 #include "can_map.h"
 #include "port.h"
 #include "urrt_cantx.h"
+#include "urrt_rtde.h"
 
 #define CAN_RUN_STARTUP_MS 5000u /* "starting" lasts at most this long without data */
 
@@ -31,6 +32,11 @@ struct can_run;
  * (out of memory, or a table lib/ refuses: a check missing in can_map). */
 struct can_run *can_run_build(const struct can_map *map, char *err, size_t errlen);
 void can_run_free(struct can_run *run);
+
+/* Robot `robot`'s package has these RTDE-only values (NULL: a RealTime
+ * packet, none): its frames' RTDE-only signals carry them until the next.
+ * Call it before urrt_cantx_on_packet with the package's state. */
+void can_run_rtde(struct can_run *run, size_t robot, const urrt_rtde_values *values);
 
 /* The CAN core over the tables, and the heartbeat's index in them. */
 urrt_cantx *can_run_tx(struct can_run *run);

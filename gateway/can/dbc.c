@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "can_rtde.h"
+
 #define DBC_EXTENDED_FLAG 0x80000000u
 #define DBC_UNKNOWN_ROBOT_CYCLE_MS 8u /* 125 Hz: the slower rate, so a receiver's timeout is not too tight */
 
@@ -184,6 +186,25 @@ static void put_field_comment(FILE *out, unsigned long id, const struct can_map 
     fprintf(out, "\";\n");
 }
 
+/* An RTDE-only value's comment: its RTDE name and type, and the mask rule. */
+static void put_rtde_comment(FILE *out, unsigned long id, const struct can_map_signal *m, const urrt_can_signal *sig)
+{
+    char name[URRT_RTDE_NAME_MAX];
+    urrt_rtde_type type = urrt_rtde_var_type(m->var);
+    (void)urrt_rtde_var_name(m->var, name, sizeof name);
+    fprintf(out, "CM_ SG_ %lu %s \"%s", id, m->name, name);
+    if (can_rtde_elements(m->var) > 1) {
+        fprintf(out, "[%u]", m->elem);
+    }
+    fprintf(out, ": RTDE output %s, RTDE only (the robot's source = rtde), as of the package the frame's data is",
+            urrt_rtde_type_name(type));
+    if (m->bitmask) {
+        fprintf(out, "; a bit mask, sent bit for bit (never scaled or saturated): bit n of this signal is bit %u+n "
+                     "of the value", URRT_CAN_SIG_MASK_FIRST(sig->flags));
+    }
+    fprintf(out, "\";\n");
+}
+
 /* Whether any frame is FD, and whether FD frames switch bit rate. */
 static bool any_fd(const struct can_map *map)
 {
@@ -258,6 +279,7 @@ static void put_frame_comment(FILE *out, const struct can_map *map, const struct
         const struct can_map_signal *m = &f->meta[k];
         switch (m->role) {
         case CAN_MAP_ROLE_FIELD: put_field_comment(out, id, map, m, &f->sigs[k]); break;
+        case CAN_MAP_ROLE_RTDE: put_rtde_comment(out, id, m, &f->sigs[k]); break;
         case CAN_MAP_ROLE_ALIVE:
             fprintf(out, "CM_ SG_ %lu %s \"Alive counter: +1 modulo 16 with every frame sent\";\n", id, m->name);
             break;

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "can_rtde.h"
 #include "dbc.h"
 
 #define ACCESS_RO "ro"
@@ -148,6 +149,23 @@ static void put_dummy_usage(FILE *out, const urrt_co_desc *d)
 
 /* ---- names and scaling ------------------------------------------------------------------ */
 
+/* The robot value a signal carries, by name: q_actual[2], output_int_register_24. */
+static void value_name(const struct can_map_signal *m, char *buf, size_t size)
+{
+    const urrt_field_info *info = m->role == CAN_MAP_ROLE_FIELD ? urrt_field((urrt_field_id)m->field) : NULL;
+    char rtde[URRT_RTDE_NAME_MAX] = "?";
+    const char *name = info != NULL ? info->name : rtde;
+    unsigned count = info != NULL ? info->count : can_rtde_elements(m->var);
+    if (m->role == CAN_MAP_ROLE_RTDE) {
+        (void)urrt_rtde_var_name(m->var, rtde, sizeof rtde);
+    }
+    if (count > 1) {
+        snprintf(buf, size, "%s[%u]", name, m->elem);
+    } else {
+        snprintf(buf, size, "%s", name);
+    }
+}
+
 /* What an object of the description carries, in words: its ParameterName. */
 static void object_name(const struct can_map *can, const urrt_co_object *o, size_t hb, char *buf, size_t size)
 {
@@ -160,18 +178,13 @@ static void object_name(const struct can_map *can, const urrt_co_object *o, size
     const struct can_map_frame *fr = &can->frames[o->frame];
     const struct can_map_signal *m = &fr->meta[o->item];
     const urrt_can_signal *sig = &fr->sigs[o->item];
-    if (m->role != CAN_MAP_ROLE_FIELD) {
+    if (m->role != CAN_MAP_ROLE_FIELD && m->role != CAN_MAP_ROLE_RTDE) {
         snprintf(buf, size, "%s %s", fr->name,
                  m->role == CAN_MAP_ROLE_ALIVE ? "alive counter (+1 per TPDO sent)" : "valid (1: fresh and exact)");
         return;
     }
-    const urrt_field_info *info = urrt_field((urrt_field_id)m->field);
     char field[48];
-    if (info != NULL && info->count > 1) {
-        snprintf(field, sizeof field, "%s[%u]", info->name, m->elem);
-    } else {
-        snprintf(field, sizeof field, "%s", info ? info->name : "?");
-    }
+    value_name(m, field, sizeof field);
     if (m->bitmask) {
         snprintf(buf, size, "%s: %s, a bit mask as the robot sends it", m->name, field);
         return;
@@ -182,7 +195,11 @@ static void object_name(const struct can_map *can, const urrt_co_object *o, size
 
 static bool is_robot_value(const struct can_map *can, const urrt_co_object *o, size_t hb)
 {
-    return o->frame != hb && can->frames[o->frame].meta[o->item].role == CAN_MAP_ROLE_FIELD;
+    if (o->frame == hb) {
+        return false;
+    }
+    enum can_map_role role = can->frames[o->frame].meta[o->item].role;
+    return role == CAN_MAP_ROLE_FIELD || role == CAN_MAP_ROLE_RTDE;
 }
 
 /* [Comments]: two notes, then the scaling of every mapped robot value with its limits. */

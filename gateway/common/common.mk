@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: MIT
 # gateway/common/common.mk: what the three programs share: the value parsers of
-# the configuration front end (conf) and the command-line helpers (cli).
+# the configuration front end (conf), the command-line helpers (cli), and the
+# RTDE session on a robot link (rtde_source: urrt-gateway and urrt-dump).
 #
 # Every gateway/ folder compiles its .c files with GW_CFLAGS: -MMD -MP let the
 # compiler tell make which headers an object depends on, so no .mk lists them.
@@ -12,9 +13,10 @@ GATEWAY_HDRS := $(wildcard gateway/*/*.h)
 
 CONF_OBJ := $(BUILD)/gateway/common/conf.o
 CLI_OBJ := $(BUILD)/gateway/common/cli.o $(CONF_OBJ)
+RTDE_SOURCE_OBJ := $(BUILD)/gateway/common/rtde_source.o
 
 $(BUILD)/gateway/common/%.o: gateway/common/%.c
 	@mkdir -p $(@D)
 	$(CC) $(GW_CFLAGS) -c $< -o $@
 
--include $(CLI_OBJ:.o=.d)
+-include $(CLI_OBJ:.o=.d) $(RTDE_SOURCE_OBJ:.o=.d)

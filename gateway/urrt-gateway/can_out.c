@@ -13,12 +13,16 @@ struct can_out {
     uint64_t node_us;       /* the node's latest time: a frame received earlier is handed over at it */
     urrt_canlink *link;
     uint64_t refused;       /* frames the link refused (cannot happen with a checked map) */
+    uint64_t emcys;         /* EMCY frames the node sent (metrics.h) */
     bool robot_up[GW_MAX_ROBOTS];
 };
 
 static void emit(void *ctx, const urrt_can_frame *frame, uint64_t now_us)
 {
     can_out *out = ctx;
+    if (out->node != NULL && !frame->extended && frame->id == (out->node->emcy_cob_id & 0x7FFu)) {
+        out->emcys++;
+    }
     if (urrt_canlink_send(out->link, frame, now_us) < 0) {
         out->refused++;
     }
@@ -68,7 +72,9 @@ static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
     can_out *out = ctx;
     /* The core judges staleness by the data's age, not by the read: a
      * backlog read just now is as old as its data. Frames are due by the
-     * clock now, just before they are sent. */
+     * clock now, just before they are sent. The RTDE-only values go with
+     * the package they came in, and are as old as it. */
+    can_run_rtde(out->run, robot->index, pkt->rtde);
     urrt_cantx_on_packet(out->tx, robot->index, pkt->state, pkt->data_us);
     out->robot_up[robot->index] = true;
     run_due(out, urrt_port_monotonic_us());
@@ -192,6 +198,15 @@ can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run
         can_run_start(run, urrt_port_monotonic_us());
     }
     return out;
+}
+
+void can_out_get_info(const can_out *out, can_out_info *info)
+{
+    info->link = urrt_canlink_get_stats(out->link);
+    info->up = urrt_canlink_get_state(out->link) == URRT_CANLINK_UP;
+    info->node = out->node != NULL;
+    info->nmt = out->node != NULL ? urrt_co_state(out->node) : URRT_CO_INITIALISING;
+    info->emcys = out->emcys;
 }
 
 gw_output can_out_output(can_out *out)

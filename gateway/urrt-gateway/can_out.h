@@ -24,4 +24,14 @@ typedef struct can_out can_out;
 can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run, struct co_run *node);
 gw_output can_out_output(can_out *out);
 
+/* What the metrics (metrics.h) and systemd's status (notify.h) say of it. */
+typedef struct can_out_info {
+    const urrt_canlink_stats *link;
+    bool up;                 /* the interface is open and up */
+    bool node;               /* a CANopen node runs: nmt and emcys hold */
+    urrt_co_nmt nmt;
+    uint64_t emcys;          /* EMCY frames the node sent */
+} can_out_info;
+void can_out_get_info(const can_out *out, can_out_info *info);
+
 #endif

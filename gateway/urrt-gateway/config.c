@@ -46,7 +46,7 @@ struct config_ctx {
     int *seen_line;           /* per table entry: line of its first header, 0 if none */
 };
 
-static const char *const kind_names[GW_KIND_COUNT] = {"state", "joints", "tool", "status", "gateway"};
+static const char *const kind_names[GW_KIND_COUNT] = {"state", "joints", "tool", "status", "rtde", "gateway"};
 
 const char *gw_kind_name(gw_kind kind)
 {
@@ -173,12 +173,40 @@ static bool set_log_level(void *obj, const struct conf_key *key, const char *val
            conf_fail(why, n, "log_level must be err, warning, notice, info or debug, not \"%s\"", value);
 }
 
+/* off, or an absolute file name the gateway can rename a PATH.tmp onto
+ * (a service's working directory is /: a relative name would mislead). */
+static bool set_metrics_file(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
+                             size_t n)
+{
+    gw_config *cfg = obj;
+    size_t len = strlen(value);
+    (void)key, (void)at;
+    if (!conf_printable(value, why, n)) {
+        return false;
+    }
+    free(cfg->metrics_file);
+    cfg->metrics_file = NULL;
+    if (strcmp(value, "off") == 0) {
+        return true;
+    }
+    if (value[0] != '/' || value[len - 1] == '/') {
+        return conf_fail(why, n, "metrics_file = \"%s\": give off or a file's absolute path, e.g. "
+                         "/run/urrt-metrics/gateway.prom", value);
+    }
+    cfg->metrics_file = xstrdup(value);
+    return true;
+}
+
 static const struct conf_key gateway_keys[] = {
     {"log_level", CONF_FN, 0, 0, 0, 0, set_log_level, NULL, false, "err|warning|notice|info|debug", "notice", NULL,
      "the least severe message logged"},
     {"summary", CONF_BOOL, CONF_FIELD(gw_config, summary), 0, 0, NULL,
      "%1$s must be yes or no (or true/false, on/off, 1/0), not \"%2$s\"", false, NULL, "no", NULL,
      "one status line per robot each second on stdout"},
+    {"metrics_file", CONF_FN, 0, 0, 0, 0, set_metrics_file, NULL, false, "off|PATH", "off", NULL,
+     "a Prometheus textfile (node_exporter) written every metrics_interval, via PATH.tmp and a rename"},
+    {"metrics_interval", CONF_MS, CONF_FIELD(gw_config, metrics_interval_ms), 100, 3600000, NULL, NULL, false, NULL,
+     "5 s", NULL, "how often metrics_file is written"},
 };
 
 /* ---- [lcm] ------------------------------------------------------------------------ */
@@ -344,6 +372,7 @@ static const struct conf_key lcm_keys[] = {
     LCM_KIND_KEYS("joints", "JOINTS", "every", "every|N Hz|off"),
     LCM_KIND_KEYS("tool", "TOOL", "every", "every|N Hz|off"),
     LCM_KIND_KEYS("status", "STATUS", "10 Hz", "every|N Hz|off"),
+    LCM_KIND_KEYS("rtde", "RTDE", "every", "every|N Hz|off"),
     LCM_KIND_KEYS("gateway", "GATEWAY", "1 Hz", "N Hz|off"),
 };
 
@@ -465,6 +494,115 @@ static bool set_host(void *obj, const struct conf_key *key, const char *host, st
     return true;
 }
 
+static bool set_port(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
+                     size_t n)
+{
+    gw_robot_config *robot = obj;
+    uint32_t port;
+    char reason[CONF_WHY_MAX];
+    (void)key;
+    (void)at;
+    if (!conf_u32(value, 1, 65535, &port, reason, sizeof reason)) {
+        if (CONF_IS_LEADING_ZERO(reason)) {
+            return conf_fail(why, n, "port = \"%s\": %s", value, reason);
+        }
+        return conf_fail(why, n, "port must be a whole number from 1 to 65535, not \"%s\"", value);
+    }
+    robot->port = (uint16_t)port;
+    return true;
+}
+
+static bool set_source(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
+                       size_t n)
+{
+    gw_robot_config *robot = obj;
+    (void)key;
+    if (strcmp(value, "realtime") == 0) {
+        robot->source = GW_SOURCE_REALTIME;
+    } else if (strcmp(value, "rtde") == 0) {
+        robot->source = GW_SOURCE_RTDE;
+    } else {
+        return conf_fail(why, n, "source must be \"realtime\" (port 30003) or \"rtde\" (port 30004), not \"%s\"",
+                         value);
+    }
+    robot->source_line = at.line;
+    return true;
+}
+
+/* "auto" or "N Hz": RTDE streams at most at the controller's own rate. */
+static bool set_rtde_frequency(void *obj, const struct conf_key *key, const char *value, struct conf_at at,
+                               char *why, size_t n)
+{
+    gw_robot_config *robot = obj;
+    gw_rate rate;
+    (void)key;
+    if (strcmp(value, "auto") == 0) {
+        robot->rtde_frequency = 0.0;
+        robot->rtde_frequency_line = at.line;
+        return true;
+    }
+    if (strcmp(value, "every") == 0 || strcmp(value, "off") == 0 ||
+        !parse_rate("rtde_frequency", value, &rate, why, n)) {
+        char number[64];
+        double hz;
+        size_t len = strcspn(value, " \tH");
+        snprintf(number, sizeof number, "%.*s", (int)(len < sizeof number ? len : sizeof number - 1), value);
+        if (conf_number(number, -INFINITY, INFINITY, &hz, NULL, 0) && hz > URRT_RTDE_HZ_E_SERIES) {
+            return conf_fail(why, n, "rtde_frequency %s is above %g Hz, the fastest any controller streams "
+                             "RTDE: give at most %g Hz, or auto", value, URRT_RTDE_HZ_E_SERIES,
+                             URRT_RTDE_HZ_E_SERIES);
+        }
+        return conf_fail(why, n, "rtde_frequency must be \"auto\" or a rate such as \"125 Hz\" (at most %g Hz), "
+                         "not \"%s\"", URRT_RTDE_HZ_E_SERIES, value);
+    }
+    robot->rtde_frequency = rate.hz;
+    robot->rtde_frequency_line = at.line;
+    return true;
+}
+
+/* A list of RTDE-only variable names (comma or blank separated); the key
+ * may be repeated, each line adding to the list (a line holds 198
+ * characters, a recipe up to 2048 bytes of names). */
+static bool set_rtde_values(void *obj, const struct conf_key *key, const char *value, struct conf_at at,
+                            char *why, size_t n)
+{
+    gw_robot_config *robot = obj;
+    const char *p = value;
+    size_t count = robot->rtde_value_count;
+    (void)key;
+    if (strcmp(value, "none") == 0) {
+        return true; /* the default */
+    }
+    while (*(p += strspn(p, ", \t")) != '\0') {
+        size_t len = strcspn(p, ", \t");
+        int var = urrt_rtde_var_find(p, len);
+        if (var < 0) {
+            return conf_fail(why, n, "rtde_values: \"%.*s\" is no RTDE output (names are case-sensitive, e.g. "
+                             "output_int_register_24, safety_status_bits; docs/rtde.md lists them)", (int)len, p);
+        }
+        if (var < URRT_RTDE_MAPPED_COUNT) {
+            return conf_fail(why, n, "rtde_values: \"%.*s\" is a value RealTime has too: it is published on "
+                             "NAME.STATE already (as %s); list only RTDE-only values here", (int)len, p,
+                             urrt_field((urrt_field_id)urrt_rtde_var_field(var))->name);
+        }
+        for (size_t i = 0; i < count; i++) {
+            if (robot->rtde_values[i] == var) {
+                return conf_fail(why, n, "rtde_values: \"%.*s\" is listed twice", (int)len, p);
+            }
+        }
+        if (count == URRT_RTDE_MAX_VARS) {
+            return conf_fail(why, n, "rtde_values: more than %d names", URRT_RTDE_MAX_VARS);
+        }
+        robot->rtde_values[count++] = (uint16_t)var;
+        p += len;
+    }
+    robot->rtde_value_count = count;
+    if (robot->rtde_values_line == 0) {
+        robot->rtde_values_line = at.line;
+    }
+    return true;
+}
+
 #define LINK_FIELD(member) CONF_FIELD(gw_robot_config, link.member)
 /* A number as the text of the file: the port's constants are literals. */
 #define TEXT_OF(x) TEXT_OF_(x)
@@ -473,9 +611,15 @@ static bool set_host(void *obj, const struct conf_key *key, const char *host, st
 static const struct conf_key robot_keys[] = {
     {"host", CONF_FN, 0, 0, 0, 0, set_host, NULL, false, "ADDRESS", NULL, "required",
      "the robot's IPv4 or IPv6 address (no brackets, no :PORT), or host name"},
-    {"port", CONF_UINT, CONF_FIELD(gw_robot_config, port), 1, 65535, NULL,
-     "%1$s must be a whole number from 1 to 65535, not \"%2$s\"", false, NULL, TEXT_OF(URRT_LINK_PORT_RW), NULL,
-     "the RealTime port; " TEXT_OF(URRT_LINK_PORT_RO) " is the read-only one"},
+    {"port", CONF_FN, 0, 0, 1, 65535, set_port, NULL, false, "PORT", NULL,
+     TEXT_OF(URRT_LINK_PORT_RW) ", or " TEXT_OF(URRT_RTDE_PORT) " with source = rtde",
+     "the robot's port; " TEXT_OF(URRT_LINK_PORT_RO) " is RealTime's read-only one"},
+    {"source", CONF_FN, 0, 0, 0, 0, set_source, NULL, false, "realtime|rtde", "realtime", NULL,
+     "the interface read: RealTime (30003) or RTDE (30004, a recipe of exactly what is published)"},
+    {"rtde_frequency", CONF_FN, 0, 0, 0, 0, set_rtde_frequency, NULL, false, "auto|N Hz", "auto", NULL,
+     "source = rtde: the rate asked for; auto is the controller's (125 Hz CB3, 500 Hz e-Series)"},
+    {"rtde_values", CONF_FN, 0, 0, 0, 0, set_rtde_values, NULL, true, "none|NAME, ...", "none", NULL,
+     "source = rtde: RTDE-only values (output_int_register_24, safety_status_bits, ...) on NAME.RTDE; repeatable"},
     {"version", CONF_FN, 0, 0, 0, 0, set_version, NULL, false, "auto|X.Y|BYTES", "auto", NULL,
      "the expected controller version or message size: others are mismatches"},
     {"connect_timeout", CONF_MS, LINK_FIELD(connect_timeout_ms), 10, 600000, NULL, NULL, false, NULL, "2 s", NULL,
@@ -525,6 +669,33 @@ static bool robot_begin(config_ctx *ctx, gw_config *cfg, const char *name)
     return true;
 }
 
+/* What only an RTDE robot may say, and the rate it then sends at. */
+static void robot_source_check(config_ctx *ctx, gw_robot_config *robot)
+{
+    if (robot->source != GW_SOURCE_RTDE) {
+        if (robot->rtde_value_count > 0) {
+            config_error(ctx, robot->rtde_values_line, "[robot %s]: rtde_values are RTDE-only values, and this "
+                         "robot's source is realtime: add \"source = rtde\" or remove them", robot->name);
+        }
+        if (robot->rtde_frequency > 0.0) {
+            config_error(ctx, robot->rtde_frequency_line, "[robot %s]: rtde_frequency applies to source = rtde "
+                         "only: add \"source = rtde\" or remove it", robot->name);
+        }
+        return;
+    }
+    if (strncmp(robot->expected, "1.", 2) == 0) {
+        config_error(ctx, robot->version_line, "[robot %s]: version %s has no RTDE (it came with 3.3): use "
+                     "source = realtime", robot->name, robot->expected);
+    } else if (robot->rtde_frequency > robot->max_rate_hz) {
+        config_error(ctx, robot->rtde_frequency_line, "[robot %s]: rtde_frequency %g Hz is above the %u Hz "
+                     "version %s (line %d) streams: lower it, or set rtde_frequency = auto", robot->name,
+                     robot->rtde_frequency, robot->max_rate_hz, robot->expected, robot->version_line);
+    } else if (robot->rtde_frequency > 0.0) {
+        robot->max_rate_hz = (unsigned)ceil(robot->rtde_frequency);
+    }
+    robot->expected_length = 0; /* RTDE packages are the recipe's size: version names the controller only */
+}
+
 static void robot_finish(config_ctx *ctx, gw_config *cfg)
 {
     if (cfg->robot_count == 0) {
@@ -542,6 +713,10 @@ static void robot_finish(config_ctx *ctx, gw_config *cfg)
                          robot->name, (unsigned)robot->link.backoff_max_ms,
                          (unsigned)robot->link.backoff_initial_ms);
         }
+        if (robot->port == 0) {
+            robot->port = robot->source == GW_SOURCE_RTDE ? URRT_RTDE_PORT : URRT_LINK_PORT_RW;
+        }
+        robot_source_check(ctx, robot);
         robot->link.name = robot->name;
         robot->link.host = robot->host;
         robot->link.port = robot->port;
@@ -629,6 +804,117 @@ static void can_finish(config_ctx *ctx, gw_config *cfg)
         config_error(ctx, 0, "%s", why);
     } else if (node) {
         canopen_build(ctx, cfg);
+    }
+}
+
+/* ---- the RTDE recipes: exactly what the whole file publishes ---------------------- */
+
+/* Adds var to the robot's recipe (once; a required entry stays required). */
+static void recipe_add(gw_robot_config *robot, int var, bool optional)
+{
+    for (size_t i = 0; i < robot->recipe_count; i++) {
+        if (robot->recipe[i] == var) {
+            robot->recipe_optional[i] = robot->recipe_optional[i] && optional;
+            return;
+        }
+    }
+    if (robot->recipe_count < URRT_RTDE_MAX_VARS) {
+        robot->recipe[robot->recipe_count] = (uint16_t)var;
+        robot->recipe_optional[robot->recipe_count++] = optional;
+    }
+}
+
+/* The fields and RTDE-only values of robot index's CAN signals: required. */
+static void recipe_add_can(config_ctx *ctx, gw_config *cfg, gw_robot_config *robot, unsigned index)
+{
+    for (size_t f = 0; cfg->can.finished && f < cfg->can.frame_count; f++) {
+        const struct can_map_frame *frame = &cfg->can.frames[f];
+        if (frame->robot_index != index) {
+            continue;
+        }
+        for (size_t i = 0; i < frame->count; i++) {
+            const struct can_map_signal *m = &frame->meta[i];
+            int var = m->role == CAN_MAP_ROLE_FIELD  ? urrt_rtde_var_of_field((urrt_field_id)m->field)
+                      : m->role == CAN_MAP_ROLE_RTDE ? m->var
+                                                     : -2;
+            if (var == -1) {
+                config_error(ctx, m->loc.line, "signal %s: RTDE has no %s: robot \"%s\" has source = rtde; "
+                             "use another value or source = realtime", m->name,
+                             urrt_field((urrt_field_id)m->field)->name, robot->name);
+            } else if (var >= 0) {
+                recipe_add(robot, var, false);
+            }
+        }
+    }
+}
+
+/* The bytes of the recipe's name list on the wire (names and commas). */
+static size_t recipe_names_length(const gw_robot_config *robot)
+{
+    size_t total = 0;
+    for (size_t i = 0; i < robot->recipe_count; i++) {
+        char name[URRT_RTDE_NAME_MAX];
+        int len = urrt_rtde_var_name(robot->recipe[i], name, sizeof name);
+        total += (size_t)(len > 0 ? len : 0) + (i > 0 ? 1u : 0u);
+    }
+    return total;
+}
+
+/* timestamp (the data's time, for freshness) first, required; STATE's
+ * shared fields when any robot message is published, optional (only where
+ * the controller has them: rtde_source.h); the CAN signals' fields and the
+ * RTDE-only values, required. */
+static void build_recipe(config_ctx *ctx, gw_config *cfg, gw_robot_config *robot, unsigned index)
+{
+    bool messages = false;
+    size_t wanted = 1 + robot->rtde_value_count;
+    for (unsigned k = GW_KIND_STATE; k <= GW_KIND_STATUS; k++) {
+        messages = messages || cfg->lcm.rate[k].mode != GW_RATE_OFF;
+    }
+    robot->recipe_count = 0;
+    recipe_add(robot, URRT_RTDE_V_TIMESTAMP, false);
+    for (int v = 0; messages && v < URRT_RTDE_MAPPED_COUNT; v++) {
+        recipe_add(robot, v, true);
+    }
+    recipe_add_can(ctx, cfg, robot, index);
+    for (size_t i = 0; i < robot->rtde_value_count; i++) {
+        recipe_add(robot, robot->rtde_values[i], false);
+    }
+    wanted += messages ? URRT_RTDE_MAPPED_COUNT : 0;
+    if (robot->recipe_count == URRT_RTDE_MAX_VARS && wanted > URRT_RTDE_MAX_VARS) {
+        config_error(ctx, robot->line, "[robot %s]: the RTDE recipe would hold more than %d values: publish "
+                     "fewer (rtde_values, CAN signals)", robot->name, URRT_RTDE_MAX_VARS);
+    } else if (recipe_names_length(robot) > URRT_RTDE_NAMES_MAX) {
+        config_error(ctx, robot->rtde_values_line != 0 ? robot->rtde_values_line : robot->line,
+                     "[robot %s]: the RTDE recipe's names take %zu bytes, over the controller's limit of %d: "
+                     "publish fewer values (rtde_values, CAN signals), or turn off messages in [lcm]",
+                     robot->name, recipe_names_length(robot), URRT_RTDE_NAMES_MAX);
+    }
+}
+
+/* A realtime robot's CAN signals naming an RTDE-only value: RealTime has none. */
+static void refuse_rtde_signals(config_ctx *ctx, gw_config *cfg, const gw_robot_config *robot, unsigned index)
+{
+    for (size_t f = 0; cfg->can.finished && f < cfg->can.frame_count; f++) {
+        const struct can_map_frame *frame = &cfg->can.frames[f];
+        for (size_t i = 0; frame->robot_index == index && i < frame->count; i++) {
+            if (frame->meta[i].role == CAN_MAP_ROLE_RTDE) {
+                config_error(ctx, frame->meta[i].loc.line, "signal %s: an RTDE-only value, and robot \"%s\" reads "
+                             "RealTime, which has none: add \"source = rtde\" to [robot %s] or remove the signal",
+                             frame->meta[i].name, robot->name, robot->name);
+            }
+        }
+    }
+}
+
+static void build_recipes(config_ctx *ctx, gw_config *cfg)
+{
+    for (unsigned i = 0; i < cfg->robot_count; i++) {
+        if (cfg->robots[i].source == GW_SOURCE_RTDE) {
+            build_recipe(ctx, cfg, &cfg->robots[i], i);
+        } else {
+            refuse_rtde_signals(ctx, cfg, &cfg->robots[i], i);
+        }
     }
 }
 
@@ -950,6 +1236,7 @@ static int config_parse(gw_config *cfg, FILE *in, FILE *err)
             config_sections[i].finish(&ctx, cfg);
         }
     }
+    build_recipes(&ctx, cfg);
     can_map_set_reporter(&cfg->can, NULL, NULL);
     print_errors(&ctx);
     return ctx.errors;
@@ -981,6 +1268,7 @@ int gw_config_load_stream(gw_config *cfg, FILE *in, const char *path, FILE *err)
 
 void gw_config_free(gw_config *cfg)
 {
+    free(cfg->metrics_file);
     free(cfg->lcm.url);
     for (unsigned k = 0; k < GW_KIND_COUNT; k++) {
         free(cfg->lcm.channel[k]);

@@ -26,6 +26,7 @@
 #include "co_run.h"
 #include "conf.h"
 #include "port.h"
+#include "urrt_rtde.h"
 
 /* The LCM messages, one channel each per robot: "NAME.SUFFIX". */
 typedef enum gw_kind {
@@ -33,6 +34,7 @@ typedef enum gw_kind {
     GW_KIND_JOINTS,    /* urrt.joints_t */
     GW_KIND_TOOL,      /* urrt.tool_t */
     GW_KIND_STATUS,    /* urrt.status_t */
+    GW_KIND_RTDE,      /* urrt.rtde_t: the RTDE-only values (source = rtde) */
     GW_KIND_GATEWAY,   /* urrt.gateway_t: the gateway's view of the robot */
     GW_KIND_COUNT
 } gw_kind;
@@ -60,12 +62,32 @@ typedef struct gw_lcm_config {
     int rate_line[GW_KIND_COUNT];
 } gw_lcm_config;
 
+/* Where a robot's data comes from. */
+typedef enum gw_source {
+    GW_SOURCE_REALTIME = 0, /* the RealTime stream, port 30003 */
+    GW_SOURCE_RTDE          /* an RTDE recipe, port 30004 (gateway/common/rtde_source.h) */
+} gw_source;
+
 typedef struct gw_robot_config {
     char *name;            /* channel prefix */
     int line;              /* of the section header */
     char *host;
     int host_line;
-    uint16_t port;
+    uint16_t port;         /* 0 until robot_finish: by source when not given */
+    gw_source source;
+    int source_line;
+    double rtde_frequency; /* Hz; 0: auto, the controller's rate */
+    int rtde_frequency_line;
+    /* rtde_values: RTDE-only variables published on NAME.RTDE */
+    uint16_t rtde_values[URRT_RTDE_MAX_VARS];
+    size_t rtde_value_count;
+    int rtde_values_line;
+    /* The RTDE recipe, built from the whole file (config.c: build_recipes):
+     * timestamp, STATE's shared fields (optional: only where the controller
+     * has them), the CAN signals' fields and the RTDE-only values. */
+    uint16_t recipe[URRT_RTDE_MAX_VARS];
+    bool recipe_optional[URRT_RTDE_MAX_VARS];
+    size_t recipe_count;
     uint32_t expected_length; /* 0: auto, any length is accepted */
     char *expected;        /* "auto", or the version/length as written */
     unsigned max_rate_hz;  /* 125 for a 1.x/3.x version, else 500 */
@@ -82,6 +104,8 @@ typedef struct gw_config {
     const char *path;
     urrt_log_level log_level;
     bool summary;          /* one line per second on stdout */
+    char *metrics_file;    /* Prometheus textfile (metrics.h); NULL: none */
+    uint32_t metrics_interval_ms;
     gw_lcm_config lcm;
     gw_robot_config *robots;
     unsigned robot_count;

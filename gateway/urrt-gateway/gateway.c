@@ -115,18 +115,24 @@ static void on_late(gw_robot *robot, uint64_t lag_us)
     robot->late = true;
 }
 
+static void dispatch(gw_robot *robot, const uint8_t *bytes, size_t length, uint64_t rx_us, bool new_connection);
+
 /* The one per-packet path: check, decode once, hand to every output. */
 static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t rx_us)
 {
     gw_robot *robot = ctx;
-    gateway *gw = robot->gw;
-    gw_packet pkt;
     uint64_t connects = urrt_link_get_stats(robot->link)->connects;
     bool new_connection = connects != robot->connects_seen;
-    uint64_t lag;
     int r;
 
     robot->connects_seen = connects;
+    if (robot->rtde != NULL) {
+        /* Decoded by the session already, through the recipe: nothing to
+         * check against a version's length. */
+        robot->state = *rtde_source_state(robot->rtde);
+        dispatch(robot, bytes, length, rx_us, new_connection);
+        return;
+    }
     if (robot->cfg->expected_length != 0 && length != robot->cfg->expected_length) {
         /* Not decoded: the host's clock alone says how old it is. */
         robot->newest_data_us = urrt_link_packet_empty_us(robot->link);
@@ -145,7 +151,17 @@ static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t r
         snprintf(robot->last_error, sizeof robot->last_error, "decode: %s", urrt_strerror(r));
         return;
     }
-    lag = packet_lag(robot, &robot->state, rx_us, new_connection);
+    dispatch(robot, bytes, length, rx_us, new_connection);
+}
+
+/* A decoded packet (robot->state): judged fresh or late, then handed to
+ * every output. The controller's timestamp is the data's time, whichever
+ * source brought it. */
+static void dispatch(gw_robot *robot, const uint8_t *bytes, size_t length, uint64_t rx_us, bool new_connection)
+{
+    gateway *gw = robot->gw;
+    gw_packet pkt;
+    uint64_t lag = packet_lag(robot, &robot->state, rx_us, new_connection);
     if (lag == GW_AGE_UNKNOWN) {
         on_late(robot, lag);
         return;
@@ -165,6 +181,7 @@ static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t r
     pkt.bytes = bytes;
     pkt.length = length;
     pkt.state = &robot->state;
+    pkt.rtde = robot->rtde != NULL ? rtde_source_values(robot->rtde) : NULL;
     pkt.rx_us = rx_us;
     pkt.data_us = robot->data_us;
     pkt.rx_wall_us = gw_wall_us(rx_us);
@@ -172,6 +189,24 @@ static void on_packet(void *ctx, const uint8_t *bytes, size_t length, uint64_t r
     for (unsigned i = 0; i < gw->output_count; i++) {
         gw->outputs[i].packet(gw->outputs[i].ctx, robot, &pkt);
     }
+}
+
+/* The robot's RTDE session on its link, with the configuration's recipe. */
+static bool rtde_attach(gw_robot *robot)
+{
+    char why[256];
+    rtde_source_config rc = {.name = robot->cfg->name,
+                             .vars = robot->cfg->recipe,
+                             .optional = robot->cfg->recipe_optional,
+                             .count = robot->cfg->recipe_count,
+                             .frequency = robot->cfg->rtde_frequency};
+    robot->rtde = rtde_source_new(&rc, why, sizeof why);
+    if (robot->rtde == NULL) {
+        urrt_log(URRT_LOG_ERR, "robot %s: %s", robot->cfg->name, why);
+        return false;
+    }
+    rtde_source_attach(robot->rtde, robot->link);
+    return true;
 }
 
 bool gw_init(gateway *gw, const gw_config *cfg)
@@ -192,7 +227,7 @@ bool gw_init(gateway *gw, const gw_config *cfg)
         robot->cfg = &cfg->robots[i];
         urrt_state_clear(&robot->state);
         robot->link = urrt_link_new(&robot->cfg->link);
-        if (robot->link == NULL) {
+        if (robot->link == NULL || (robot->cfg->source == GW_SOURCE_RTDE && !rtde_attach(robot))) {
             gw_close(gw);
             return false;
         }
@@ -361,6 +396,7 @@ void gw_close(gateway *gw)
     gw->output_count = 0;
     for (unsigned i = 0; i < gw->robot_count; i++) {
         urrt_link_free(gw->robots[i].link);
+        rtde_source_free(gw->robots[i].rtde);
     }
     free(gw->robots);
     gw->robots = NULL;

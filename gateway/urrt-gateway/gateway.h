@@ -2,8 +2,10 @@
 /*
  * gateway.h: the core of urrt-gateway: robots, outputs, one poll loop.
  *
- * Each robot has a link (port.h). Every complete packet of the expected
- * length is decoded once and handed to every output through one dispatch
+ * Each robot has a link (port.h), reading RealTime or, with source = rtde,
+ * an RTDE session through the link's source seam (rtde_source.h). Every
+ * complete packet of the expected length (every RTDE data package) is
+ * decoded once and handed to every output through one dispatch
  * (gw_output.packet); every output also gets a periodic tick, may add
  * descriptors to the poll set and counters to each robot's status. The
  * outputs are LCM (lcm_out.h) and CAN (can_out.h), each registered with
@@ -24,6 +26,7 @@
 #include "config.h"
 #include "freshness.h"
 #include "port.h"
+#include "rtde_source.h"
 #include "urrt.h"
 
 #define GW_MAX_OUTPUTS 8
@@ -39,6 +42,7 @@ typedef struct gw_robot {
     unsigned index;
     const gw_robot_config *cfg;
     urrt_link *link;
+    rtde_source *rtde;         /* source = rtde: the session on link; NULL for RealTime */
     urrt_state state;          /* the last packet decoded */
     uint64_t sequence;         /* packets dispatched to the outputs */
     uint64_t mismatches;       /* packets not of the expected length */
@@ -61,6 +65,7 @@ typedef struct gw_packet {
     const uint8_t *bytes;      /* valid during the call only */
     size_t length;
     const urrt_state *state;   /* decoded */
+    const urrt_rtde_values *rtde; /* source = rtde: the RTDE-only values; NULL for RealTime */
     uint64_t rx_us;            /* monotonic time the bytes were read */
     uint64_t data_us;          /* the data is no older than now - data_us (<= rx_us) */
     uint64_t rx_wall_us;       /* the same instant on the wall clock (utime) */

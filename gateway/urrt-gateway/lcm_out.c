@@ -14,6 +14,7 @@
 
 #include "urrt_gateway_t.h"
 #include "urrt_joints_t.h"
+#include "urrt_rtde_t.h"
 #include "urrt_state_t.h"
 #include "urrt_status_t.h"
 #include "urrt_tool_t.h"
@@ -33,6 +34,10 @@
 
 typedef struct lcm_robot {
     char *channel[GW_KIND_COUNT];
+    /* NAME.RTDE: the rtde_values' elements, named once at start */
+    char **rtde_names;
+    double *rtde_values;
+    int16_t rtde_count;
     bool scheduled[GW_KIND_COUNT];
     int64_t next_due_us[GW_KIND_COUNT]; /* controller time of the next slot */
     int64_t last_time_us;
@@ -65,6 +70,7 @@ struct lcm_out {
     urrt_joints_t joints;
     urrt_tool_t tool;
     urrt_status_t status;
+    urrt_rtde_t rtde;
     urrt_gateway_t report;
     double extra[URRT_MAX_DOUBLES];
     gw_counter counters[LCM_OUT_MAX_COUNTERS];
@@ -233,7 +239,8 @@ static int encode_state(lcm_out *out, const gw_packet *pkt)
 {
     urrt_state_t *msg = &out->state;
     const urrt_state *st = pkt->state;
-    const char *versions = urrt_versions_of(st->length);
+    /* An RTDE package's size is its recipe's: no RealTime version has it. */
+    const char *versions = pkt->rtde == NULL ? urrt_versions_of(st->length) : NULL;
     msg->utime = (int64_t)pkt->rx_wall_us;
     msg->length = (int32_t)st->length;
     msg->doubles = (int16_t)st->doubles;
@@ -327,6 +334,90 @@ static int encode_status(lcm_out *out, const gw_packet *pkt)
     return urrt_status_t_encode(out->buf, 0, LCM_OUT_BUFFER, msg);
 }
 
+/* One element of an RTDE-only value as a double (exact for every type but
+ * a 64-bit integer past 2^53). */
+static double rtde_element(const urrt_rtde_values *v, int var, unsigned i)
+{
+    const void *p = urrt_rtde_value(v, var);
+    if (p == NULL || !urrt_rtde_has(v, var)) {
+        return NAN;
+    }
+    switch (urrt_rtde_var_type(var)) {
+    case URRT_RTDE_T_BOOL:
+    case URRT_RTDE_T_UINT8: return ((const uint8_t *)p)[i];
+    case URRT_RTDE_T_UINT32:
+    case URRT_RTDE_T_VECTOR6UINT32: return ((const uint32_t *)p)[i];
+    case URRT_RTDE_T_UINT64: return (double)((const uint64_t *)p)[i];
+    case URRT_RTDE_T_INT32:
+    case URRT_RTDE_T_VECTOR6INT32: return ((const int32_t *)p)[i];
+    default: return ((const double *)p)[i];
+    }
+}
+
+/* Elements of an RTDE-only value: NAME.RTDE has an entry for each. */
+static unsigned rtde_elements(int var)
+{
+    switch (urrt_rtde_var_type(var)) {
+    case URRT_RTDE_T_VECTOR3D: return 3;
+    case URRT_RTDE_T_VECTOR6D:
+    case URRT_RTDE_T_VECTOR6INT32:
+    case URRT_RTDE_T_VECTOR6UINT32: return 6;
+    case URRT_RTDE_T_NONE:
+    case URRT_RTDE_T_COUNT: return 0;
+    default: return 1;
+    }
+}
+
+static int encode_rtde(lcm_out *out, gw_robot *robot, const gw_packet *pkt)
+{
+    lcm_robot *lr = &out->robots[robot->index];
+    urrt_rtde_t *msg = &out->rtde;
+    const gw_robot_config *cfg = robot->cfg;
+    unsigned n = 0;
+    msg->utime = (int64_t)pkt->rx_wall_us;
+    msg->controller_time = pkt->state->time[0];
+    msg->sequence = (int64_t)pkt->sequence;
+    for (size_t i = 0; i < cfg->rtde_value_count; i++) {
+        for (unsigned e = 0; e < rtde_elements(cfg->rtde_values[i]); e++) {
+            lr->rtde_values[n++] = rtde_element(pkt->rtde, cfg->rtde_values[i], e);
+        }
+    }
+    msg->count = lr->rtde_count;
+    msg->names = lr->rtde_names;
+    msg->values = lr->rtde_values;
+    return urrt_rtde_t_encode(out->buf, 0, LCM_OUT_BUFFER, msg);
+}
+
+/* NAME.RTDE's element names: "safety_status_bits", "tcp_offset[3]". */
+static bool name_rtde_values(lcm_robot *lr, const gw_robot_config *cfg)
+{
+    unsigned total = 0, n = 0;
+    for (size_t i = 0; i < cfg->rtde_value_count; i++) {
+        total += rtde_elements(cfg->rtde_values[i]);
+    }
+    lr->rtde_names = calloc(total + 1, sizeof *lr->rtde_names);
+    lr->rtde_values = calloc(total + 1, sizeof *lr->rtde_values);
+    if (lr->rtde_names == NULL || lr->rtde_values == NULL) {
+        return false;
+    }
+    for (size_t i = 0; i < cfg->rtde_value_count; i++) {
+        char name[URRT_RTDE_NAME_MAX];
+        unsigned count = rtde_elements(cfg->rtde_values[i]);
+        urrt_rtde_var_name(cfg->rtde_values[i], name, sizeof name);
+        for (unsigned e = 0; e < count; e++) {
+            int r = count == 1 ? asprintf(&lr->rtde_names[n], "%s", name)
+                               : asprintf(&lr->rtde_names[n], "%s[%u]", name, e);
+            if (r < 0) {
+                lr->rtde_names[n] = NULL;
+                return false;
+            }
+            n++;
+        }
+    }
+    lr->rtde_count = (int16_t)total;
+    return true;
+}
+
 static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
 {
     lcm_out *out = ctx;
@@ -351,6 +442,9 @@ static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
     if (due(&rates[GW_KIND_STATUS], lr, GW_KIND_STATUS, t_us)) {
         publish_data(out, robot, GW_KIND_STATUS, encode_status(out, pkt), pkt);
     }
+    if (pkt->rtde != NULL && lr->rtde_count > 0 && due(&rates[GW_KIND_RTDE], lr, GW_KIND_RTDE, t_us)) {
+        publish_data(out, robot, GW_KIND_RTDE, encode_rtde(out, robot, pkt), pkt);
+    }
     lr->last_time_us = t_us;
 }
 
@@ -363,6 +457,7 @@ static void report(lcm_out *out, gw_robot *robot, uint64_t now_us)
     const urrt_link_stats *ls = urrt_link_get_stats(robot->link);
     urrt_link_state state = urrt_link_get_state(robot->link);
     const char *versions = ls->last_length != 0 ? urrt_versions_of(ls->last_length) : NULL;
+    char controller[64];
     uint64_t published = 0;
     unsigned n;
 
@@ -381,6 +476,14 @@ static void report(lcm_out *out, gw_robot *robot, uint64_t now_us)
     msg->length = (int32_t)ls->last_length;
     msg->versions = (char *)(versions != NULL ? versions : "");
     msg->generation = (int8_t)(ls->last_length != 0 ? urrt_generation_of(ls->last_length) : URRT_GEN_UNKNOWN);
+    if (robot->rtde != NULL) {
+        /* RTDE names the controller's version itself; its package sizes are the recipe's. */
+        const uint32_t *v = rtde_source_session(robot->rtde)->controller;
+        snprintf(controller, sizeof controller, v[0] != 0 ? "%u.%u.%u.%u" : "", (unsigned)v[0], (unsigned)v[1],
+                 (unsigned)v[2], (unsigned)v[3]);
+        msg->versions = controller;
+        msg->generation = (int8_t)(v[0] != 0 ? URRT_GEN_3X : URRT_GEN_UNKNOWN);
+    }
     /* Over at least half a second: reports sent early, when the data starts
      * or stops, would give a rate of a few packets in a few microseconds. */
     if (lr->report_us == 0) {
@@ -489,7 +592,7 @@ static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *b
     size_t n = 0;
     for (unsigned k = 0; k < GW_KIND_COUNT && n < size; k++) {
         double rate = gw_meter_rate(&lr->sent[k], now_us);
-        if (out->cfg->rate[k].mode == GW_RATE_OFF) {
+        if (out->cfg->rate[k].mode == GW_RATE_OFF || (k == GW_KIND_RTDE && lr->rtde_count == 0)) {
             continue;
         }
         if (rate < 0) {
@@ -516,6 +619,11 @@ static void on_close(void *ctx)
         for (unsigned k = 0; k < GW_KIND_COUNT; k++) {
             free(out->robots[i].channel[k]);
         }
+        for (int16_t e = 0; out->robots[i].rtde_names != NULL && e <= out->robots[i].rtde_count; e++) {
+            free(out->robots[i].rtde_names[e]);
+        }
+        free(out->robots[i].rtde_names);
+        free(out->robots[i].rtde_values);
     }
     free(out->robots);
     free(out->buf);
@@ -549,10 +657,22 @@ lcm_out *lcm_out_new(gateway *gw, const gw_lcm_config *cfg)
                 return NULL;
             }
         }
+        if (!name_rtde_values(&out->robots[i], gw->robots[i].cfg)) {
+            on_close(out);
+            return NULL;
+        }
     }
     out->retry_ms = LCM_OUT_RETRY_MIN_MS;
     try_open(out, urrt_port_monotonic_us());
     return out;
+}
+
+void lcm_out_get_counts(const lcm_out *out, unsigned robot, lcm_out_counts *counts)
+{
+    const lcm_robot *lr = &out->robots[robot];
+    memcpy(counts->published, lr->published, sizeof counts->published);
+    counts->errors = lr->errors;
+    counts->stale_dropped = lr->stale_dropped;
 }
 
 gw_output lcm_out_output(lcm_out *out)

@@ -26,4 +26,12 @@ lcm_out *lcm_out_new(gateway *gw, const gw_lcm_config *cfg);
 /* The gw_output to register with gw_add_output; close frees it. */
 gw_output lcm_out_output(lcm_out *out);
 
+/* A robot's counts, for the metrics (metrics.h). */
+typedef struct lcm_out_counts {
+    uint64_t published[GW_KIND_COUNT]; /* messages per channel */
+    uint64_t errors;                   /* messages lost: publishing failed */
+    uint64_t stale_dropped;            /* messages not published: the data was stale */
+} lcm_out_counts;
+void lcm_out_get_counts(const lcm_out *out, unsigned robot, lcm_out_counts *counts);
+
 #endif

@@ -21,6 +21,8 @@ if "$here/stage-python.sh" "$build/canopen/py"; then
       $build/bin/urrt-gateway $here/canopen.ini $here/master.py $here/eds.py $here/canopen.sh"
   echo "==== $here/canopen.post (host)"
   counted "canopen.post" "$here/canopen.post" "$out/out" "$build/bin/urrt-dump" "$here/canopen.ini"
+  echo "==== $here/check-rtde-plc.sh (docs/examples/rtde-plc.ini over urrt-sim's RTDE port, its own VM)"
+  counted "check-rtde-plc.sh" "$here/check-rtde-plc.sh" "$build"
 else
   fail "could not stage Python for the VM (see above)"
 fi

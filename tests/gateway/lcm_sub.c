@@ -28,6 +28,7 @@
 #include "urrt.h"
 #include "urrt_gateway_t.h"
 #include "urrt_joints_t.h"
+#include "urrt_rtde_t.h"
 #include "urrt_state_t.h"
 #include "urrt_status_t.h"
 #include "urrt_tool_t.h"
@@ -129,6 +130,7 @@ static void on_message(const lcm_recv_buf_t *rbuf, const char *channel, void *us
     urrt_tool_t to;
     urrt_status_t su;
     urrt_gateway_t gw;
+    urrt_rtde_t rt;
 
     fputs("{\"ch\":", out);
     str(channel);
@@ -186,6 +188,17 @@ static void on_message(const lcm_recv_buf_t *rbuf, const char *channel, void *us
         }
         fputc('}', out);
         urrt_gateway_t_decode_cleanup(&gw);
+    } else if (urrt_rtde_t_decode(data, 0, size, &rt) == size) {
+        fputs(",\"type\":\"rtde_t\"", out);
+        I(&rt, utime); D(&rt, controller_time); I(&rt, sequence); I(&rt, count);
+        SA(&rt, names, rt.count);
+        fputs(",\"values\":[", out);
+        for (int i = 0; i < rt.count; i++) {
+            if (i) fputc(',', out);
+            num(rt.values[i]);
+        }
+        fputc(']', out);
+        urrt_rtde_t_decode_cleanup(&rt);
     } else {
         fputs(",\"type\":null", out);
         undecodable++;
@@ -199,6 +212,7 @@ int main(int argc, char **argv)
         /* What the encoder writes first: the same number Java's LCM_FINGERPRINT holds. */
         printf("gateway_t %llx\n", (unsigned long long)__urrt_gateway_t_get_hash());
         printf("joints_t %llx\n", (unsigned long long)__urrt_joints_t_get_hash());
+        printf("rtde_t %llx\n", (unsigned long long)__urrt_rtde_t_get_hash());
         printf("state_t %llx\n", (unsigned long long)__urrt_state_t_get_hash());
         printf("status_t %llx\n", (unsigned long long)__urrt_status_t_get_hash());
         printf("tool_t %llx\n", (unsigned long long)__urrt_tool_t_get_hash());

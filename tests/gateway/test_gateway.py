@@ -37,7 +37,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "ref"))
 import urrt_ref as ref  # noqa: E402
 
-KINDS = ("STATE", "JOINTS", "TOOL", "STATUS", "GATEWAY")
+KINDS = ("STATE", "JOINTS", "TOOL", "STATUS", "RTDE", "GATEWAY")
 DATA_KINDS = ("STATE", "JOINTS", "TOOL", "STATUS")
 # Upper bound of any wait: reached only when something is broken.
 WAIT = 60
@@ -103,6 +103,16 @@ class Run:
         if not os.path.exists(port_file):
             raise RuntimeError("urrt-sim did not listen: %s" % self.log(log)[-300:])
         return p, int(open(port_file).read())
+
+    def sim_rtde(self, *extra, port=0, rtde_port=0, log="sim.log"):
+        """urrt-sim serving RealTime and RTDE from the same arm; returns (process, port, RTDE port)."""
+        rtde_file = self.path(log + ".rtde")
+        p, rt = self.sim("--rtde", "127.0.0.1:%d" % rtde_port, "--rtde-port-file", rtde_file, *extra, port=port,
+                         log=log)
+        wait_for(lambda: os.path.exists(rtde_file) or p.poll() is not None, WAIT)
+        if not os.path.exists(rtde_file):
+            raise RuntimeError("urrt-sim did not listen for RTDE: %s" % self.log(log)[-300:])
+        return p, rt, int(open(rtde_file).read())
 
     def sub(self, regex=None):
         ready = self.path("sub.ready")
@@ -178,6 +188,17 @@ def wait_for(pred, seconds, step=0.02):
             return True
         time.sleep(step)
     return pred()
+
+
+def source_sim(r, rtde, *extra, port=0, rtde_port=0, log="sim.log"):
+    """urrt-sim and what a robot reads of it: (process, RealTime port, the
+    robot's port, the robot's source line). With rtde the robot reads the
+    simulator's RTDE port: the same arm, the same controller time."""
+    if not rtde:
+        p, rt = r.sim(*extra, port=port, log=log)
+        return p, rt, rt, ""
+    p, rt, rd = r.sim_rtde(*extra, port=port, rtde_port=rtde_port, log=log)
+    return p, rt, rd, "source = rtde\n"
 
 
 def robot_ini(name, port, extra=""):
@@ -470,39 +491,42 @@ def t_two_robots(args):
           "two robots: %s reports ~500 packets/s (%.1f)" % (a, rates[len(rates) // 2]))
 
 
-def t_restart(args):
-    """Kill the simulator, restart it: disconnected, no stale state, then recovery."""
-    r = Run(args, "rst")
+def t_restart(args, rtde=False):
+    """Kill the simulator, restart it: disconnected, no stale state, then
+    recovery (with RTDE: the whole handshake again)."""
+    r = Run(args, "rst" + ("rd" if rtde else ""))
+    what = "rtde restart" if rtde else "restart"
     try:
         r.sub()
-        sim, port = r.sim("--version", "5.10", "--clock", "realtime", log="sim1.log")
+        sim, rt_port, port, source = source_sim(r, rtde, "--version", "5.10", "--clock", "realtime", log="sim1.log")
         r.gateway(lcm_ini(r, gateway_rate="10 Hz") +
-                  robot_ini(r.prefix, port, "silence_timeout = 100 ms\nbackoff_initial = 100 ms\nbackoff_max = 200 ms"))
-        r.wait(lambda: len(r.channel("STATE")) >= 500, "restart: state flows before the kill")
+                  robot_ini(r.prefix, port, source +
+                            "silence_timeout = 100 ms\nbackoff_initial = 100 ms\nbackoff_max = 200 ms"))
+        r.wait(lambda: len(r.channel("STATE")) >= 500, what + ": state flows before the kill")
         sim.kill()
         sim.wait()
         killed = time.time() * 1e6
         r.wait(lambda: len([g for g in r.channel("GATEWAY") if g["utime"] > killed + 300000]) >= 10,
-               "restart: GATEWAY reports while the simulator is gone")
+               what + ": GATEWAY reports while the simulator is gone")
         restarted = time.time() * 1e6
-        r.sim("--version", "5.10", "--clock", "realtime", port=port, log="sim2.log")
+        source_sim(r, rtde, "--version", "5.10", "--clock", "realtime", port=rt_port, rtde_port=port, log="sim2.log")
         r.wait(lambda: len([m for m in r.channel("STATE") if m["utime"] > restarted]) > 500 and
                any(g["data_fresh"] and g["utime"] > restarted for g in r.channel("GATEWAY")),
-               "restart: state flows again after the restart")
+               what + ": state flows again after the restart")
         stopping = time.time() * 1e6
     finally:
         r.stop()
     state = [m for k in DATA_KINDS for m in r.channel(k)]
     gap = [m for m in state if killed < m["utime"] < restarted]
-    check(len(gap) == 0, "restart: no packet read between the kill and the restart (%d)" % len(gap))
+    check(len(gap) == 0, what + ": no packet read between the kill and the restart (%d)" % len(gap))
     down = [m for m in r.channel("GATEWAY") if killed + 100000 + 1000 < m["utime"] < restarted]
     check(len(down) >= 10 and all(not m["data_fresh"] and m["link_state_name"] != "up" for m in down),
-          "restart: %d GATEWAY reports while down, all saying no data and link not up" % len(down))
+          what + ": %d GATEWAY reports while down, all saying no data and link not up" % len(down))
     last = [g for g in r.channel("GATEWAY") if g["utime"] < stopping][-1]
     check(last.get("data_fresh") and last.get("reconnects", 0) >= 1 and last.get("disconnects", 0) >= 1,
-          "restart: the last GATEWAY says fresh again, reconnects %s, disconnects %s" %
+          what + ": the last GATEWAY says fresh again, reconnects %s, disconnects %s" %
           (last.get("reconnects"), last.get("disconnects")))
-    check_truthful(r, "restart", 100000)
+    check_truthful(r, what, 100000)
 
 
 def check_gap(r, what, gap, bound_us, silences_before, expect_silences):
@@ -529,27 +553,29 @@ def check_gap(r, what, gap, bound_us, silences_before, expect_silences):
 STALL_GAP_US = 150000
 
 
-def t_stall(args):
+def t_stall(args, rtde=False):
     """Half-open links: each connection goes quiet after 500 packets for 1.5 s;
     the gateway drops it after silence_timeout and the next one has data at once."""
-    r = Run(args, "stall")
+    r = Run(args, "stall" + ("rd" if rtde else ""))
+    what = "rtde stall" if rtde else "stall"
     bound = 100000
     try:
         r.sub()
-        _, port = r.sim("--version", "5.10", "--clock", "realtime", "--fault", "stall-after=500,for=1500")
-        r.gateway(lcm_ini(r, gateway_rate="10 Hz") + robot_ini(r.prefix, port, "silence_timeout = 100 ms"))
+        _, _, port, source = source_sim(r, rtde, "--version", "5.10", "--clock", "realtime", "--fault",
+                                        "stall-after=500,for=1500")
+        r.gateway(lcm_ini(r, gateway_rate="10 Hz") + robot_ini(r.prefix, port, source + "silence_timeout = 100 ms"))
         # Two gaps, and data again after the second.
         r.wait(lambda: len(gaps(r.channel("STATE"), STALL_GAP_US)) >= 2 and
                r.channel("STATE")[-1]["utime"] > gaps(r.channel("STATE"), STALL_GAP_US)[1][1] + 200000 and
                r.channel("GATEWAY")[-1]["utime"] > gaps(r.channel("STATE"), STALL_GAP_US)[1][1],
-               "stall: two stalls and recovery")
+               what + ": two stalls and recovery")
     finally:
         r.stop()
     found = gaps(r.channel("STATE"), STALL_GAP_US)[:2]
     for n, gap in enumerate(found):
         before = [g for g in r.channel("GATEWAY") if g["utime"] <= gap[0]]
-        check_gap(r, "stall %d" % (n + 1), gap, bound, before[-1]["silences"] if before else 0, (1,))
-    check_truthful(r, "stall", bound)
+        check_gap(r, "%s %d" % (what, n + 1), gap, bound, before[-1]["silences"] if before else 0, (1,))
+    check_truthful(r, what, bound)
 
 
 def t_frozen(args):
@@ -617,25 +643,26 @@ SIGSTOP_ROBOT = ("silence_timeout = 100 ms\nbackoff_initial = 100 ms\nbackoff_ma
                  "connect_timeout = 500 ms")
 
 
-def t_sigstop(args):
+def t_sigstop(args, rtde=False):
     """The simulator stopped (SIGSTOP) past the silence timeout and several
     reconnects: the link is down until data flows again, once, as GATEWAY,
     the CANopen node's EMCY 0xFF01 and the CAN heartbeat's state all say."""
-    r = Run(args, "sigstop")
+    r = Run(args, "sigstop" + ("rd" if rtde else ""))
+    what = "rtde sigstop" if rtde else "sigstop"
     node = 5
     emcy_log, hb_log = r.path("emcy.log"), r.path("hb.log")
     hb = r.prefix + "hb"
     try:
         r.sub()
-        sim, port = r.sim("--version", "5.10", "--clock", "realtime")
-        r.gateway(lcm_ini(r, gateway_rate="10 Hz") + robot_ini(r.prefix, port, SIGSTOP_ROBOT) +
+        sim, _, port, source = source_sim(r, rtde, "--version", "5.10", "--clock", "realtime")
+        r.gateway(lcm_ini(r, gateway_rate="10 Hz") + robot_ini(r.prefix, port, source + SIGSTOP_ROBOT) +
                   "[can]\ninterface = log:%s\nstale_after_ms = 100\n[canopen]\nnode_id = %d\n"
                   "nmt_start = operational\n[frame tpdo1]\nperiod_ms = 10\n"
                   "signal = q_actual[0] @0|16 intel signed factor=0.0002 min=-6.3 max=6.3 name=q0\n" % (emcy_log, node))
         # A second gateway with a plain CAN heartbeat (the node's status TPDO is off until a manager enables it).
         with open(r.path("gw_hb.ini"), "w") as f:
             f.write(lcm_ini(r, state_rate="off", joints_rate="off", tool_rate="off", status_rate="off",
-                            gateway_rate="off") + robot_ini(hb, port, SIGSTOP_ROBOT) +
+                            gateway_rate="off") + robot_ini(hb, port, source + SIGSTOP_ROBOT) +
                     "[can]\ninterface = log:%s\nheartbeat_id = 0x701\nheartbeat_period_ms = 20\nstale_after_ms = 100\n"
                     "[frame f]\nid = 0x181\nperiod_ms = 100\nsignal = q_actual[0] @0|16 intel signed factor=0.001\n"
                     % hb_log)
@@ -643,19 +670,19 @@ def t_sigstop(args):
         hb_state = lambda f: f[2][0] & 0x0F  # noqa: E731
         r.wait(lambda: len(r.channel("STATE")) >= 200 and any(g["data_fresh"] for g in r.channel("GATEWAY")) and
                any(i == 0x701 and hb_state((t, i, d)) == 1 for t, i, d in read_can_log(hb_log)),
-               "sigstop: data flows, GATEWAY fresh, the heartbeat says OK")
+               what + ": data flows, GATEWAY fresh, the heartbeat says OK")
         before = r.channel("GATEWAY")[-1]
         stopped = time.time() * 1e6
         sim.send_signal(signal.SIGSTOP)
         # Several reconnects into the stopped simulator, each accepted by its kernel.
         r.wait(lambda: r.channel("GATEWAY")[-1]["connect_failures"] >= before["connect_failures"] + 3,
-               "sigstop: three reconnects while stopped")
+               what + ": three reconnects while stopped")
         thawed = time.time() * 1e6
         sim.send_signal(signal.SIGCONT)
         r.wait(lambda: len([g for g in r.channel("GATEWAY") if g["utime"] > thawed and g["data_fresh"]]) >= 3 and
                emcy_events(read_can_log(emcy_log), 0x80 + node, 0xFF01)[1] and
                any(t > thawed and i == 0x701 and hb_state((t, i, d)) == 1 for t, i, d in read_can_log(hb_log)),
-               "sigstop: data, the EMCY reset and an OK heartbeat after SIGCONT")
+               what + ": data, the EMCY reset and an OK heartbeat after SIGCONT")
         # Stopping the simulator first ends the gateways' links: what comes after this is the teardown.
         ending = time.time() * 1e6
     finally:
@@ -664,34 +691,34 @@ def t_sigstop(args):
     frozen = [g for g in reports if stopped + 150000 < g["utime"] < thawed]
     check(len(frozen) >= 5 and all(g["link_state_name"] != "up" and g["link_state"] != 2 and not g["data_fresh"]
                                    for g in frozen),
-          "sigstop: all %d GATEWAY reports while stopped say the link is not up (%s)" %
+          what + ": all %d GATEWAY reports while stopped say the link is not up (%s)" %
           (len(frozen), sorted(set(g["link_state_name"] for g in frozen))))
     ups = [b["utime"] for a, b in zip(reports, reports[1:])
            if b["utime"] > stopped and a["link_state_name"] != "up" and b["link_state_name"] == "up"]
-    check(len(ups) == 1 and ups[0] > thawed, "sigstop: the link comes up once, after SIGCONT (%d times, %s)" %
+    check(len(ups) == 1 and ups[0] > thawed, what + ": the link comes up once, after SIGCONT (%d times, %s)" %
           (len(ups), ["%+.0f ms" % ((u - thawed) / 1e3) for u in ups]))
     last = reports[-1]
     check(last["connects"] - before["connects"] == 1 and last["reconnects"] - before["reconnects"] == 1 and
           last["disconnects"] - before["disconnects"] == 1 and last["silences"] - before["silences"] == 1,
-          "sigstop: one disconnect, one silence, one connect, one reconnect (%+d %+d %+d %+d)" %
+          what + ": one disconnect, one silence, one connect, one reconnect (%+d %+d %+d %+d)" %
           (last["disconnects"] - before["disconnects"], last["silences"] - before["silences"],
            last["connects"] - before["connects"], last["reconnects"] - before["reconnects"]))
     late = [m for k in DATA_KINDS for m in r.channel(k) if stopped + 100000 < m["utime"] < thawed]
-    check(not late, "sigstop: no data message read while stopped (%d)" % len(late))
+    check(not late, what + ": no data message read while stopped (%d)" % len(late))
     frames = [f for f in read_can_log(emcy_log) if f[0] < ending]
     raised, reset = emcy_events(frames, 0x80 + node, 0xFF01)
     check(len(raised) == 1 and stopped < raised[0] < thawed,
-          "sigstop: EMCY 0xFF01 raised once, while stopped (%d times, %s)" %
+          what + ": EMCY 0xFF01 raised once, while stopped (%d times, %s)" %
           (len(raised), ["%+.0f ms" % ((t - stopped) / 1e3) for t in raised]))
-    check(len(reset) == 1 and reset[0] > thawed, "sigstop: its reset once, after data flows again (%d times, %s)" %
+    check(len(reset) == 1 and reset[0] > thawed, what + ": its reset once, after data flows again (%d times, %s)" %
           (len(reset), ["%+.0f ms after SIGCONT" % ((t - thawed) / 1e3) for t in reset]))
     states = [(t, hb_state((t, i, d))) for t, i, d in read_can_log(hb_log) if i == 0x701 and t < ending]
     entered = [t for (_, a), (t, b) in zip(states, states[1:]) if b == 3 and a != 3]
     down = [s for t, s in states if entered and entered[0] <= t < thawed]
     check(len(entered) == 1 and stopped < entered[0] < thawed and down and all(s == 3 for s in down),
-          "sigstop: the heartbeat says ROBOT_DISCONNECTED once, and in all %d heartbeats until SIGCONT (%s)" %
+          what + ": the heartbeat says ROBOT_DISCONNECTED once, and in all %d heartbeats until SIGCONT (%s)" %
           (len(down), sorted(set(down))))
-    check(any(s == 1 for t, s in states if t > thawed), "sigstop: the heartbeat says OK after SIGCONT")
+    check(any(s == 1 for t, s in states if t > thawed), what + ": the heartbeat says OK after SIGCONT")
 
 
 def t_summary(args):
@@ -729,16 +756,18 @@ def t_summary(args):
     check(near("STATE", 500, 0.05), "summary: STATE at 500/s (%s)" % [rate(l, "STATE") for l in steady])
 
 
-def t_backlog(args):
+def t_backlog(args, rtde=False):
     """A gateway stopped for a second finds a backlog in its socket: no message
     may carry data older than the silence timeout."""
-    r = Run(args, "backlog")
+    r = Run(args, "backlog" + ("rd" if rtde else ""))
+    what = "rtde backlog" if rtde else "backlog"
     bound = 100000
     try:
         r.sub()
-        _, port = r.sim("--version", "5.10", "--clock", "realtime")
-        gw = r.gateway(lcm_ini(r, gateway_rate="10 Hz") + robot_ini(r.prefix, port, "silence_timeout = 100 ms"))
-        r.wait(lambda: len(r.channel("STATE")) >= 500, "backlog: state flows")
+        _, _, port, source = source_sim(r, rtde, "--version", "5.10", "--clock", "realtime")
+        gw = r.gateway(lcm_ini(r, gateway_rate="10 Hz") +
+                       robot_ini(r.prefix, port, source + "silence_timeout = 100 ms"))
+        r.wait(lambda: len(r.channel("STATE")) >= 500, what + ": state flows")
         stopped = time.time() * 1e6
         gw.send_signal(signal.SIGSTOP)
         time.sleep(1)  # the stimulus: how long the gateway is stopped
@@ -750,7 +779,7 @@ def t_backlog(args):
         gw.send_signal(signal.SIGCONT)
         r.wait(lambda: len([m for m in r.channel("STATE") if m["utime"] > resumed]) >= 500 and
                any(g["utime"] > resumed and counter(g, "late_packets") > 0 for g in r.channel("GATEWAY")),
-               "backlog: state flows after the stop")
+               what + ": state flows after the stop")
     finally:
         r.stop()
     data = [m for k in DATA_KINDS for m in r.channel(k)]
@@ -759,48 +788,186 @@ def t_backlog(args):
     # most one packet's messages.
     in_flight = [m for m in data if m["utime"] < resumed and m["recv_utime"] > resumed]
     check(len(in_flight) <= 4 and all(m["utime"] < stopped + 50000 for m in in_flight),
-          "backlog: only messages read before the stop arrive after it (%d)" % len(in_flight))
+          what + ": only messages read before the stop arrive after it (%d)" % len(in_flight))
     times = lambda m: m["time"] if "time" in m else m["controller_time"]  # noqa: E731
     old_at_read = [m for m in data if m["utime"] - times(m) * 1e6 > bound + AGE_MARGIN_US]
-    check(not old_at_read, "backlog: no message's data older than the bound when read (%d)" % len(old_at_read))
+    check(not old_at_read, what + ": no message's data older than the bound when read (%d)" % len(old_at_read))
     after = [m for m in data if m["utime"] > resumed]
     old = [m for m in after if m["recv_utime"] - times(m) * 1e6 > bound + AGE_MARGIN_US]
-    check(after and not old, "backlog: no message read after the stop older than the bound when received (%d)" %
+    check(after and not old, what + ": no message read after the stop older than the bound when received (%d)" %
           len(old))
     g = r.channel("GATEWAY")
     counted = counter(g[-1], "late_packets") if g else 0
-    check(counted > 0, "backlog: GATEWAY counts the late packets (%d)" % counted)
-    check("older than silence_timeout" in r.log(), "backlog: logged")
-    check_truthful(r, "backlog", bound)
+    check(counted > 0, what + ": GATEWAY counts the late packets (%d)" % counted)
+    check("older than silence_timeout" in r.log(), what + ": logged")
+    check_truthful(r, what, bound)
 
 
-def t_overload(args):
+def t_overload(args, rtde=False):
     """A gateway slower than its robot: every STATE publish takes 2.5 ms, so
     it handles about 400 of 500 packets a second. The lag grows slowly; the
     gateway must notice it, drop what is too old, say so, and never publish
     data older than the bound."""
-    r = Run(args, "overload")
+    r = Run(args, "overload" + ("rd" if rtde else ""))
+    what = "rtde overload" if rtde else "overload"
     bound = 100000
     env = {"LD_PRELOAD": args.shim, "ALLOC_SHIM_DELAY_US": "2500", "ALLOC_SHIM_DELAY_SUFFIX": ".STATE"}
     try:
         r.sub()
-        _, port = r.sim("--version", "5.10", "--clock", "realtime")
-        r.gateway(lcm_ini(r, gateway_rate="10 Hz") + robot_ini(r.prefix, port, "silence_timeout = 100 ms"), env=env)
+        _, _, port, source = source_sim(r, rtde, "--version", "5.10", "--clock", "realtime")
+        r.gateway(lcm_ini(r, gateway_rate="10 Hz") + robot_ini(r.prefix, port, source + "silence_timeout = 100 ms"),
+                  env=env)
         r.wait(lambda: len(r.channel("STATE")) >= 1500 and
                sum(1 for g in r.channel("GATEWAY") if not g["data_fresh"]) >= 3,
-               "overload: state published and the overload reported")
+               what + ": state published and the overload reported")
     finally:
         r.stop()
     g = r.channel("GATEWAY")
     late = counter(g[-1], "late_packets") if g else 0
     stale = counter(g[-1], "lcm.stale_dropped") if g else 0
-    check(late + stale > 0, "overload: counted (%d late when read, %d stale at send)" % (late, stale))
+    check(late + stale > 0, what + ": counted (%d late when read, %d stale at send)" % (late, stale))
     fresh = [m for m in g if m["data_fresh"]]
     check(len(fresh) >= 1 and len(g) > len(fresh),
-          "overload: GATEWAY says fresh (%d) and not fresh (%d) as the lag comes and goes" %
+          what + ": GATEWAY says fresh (%d) and not fresh (%d) as the lag comes and goes" %
           (len(fresh), len(g) - len(fresh)))
-    check("older than silence_timeout" in r.log(), "overload: logged")
-    check_truthful(r, "overload", bound)
+    check("older than silence_timeout" in r.log(), what + ": logged")
+    check_truthful(r, what, bound)
+
+
+# ---- RTDE as the source -----------------------------------------------------------------
+
+RTDE_VALUES = "safety_status_bits, output_int_register_24, tcp_offset"
+RTDE_NAMES = ["safety_status_bits", "output_int_register_24"] + ["tcp_offset[%d]" % i for i in range(6)]
+# The same signals in a frame per robot, a frame per packet: payloads that change every packet.
+RTDE_CAN_SIGNALS = ("signal = q_actual[0] @0|32 intel signed factor=0.0000001 name=q0\n"
+                    "signal = qd_actual[1] @32|32 intel signed factor=0.0000001 name=qd1\n")
+# Message members that are not values of the packet.
+NOT_VALUES = ("ch", "recv_utime", "size", "type", "utime", "sequence", "length", "doubles", "versions", "present",
+              "extra_columns", "extra")
+
+
+def differing(a, b, absent=()):
+    """Names of the values a and b (messages of one kind) hold differently;
+    names in absent are NaN in a."""
+    out = []
+    for name, v in a.items():
+        if name in NOT_VALUES:
+            continue
+        if name in absent:
+            if not all(math.isnan(x) for x in (v if isinstance(v, list) else [v])):
+                out.append(name + " (absent)")
+            continue
+        x, y = (v if isinstance(v, list) else [v]), (b[name] if isinstance(b[name], list) else [b[name]])
+        if len(x) != len(y) or not all(same(p, q) if not isinstance(p, str) else p == q for p, q in zip(x, y)):
+            out.append(name)
+    return out
+
+
+def t_rtde_values(args):
+    """One gateway, a robot on each port of one simulator (the same arm, the
+    same controller time): the RTDE robot publishes on LCM and CAN the same
+    values as the RealTime one, and its RTDE-only values on NAME.RTDE."""
+    r = Run(args, "rdval")
+    rt, rd = r.prefix + "rt", r.prefix + "rd"
+    can_log = r.path("can.log")
+    try:
+        r.sub()
+        _, port, rport = r.sim_rtde("--version", "5.10", "--clock", "realtime")
+        r.gateway(lcm_ini(r, status_rate="every", gateway_rate="10 Hz") + robot_ini(rt, port) +
+                  robot_ini(rd, rport, "source = rtde\nrtde_values = %s\n" % RTDE_VALUES) +
+                  "[can]\ninterface = log:%s\nheartbeat_id = 0x701\nheartbeat_robot = %s\n" % (can_log, rd) +
+                  "[frame frt]\nid = 0x181\nperiod_ms = every\nrobot = %s\n%s" % (rt, RTDE_CAN_SIGNALS) +
+                  "[frame frd]\nid = 0x182\nperiod_ms = every\nrobot = %s\n%s" %
+                  (rd, RTDE_CAN_SIGNALS.replace("q_actual[0]", "actual_q[0]")))  # by its RTDE name
+        r.wait(lambda: min(len(r.channel(k, p)) for k in DATA_KINDS for p in (rt, rd)) >= 1000 and
+               len(r.channel("RTDE", rd)) >= 1000, "rtde values: both robots publish every message")
+    finally:
+        r.stop()
+    # What RealTime 5.10 has and RTDE not: the test value and reserved
+    # columns (no RTDE output), payload_inertia (RTDE from 5.11 on).
+    lacks = {"test_value", "reserved_103", "reserved_112", "reserved_120", "reserved_121", "reserved_140",
+             "payload_inertia"}
+    st, ref_st = r.channel("STATE", rd), r.channel("STATE", rt)
+    rd_absent = {n for i, n in enumerate(ref.ALL_NAMES) if st and not st[-1]["present"] >> i & 1}
+    rt_present = {n for i, n in enumerate(ref.ALL_NAMES) if ref_st and ref_st[-1]["present"] >> i & 1}
+    check(rt_present & rd_absent == lacks, "rtde values: the RTDE robot lacks exactly %s (%s)" %
+          (sorted(lacks), sorted(rt_present & rd_absent)))
+    for kind in DATA_KINDS:
+        key = "time" if kind == "STATE" else "controller_time"
+        ref_msgs = {m[key]: m for m in r.channel(kind, rt)}
+        pairs = [(m, ref_msgs[m[key]]) for m in r.channel(kind, rd) if m[key] in ref_msgs]
+        bad = [(m[key], differing(m, o, rd_absent)) for m, o in pairs if differing(m, o, rd_absent)]
+        check(len(pairs) >= 500 and not bad, "rtde values: %d %s messages equal RealTime's at the same controller "
+              "time%s" % (len(pairs), kind, " (%d differ; first t=%r: %s)" % (len(bad), bad[0][0], bad[0][1])
+                          if bad else ""))
+    check(st and all(m["type"] == "state_t" and m["versions"] == "" for m in st),
+          "rtde values: NAME.STATE keeps its type (state_t), no RealTime version named")
+    rtde = r.channel("RTDE", rd)
+    check(rtde and all(m["type"] == "rtde_t" and m["names"] == RTDE_NAMES for m in rtde),
+          "rtde values: NAME.RTDE is an rtde_t naming %s" % ", ".join(RTDE_NAMES))
+    # The simulator's model: safety_status_bits has bit (safety_mode - 1) set.
+    states = {m["time"]: m for m in st}
+    bad = [m["controller_time"] for m in rtde if m["controller_time"] not in states or
+           m["sequence"] != states[m["controller_time"]]["sequence"] or
+           m["values"][0] != 2 ** (int(states[m["controller_time"]]["safety_mode"]) - 1) or
+           m["values"][1] != int(m["values"][1]) or m["values"][2:] != [0.0] * 6]
+    check(rtde and not bad, "rtde values: %d RTDE messages hold the package's values (safety_status_bits of its safety "
+          "mode, an integer register, tcp_offset zero) under STATE's sequence (%d do not)" % (len(rtde), len(bad)))
+    frames = read_can_log(can_log)
+    a = [d for _, i, d in frames if i == 0x181]
+    b = [d for _, i, d in frames if i == 0x182]
+    common = set(a) & set(b)
+    inner = b[5:-5]
+    check(len(inner) >= 500 and all(d in common for d in inner),
+          "rtde values: every CAN frame of the RTDE robot (%d) carries a payload the RealTime robot's sends too "
+          "(%d do not)" % (len(inner), sum(1 for d in inner if d not in common)))
+    check_truthful(r, "rtde values", 100000, prefix=rd)
+
+
+def t_rtde_refused(args):
+    """A controller without a value the configuration publishes: one error
+    line naming it and the version, the long backoff, never a tight loop,
+    nothing published."""
+    r = Run(args, "rdref")
+    try:
+        r.sub()
+        _, _, rport = r.sim_rtde("--version", "3.10", "--clock", "realtime")
+        r.gateway(lcm_ini(r, gateway_rate="10 Hz") +
+                  robot_ini(r.prefix, rport, "source = rtde\nrtde_values = ft_raw_wrench\n"
+                            "backoff_initial = 100 ms\nbackoff_max = 500 ms\n"))
+        r.wait(lambda: len(r.channel("GATEWAY")) >= 30, "rtde refused: three seconds of reports")
+    finally:
+        r.stop()
+    lines = [l for l in r.log().splitlines() if "does not have ft_raw_wrench" in l]
+    check(len(lines) == 1 and "3.10" in lines[0] and "error" in lines[0],
+          "rtde refused: one error line names the value and the controller's version (%r)" % lines[:2])
+    g = r.channel("GATEWAY")
+    check(all(not m["data_fresh"] and m["link_state_name"] != "up" for m in g) and not r.channel("STATE"),
+          "rtde refused: the link never comes up, nothing is published")
+    tries = g[-1]["connect_failures"] if g else 0
+    span = (g[-1]["utime"] - g[0]["utime"]) / 1e6 if g else 0
+    check(2 <= tries <= span / 0.5 + 2, "rtde refused: %d attempts in %.1f s: every backoff_max (500 ms), "
+          "not a tight loop" % (tries, span))
+
+
+def t_rtde_fallback(args):
+    """A controller that refuses protocol 2 gets protocol 1; its text
+    messages go to the log at their level."""
+    r = Run(args, "rdfb")
+    try:
+        r.sub()
+        _, _, rport = r.sim_rtde("--version", "5.10", "--clock", "realtime", "--fault", "rtde-refuse-v2",
+                                 "--fault", "rtde-text-every=100,level=2")
+        r.gateway(lcm_ini(r) + robot_ini(r.prefix, rport, "source = rtde\n"))
+        r.wait(lambda: len(r.channel("STATE")) >= 500, "rtde fallback: state flows over protocol 1")
+    finally:
+        r.stop()
+    log = r.log()
+    check("refuses RTDE protocol 2: asking for 1" in log, "rtde fallback: logged")
+    said = [l for l in log.splitlines() if "controller says" in l]
+    check(said and all("warning" in l for l in said), "rtde fallback: %d text messages logged as warnings" %
+          len(said))
+    check_truthful(r, "rtde fallback", 100000)
 
 
 def t_mismatch(args):
@@ -821,28 +988,32 @@ def t_mismatch(args):
     check("1116-byte packets" in r.log() and "expected 1220" in r.log(), "version mismatch: logged with both lengths")
 
 
-def t_allocations(args):
-    """Zero allocations per packet in steady state, publish included."""
-    r = Run(args, "alloc")
+def t_allocations(args, rtde=False):
+    """Zero allocations per packet in steady state, publish included (with
+    RTDE: the session's feed and NAME.RTDE too)."""
+    r = Run(args, "alloc" + ("rd" if rtde else ""))
+    what = "rtde allocations" if rtde else "allocations"
     report = r.path("alloc.txt")
     warm, window = 4000, 20000
     env = {"LD_PRELOAD": args.shim, "ALLOC_SHIM_OUT": report, "ALLOC_SHIM_WARMUP": str(warm),
            "ALLOC_SHIM_WINDOW": str(window)}
     try:
-        _, port = r.sim("--version", "5.10", "--rate", "2500")
-        r.gateway(lcm_ini(r, status_rate="every") + robot_ini(r.prefix, port), env=env)
+        # RTDE streams at the controller's 500 Hz: the window takes 8 s there.
+        _, _, port, source = source_sim(r, rtde, "--version", "5.10", *(() if rtde else ("--rate", "2500")))
+        r.gateway(lcm_ini(r, status_rate="every") +
+                  robot_ini(r.prefix, port, source + ("rtde_values = %s\n" % RTDE_VALUES if rtde else "")), env=env)
         wait_for(lambda: os.path.exists(report) and os.path.getsize(report) > 0, WAIT)
     finally:
         r.stop()
     text = open(report).read() if os.path.exists(report) else ""
     m = re.match(r"publishes (\d+) allocs (\d+) in_publish (\d+) outside (\d+)", text)
-    if not check(m is not None, "allocations: the shim reported (%r)" % text.strip()):
+    if not check(m is not None, what + ": the shim reported (%r)" % text.strip()):
         return
     pubs, total, inside, outside = map(int, m.groups())
-    print("allocations: %d publishes (%d packets): %d allocations, %d inside lcm_publish" %
-          (pubs, pubs // 4, total, inside))
-    check(outside == 0, "allocations: the gateway's own per-packet path allocates nothing (%d)" % outside)
-    check(inside == 0, "allocations: lcm_publish allocates nothing either (%d)" % inside)
+    print(what + ": %d publishes (%d packets): %d allocations, %d inside lcm_publish" %
+          (pubs, pubs // (5 if rtde else 4), total, inside))
+    check(outside == 0, what + ": the gateway's own per-packet path allocates nothing (%d)" % outside)
+    check(inside == 0, what + ": lcm_publish allocates nothing either (%d)" % inside)
 
 
 def t_publish_errors(args):
@@ -916,6 +1087,11 @@ def t_jar(args):
               "jar: %s fingerprint Java %s == C %s" % (n, jfp.get(n), cfp.get(n)))
 
 
+# 96 RTDE-only names, six to a line (a line holds 198 characters).
+RTDE_LONG_NAMES = ["output_double_register_%d" % i for i in range(48)] + ["input_double_register_%d" % i for i in range(48)]
+RTDE_LONG_RECIPE = "".join("rtde_values = %s\n" % ", ".join(RTDE_LONG_NAMES[k:k + 6]) for k in range(0, 96, 6))
+
+
 BAD_CONFIGS = [
     # (name, text, line, reason pattern)
     ("unknown section", "[robots arm]\nhost = a\n", 1, r"unknown section \[robots arm\]"),
@@ -958,6 +1134,30 @@ BAD_CONFIGS = [
     ("header", "[robot a\nhost = h\n", 1, r"without '\]'"),
     ("long line", "[robot a]\nhost = h\n# " + "x" * 300 + "\n", 3, r"line longer than"),
     ("no robot", "[lcm]\n", 0, r"no robot"),
+    ("rtde value on realtime", "[robot a]\nhost = h\nrtde_values = safety_status_bits\n", 3,
+     r"rtde_values are RTDE-only values, and this robot's source is realtime"),
+    ("rtde unknown value", "[robot a]\nhost = h\nsource = rtde\nrtde_values = output_int_register_48\n", 4,
+     r'"output_int_register_48" is no RTDE output'),
+    ("rtde shared value", "[robot a]\nhost = h\nsource = rtde\nrtde_values = actual_q\n", 4,
+     r"on NAME.STATE already \(as q_actual\)"),
+    ("rtde source", "[robot a]\nhost = h\nsource = RTDE\n", 3, r'source must be "realtime"'),
+    ("rtde-only value on CAN, realtime robot", "[robot a]\nhost = h\n[can]\ninterface = log:-\nheartbeat_id = 0x701\n"
+     "[frame f]\nid = 0x181\nperiod_ms = 10\nsignal = safety_status_bits @0|32 intel unsigned\n", 9,
+     r'signal safety_status_bits: an RTDE-only value, and robot "a" reads RealTime, which has none'),
+    ("field without RTDE on CAN", "[robot a]\nhost = h\nsource = rtde\n[can]\ninterface = log:-\n"
+     "heartbeat_id = 0x701\n[frame f]\nid = 0x181\nperiod_ms = 10\nsignal = test_value @0|32 intel float32\n", 10,
+     r"RTDE has no test_value"),
+    ("rtde on 1.x", "[robot a]\nhost = h\nversion = 1.8\nsource = rtde\n", 3, r"version 1.8 has no RTDE"),
+    ("rtde frequency", "[robot a]\nhost = h\nsource = rtde\nrtde_frequency = 501 Hz\n", 4,
+     r"above 500 Hz, the fastest any controller streams RTDE"),
+    ("rtde frequency of the version", "[robot a]\nhost = h\nversion = 3.10\nsource = rtde\n"
+     "rtde_frequency = 200 Hz\n", 5, r"above the 125 Hz version 3.10"),
+    ("rtde frequency on realtime", "[robot a]\nhost = h\nrtde_frequency = 125 Hz\n", 3,
+     r"applies to source = rtde only"),
+    # 96 registers of 24 and 25 letters: 2,437 bytes of names with the timestamp's.
+    ("rtde recipe too long", "[lcm]\nstate_rate = off\njoints_rate = off\ntool_rate = off\nstatus_rate = off\n"
+     "[robot a]\nhost = h\nsource = rtde\n" + RTDE_LONG_RECIPE, 9, r"names take 2\d\d\d bytes, over the controller's "
+     "limit of 2048"),
 ]
 
 
@@ -979,6 +1179,14 @@ def t_configs(args):
     p = subprocess.run([args.gateway, "--check-config", example], capture_output=True, text=True, timeout=10)
     check(p.returncode == 0 and "arm1.STATE: every packet" in p.stdout and "arm1.STATUS: 10 Hz" in p.stdout,
           "config: the example configuration is valid and its plan printed")
+    example = os.path.join(HERE, "..", "..", "docs", "examples", "rtde.ini")
+    p = subprocess.run([args.gateway, "--check-config", example], capture_output=True, text=True, timeout=10)
+    check(p.returncode == 0 and "robot arm1: 192.168.1.10:30004," in p.stdout and
+          re.search(r"rtde: 41 values .*: timestamp,\[target_q\],.*,\[payload_inertia\],output_int_register_24,"
+                    r"output_double_register_24,robot_status_bits,safety_status_bits,target_speed_fraction\n",
+                    p.stdout) and "arm1.RTDE: every packet" in p.stdout,
+          "config: the RTDE example is valid: port 30004, its recipe (STATE's fields optional, the RTDE-only "
+          "values required) and arm1.RTDE in the plan")
     good = os.path.join(d, "good.ini")
     with open(good, "w") as f:
         f.write("; comment\n[robot a]\nhost = ::1  # inline comment\nversion = 1.8\nconnect_timeout = 1.5 s\n"
@@ -1160,6 +1368,15 @@ def main():
         ("alloc", lambda: t_allocations(args)),
         ("publish_errors", lambda: t_publish_errors(args)),
         ("publish_reopen", lambda: t_publish_reopen(args)),
+        ("rtde_values", lambda: t_rtde_values(args)),
+        ("rtde_refused", lambda: t_rtde_refused(args)),
+        ("rtde_fallback", lambda: t_rtde_fallback(args)),
+        ("rtde_restart", lambda: t_restart(args, rtde=True)),
+        ("rtde_stall", lambda: t_stall(args, rtde=True)),
+        ("rtde_sigstop", lambda: t_sigstop(args, rtde=True)),
+        ("rtde_backlog", lambda: t_backlog(args, rtde=True)),
+        ("rtde_overload", lambda: t_overload(args, rtde=True)),
+        ("rtde_alloc", lambda: t_allocations(args, rtde=True)),
     ]
     for name, fn in tests:
         if args.only and not re.search(args.only, name):

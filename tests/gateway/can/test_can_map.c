@@ -20,6 +20,7 @@
 #include "dbc.h"
 #include "testutil.h"
 #include "urrt_can.h"
+#include "urrt_rtde.h"
 
 /* ---- can_map: configuration ---------------------------------------------------------- */
 
@@ -1170,6 +1171,207 @@ static void test_dbc_text(void)
     CHECK(strtod(dbc_number(0.1 + 0.2, num, sizeof num), NULL) == 0.1 + 0.2, "shortest round trip %s", num);
 }
 
+
+/* ---- RTDE-only values as signals -------------------------------------------------------- */
+
+#define RTDE_ROBOT "[robot arm]\nhost = h\nversion = 5.10\nsource = rtde\n"
+
+/* Loads text as "t.ini" into *cfg, kept whole (the recipe too): the error
+ * count, the messages in err. */
+static int load_cfg(gw_config *cfg, const char *text, char *err, size_t errlen)
+{
+    char *messages = NULL;
+    size_t size = 0;
+    FILE *in = fmemopen((void *)text, strlen(text), "r");
+    FILE *out = open_memstream(&messages, &size);
+    int errors = gw_config_load_stream(cfg, in, "t.ini", out);
+    fclose(in);
+    fclose(out);
+    snprintf(err, errlen, "%.*s", (int)(size > 0 && messages[size - 1] == '\n' ? size - 1 : size), messages);
+    free(messages);
+    return errors;
+}
+
+static const char *const rtde_config =
+    CAN_HEAD
+    "[frame regs]\nid = 0x100\nperiod_ms = 10\nvalidity_bit = 63\nstale_policy = invalid\n"
+    "signal = output_int_register_24 @0|32 intel signed name=reg24\n"              /* line 9 */
+    "signal = robot_status_bits @32|8 intel unsigned bits=0-7\n"
+    "signal = output_bit_register_64 @40|1 intel unsigned name=bit64\n"
+    "signal = output_int_register_47 @48|8 intel signed factor=2 name=reg47\n"
+    "[frame masks]\nid = 0x101\nperiod_ms = 10\n"
+    "signal = actual_configurable_digital_output_bits @0|64 intel unsigned name=cdo\n"
+    "[frame top]\nid = 0x102\nperiod_ms = 10\n"
+    "signal = actual_configurable_digital_output_bits @0|8 intel unsigned bits=56-63 name=cdo_top\n"
+    "signal = safety_status_bits @15|32 motorola unsigned\n"
+    "signal = tcp_offset[5] @40|16 intel signed factor=0.001\n"
+    RTDE_ROBOT;
+
+static void set_var(urrt_rtde_values *v, int var)
+{
+    unsigned bit = (unsigned)(var - URRT_RTDE_MAPPED_COUNT);
+    v->present[bit / 8u] |= (uint8_t)(1u << (bit % 8u));
+}
+
+/* Frame `frame` as it would go out now, after a package with these values. */
+static urrt_can_frame rtde_frame(gw_config *cfg, const urrt_rtde_values *v, uint64_t t, size_t frame)
+{
+    urrt_can_frame out;
+    urrt_state st;
+    urrt_state_clear(&st);
+    st.generation = URRT_GEN_3X;
+    st.time[0] = (double)t / 1e6;
+    st.present = UINT64_C(1) << URRT_F_TIME;
+    can_run_rtde(cfg->can_run, 0, v);
+    urrt_cantx_on_packet(can_run_tx(cfg->can_run), 0, &st, t);
+    urrt_cantx_peek(can_run_tx(cfg->can_run), frame, t, &out);
+    return out;
+}
+
+/* Every INT32 edge, BOOL, a UINT32 mask: bit for bit. */
+static void rtde_registers(gw_config *cfg)
+{
+    static const int32_t edges[] = {INT32_MIN, INT32_MIN + 1, -1, 0, 1, INT32_MAX - 1, INT32_MAX};
+    urrt_rtde_values v;
+    for (size_t i = 0; i < sizeof edges / sizeof edges[0]; i++) {
+        urrt_rtde_values_clear(&v);
+        v.output_int_register[24] = edges[i];
+        v.output_int_register[47] = (int32_t)(i * 2) - 6; /* -6 .. 6, factor 2: raw -3 .. 3 */
+        v.robot_status_bits[0] = 0xA5u + (uint32_t)i;
+        v.output_bit_register[0] = (uint8_t)(i & 1u);
+        set_var(&v, URRT_RTDE_V_OUTPUT_INT_REGISTER + 24);
+        set_var(&v, URRT_RTDE_V_OUTPUT_INT_REGISTER + 47);
+        set_var(&v, URRT_RTDE_V_ROBOT_STATUS_BITS);
+        set_var(&v, URRT_RTDE_V_OUTPUT_BIT_REGISTER);
+        urrt_can_frame f = rtde_frame(cfg, &v, 1000000u + i * 10000u, 0);
+        CHECK(bits_of(&f, 0, 32) == (uint32_t)edges[i], "reg24 %ld: raw 0x%llx", (long)edges[i],
+              (unsigned long long)bits_of(&f, 0, 32));
+        CHECK(bits_of(&f, 32, 8) == ((0xA5u + i) & 0xFFu), "robot_status_bits 0..7 of 0x%zx",
+              (size_t)(0xA5u + i));
+        CHECK(bits_of(&f, 40, 1) == (i & 1u), "output_bit_register_64 %zu", i & 1u);
+        CHECK(bits_of(&f, 48, 8) == (uint8_t)(int8_t)((int)i - 3), "reg47 scaled by 2: raw %d", (int)i - 3);
+        CHECK(bits_of(&f, 63, 1) == 1, "valid while fresh and exact");
+    }
+    /* A register reg47's 8 bits cannot carry (300 / 2 = 150 > 127): saturated, and the frame says so. */
+    urrt_rtde_values_clear(&v);
+    v.output_int_register[47] = 300;
+    set_var(&v, URRT_RTDE_V_OUTPUT_INT_REGISTER + 47);
+    urrt_can_frame f = rtde_frame(cfg, &v, 1500000u, 0);
+    CHECK(bits_of(&f, 48, 8) == 127 && bits_of(&f, 63, 1) == 0, "reg47 300 saturated to raw 127, valid 0: %llu %llu",
+          (unsigned long long)bits_of(&f, 48, 8), (unsigned long long)bits_of(&f, 63, 1));
+}
+
+/* A UINT64 mask keeps all 64 bits, bit 63 too: no double past 2^53 on the way. */
+static void rtde_masks(gw_config *cfg)
+{
+    static const uint64_t masks[] = {UINT64_C(0x8000000000000001), UINT64_MAX, UINT64_C(0x0123456789ABCDEF),
+                                     (UINT64_C(1) << 53) + 1, 0};
+    urrt_rtde_values v;
+    for (size_t i = 0; i < sizeof masks / sizeof masks[0]; i++) {
+        urrt_rtde_values_clear(&v);
+        v.actual_configurable_digital_output_bits[0] = masks[i];
+        v.safety_status_bits[0] = UINT32_C(0x80000001) ^ (uint32_t)i;
+        v.tcp_offset[5] = -1.5;
+        set_var(&v, URRT_RTDE_V_ACTUAL_CONFIGURABLE_DIGITAL_OUTPUT_BITS);
+        set_var(&v, URRT_RTDE_V_SAFETY_STATUS_BITS);
+        set_var(&v, URRT_RTDE_V_TCP_OFFSET);
+        urrt_can_frame f = rtde_frame(cfg, &v, 2000000u + i * 10000u, 1);
+        CHECK(bits_of(&f, 0, 64) == masks[i], "UINT64 mask 0x%016llx sent as 0x%016llx",
+              (unsigned long long)masks[i], (unsigned long long)bits_of(&f, 0, 64));
+        f = rtde_frame(cfg, &v, 2000000u + i * 10000u + 1u, 2);
+        CHECK(f.data[0] == (uint8_t)(masks[i] >> 56), "bits=56-63 of 0x%016llx: 0x%02x",
+              (unsigned long long)masks[i], f.data[0]);
+        /* Motorola, start bit 15 (the MSB of byte 1): bytes 1..4 big-endian. */
+        uint32_t be = (uint32_t)f.data[1] << 24 | (uint32_t)f.data[2] << 16 | (uint32_t)f.data[3] << 8 | f.data[4];
+        CHECK(be == (UINT32_C(0x80000001) ^ (uint32_t)i), "safety_status_bits motorola 0x%08x", be);
+        CHECK(bits_of(&f, 40, 16) == (uint16_t)-1500, "tcp_offset[5] -1.5 rad at 0.001: raw %llu",
+              (unsigned long long)bits_of(&f, 40, 16));
+    }
+    /* A package without the values (before the first): no bits set, never a guess. */
+    urrt_rtde_values_clear(&v);
+    urrt_can_frame f = rtde_frame(cfg, &v, 3000000u, 1);
+    CHECK(bits_of(&f, 0, 64) == 0, "absent mask: 0");
+}
+
+static bool recipe_has(const gw_robot_config *r, int var, bool optional)
+{
+    for (size_t i = 0; i < r->recipe_count; i++) {
+        if (r->recipe[i] == var) {
+            return r->recipe_optional[i] == optional;
+        }
+    }
+    return false;
+}
+
+static void rtde_recipe_and_dbc(gw_config *cfg)
+{
+    const gw_robot_config *r = &cfg->robots[0];
+    char *text = NULL;
+    size_t size = 0;
+    CHECK(recipe_has(r, URRT_RTDE_V_OUTPUT_INT_REGISTER + 24, false), "output_int_register_24 required");
+    CHECK(recipe_has(r, URRT_RTDE_V_ACTUAL_CONFIGURABLE_DIGITAL_OUTPUT_BITS, false), "a mask required");
+    CHECK(recipe_has(r, URRT_RTDE_V_TCP_OFFSET, false), "tcp_offset required");
+    CHECK(recipe_has(r, URRT_RTDE_V_OUTPUT_BIT_REGISTER, false), "output_bit_register_64 required");
+    FILE *f = open_memstream(&text, &size);
+    CHECK_EQ_INT(dbc_write(f, &cfg->can, "t.ini"), 0);
+    fclose(f);
+    CHECK(strstr(text, " SG_ reg24 : 0|32@1- (1,0) [-2147483648|2147483647] \"\" Vector__XXX\n") != NULL,
+          "reg24 SG_");
+    CHECK(strstr(text, " SG_ cdo : 0|64@1+ (1,0) [0|1.8446744073709552e+19] \"\" Vector__XXX\n") != NULL,
+          "cdo SG_: a mask's whole range");
+    CHECK(strstr(text, " SG_ tcp_offset_5 : 40|16@1- (0.001,0) [-32.768|32.767] \"rad\" Vector__XXX\n") != NULL,
+          "tcp_offset_5 SG_: the unit of elements 3-5");
+    CHECK(strstr(text, "CM_ SG_ 256 reg24 \"output_int_register_24: RTDE output INT32") != NULL, "reg24 CM_");
+    CHECK(strstr(text, "CM_ SG_ 258 cdo_top \"actual_configurable_digital_output_bits: RTDE output UINT64") !=
+              NULL && strstr(text, "bit n of this signal is bit 56+n of the value") != NULL,
+          "cdo_top CM_: a mask from bit 56");
+    free(text);
+}
+
+static const struct rejection rtde_rejections[] = {
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = output_int_register_24 @0|32 intel signed\n"
+              "[robot arm]\nhost = h\n",
+     "t.ini:7: signal output_int_register_24: an RTDE-only value, and robot \"arm\" reads RealTime, which has none"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = safety_status_bits @0|32 intel unsigned factor=2\n"
+              RTDE_ROBOT,
+     "t.ini:7: signal: safety_status_bits is a bit mask, sent bit for bit: remove factor="},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = robot_status_bits @0|32 intel unsigned max=3\n"
+              RTDE_ROBOT,
+     "t.ini:7: signal: robot_status_bits is a bit mask, sent bit for bit: remove max="},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = output_int_register_24 @0|8 intel unsigned bits=0-7\n"
+              RTDE_ROBOT,
+     "t.ini:7: signal: bits= is for bit masks"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = tcp_offset[6] @0|16 intel signed\n" RTDE_ROBOT,
+     "t.ini:7: signal: tcp_offset has 6 elements: tcp_offset[6] is out of range (0..5)"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\n"
+              "signal = actual_configurable_digital_input_bits @0|8 intel unsigned\n" RTDE_ROBOT,
+     "t.ini:7: signal: its name 'actual_configurable_digital_input_bits' is longer than a DBC name's 32"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = output_int_register_48 @0|8 intel signed\n"
+              RTDE_ROBOT,
+     "t.ini:7: signal: no field 'output_int_register_48'"},
+};
+
+static void test_rtde_values(void)
+{
+    gw_config cfg;
+    char err[4096] = "";
+    int errors = load_cfg(&cfg, rtde_config, err, sizeof err);
+    CHECK(errors == 0 && cfg.can_run != NULL, "RTDE-only signals load: %s", err);
+    if (errors == 0 && cfg.can_run != NULL) {
+        urrt_cantx_start(can_run_tx(cfg.can_run), 0);
+        rtde_registers(&cfg);
+        rtde_masks(&cfg);
+        rtde_recipe_and_dbc(&cfg);
+    }
+    gw_config_free(&cfg);
+    for (size_t i = 0; i < sizeof rtde_rejections / sizeof rtde_rejections[0]; i++) {
+        errors = load_cfg(&cfg, rtde_rejections[i].config, err, sizeof err);
+        CHECK(errors > 0 && strncmp(err, rtde_rejections[i].expect, strlen(rtde_rejections[i].expect)) == 0,
+              "RTDE rejection %zu:\n  got:  %s\n  want: %s", i, err, rtde_rejections[i].expect);
+        gw_config_free(&cfg);
+    }
+}
+
 int main(void)
 {
     test_config_good();
@@ -1183,5 +1385,6 @@ int main(void)
     test_config_mutations();
     test_masks();
     test_dbc_text();
+    test_rtde_values();
     return check_report();
 }

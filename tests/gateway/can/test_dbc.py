@@ -70,6 +70,63 @@ def read_fields():
 
 FIELDS = read_fields()
 
+
+def read_rtde_names():
+    """{RTDE name: field} from docs/protocol.md's "RTDE output" column: a
+    signal may name a shared value by either name (docs/can.md)."""
+    names = {}
+    for line in open(os.path.join(ROOT, 'docs', 'protocol.md')):
+        cells = [c.strip() for c in line.split('|')]
+        if len(cells) > 8 and cells[1].startswith('`') and cells[7].startswith('`'):
+            names[cells[7].split('`')[1]] = cells[1].strip('`')
+    return names
+
+
+RTDE_NAMES = read_rtde_names()
+
+# Units of the RTDE-only values as UR's RTDE guide gives them ("bits": a bit mask,
+# sent bit for bit), restated here so that the gateway's own table is checked.
+RTDE_UNITS = {
+    'robot_status_bits': 'bits', 'safety_status_bits': 'bits', 'tcp_offset': 'm, rad',
+    'output_bit_registers0_to_31': 'bits', 'output_bit_registers32_to_63': 'bits',
+    'input_bit_registers0_to_31': 'bits', 'input_bit_registers32_to_63': 'bits',
+    'actual_current_window': 'A', 'actual_current_as_torque': 'Nm',
+    'actual_TCP_acceleration': 'm/s^2, rad/s^2', 'target_TCP_acceleration': 'm/s^2, rad/s^2',
+    'actual_configurable_digital_input_bits': 'bits', 'actual_configurable_digital_output_bits': 'bits',
+    'target_execution_time': 's', 'analog_io_types': 'bits', 'io_current': 'mA',
+    'actual_robot_energy_consumed': 'J', 'actual_robot_braking_energy_dissipated': 'J',
+    'euromap67_input_bits': 'bits', 'euromap67_output_bits': 'bits', 'euromap67_24V_voltage': 'V',
+    'euromap67_24V_current': 'mA', 'tool_analog_input_types': 'bits', 'tool_output_voltage': 'V',
+    'tool_output_current': 'mA', 'tool_temperature': 'degC', 'tcp_force_scalar': 'N',
+    'ft_raw_wrench': 'N, Nm', 'wrench_calc_from_currents': 'N, Nm', 'target_gravity': 'm/s^2',
+    'target_base_acceleration': 'm/s^2, rad/s^2', 'target_base_wrench': 'N, Nm',
+}
+RTDE_COUNTS = {'VECTOR3D': 3, 'VECTOR6D': 6, 'VECTOR6INT32': 6, 'VECTOR6UINT32': 6}
+
+
+def read_rtde_only():
+    """{name: {'count', 'unit', 'type'}} of the RTDE-only values, by the names of
+    lib/urrt_rtde.h's URRT_RTDE_ONLY rows (a family: name + index, first .. first +
+    names - 1); units from RTDE_UNITS ('' where the guide gives none)."""
+    out = {}
+    text = open(os.path.join(ROOT, 'lib', 'urrt_rtde.h')).read()
+    for m in re.finditer(r'X\((\w+), (\w+), "(\w+)", (\w+), (\d+), (\d+), (\d+),', text):
+        name, wtype, first, names = m.group(3), m.group(4), int(m.group(5)), int(m.group(6))
+        info = {'count': RTDE_COUNTS.get(wtype, 1), 'unit': RTDE_UNITS.get(name, ''), 'type': wtype,
+                'col_1x': 0, 'col_3x': 0, 'rtde': True}
+        for n in ([name] if names == 1 else ['%s%d' % (name, first + i) for i in range(names)]):
+            out[n] = info
+    return out
+
+
+RTDE_ONLY = read_rtde_only()
+assert 'output_int_register_24' in RTDE_ONLY and 'robot_status_bits' in RTDE_ONLY, 'lib/urrt_rtde.h rows not read'
+
+
+def info_of(field):
+    """A field's entry, or an RTDE-only value's."""
+    return FIELDS[field] if field in FIELDS else RTDE_ONLY[field]
+
 # ---- an independent reader of the configuration grammar (docs/can.md) ------------------
 
 
@@ -112,10 +169,10 @@ def default_limits(sig):
 
 
 def field_unit(field, elem):
-    unit = FIELDS[field]['unit']
+    unit = info_of(field)['unit']
     if unit in ('enum', 'bits'):
         return ''
-    if ', ' in unit and FIELDS[field]['count'] == 6:
+    if ', ' in unit and info_of(field)['count'] == 6:
         return unit.split(', ')[0 if elem < 3 else 1]
     return unit
 
@@ -124,9 +181,10 @@ def parse_signal(value):
     words = re.findall(r'(?:[^\s"]|"[^"]*")+', value)
     m = re.match(r'(\w+)(?:\[(\d+)\])?$', words[0])
     field, elem = m.group(1), int(m.group(2) or 0)
+    field = field if field in FIELDS else RTDE_NAMES.get(field, field)
     start, length = (int(x) for x in words[1][1:].split('|'))
     sig = {'field': field, 'elem': elem, 'start': start, 'length': length, 'factor': 1.0, 'offset': 0.0,
-           'invalid': None, 'role': 'field'}
+           'invalid': None, 'role': 'rtde' if field in RTDE_ONLY else 'field'}
     explicit = {}
     for w in words[2:]:
         if w in ('intel', 'motorola'):
@@ -145,9 +203,11 @@ def parse_signal(value):
         sig['invalid'] = int(explicit['invalid'], 0) & ((1 << length) - 1)
     # A field of unit "bits" is a bit mask: bits=FIRST-LAST (or one BIT) says
     # which of its bits the signal carries, from bit 0 by default.
-    sig['mask'] = FIELDS[field]['unit'] == 'bits'
+    sig['mask'] = info_of(field)['unit'] == 'bits'
     sig['first'] = int(explicit.get('bits', '0').split('-')[0])
-    if FIELDS[field]['count'] > 1:
+    if sig['mask']:  # a mask's range is its bits, whatever min/max the type has
+        sig['min'], sig['max'] = 0.0, float(2 ** length - 1)
+    if info_of(field)['count'] > 1:
         sig['name'] = explicit.get('name', '%s_%d' % (field, elem))
     else:
         sig['name'] = explicit.get('name', field)
@@ -406,6 +466,17 @@ def compare_dbc(label, db, can, frames, robot_period_us):
                 check(ds.comment is not None and ds.comment.startswith(ref + ':') and
                       ('column %d' % (col + s['elem'])) in ds.comment,
                       '%s: %s.%s comment names the field and column' % (label, f['name'], s['name']), ds.comment)
+            if s['role'] == 'rtde':
+                info = RTDE_ONLY[s['field']]
+                ref = '%s[%d]' % (s['field'], s['elem']) if info['count'] > 1 else s['field']
+                check(ds.comment is not None and ds.comment.startswith('%s: RTDE output %s' % (ref, info['type'])),
+                      '%s: %s.%s comment names the RTDE-only value and its type' % (label, f['name'], s['name']),
+                      ds.comment)
+                if s['mask']:
+                    check('bit n of this signal is bit %d+n of the value' % s['first'] in ds.comment,
+                          '%s: %s.%s comment: a mask from bit %d' % (label, f['name'], s['name'], s['first']),
+                          ds.comment)
+            if s['role'] == 'field':
                 for value, name in ENUM_SPOTS.get(s['field'], []):
                     if s['field'] == 'robot_mode' and can['generation'] != 3:
                         continue

@@ -21,6 +21,7 @@
 #include "config.h"
 #include "dbc.h"
 #include "eds.h"
+#include "urrt_rtde.h"
 
 /* ---- loading ---------------------------------------------------------------------- */
 
@@ -505,6 +506,65 @@ static void test_c_tables(const char *path)
     CHECK(strstr(text, "const uint32_t urrt_gateway_rx_ids[3] = {0x000, 0x080, 0x605};") != NULL, "rx ids");
 }
 
+/* ---- RTDE-only values in a TPDO ------------------------------------------------------------ */
+
+static const char rtde_node[] =
+    "[robot a]\nhost = h\nversion = 5.10\nsource = rtde\n[can]\ninterface = log:-\n[canopen]\nnode_id = 5\n"
+    "[frame a]\nperiod_ms = 10\nsignal = output_int_register_24 @0|32 intel signed name=parts\n"
+    "signal = safety_status_bits @32|16 intel unsigned bits=0-15 name=safety\n";
+
+/* The 4 data bytes of an expedited SDO upload of index/sub, as a little-endian number. */
+static uint32_t sdo_u32(urrt_co *node, unsigned index, unsigned sub)
+{
+    struct sink s = {0};
+    uint8_t req[8] = {0x40, (uint8_t)index, (uint8_t)(index >> 8), (uint8_t)sub, 0, 0, 0, 0};
+    urrt_co_on_frame(node, 0x605, 0, req, 8, 2000, sink_emit, &s);
+    CHECK(s.count == 1 && (s.last.data[0] & 0xF3u) == 0x43u, "SDO upload 0x%04X sub %u: expedited (%02x %02x%02x%02x%02x)",
+          index, sub, s.last.data[0], s.last.data[4], s.last.data[5], s.last.data[6], s.last.data[7]);
+    return (uint32_t)s.last.data[4] | (uint32_t)s.last.data[5] << 8 | (uint32_t)s.last.data[6] << 16 |
+           (uint32_t)s.last.data[7] << 24;
+}
+
+/* The EDS names the values by their RTDE names, with the scaling; the node's
+ * objects hold the package's values, the register exactly. */
+static void test_rtde_node(void)
+{
+    gw_config cfg;
+    char *messages = NULL, buf[128];
+    int errors = load(&cfg, rtde_node, &messages);
+    CHECK(errors == 0 && cfg.co_run != NULL, "an RTDE-only TPDO loads: %s", messages);
+    free(messages);
+    if (errors == 0 && cfg.co_run != NULL) {
+        char *eds = eds_text(&cfg);
+        urrt_rtde_values v;
+        urrt_state st;
+        CHECK_EQ_STR(eds_get(eds, "2100sub1", "ParameterName", buf, sizeof buf),
+                     "parts: output_int_register_24, 1 = raw x 1 + 0");
+        CHECK_EQ_STR(eds_get(eds, "2100sub1", "DataType", buf, sizeof buf), "0x0004");
+        CHECK_EQ_STR(eds_get(eds, "2100sub2", "ParameterName", buf, sizeof buf),
+                     "safety: safety_status_bits, a bit mask as the robot sends it");
+        CHECK_EQ_STR(eds_get(eds, "2100sub2", "DataType", buf, sizeof buf), "0x0006");
+        CHECK(eds_get(eds, "2100sub2", "HighLimit", buf, sizeof buf) == NULL, "a mask has no limits");
+        free(eds);
+        urrt_rtde_values_clear(&v);
+        v.output_int_register[24] = INT32_MIN + 5;
+        v.safety_status_bits[0] = 0x0404u;
+        for (int k = 0; k < 2; k++) {
+            unsigned bit = (unsigned)((k ? URRT_RTDE_V_SAFETY_STATUS_BITS : URRT_RTDE_V_OUTPUT_INT_REGISTER + 24) -
+                                      URRT_RTDE_MAPPED_COUNT);
+            v.present[bit / 8u] |= (uint8_t)(1u << (bit % 8u));
+        }
+        urrt_state_clear(&st);
+        st.time[0] = 1.0;
+        st.present = UINT64_C(1) << URRT_F_TIME;
+        can_run_rtde(cfg.can_run, 0, &v);
+        urrt_cantx_on_packet(can_run_tx(cfg.can_run), 0, &st, 1000);
+        CHECK(sdo_u32(co_run_node(cfg.co_run), 0x2100, 1) == (uint32_t)(INT32_MIN + 5), "0x2100 sub 1: INT32_MIN + 5");
+        CHECK((sdo_u32(co_run_node(cfg.co_run), 0x2100, 2) & 0xFFFFu) == 0x0404u, "0x2100 sub 2: the mask");
+    }
+    gw_config_free(&cfg);
+}
+
 int main(int argc, char **argv)
 {
     gw_config cfg;
@@ -525,6 +585,7 @@ int main(int argc, char **argv)
     }
     test_rejections();
     test_causes_first();
+    test_rtde_node();
     CHECK(gw_config_load(&cfg, argv[1], stderr) == 0 && cfg.co_run != NULL, "%s loads, with its node", argv[1]);
     if (cfg.co_run != NULL) {
         test_description(&cfg);

@@ -583,8 +583,8 @@ static void test_causes_first(void)
 {
     static const struct { const char *text; const char *want; } cases[] = {
         {"[robot arm1]\nport = 30003\nhots = 127.0.0.1\n",
-         "t.ini:3: unknown key \"hots\" in [robot arm1]: did you mean \"host\"? (keys: host, port, version, "
-         "connect_timeout, silence_timeout, backoff_initial, backoff_max)\n"
+         "t.ini:3: unknown key \"hots\" in [robot arm1]: did you mean \"host\"? (keys: host, port, source, "
+         "rtde_frequency, rtde_values, version, connect_timeout, silence_timeout, backoff_initial, backoff_max)\n"
          "t.ini:1: [robot arm1] has no host: add \"host = ADDRESS\"\n"},
         {"[lcm]\nstate_rate = 10 Hz\n[robto arm1]\nhost = h\n",
          "t.ini:3: unknown section [robto arm1]: did you mean [robot NAME]? (sections: [gateway], [robot NAME], "
@@ -596,7 +596,8 @@ static void test_causes_first(void)
          "length, period_ms, robot, alive_counter, validity_bit, stale_after_ms, stale_policy, comment, signal)\n"
          "t.ini:6: [frame f] has no period_ms (milliseconds, or every)\n"},
         {"[gateway]\nverbose = 1\n[robot a]\nhost = h\n",
-         "t.ini:2: unknown key \"verbose\" in [gateway] (keys: log_level, summary)\n"},
+         "t.ini:2: unknown key \"verbose\" in [gateway] (keys: log_level, summary, metrics_file, "
+         "metrics_interval)\n"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         char *messages = NULL;

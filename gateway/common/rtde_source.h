@@ -1,0 +1,93 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * rtde_source.h: an RTDE session (lib/urrt_rtde.h) on a robot link
+ * (port/port.h), shared by urrt-gateway and urrt-dump.
+ *
+ * The glue between port/'s link, which speaks first through its source
+ * hooks (urrt_link_set_source), and lib/'s sans-I/O client: at every TCP
+ * connect it begins the session afresh (the whole handshake again), writes
+ * each request the session has due, feeds it every byte read, and reports
+ * each decoded data package to the link (urrt_link_source_packet), so the
+ * link comes up only after the handshake and the first data package, and
+ * the program's packet function receives the package's bytes (header
+ * included) while rtde_source_state()/rtde_source_values() hold its decoded
+ * values. What the session says goes where the link's policy wants it:
+ *
+ *   a protocol error       urrt_link_drop(PROTOCOL): reconnect, usual backoff
+ *   a configuration error  urrt_link_drop(CONFIG) with the names refused and
+ *                          the controller's version: logged once, retried
+ *                          every backoff_max_ms, never a tight loop
+ *   protocol 2 refused     protocol 1 (the session asks again by itself)
+ *   a text message         the log, at its level (exception and error: err,
+ *                          warning: warning, info and others: info)
+ *
+ * The recipe has two parts. Required variables (what the configuration
+ * names: focused messages, CAN signals, RTDE-only values) are always asked
+ * for. Optional ones (STATE's fields shared with RealTime) are asked for
+ * only where the controller has them: once its version is known, a
+ * variable urrt_rtde_var_available() says it lacks is left out (its field is
+ * then absent, NaN, as RealTime's older versions leave it). "Unknown" (no
+ * source states the version) keeps the variable: the controller's
+ * NOT_FOUND decides, a configuration error for a required one. A required
+ * variable the tables say this controller lacks is a configuration error
+ * before the setup is even sent.
+ *
+ * Allocates at rtde_source_new only; the per-package path does not.
+ *
+ * API stable from its first version; changes, if any, are listed here.
+ */
+#ifndef URRT_RTDE_SOURCE_H
+#define URRT_RTDE_SOURCE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "port.h"
+#include "urrt.h"
+#include "urrt_rtde.h"
+
+typedef struct rtde_source rtde_source;
+
+typedef struct rtde_source_config {
+    const char *name;        /* robot name for log lines */
+    const uint16_t *vars;    /* urrt_rtde_var ids, distinct (copied) */
+    const bool *optional;    /* per var: true = only where the controller has it;
+                                NULL: every var required */
+    size_t count;            /* 1..URRT_RTDE_MAX_VARS */
+    double frequency;        /* Hz, 0 for the controller's rate (125 CB3, 500 e-Series) */
+} rtde_source_config;
+
+/* Checks the recipe (urrt_rtde_begin's rules: distinct known ids, the
+ * 2,048-byte name list, a frequency of 0..500) and returns a source, or
+ * NULL with the reason written to why (one line, what failed and what to
+ * do). */
+rtde_source *rtde_source_new(const rtde_source_config *cfg, char *why, size_t why_size);
+void rtde_source_free(rtde_source *src);
+
+/* Makes src the link's source (urrt_link_set_source): call before the first
+ * urrt_link_service. One source per link. */
+void rtde_source_attach(rtde_source *src, urrt_link *link);
+
+/* During the packet function of a package from this source (and until the
+ * next byte is fed): the decoded values. The state is urrt_rtde_decode's:
+ * present holds the recipe's fields, others NaN, time the controller's
+ * timestamp when the recipe has it. */
+const urrt_state *rtde_source_state(const rtde_source *src);
+const urrt_rtde_values *rtde_source_values(const rtde_source *src);
+
+/* The session, for its statistics, protocol, controller version
+ * (controller[]) and urrt_rtde_up(). */
+const urrt_rtde *rtde_source_session(const rtde_source *src);
+
+/* The recipe of the current (or last) session as a comma-separated name
+ * list into out (NUL-terminated, truncated to size); returns its length. */
+size_t rtde_source_recipe_text(const rtde_source *src, char *out, size_t size);
+
+/* Optional: every session event (handshake steps, text, data, errors) is
+ * also handed to fn, after the source has acted on it (urrt-dump prints
+ * them). ev is valid during the call only. NULL removes it. */
+typedef void (*rtde_source_event_fn)(void *ctx, const urrt_rtde_event *ev, uint64_t rx_us);
+void rtde_source_set_event_fn(rtde_source *src, rtde_source_event_fn fn, void *ctx);
+
+#endif
