@@ -660,6 +660,37 @@ int urrt_rtde_begin(urrt_rtde *s, const uint16_t *vars, size_t count, double fre
     return URRT_OK;
 }
 
+int urrt_rtde_set_recipe(urrt_rtde *s, const uint16_t *vars, size_t count)
+{
+    uint64_t state_present;
+    uint8_t has_values;
+    size_t i;
+    int r;
+    if (s == 0 || s->phase != PH_SETUP || s->pending != REQ_SETUP || vars == 0 || count == 0 ||
+        count > URRT_RTDE_MAX_VARS) {
+        return URRT_E_ARG;
+    }
+    for (i = 0; i < count; i++) {
+        if (vars[i] >= URRT_RTDE_VAR_COUNT) {
+            return URRT_E_ARG;
+        }
+    }
+    state_present = s->state_present;
+    has_values = s->has_values;
+    r = check_vars(s, vars, count);
+    if (r < 0) {
+        s->state_present = state_present;
+        s->has_values = has_values;
+        return r;
+    }
+    find_absent(s);
+    for (i = 0; i < count; i++) {
+        s->vars[i] = vars[i];
+    }
+    s->var_count = (uint16_t)count;
+    return URRT_OK;
+}
+
 static double max_frequency(const urrt_rtde *s)
 {
     return s->controller[0] < 5 ? URRT_RTDE_HZ_CB3 : URRT_RTDE_HZ_E_SERIES;
@@ -721,7 +752,7 @@ int urrt_rtde_not_found(const urrt_rtde *s, size_t i)
         return -1;
     }
     for (k = 0; k < s->var_count; k++) {
-        if ((s->not_found[k / 8] >> (k % 8)) & 1u) {
+        if (((unsigned)s->not_found[k / 8] >> (k % 8)) & 1u) {
             if (i == 0) {
                 return s->vars[k];
             }
@@ -752,6 +783,22 @@ static int32_t to_int32(uint32_t u)
     return u >= UINT32_C(0x80000000) ? -(int32_t)(~u) - 1 : (int32_t)u;
 }
 
+/* count doubles from the wire at p into d: four at a time, so that the
+ * loads, swaps and stores of a run overlap. */
+static inline void state_doubles(double *d, const uint8_t *p, unsigned count)
+{
+    unsigned k;
+    for (k = 0; k + 4 <= count; k += 4) {
+        d[k] = load_double(p + 8u * k);
+        d[k + 1] = load_double(p + 8u * k + 8u);
+        d[k + 2] = load_double(p + 8u * k + 16u);
+        d[k + 3] = load_double(p + 8u * k + 24u);
+    }
+    for (; k < count; k++) {
+        d[k] = load_double(p + 8u * k);
+    }
+}
+
 /* One entry into urrt_state: every element as a double. */
 static void decode_to_state(const urrt_rtde_entry *e, const uint8_t *p, urrt_state *st)
 {
@@ -760,11 +807,7 @@ static void decode_to_state(const urrt_rtde_entry *e, const uint8_t *p, urrt_sta
     switch (e->type) {
     case URRT_RTDE_T_DOUBLE:
     case URRT_RTDE_T_VECTOR3D:
-    case URRT_RTDE_T_VECTOR6D:
-        for (k = 0; k < count; k++) {
-            d[k] = load_double(p + 8u * k);
-        }
-        break;
+    case URRT_RTDE_T_VECTOR6D: state_doubles(d, p, count); break;
     case URRT_RTDE_T_INT32:
     case URRT_RTDE_T_VECTOR6INT32:
         for (k = 0; k < count; k++) {
@@ -813,8 +856,10 @@ static void decode_to_values(const urrt_rtde_entry *e, const uint8_t *p, urrt_rt
 }
 
 /* Everything of *st but the recipe's fields, which the walk writes: NaN in
- * the spans of fields the recipe does not have (fewer stores than a whole
- * clear, and loops as long as the fields allow). */
+ * the spans of fields the recipe does not have, on every decode (the caller
+ * may have written anything there since: nothing stale survives). Four
+ * stores at a time, which GCC and clang join into the widest vector stores
+ * the build has (at -O2 they leave a loop of unknown count scalar). */
 static void state_begin(const urrt_rtde *s, urrt_state *st, size_t size)
 {
     rtde_bits nan;
@@ -822,7 +867,14 @@ static void state_begin(const urrt_rtde *s, urrt_state *st, size_t size)
     nan.u = RTDE_NAN_BITS;
     for (i = 0; i < s->absent_count; i++) {
         double *d = (double *)(void *)((unsigned char *)st + s->absent[i].offset);
-        for (k = 0; k < s->absent[i].count; k++) {
+        unsigned n = s->absent[i].count;
+        for (k = 0; k + 4 <= n; k += 4) {
+            d[k] = nan.d;
+            d[k + 1] = nan.d;
+            d[k + 2] = nan.d;
+            d[k + 3] = nan.d;
+        }
+        for (; k < n; k++) {
             d[k] = nan.d;
         }
     }
@@ -836,7 +888,7 @@ static void state_begin(const urrt_rtde *s, urrt_state *st, size_t size)
 int urrt_rtde_decode(const urrt_rtde *s, const uint8_t *pkg, size_t size, urrt_state *st,
                      urrt_rtde_values *vals)
 {
-    size_t i;
+    const urrt_rtde_entry *e, *end;
     if (s == 0 || pkg == 0 || (s->state_present != 0 && st == 0) || (s->has_values && vals == 0)) {
         return URRT_E_ARG;
     }
@@ -855,8 +907,12 @@ int urrt_rtde_decode(const urrt_rtde *s, const uint8_t *pkg, size_t size, urrt_s
     if (vals != 0) {
         urrt_rtde_values_clear(vals);
     }
-    for (i = 0; i < s->entry_count; i++) {
-        const urrt_rtde_entry *e = &s->recipe[i];
+    /* The doubles first (compile_recipe puts them there): no switch per entry. */
+    for (e = s->recipe, end = s->recipe + s->entry_count; e < end && e->type == URRT_RTDE_T_DOUBLE && e->to_state;
+         e++) {
+        state_doubles((double *)(void *)((unsigned char *)st + e->dest_offset), pkg + e->wire_offset, e->count);
+    }
+    for (; e < end; e++) {
         if (e->to_state) {
             decode_to_state(e, pkg + e->wire_offset, st);
         } else {
@@ -953,32 +1009,56 @@ static int type_of_word(const uint8_t *w, size_t n)
     return -1;
 }
 
-static bool is_doubles(unsigned type)
+/* The types the decode converts alike, element by element: doubles, int32s
+ * or uint32s (1, 2, 3; 0 for the others, which never join a run). */
+static unsigned run_kind(unsigned type)
 {
-    return type == URRT_RTDE_T_DOUBLE || type == URRT_RTDE_T_VECTOR3D || type == URRT_RTDE_T_VECTOR6D;
+    switch (type) {
+    case URRT_RTDE_T_DOUBLE:
+    case URRT_RTDE_T_VECTOR3D:
+    case URRT_RTDE_T_VECTOR6D: return 1;
+    case URRT_RTDE_T_INT32:
+    case URRT_RTDE_T_VECTOR6INT32: return 2;
+    case URRT_RTDE_T_UINT32:
+    case URRT_RTDE_T_VECTOR6UINT32: return 3;
+    default: return 0;
+    }
 }
 
-/* Whether entry e continues the run of doubles of the entry before it, on
- * the wire and in urrt_state: then the walk copies both in one loop. */
+/* Whether entry e continues the run of the entry before it, on the wire and
+ * in urrt_state, elements of one kind (robot_mode then joint_mode): then the
+ * walk converts both in one loop. */
 static bool continues_run(const urrt_rtde_entry *prev, const urrt_rtde_entry *e)
 {
-    return prev->to_state && e->to_state && is_doubles(prev->type) && is_doubles(e->type) &&
-           prev->wire_offset + 8u * prev->count == e->wire_offset &&
+    unsigned kind = run_kind(prev->type), element_size;
+    if (!prev->to_state || !e->to_state || kind == 0 || kind != run_kind(e->type)) {
+        return false;
+    }
+    element_size = type_table[prev->type].size / type_table[prev->type].count; /* on the wire */
+    return prev->wire_offset + element_size * prev->count == e->wire_offset &&
            prev->dest_offset + 8u * prev->count == e->dest_offset;
 }
 
-/* Compiles the accepted recipe into the entry table. */
-static void compile_recipe(urrt_rtde *s)
+/* One pass of compile_recipe over the recipe: the entries of the urrt_state
+ * doubles (doubles set) or of every other variable, appended from entry n,
+ * adjacent ones joined into runs; returns the entries then in use. */
+static unsigned compile_pass(urrt_rtde *s, unsigned n, bool doubles)
 {
-    unsigned offset = URRT_RTDE_HEADER_SIZE + (s->protocol_accepted == 2 ? 1u : 0u), n = 0;
+    unsigned offset = URRT_RTDE_HEADER_SIZE + (s->protocol_accepted == 2 ? 1u : 0u), first = n;
     size_t i;
     for (i = 0; i < s->var_count; i++) {
         urrt_rtde_entry *e = &s->recipe[n];
         int var = s->vars[i];
         const only_row *r = only_row_of(var);
-        e->wire_offset = (uint16_t)offset;
-        e->type = (uint8_t)urrt_rtde_var_type(var);
-        e->count = type_table[e->type].count;
+        unsigned type = (unsigned)urrt_rtde_var_type(var);
+        unsigned at = offset;
+        offset += type_table[type].size;
+        if ((r == 0 && run_kind(type) == 1) != doubles) {
+            continue;
+        }
+        e->wire_offset = (uint16_t)at;
+        e->type = (uint8_t)(doubles ? URRT_RTDE_T_DOUBLE : type);
+        e->count = type_table[type].count;
         e->to_state = (uint8_t)(r == 0);
         if (r == 0) {
             e->dest_offset = mapped_table[var].offset;
@@ -987,16 +1067,22 @@ static void compile_recipe(urrt_rtde *s)
             e->dest_offset = (uint16_t)value_offset(r, var);
             e->present_bit = (uint16_t)(var - URRT_RTDE_MAPPED_COUNT);
         }
-        offset += type_table[e->type].size;
-        if (n > 0 && continues_run(&s->recipe[n - 1], e)) {
-            s->recipe[n - 1].count = (uint16_t)(s->recipe[n - 1].count + e->count);
-            s->recipe[n - 1].type = URRT_RTDE_T_DOUBLE;
+        if (n > first && continues_run(&s->recipe[n - 1], e)) {
+            s->recipe[n - 1].count = (uint16_t)(s->recipe[n - 1].count + e->count); /* its type converts alike */
         } else {
             n++;
         }
     }
-    s->entry_count = (uint16_t)n;
     s->data_size = (uint16_t)offset;
+    return n;
+}
+
+/* Compiles the accepted recipe into the entry table: the urrt_state doubles
+ * first (type DOUBLE), which the decode copies in a loop without a switch,
+ * then the rest; each part in wire order. */
+static void compile_recipe(urrt_rtde *s)
+{
+    s->entry_count = (uint16_t)compile_pass(s, compile_pass(s, 0, true), false);
 }
 
 /* Checks each word of a setup reply against its name: a word that is no

@@ -432,14 +432,16 @@ typedef struct urrt_rtde_stats {
 } urrt_rtde_stats;
 
 /* One compiled recipe entry: where a variable sits in a data package and
- * where it goes. Doubles that follow each other both on the wire and in
- * urrt_state (target_q, target_qd, ...) are one entry, a run. */
+ * where it goes. Variables that follow each other both on the wire and in
+ * urrt_state, of types converted alike (target_q, target_qd, ...: doubles;
+ * robot_mode, joint_mode, safety_mode: int32s) are one entry, a run; the
+ * entries of urrt_state doubles come first. */
 typedef struct urrt_rtde_entry {
     uint16_t wire_offset; /* from the package's first byte */
     uint16_t dest_offset; /* bytes into urrt_state or urrt_rtde_values */
     uint16_t present_bit; /* RTDE-only variable index (urrt_state's come from the recipe's mask) */
     uint16_t count;       /* elements */
-    uint8_t type;         /* urrt_rtde_type (a run: DOUBLE) */
+    uint8_t type;         /* urrt_rtde_type (urrt_state doubles: DOUBLE; a run: its first variable's) */
     uint8_t to_state;     /* 1: urrt_state (as doubles), 0: urrt_rtde_values */
 } urrt_rtde_entry;
 
@@ -492,6 +494,12 @@ void urrt_rtde_init(urrt_rtde *s);
  * in which case the session waits for a good begin.
  */
 int urrt_rtde_begin(urrt_rtde *s, const uint16_t *vars, size_t count, double frequency);
+
+/* Between EV_CONTROLLER and the setup request, the controller's version now
+ * known (s->controller): replace the recipe, by begin's rules (to leave out
+ * what this version lacks). URRT_OK, or begin's errors, or URRT_E_ARG in
+ * another phase; on an error the recipe is unchanged. */
+int urrt_rtde_set_recipe(urrt_rtde *s, const uint16_t *vars, size_t count);
 
 /* The next request to send: writes it whole into out (cap >=
  * URRT_RTDE_REQUEST_MAX is always enough) and returns its size, 0 when none

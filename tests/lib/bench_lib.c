@@ -467,6 +467,10 @@ int main(void)
         printf("%srtde_decode_state_ns: %.1f\n", URRT_BENCH_PREFIX, s);
         printf("%srtde_decode_state_copy_floor_ns: %.1f\n", URRT_BENCH_PREFIX, b);
         printf("%srtde_decode_state_vs_copy_floor: %.2f\n", URRT_BENCH_PREFIX, r);
+        /* beside it, the RealTime decode of a 1116-byte packet (4 bytes past a 64-byte boundary) */
+        measure(bench_rtde_decode, &rtde, bench_decode, &p1116, &s, &b, &r);
+        printf("%srtde_decode_state_realtime_decode_1116_ns: %.1f\n", URRT_BENCH_PREFIX, b);
+        printf("%srtde_decode_state_vs_realtime_decode_1116: %.2f\n", URRT_BENCH_PREFIX, r);
     }
 
     for (int i = 0; i < 3; i++) {

@@ -9,6 +9,7 @@
  *   test_rtde VECTORS
  */
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -36,7 +37,7 @@ static const named errors[] = {
     {"NOT_FOUND", URRT_RTDE_E_NOT_FOUND}, {"TYPE_MISMATCH", URRT_RTDE_E_TYPE_MISMATCH},
     {"PROTOCOL_REFUSED", URRT_RTDE_E_PROTOCOL_REFUSED}, {"START_REFUSED", URRT_RTDE_E_START_REFUSED},
     {"FREQUENCY", URRT_RTDE_E_FREQUENCY}, {"NAMES_TOO_LONG", URRT_RTDE_E_NAMES_TOO_LONG},
-    {"DUPLICATE", URRT_RTDE_E_DUPLICATE},
+    {"DUPLICATE", URRT_RTDE_E_DUPLICATE}, {"ARG", URRT_E_ARG},
 };
 
 static const named kinds[] = {
@@ -103,6 +104,10 @@ static int next_event(void)
     while (R.in_pos < R.in_len) {
         size_t n = R.in_len - R.in_pos < R.chunk ? R.in_len - R.in_pos : R.chunk;
         size_t used = 99999;
+        /* The caller may write its struct between packages: every double
+         * (not present, nor length) poisoned, so that a decode that keeps
+         * the NaN of the absent fields from its last call is caught. */
+        memset(&R.st, 0x3F, offsetof(urrt_state, present));
         int k = urrt_rtde_feed(&R.s, R.in + R.in_pos, n, &used, &R.ev, &R.st, &R.vals);
         CHECK(used <= n, "%s: used %zu of %zu", R.session, used, n);
         R.in_pos += used;
@@ -134,6 +139,39 @@ static void parse_vars(char *list)
         if (R.var_count < URRT_RTDE_MAX_VARS) {
             R.vars[R.var_count++] = (uint16_t)(var < 0 ? 0 : var);
         }
+    }
+}
+
+/* set_recipe [ERR] NAMES: the caller replaces the recipe; with ERR it must
+ * be refused so, and R.vars (what the data must hold) stay as they were. */
+static void do_set_recipe(char *arg, int must_fail)
+{
+    uint16_t old[URRT_RTDE_MAX_VARS];
+    size_t old_count = R.var_count;
+    const char *err = arg;
+    int r;
+    if (must_fail) {
+        char *sp = strchr(arg, ' ');
+        CHECK(sp != NULL, "%s: set_recipe_error without names", R.session);
+        if (sp == NULL) {
+            return;
+        }
+        *sp = '\0';
+        arg = sp + 1;
+    }
+    memcpy(old, R.vars, sizeof old);
+    if (strcmp(arg, "-") == 0) {
+        R.var_count = 0;
+    } else {
+        parse_vars(arg);
+    }
+    r = urrt_rtde_set_recipe(&R.s, R.vars, R.var_count);
+    if (must_fail) {
+        CHECK(r == LOOKUP(errors, err), "%s: set_recipe gave %s, expected %s", R.session, urrt_rtde_strerror(r), err);
+        memcpy(R.vars, old, sizeof old);
+        R.var_count = old_count;
+    } else {
+        CHECK(r == URRT_OK, "%s: set_recipe: %s", R.session, urrt_rtde_strerror(r));
     }
 }
 
@@ -329,6 +367,8 @@ static void directive(char *line)
         check_value(arg);
     } else if (strcmp(line, "absent") == 0) {
         check_absent(arg);
+    } else if (strcmp(line, "set_recipe") == 0 || strcmp(line, "set_recipe_error") == 0) {
+        do_set_recipe(arg, strcmp(line, "set_recipe_error") == 0);
     } else if (strcmp(line, "pause") == 0) {
         CHECK_EQ_INT(urrt_rtde_pause(&R.s), URRT_OK);
     } else if (strcmp(line, "start") == 0) {
@@ -493,7 +533,7 @@ static void run_splits(const char *path)
         } else if (strncmp(line, "recv ", 5) == 0) {
             r.len += unhex(arg, r.stream + r.len, IN_MAX - r.len);
         } else if (!strncmp(line, "pause", 5) || !strncmp(line, "start", 5) || !strncmp(line, "finish", 6) ||
-                   !strncmp(line, "begin_error", 11)) {
+                   !strncmp(line, "begin_error", 11) || !strncmp(line, "set_recipe", 10)) {
             usable = 0;
         } else if (strcmp(line, "end") == 0 && usable && r.len > 0) {
             check_splits(&r, name);
@@ -626,6 +666,38 @@ static void test_api_errors(void)
     CHECK_EQ_STR(urrt_rtde_strerror(URRT_E_NO_SPACE), urrt_strerror(URRT_E_NO_SPACE));
 }
 
+/* What the vectors cannot say: ids out of range, null pointers, and that a
+ * refused change keeps the recipe's need for values (a recipe of urrt_state
+ * fields only still takes vals NULL). The controller's two replies are
+ * docs/rtde.md's layouts: V accepted, v 5.12.0.1. */
+static void test_set_recipe_api(void)
+{
+    static urrt_rtde s;
+    static urrt_state st;
+    static const uint8_t replies[] = {0, 4, 'V', 1, 0, 19, 'v', 0, 0, 0, 5, 0, 0, 0, 12, 0, 0, 0, 0, 0, 0, 0, 1};
+    uint16_t mapped[] = {URRT_RTDE_V_ACTUAL_Q}, regs[] = {URRT_RTDE_V_OUTPUT_INT_REGISTER, URRT_RTDE_V_OUTPUT_INT_REGISTER};
+    uint16_t unknown[] = {URRT_RTDE_V_TIMESTAMP, URRT_RTDE_VAR_COUNT};
+    uint8_t out[URRT_RTDE_REQUEST_MAX];
+    urrt_rtde_event ev;
+    size_t used;
+    urrt_rtde_init(&s);
+    CHECK_EQ_INT(urrt_rtde_set_recipe(&s, mapped, 1), URRT_E_ARG); /* before begin */
+    CHECK_EQ_INT(urrt_rtde_set_recipe(NULL, mapped, 1), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_begin(&s, mapped, 1, 0.0), URRT_OK);
+    CHECK_EQ_INT(urrt_rtde_output(&s, out, sizeof out), 5);
+    CHECK_EQ_INT(urrt_rtde_feed(&s, replies, sizeof replies, &used, &ev, &st, NULL), URRT_RTDE_EV_PROTOCOL);
+    CHECK_EQ_INT(urrt_rtde_output(&s, out, sizeof out), 3);
+    CHECK_EQ_INT(urrt_rtde_feed(&s, replies + 4, sizeof replies - 4, &used, &ev, &st, NULL), URRT_RTDE_EV_CONTROLLER);
+    CHECK_EQ_INT(urrt_rtde_set_recipe(&s, NULL, 1), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_set_recipe(&s, mapped, URRT_RTDE_MAX_VARS + 1), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_set_recipe(&s, unknown, 2), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_rtde_set_recipe(&s, regs, 2), URRT_RTDE_E_DUPLICATE);
+    CHECK_EQ_INT(urrt_rtde_feed(&s, replies, 0, &used, &ev, &st, NULL), URRT_RTDE_EV_NONE); /* vals not needed */
+    CHECK(s.state_present == UINT64_C(1) << URRT_F_Q_ACTUAL, "a refused set_recipe changed the present mask");
+    CHECK_EQ_INT(urrt_rtde_set_recipe(&s, regs, 1), URRT_OK);
+    CHECK_EQ_INT(urrt_rtde_feed(&s, replies, 0, &used, &ev, &st, NULL), URRT_E_ARG); /* now they are */
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -636,6 +708,7 @@ int main(int argc, char **argv)
     test_versions();
     test_largest_recipe();
     test_api_errors();
+    test_set_recipe_api();
     int sessions = run_vectors(argv[1], SIZE_MAX);
     CHECK(sessions >= 40, "only %d sessions in %s", sessions, argv[1]);
     run_vectors(argv[1], 1);

@@ -29,6 +29,10 @@ Output format (one directive per line):
                                 the C value, 2/8/16 hex digits by width)
     absent NAME                 after `data`: the variable is not present
     pause | start               the caller asks for a pause / a restart
+    set_recipe NAME,...         the caller replaces the recipe (urrt_rtde_set_recipe, once the
+                                controller version is known, before the setup request is taken)
+    set_recipe_error ERR NAME,...  the same must be refused with ERR (ARG: not in that phase),
+                                the recipe unchanged ("-": an empty list)
     finish N                    the connection closes: N bytes of a package dropped
     ended                       the rest of the input, and any more, is refused (session over)
     end
@@ -561,8 +565,76 @@ def close_and_begin_errors(rng):
     return out
 
 
+def up_to_controller(s, protocol, controller):
+    """The handshake up to the controller version: the setup request is due."""
+    s.send(req_protocol(2))
+    if protocol == 1:
+        s.recv(rep_flag(V, 0))
+        s.event("fallback", 1)
+        s.send(req_protocol(1))
+    s.recv(rep_flag(V, 1))
+    s.event("protocol", protocol)
+    s.send(req_controller())
+    s.recv(rep_controller(*controller))
+    s.event("controller", *controller)
+
+
+def setup_and_stream(rng, s, protocol, freq, absent, packages=2):
+    """The setup request for s.names, its reply, start, data packages."""
+    recipe_id = 7 if protocol == 2 else 0
+    s.send(req_setup(protocol, freq, s.names))
+    s.add("set_recipe_error ARG timestamp")  # the setup request is out: too late
+    s.recv(rep_setup(protocol, recipe_id, [type_of(n) for n in s.names]))
+    s.event("recipe", recipe_id)
+    s.send(req_start())
+    s.started()
+    for k in range(packages):
+        s.data(protocol, recipe_id, random_values(rng, s.names, k), k == 0, absent)
+    s.add("set_recipe_error ARG timestamp")  # streaming: too late
+    s.add("idle")
+
+
+def recipe_changes(rng):
+    """The caller replaces the recipe once the controller's version is known
+    (to leave out what it lacks): the setup request, the decode and the
+    present fields follow the new one; a refused change, or one outside that
+    phase, leaves the old one in force."""
+    out = []
+    # CB3 3.10 has no payload (3.11): the caller drops it and adds a register.
+    s = Session("set_recipe_cb3", ["timestamp", "actual_q", "payload", "robot_status_bits"])
+    s.add("set_recipe_error ARG timestamp")  # the version is not known yet
+    up_to_controller(s, 2, (3, 10, 0, 1))
+    s.add("set_recipe_error DUPLICATE timestamp,elbow_position,timestamp")
+    s.add("set_recipe_error NAMES_TOO_LONG " + ",".join(
+        ["input_double_register_%d" % i for i in range(48)] + ["output_double_register_%d" % i for i in range(48)] +
+        ["input_int_register_%d" % i for i in range(32)]))
+    s.add("set_recipe_error ARG -")
+    s.names = ["actual_q", "timestamp", "output_int_register_30", "safety_status"]
+    s.add("set_recipe " + ",".join(s.names))
+    setup_and_stream(rng, s, 2, 125.0, ["payload", "robot_status_bits", "elbow_position"])
+    out.append(s.end())
+    # A refused change keeps the recipe begin gave (its present fields too);
+    # protocol 1, whose setup request has no frequency.
+    s = Session("set_recipe_refused_v1", ["timestamp", "actual_q", "robot_mode"])
+    up_to_controller(s, 1, (3, 9, 1, 1))
+    s.add("set_recipe_error DUPLICATE payload,payload")
+    s.add("set_recipe_error DUPLICATE output_int_register_3,output_int_register_3")
+    setup_and_stream(rng, s, 1, 125.0, ["payload", "output_int_register_3"])
+    out.append(s.end())
+    # Changed twice: the last one counts; fewer fields than begin's.
+    s = Session("set_recipe_twice", STATE_VARS)
+    up_to_controller(s, 2, (5, 4, 0, 9))
+    s.add("set_recipe payload_inertia,tcp_offset")
+    s.names = ["target_q", "speed_scaling", "actual_digital_output_bits"]
+    s.add("set_recipe " + ",".join(s.names))
+    setup_and_stream(rng, s, 2, 500.0, ["payload_inertia", "tcp_offset", "actual_q", "timestamp"], packages=3)
+    out.append(s.end())
+    return out
+
+
 def error_sessions(rng):
-    return framing_errors(rng) + setup_errors() + text_and_reply_errors() + close_and_begin_errors(rng)
+    return (framing_errors(rng) + setup_errors() + text_and_reply_errors() + close_and_begin_errors(rng) +
+            recipe_changes(rng))
 
 
 def check_sizes():

@@ -12,6 +12,7 @@
 #include "test_vectors.h"
 #include "urrt.h"
 #include "urrt_can.h"
+#include "urrt_rtde.h"
 
 /* Marks for the trace: the operation runs between their calls. */
 __attribute__((noinline)) void bench_begin(void)
@@ -86,7 +87,12 @@ static urrt_framer framer;
 static uint64_t packet_words[1224 / 8 + 1];
 static uint64_t copy_words[1220 / 8];
 #define STREAM_PACKETS 4 /* 3 whole segments; small enough for 16 KiB of RAM */
-static uint8_t stream[STREAM_PACKETS * 1116];
+/* The framer's stream and the RTDE session are never in use at once: one
+ * piece of RAM (the Cortex-M0 board has 16 KiB). */
+static union {
+    uint8_t stream[STREAM_PACKETS * 1116];
+    urrt_rtde rtde;
+} ram;
 
 static const urrt_field_id read_fields[10] = {
     URRT_F_TIME, URRT_F_Q_ACTUAL, URRT_F_QD_ACTUAL, URRT_F_TOOL_VECTOR_ACTUAL, URRT_F_TCP_FORCE,
@@ -177,13 +183,13 @@ static int bench_framer(const tv_vector *v1116)
     uint32_t ticks, i;
     int sink = 0;
     uint32_t total = 0, segments = 0, pos;
-    for (i = 0; i < sizeof stream; i++) {
-        stream[i] = v1116->packet[i % 1116u];
+    for (i = 0; i < sizeof ram.stream; i++) {
+        ram.stream[i] = v1116->packet[i % 1116u];
     }
     urrt_framer_init(&framer);
-    for (pos = 0; pos + 1460u <= sizeof stream; pos += 1460u) {
+    for (pos = 0; pos + 1460u <= sizeof ram.stream; pos += 1460u) {
         TIMED(ticks, {
-            const uint8_t *p = stream + pos;
+            const uint8_t *p = ram.stream + pos;
             size_t n = 1460, used;
             while (n > 0) {
                 sink += urrt_framer_feed(&framer, p, n, &used);
@@ -222,6 +228,103 @@ static int bench_can_pack(const tv_vector *v1116)
     return sink;
 }
 
+/* ---- RTDE: one data package of the STATE recipe ---------------------------- */
+
+/* The recipe that mirrors what urrt publishes from RealTime (docs/rtde.md):
+ * a 904-byte data package, as tests/lib/bench_lib.c measures it on the host. */
+static const char *const rtde_state_names[] = {
+    "timestamp", "target_q", "target_qd", "target_qdd", "target_current", "target_moment", "actual_q",
+    "actual_qd", "actual_current", "joint_control_output", "actual_TCP_pose", "actual_TCP_speed",
+    "actual_TCP_force", "target_TCP_pose", "target_TCP_speed", "actual_digital_input_bits",
+    "joint_temperatures", "actual_execution_time", "robot_mode", "joint_mode", "safety_mode",
+    "actual_tool_accelerometer", "speed_scaling", "actual_momentum", "actual_main_voltage",
+    "actual_robot_voltage", "actual_robot_current", "actual_joint_voltage", "actual_digital_output_bits",
+    "runtime_state"};
+#define RTDE_STATE_VARS (sizeof rtde_state_names / sizeof rtde_state_names[0])
+#define RTDE_STATE_SIZE 904u
+
+static size_t text_length(const char *s)
+{
+    size_t n = 0;
+    while (s[n] != '\0') {
+        n++;
+    }
+    return n;
+}
+
+/* One controller package (type, n bytes of body at pkg + 3) fed to the
+ * session after its due request is taken out: the event it gives. */
+static int rtde_reply(uint8_t *pkg, uint8_t type, size_t n)
+{
+    urrt_rtde_event ev;
+    size_t used;
+    pkg[0] = (uint8_t)((n + 3u) >> 8);
+    pkg[1] = (uint8_t)(n + 3u);
+    pkg[2] = type;
+    while (urrt_rtde_output(&ram.rtde, (uint8_t *)copy_words, sizeof copy_words) > 0) {
+    }
+    return urrt_rtde_feed(&ram.rtde, pkg, n + 3u, &used, &ev, &st, NULL);
+}
+
+/* A controller's type list for the STATE recipe at pkg + 4 (after the
+ * recipe id): its length. */
+static size_t rtde_types(uint8_t *pkg, uint16_t *vars)
+{
+    size_t at = 4, i, k;
+    for (i = 0; i < RTDE_STATE_VARS; i++) {
+        const char *type;
+        vars[i] = (uint16_t)urrt_rtde_var_find(rtde_state_names[i], text_length(rtde_state_names[i]));
+        type = urrt_rtde_type_name(urrt_rtde_var_type(vars[i]));
+        if (i > 0) {
+            pkg[at++] = ',';
+        }
+        for (k = 0; type[k] != '\0'; k++) {
+            pkg[at++] = (uint8_t)type[k];
+        }
+    }
+    return at - 3;
+}
+
+/* The session through the handshake (the bench's own replies: what is timed
+ * is the decode), then one data package of the STATE recipe: the 1116-byte
+ * packet's bytes as its body. */
+static int bench_rtde(const tv_vector *v1116)
+{
+    static const uint8_t version[16] = {0, 0, 0, 5, 0, 0, 0, 12, 0, 0, 0, 0, 0, 0, 0, 1};
+    uint16_t vars[RTDE_STATE_VARS];
+    uint8_t *pkg = (uint8_t *)packet_words;
+    uint32_t ticks;
+    size_t k;
+    int sink = 0, ok;
+    urrt_rtde_init(&ram.rtde);
+    (void)rtde_types(pkg, vars);
+    ok = urrt_rtde_begin(&ram.rtde, vars, RTDE_STATE_VARS, 0.0) == URRT_OK;
+    pkg[3] = 1;
+    ok = ok && rtde_reply(pkg, 'V', 1) == URRT_RTDE_EV_PROTOCOL;
+    for (k = 0; k < 16; k++) {
+        pkg[3 + k] = version[k];
+    }
+    ok = ok && rtde_reply(pkg, 'v', 16) == URRT_RTDE_EV_CONTROLLER;
+    pkg[3] = 1;
+    ok = ok && rtde_reply(pkg, 'O', rtde_types(pkg, vars)) == URRT_RTDE_EV_RECIPE;
+    pkg[3] = 1;
+    ok = ok && rtde_reply(pkg, 'S', 1) == URRT_RTDE_EV_STARTED && ram.rtde.data_size == RTDE_STATE_SIZE;
+    if (!ok) {
+        target_puts("bench: the RTDE handshake failed\n");
+        target_exit(2);
+    }
+    for (k = 4; k < RTDE_STATE_SIZE; k++) {
+        pkg[k] = v1116->packet[k];
+    }
+    pkg[0] = (uint8_t)(RTDE_STATE_SIZE >> 8);
+    pkg[1] = (uint8_t)RTDE_STATE_SIZE;
+    pkg[2] = 'U';
+    pkg[3] = 1;
+    TIMED(ticks, sink += urrt_rtde_decode(&ram.rtde, pkg, RTDE_STATE_SIZE, &st, NULL));
+    report("rtde_decode_state", ticks);
+    return sink;
+}
+
 int main(void)
 {
     int sink = 0;
@@ -233,6 +336,7 @@ int main(void)
     sink += bench_decode(v1220, "decode_1220", "swap_copy_1220");
     sink += bench_framer(v1116);
     sink += bench_can_pack(v1116);
+    sink += bench_rtde(v1116);
     target_puts("bench: sink ");
     target_put_uint((uint32_t)sink);
     target_puts("\n");

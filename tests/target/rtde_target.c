@@ -11,7 +11,8 @@
  *
  * It also prints the stack high-water mark of every public urrt_rtde
  * function ("stack: NAME BYTES", as tests/target/stack_target.h does for the
- * rest of lib/), worst over the first pass, whose reads take every path:
+ * rest of lib/), worst over the first pass, whose reads take every path
+ * (and the calls the reads do not make, measured apart after it):
  * tests/target/stack.py holds them to -fstack-usage and docs/footprint.md.
  */
 #include <stdbool.h>
@@ -262,6 +263,33 @@ static void measure_rest(void)
     (void)b;
 }
 
+/* urrt_rtde_set_recipe, which the sessions' reads never call: the first
+ * session's stream up to the controller's version (the setup request is
+ * then due), and its recipe set again, every name checked and the absent
+ * fields found (the one path it has past its argument checks). */
+static void measure_set_recipe(void)
+{
+    const rtv_session *t = &rtv_sessions[0];
+    uint16_t vars[URRT_RTDE_MAX_VARS];
+    size_t pos = 0, used;
+    urrt_rtde_event ev;
+    int k = URRT_RTDE_EV_NONE, r;
+    for (unsigned i = 0; i < t->var_count; i++) {
+        vars[i] = (uint16_t)var_of(t->vars[i]);
+    }
+    urrt_rtde_init(&s);
+    CHECK_EQ_INT(urrt_rtde_begin(&s, vars, t->var_count, t->freq), URRT_OK);
+    while (k != URRT_RTDE_EV_CONTROLLER && k >= 0 && pos < t->stream_len) {
+        while (urrt_rtde_output(&s, out, sizeof out) > 0) {
+        }
+        k = urrt_rtde_feed(&s, t->stream + pos, t->stream_len - pos, &used, &ev, &st, &vals);
+        pos += used;
+    }
+    CHECK(k == URRT_RTDE_EV_CONTROLLER, "%s: no controller version to set a recipe after", t->name);
+    MEASURED(r, urrt_rtde_set_recipe, (&s, vars, t->var_count));
+    CHECK_EQ_INT(r, URRT_OK);
+}
+
 int main(void)
 {
     static const size_t chunks[] = {SIZE_MAX, 1, 7};
@@ -274,6 +302,7 @@ int main(void)
     }
     measuring = true;
     measure_rest();
+    measure_set_recipe();
     for (unsigned i = 0; i < mark_count; i++) {
         check_printf("stack: %s %u\n", marks[i].name, marks[i].bytes);
     }

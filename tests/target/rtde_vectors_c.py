@@ -5,7 +5,7 @@ data for the bare-metal driver tests/target/rtde_target.c: per session the
 recipe, the controller's stream, every request the client must write (in
 order), the events it must report and the values each data package must
 decode to. Sessions in which the caller acts between packages (pause, start,
-finish, a refused begin) are left out: the driver only feeds and takes output.
+finish, a refused begin, a recipe change) are left out: the driver only feeds and takes output.
 Usage: rtde_vectors_c.py VECTORS OUT.c [MAX_DATA_VALUES]
 (MAX_DATA_VALUES bounds the value checks per session, for small flash.)"""
 import sys
@@ -39,7 +39,7 @@ def sessions(path):
         elif word == "value":
             name, elem, raw = arg.split(" ")
             cur["values"].append((len(cur["events"]) - 1, name, int(elem), raw))
-        elif word in ("pause", "start", "finish", "begin_error"):
+        elif word in ("pause", "start", "finish", "begin_error", "set_recipe", "set_recipe_error"):
             cur["usable"] = False
         elif word == "end" and cur["usable"]:
             yield cur
