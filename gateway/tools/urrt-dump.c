@@ -1,11 +1,14 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * urrt-dump: see what a robot sends on its RealTime port.
+ * urrt-dump: see what a robot sends on its RealTime port, or over RTDE.
  *
  * Reads from a robot or simulator through the port's robot link (so it
  * reconnects like the gateway does), or from a raw capture, and prints each
  * packet as a table, CSV, JSON lines or gnuplot columns. A summary of the
- * stream goes to stderr at the end. See usage() and docs/tools.md.
+ * stream goes to stderr at the end. With --rtde the link carries an RTDE
+ * session (gateway/common/rtde_source): the recipe is what the format and
+ * -k need, and each data package prints like a RealTime packet, RTDE-only
+ * values under their RTDE names. See usage() and docs/tools.md.
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -21,7 +24,9 @@
 
 #include "cli.h"
 #include "port.h"
+#include "rtde_source.h"
 #include "urrt.h"
+#include "urrt_rtde.h"
 
 #define PROGRAM "urrt-dump"
 #define MAX_LENGTHS 16
@@ -32,17 +37,26 @@
  * so that a wrong port does not look like a robot that is just slow to start. */
 #define QUIET_NOTICE_FIRST_US 3000000u
 #define QUIET_NOTICE_MAX_US 60000000u
+/* What to check when RTDE does not answer. */
+#define RTDE_HINT "30004; RTDE must be enabled on the controller: PolyScope 5.10 and later, Settings > " \
+                  "Security > Services"
 
 typedef enum format { FORMAT_TABLE, FORMAT_CSV, FORMAT_JSON, FORMAT_GNUPLOT } format;
+
+/* What -k selects, as one number: a urrt_state field (RealTime's, which
+ * RTDE's mapped variables fill) below KEY_RTDE, an RTDE-only variable
+ * (KEY_RTDE + its urrt_rtde_var id) from there on. */
+#define KEY_RTDE ((unsigned)URRT_FIELD_COUNT)
+#define KEY_COUNT (KEY_RTDE + (unsigned)URRT_RTDE_VAR_COUNT)
 
 static volatile sig_atomic_t running = 1;
 
 typedef struct options {
     format fmt;
     bool fields_given;
-    bool field_on[URRT_FIELD_COUNT];
-    unsigned field_order[URRT_FIELD_COUNT]; /* the fields to print, in this order */
-    unsigned nfields;
+    bool key_on[KEY_COUNT];
+    unsigned key_order[KEY_COUNT]; /* the keys to print, in this order */
+    unsigned nkeys;
     uint64_t count;
     uint64_t every;
     const char *record_path;
@@ -50,6 +64,8 @@ typedef struct options {
     char host[256];
     uint16_t port;
     bool once;
+    bool rtde; /* the address is read over RTDE */
+    bool list; /* --rtde --list: the controller's variables, then exit */
     double timeout_s;
     uint32_t connect_timeout_ms;
     uint32_t silence_timeout_ms;
@@ -82,6 +98,10 @@ typedef struct dump {
     size_t partial_at_end;
     /* csv */
     bool csv_header_done;
+    /* rtde */
+    rtde_source *src;
+    int rtde_status;      /* CLI_EXIT_RUNTIME once the session refused what was asked */
+    bool hush_drop;       /* the reason is told: keep the link's drop line out of the log */
     /* recording */
     FILE *record;
     uint8_t *pending;
@@ -94,11 +114,19 @@ static void usage(FILE *out)
     fprintf(out,
 "Usage: " PROGRAM " [options] HOST[:PORT]\n"
 "       " PROGRAM " [options] --file PATH|-\n"
+"       " PROGRAM " [options] --rtde HOST[:PORT]\n"
+"       " PROGRAM " --rtde --list HOST[:PORT]\n"
 "\n"
 "Prints what a Universal Robots controller sends on its RealTime port\n"
 "(30003, or the read-only 30013), from the robot or simulator at HOST (port\n"
 "30003 unless given; IPv6 as [::1]:30003) or from a raw capture. It never\n"
-"sends a byte to the robot, and reconnects when the link drops.\n"
+"sends a byte to the RealTime port, and reconnects when the link drops.\n"
+"\n"
+"With --rtde it reads HOST over RTDE instead (port 30004 unless given): it\n"
+"asks for the values the format and -k need (without -k every value of the\n"
+"RealTime set this controller has), plus the timestamp, and sends nothing\n"
+"but the handshake (protocol version, controller version, output setup,\n"
+"start). Text messages of the controller go to stderr with their level.\n"
 "\n"
 "Output (stdout):\n"
 "  -F, --format FMT        table (default): names, units, enum names, bit masks\n"
@@ -108,7 +136,10 @@ static void usage(FILE *out)
 "                          printed round-trip exact, so that column N is UR's\n"
 "                          \"Gnuplot col.\" N (column 1 is the time)\n"
 "  -k, --fields A,B,...    only these fields, in this order (table, csv, json);\n"
-"                          names as in the field table, e.g. time,q_actual\n"
+"                          names as in the field table, e.g. time,q_actual;\n"
+"                          with --rtde also RTDE names: actual_q is q_actual,\n"
+"                          and RTDE-only values (output_int_register_24,\n"
+"                          safety_status_bits, ...) print under their names\n"
 "  -n, --count N           stop after N packets\n"
 "  -e, --every N           print every Nth packet only (all are counted)\n"
 "  -w, --record PATH       save the raw stream (every byte up to the last\n"
@@ -118,6 +149,10 @@ static void usage(FILE *out)
 "\n"
 "Source:\n"
 "  -f, --file PATH         read a raw capture instead of a robot; - is stdin\n"
+"      --rtde              read HOST over RTDE (port 30004 unless given)\n"
+"      --list              with --rtde: the controller's version, then every\n"
+"                          RTDE variable urrt knows, its type and whether this\n"
+"                          controller has it (asked where no version is known)\n"
 "      --once              end when the connection ends instead of reconnecting\n"
 "  -t, --timeout SEC       fail when no packet arrives for SEC seconds (without\n"
 "                          it, a notice every few seconds says none has come)\n"
@@ -143,14 +178,33 @@ static void usage(FILE *out)
 "Exit status: 0 done (--count reached, end of file, SIGINT/SIGTERM, end of\n"
 "connection with --once), 1 runtime error (cannot open or write a file, a\n"
 "file without a packet, no packet within --timeout, --once without a\n"
-"packet), 2 usage error.\n"
+"packet, an RTDE controller without a -k field), 2 usage error.\n"
 "\n"
 "Examples:\n"
 "  " PROGRAM " 192.168.1.10:30013 -n 1                # one packet, as a table\n"
 "  " PROGRAM " -F csv -k time,q_actual,i_actual robot -n 5000 > joints.csv\n"
 "  " PROGRAM " -F gnuplot [::1]:30003 -w capture.bin -n 2500 > capture.dat\n"
 "  " PROGRAM " -F json --file capture.bin | head\n"
-"  nc robot 30013 | " PROGRAM " --file - -F gnuplot > live.dat\n");
+"  nc robot 30013 | " PROGRAM " --file - -F gnuplot > live.dat\n"
+"  " PROGRAM " --rtde robot -F csv -k timestamp,actual_q,output_int_register_24\n"
+"  " PROGRAM " --rtde --list robot                    # what this controller has\n");
+}
+
+/* The key of a -k name: a urrt field name, or an RTDE name (a mapped one is
+ * its urrt field: actual_q is q_actual); -1 for neither. */
+static int key_of_name(const char *name, size_t len)
+{
+    int id = urrt_field_find(name, len);
+    int var;
+    if (id >= 0) {
+        return id;
+    }
+    var = urrt_rtde_var_find(name, len);
+    if (var < 0) {
+        return -1;
+    }
+    id = urrt_rtde_var_field(var);
+    return id >= 0 ? id : (int)KEY_RTDE + var;
 }
 
 /* --fields A,B,...: the fields to print, in this order. */
@@ -162,18 +216,25 @@ static void parse_fields(const cli_option *row, const char *list, void *obj)
     while (*p != '\0') {
         const char *comma = strchr(p, ',');
         size_t n = comma != NULL ? (size_t)(comma - p) : strlen(p);
-        int id = urrt_field_find(p, n);
+        int id = key_of_name(p, n);
         if (id < 0) {
-            fprintf(stderr, PROGRAM ": --fields: no field named \"%.*s\". Fields:\n", (int)n, p);
+            fprintf(stderr, PROGRAM ": --fields: no field named \"%.*s\". Fields (with --rtde also RTDE "
+                    "names, which --rtde --list HOST shows):\n", (int)n, p);
             for (unsigned i = 0; i < URRT_FIELD_COUNT; i++) {
                 const urrt_field_info *f = urrt_field((urrt_field_id)i);
-                fprintf(stderr, "  %-22s %-11s %s\n", f->name, f->unit[0] ? f->unit : "-", f->description);
+                int var = urrt_rtde_var_of_field((urrt_field_id)i);
+                char rtde[URRT_RTDE_NAME_MAX] = "-";
+                if (var >= 0) {
+                    urrt_rtde_var_name(var, rtde, sizeof rtde);
+                }
+                fprintf(stderr, "  %-22s %-11s %-27s %s\n", f->name, f->unit[0] ? f->unit : "-", rtde,
+                        f->description);
             }
             exit(CLI_EXIT_USAGE);
         }
-        if (!o->field_on[id]) {
-            o->field_on[id] = true;
-            o->field_order[o->nfields++] = (unsigned)id;
+        if (!o->key_on[id]) {
+            o->key_on[id] = true;
+            o->key_order[o->nkeys++] = (unsigned)id;
         }
         o->fields_given = true;
         p += n;
@@ -208,6 +269,8 @@ static const cli_option option_table[] = {
     {"every", 'e', required_argument, CLI_UINT, AT(every), 1, UINT64_MAX, NULL, NULL, NULL},
     {"record", 'w', required_argument, CLI_TEXT, AT(record_path), 0, 0, NULL, NULL, NULL},
     {"file", 'f', required_argument, CLI_TEXT, AT(file_path), 0, 0, NULL, NULL, NULL},
+    {"rtde", 0, no_argument, CLI_TRUE, AT(rtde), 0, 0, NULL, NULL, NULL},
+    {"list", 0, no_argument, CLI_TRUE, AT(list), 0, 0, NULL, NULL, NULL},
     {"once", 0, no_argument, CLI_TRUE, AT(once), 0, 0, NULL, NULL, NULL},
     {"timeout", 't', required_argument, CLI_SECONDS, AT(timeout_s), 1000, UINT64_C(1000000000000),
      " (seconds, e.g. 2.5)", NULL, NULL},
@@ -225,10 +288,53 @@ static const cli_option option_table[] = {
 };
 #undef AT
 
-/* The source: a file, or one robot. */
+/* A key's name: the urrt field's, or the RTDE-only variable's. */
+static const char *key_name(unsigned key, char *buf, size_t size)
+{
+    if (key < KEY_RTDE) {
+        return urrt_field((urrt_field_id)key)->name;
+    }
+    return urrt_rtde_var_name((int)(key - KEY_RTDE), buf, size) >= 0 ? buf : "?";
+}
+
+/* The RTDE variable a key asks for, -1 for a field RTDE does not have. */
+static int key_var(unsigned key)
+{
+    return key < KEY_RTDE ? urrt_rtde_var_of_field((urrt_field_id)key) : (int)(key - KEY_RTDE);
+}
+
+/* -k against the source: RTDE-only values need --rtde, and RTDE has no
+ * value for some RealTime fields (test_value, the reserved ones). */
+static void check_keys(const options *o)
+{
+    char buf[URRT_RTDE_NAME_MAX];
+    for (unsigned k = 0; k < o->nkeys; k++) {
+        unsigned key = o->key_order[k];
+        if (!o->rtde && key >= KEY_RTDE) {
+            cli_usage_error(PROGRAM, "-k %s: only RTDE has this value: add --rtde (and the RTDE port, 30004, "
+                            "is the default then)", key_name(key, buf, sizeof buf));
+        }
+        if (o->rtde && key_var(key) < 0) {
+            cli_usage_error(PROGRAM, "-k %s: RTDE has no such value (RealTime only): leave it out, or read the "
+                            "RealTime port without --rtde", key_name(key, buf, sizeof buf));
+        }
+    }
+}
+
+/* The source: a file, or one robot (over RTDE with --rtde). */
 static void check_source(int argc, char **argv, int operand, options *o)
 {
     const char *err;
+    if (o->list && !o->rtde) {
+        cli_usage_error(PROGRAM, "--list lists a controller's RTDE variables: give --rtde --list HOST[:PORT]");
+    }
+    if (o->list && (o->fields_given || o->count != 0 || o->record_path != NULL)) {
+        cli_usage_error(PROGRAM, "--list prints the variables and ends: leave out -k, -n and -w");
+    }
+    if (o->rtde && (o->file_path != NULL || o->record_path != NULL)) {
+        cli_usage_error(PROGRAM, "--file and --record are for RealTime streams: with --rtde read HOST[:PORT] "
+                        "live (RTDE is a dialogue, a capture of it does not replay)");
+    }
     if (o->file_path != NULL) {
         if (operand < argc) {
             cli_usage_error(PROGRAM, "give --file or HOST[:PORT], not both");
@@ -244,8 +350,17 @@ static void check_source(int argc, char **argv, int operand, options *o)
     if (operand + 1 < argc) {
         cli_usage_error(PROGRAM, "unexpected argument \"%s\" (one robot at a time)", argv[operand + 1]);
     }
-    if ((err = cli_parse_host_port(argv[operand], URRT_LINK_PORT_RW, o->host, sizeof o->host, &o->port)) != NULL) {
+    if ((err = cli_parse_host_port(argv[operand], o->rtde ? URRT_RTDE_PORT : URRT_LINK_PORT_RW, o->host,
+                                   sizeof o->host, &o->port)) != NULL) {
         cli_usage_error(PROGRAM, "%s: %s", argv[operand], err);
+    }
+    /* RTDE speaks first: never to a port that would take its bytes for
+     * URScript (primary, secondary, RealTime, and their read-only twins). */
+    if (o->rtde && ((o->port >= 30001 && o->port <= 30003) || (o->port >= 30011 && o->port <= 30013))) {
+        cli_usage_error(PROGRAM, "--rtde %s: port %u is not RTDE (30001-30003 run what they receive as URScript, "
+                        "30011-30013 are their read-only twins): RTDE is port 30004, or drop --rtde to read "
+                        "RealTime",
+                        argv[operand], (unsigned)o->port);
     }
 }
 
@@ -265,6 +380,7 @@ static void parse_options(int argc, char **argv, options *o)
     o->log_level = URRT_LOG_NOTICE;
     operand = cli_parse_options(&set, argc, argv, o);
     check_source(argc, argv, operand, o);
+    check_keys(o);
     if (o->fmt == FORMAT_GNUPLOT && o->fields_given) {
         cli_usage_error(PROGRAM, "gnuplot output holds every column (column N is UR's col. N): use csv or json "
                                  "for --fields");
@@ -282,17 +398,75 @@ static void print_number(FILE *out, double v, bool json)
     }
 }
 
-/* The ids to print: those asked for, in the order asked, or else the packet's. */
-static unsigned selected_fields(const dump *d, const urrt_state *st, unsigned *ids)
+/* What a packet holds to print: RealTime's (or RTDE's mapped) fields in st,
+ * RTDE-only values in vals (NULL for a RealTime packet). */
+typedef struct sample {
+    const urrt_state *st;
+    const urrt_rtde_values *vals;
+} sample;
+
+/* Elements of an RTDE-only variable's value (3 for a VECTOR3D, ...). */
+static unsigned rtde_elems(int var)
+{
+    switch (urrt_rtde_var_type(var)) {
+    case URRT_RTDE_T_VECTOR3D: return 3;
+    case URRT_RTDE_T_VECTOR6D:
+    case URRT_RTDE_T_VECTOR6INT32:
+    case URRT_RTDE_T_VECTOR6UINT32: return 6;
+    default: return 1;
+    }
+}
+
+/* Element i of an RTDE-only value in its own type: integers exact. */
+static void print_rtde_elem(FILE *out, const urrt_rtde_values *vals, int var, unsigned i, bool json)
+{
+    const void *p = urrt_rtde_value(vals, var);
+    switch (urrt_rtde_var_type(var)) {
+    case URRT_RTDE_T_BOOL:
+    case URRT_RTDE_T_UINT8: fprintf(out, "%u", (unsigned)((const uint8_t *)p)[i]); break;
+    case URRT_RTDE_T_UINT32:
+    case URRT_RTDE_T_VECTOR6UINT32: fprintf(out, "%" PRIu32, ((const uint32_t *)p)[i]); break;
+    case URRT_RTDE_T_UINT64: fprintf(out, "%" PRIu64, ((const uint64_t *)p)[i]); break;
+    case URRT_RTDE_T_INT32:
+    case URRT_RTDE_T_VECTOR6INT32: fprintf(out, "%" PRId32, ((const int32_t *)p)[i]); break;
+    default: print_number(out, ((const double *)p)[i], json); break;
+    }
+}
+
+static unsigned key_elems(unsigned key)
+{
+    return key < KEY_RTDE ? urrt_field((urrt_field_id)key)->count : rtde_elems((int)(key - KEY_RTDE));
+}
+
+static bool key_present(const sample *s, unsigned key)
+{
+    if (key < KEY_RTDE) {
+        return urrt_has(s->st, key);
+    }
+    return s->vals != NULL && urrt_rtde_has(s->vals, key - KEY_RTDE);
+}
+
+static void print_key_elem(FILE *out, const sample *s, unsigned key, unsigned i, bool json)
+{
+    if (key < KEY_RTDE) {
+        print_number(out, urrt_field_values(s->st, key)[i], json);
+    } else {
+        print_rtde_elem(out, s->vals, (int)(key - KEY_RTDE), i, json);
+    }
+}
+
+/* The keys to print: those asked for, in the order asked, or else the
+ * packet's fields. */
+static unsigned selected_keys(const dump *d, const urrt_state *st, unsigned *keys)
 {
     unsigned n = 0;
     if (d->opt.fields_given) {
-        memcpy(ids, d->opt.field_order, d->opt.nfields * sizeof *ids);
-        return d->opt.nfields;
+        memcpy(keys, d->opt.key_order, d->opt.nkeys * sizeof *keys);
+        return d->opt.nkeys;
     }
     for (unsigned id = 0; id < URRT_FIELD_COUNT; id++) {
         if (urrt_has(st, id)) {
-            ids[n++] = id;
+            keys[n++] = id;
         }
     }
     return n;
@@ -315,40 +489,80 @@ static void print_gnuplot(const dump *d, FILE *out, const uint8_t *pkt, size_t l
     fputc('\n', out);
 }
 
-static void print_csv(dump *d, FILE *out, const urrt_state *st)
+/* An RTDE package has no column layout of UR's: every value of the recipe's
+ * fields in field order (RealTime's order, so column 1 is the time), and a
+ * first comment line that names the columns. */
+static void print_gnuplot_rtde(const dump *d, FILE *out, const urrt_state *st)
+{
+    unsigned keys[URRT_FIELD_COUNT];
+    unsigned n = selected_keys(d, st, keys);
+    unsigned col = 1;
+    if (d->packets == 1) {
+        fputs("# urrt-dump --rtde: one line per data package; columns:", out);
+        for (unsigned k = 0; k < n; k++) {
+            const urrt_field_info *f = urrt_field((urrt_field_id)keys[k]);
+            if (f->count > 1) {
+                fprintf(out, " %u-%u %s", col, col + f->count - 1u, f->name);
+            } else {
+                fprintf(out, " %u %s", col, f->name);
+            }
+            col += f->count;
+        }
+        fputc('\n', out);
+    }
+    for (unsigned k = 0; k < n; k++) {
+        const urrt_field_info *f = urrt_field((urrt_field_id)keys[k]);
+        const double *v = urrt_field_values(st, keys[k]);
+        for (unsigned i = 0; i < f->count; i++) {
+            if (k > 0 || i > 0) {
+                fputc(' ', out);
+            }
+            fprintf(out, "%.17g", v[i]);
+        }
+    }
+    fputc('\n', out);
+}
+
+static void print_csv_header(dump *d, FILE *out, const urrt_state *st)
+{
+    char buf[URRT_RTDE_NAME_MAX];
+    bool first = true;
+    /* Without --fields the columns are those of the first packet. */
+    if (!d->opt.fields_given) {
+        d->opt.nkeys = selected_keys(d, st, d->opt.key_order);
+        d->opt.fields_given = true;
+    }
+    for (unsigned k = 0; k < d->opt.nkeys; k++) {
+        unsigned key = d->opt.key_order[k];
+        unsigned count = key_elems(key);
+        for (unsigned i = 0; i < count; i++) {
+            fprintf(out, first ? "%s" : ",%s", key_name(key, buf, sizeof buf));
+            if (count > 1) {
+                fprintf(out, "[%u]", i);
+            }
+            first = false;
+        }
+    }
+    fputc('\n', out);
+    d->csv_header_done = true;
+}
+
+static void print_csv(dump *d, FILE *out, const sample *s)
 {
     bool first = true;
     if (!d->csv_header_done) {
-        /* Without --fields the columns are those of the first packet. */
-        if (!d->opt.fields_given) {
-            d->opt.nfields = selected_fields(d, st, d->opt.field_order);
-            d->opt.fields_given = true;
-        }
-        for (unsigned k = 0; k < d->opt.nfields; k++) {
-            const urrt_field_info *f = urrt_field((urrt_field_id)d->opt.field_order[k]);
-            for (unsigned i = 0; i < f->count; i++) {
-                fprintf(out, first ? "%s" : ",%s", f->name);
-                if (f->count > 1) {
-                    fprintf(out, "[%u]", i);
-                }
-                first = false;
-            }
-        }
-        fputc('\n', out);
-        d->csv_header_done = true;
-        first = true;
+        print_csv_header(d, out, s->st);
     }
-    for (unsigned k = 0; k < d->opt.nfields; k++) {
-        unsigned id = d->opt.field_order[k];
-        const urrt_field_info *f = urrt_field((urrt_field_id)id);
-        const double *v = urrt_field_values(st, id);
-        for (unsigned i = 0; i < f->count; i++) {
+    for (unsigned k = 0; k < d->opt.nkeys; k++) {
+        unsigned key = d->opt.key_order[k];
+        unsigned count = key_elems(key);
+        for (unsigned i = 0; i < count; i++) {
             if (!first) {
                 fputc(',', out);
             }
             first = false;
-            if (urrt_has(st, id)) {
-                print_number(out, v[i], false);
+            if (key_present(s, key)) {
+                print_key_elem(out, s, key, i, false);
             }
         }
     }
@@ -360,10 +574,20 @@ static bool is_bits(const urrt_field_info *f)
     return strcmp(f->unit, "bits") == 0;
 }
 
-static void print_json(const dump *d, FILE *out, const urrt_state *st)
+/* The JSON head of a packet: what the packet is (RealTime: its generation
+ * and the versions that send its length; RTDE: protocol and controller). */
+static void print_json_head(const dump *d, FILE *out, const urrt_state *st)
 {
+    fprintf(out, "{\"packet\":%" PRIu64 ",\"length\":%u", d->packets, (unsigned)st->length);
+    if (d->src != NULL) {
+        const urrt_rtde *ses = rtde_source_session(d->src);
+        fprintf(out, ",\"source\":\"rtde\",\"protocol\":%u,\"controller\":\"%" PRIu32 ".%" PRIu32 ".%" PRIu32
+                ".%" PRIu32 "\"", (unsigned)ses->protocol_accepted, ses->controller[0], ses->controller[1],
+                ses->controller[2], ses->controller[3]);
+        return;
+    }
     const char *versions = urrt_versions_of(st->length);
-    fprintf(out, "{\"packet\":%" PRIu64 ",\"length\":%u,\"generation\":\"%s\"", d->packets, (unsigned)st->length,
+    fprintf(out, ",\"generation\":\"%s\"",
             st->generation == URRT_GEN_1X ? "1.x" : st->generation == URRT_GEN_3X ? "3.x/5.x" : "unknown");
     if (versions != NULL) {
         fprintf(out, ",\"versions\":\"%s\"", versions);
@@ -371,52 +595,86 @@ static void print_json(const dump *d, FILE *out, const urrt_state *st)
     if (st->extra_columns > 0) {
         fprintf(out, ",\"extra_columns\":%u", (unsigned)st->extra_columns);
     }
-    unsigned ids[URRT_FIELD_COUNT];
-    unsigned n = selected_fields(d, st, ids);
-    for (unsigned k = 0; k < n; k++) {
-        unsigned id = ids[k];
-        const urrt_field_info *f = urrt_field((urrt_field_id)id);
-        const double *v = urrt_field_values(st, id);
-        urrt_enum_kind kind = urrt_field_enum((urrt_field_id)id, st->generation);
-        if (!urrt_has(st, id)) {
-            continue;
+}
+
+/* One field of urrt_state as JSON: its values, bit masks as integers, and
+ * enumerations by name too. */
+static void print_json_field(FILE *out, const urrt_state *st, unsigned id)
+{
+    const urrt_field_info *f = urrt_field((urrt_field_id)id);
+    const double *v = urrt_field_values(st, id);
+    urrt_enum_kind kind = urrt_field_enum((urrt_field_id)id, st->generation);
+    fprintf(out, ",\"%s\":", f->name);
+    if (f->count > 1) {
+        fputc('[', out);
+    }
+    for (unsigned i = 0; i < f->count; i++) {
+        uint64_t mask;
+        if (i > 0) {
+            fputc(',', out);
         }
-        fprintf(out, ",\"%s\":", f->name);
+        if (is_bits(f) && urrt_bitmask(v[i], &mask) == URRT_OK) {
+            fprintf(out, "%" PRIu64, mask);
+        } else {
+            print_number(out, v[i], true);
+        }
+    }
+    if (f->count > 1) {
+        fputc(']', out);
+    }
+    if (kind != URRT_ENUM_NONE) {
+        fprintf(out, ",\"%s_name\":", f->name);
         if (f->count > 1) {
             fputc('[', out);
         }
         for (unsigned i = 0; i < f->count; i++) {
-            uint64_t mask;
-            if (i > 0) {
-                fputc(',', out);
-            }
-            if (is_bits(f) && urrt_bitmask(v[i], &mask) == URRT_OK) {
-                fprintf(out, "%" PRIu64, mask);
-            } else {
-                print_number(out, v[i], true);
-            }
+            fprintf(out, i > 0 ? ",\"%s\"" : "\"%s\"", urrt_enum_name(kind, v[i]));
         }
         if (f->count > 1) {
             fputc(']', out);
         }
-        if (kind != URRT_ENUM_NONE) {
-            fprintf(out, ",\"%s_name\":", f->name);
-            if (f->count > 1) {
-                fputc('[', out);
+    }
+}
+
+static void print_json(const dump *d, FILE *out, const sample *s)
+{
+    char buf[URRT_RTDE_NAME_MAX];
+    unsigned keys[KEY_COUNT];
+    unsigned n = selected_keys(d, s->st, keys);
+    print_json_head(d, out, s->st);
+    for (unsigned k = 0; k < n; k++) {
+        unsigned key = keys[k];
+        unsigned count = key_elems(key);
+        if (!key_present(s, key)) {
+            continue;
+        }
+        if (key < KEY_RTDE) {
+            print_json_field(out, s->st, key);
+            continue;
+        }
+        fprintf(out, count > 1 ? ",\"%s\":[" : ",\"%s\":", key_name(key, buf, sizeof buf));
+        for (unsigned i = 0; i < count; i++) {
+            if (i > 0) {
+                fputc(',', out);
             }
-            for (unsigned i = 0; i < f->count; i++) {
-                fprintf(out, i > 0 ? ",\"%s\"" : "\"%s\"", urrt_enum_name(kind, v[i]));
-            }
-            if (f->count > 1) {
-                fputc(']', out);
-            }
+            print_key_elem(out, s, key, i, true);
+        }
+        if (count > 1) {
+            fputc(']', out);
         }
     }
     fputs("}\n", out);
 }
 
-static void print_table(const dump *d, FILE *out, const urrt_state *st)
+static void print_table_head(const dump *d, FILE *out, const urrt_state *st)
 {
+    if (d->src != NULL) {
+        const urrt_rtde *ses = rtde_source_session(d->src);
+        fprintf(out, "package %" PRIu64 ": %u bytes, RTDE protocol %u, controller %" PRIu32 ".%" PRIu32 ".%" PRIu32
+                ".%" PRIu32 "\n", d->packets, (unsigned)st->length, (unsigned)ses->protocol_accepted,
+                ses->controller[0], ses->controller[1], ses->controller[2], ses->controller[3]);
+        return;
+    }
     const char *versions = urrt_versions_of(st->length);
     fprintf(out, "packet %" PRIu64 ": %u bytes, %s (%s)", d->packets, (unsigned)st->length,
             st->generation == URRT_GEN_1X ? "1.x" : st->generation == URRT_GEN_3X ? "3.x/5.x" : "generation unknown",
@@ -425,37 +683,75 @@ static void print_table(const dump *d, FILE *out, const urrt_state *st)
         fprintf(out, ", %u extra columns", (unsigned)st->extra_columns);
     }
     fputc('\n', out);
-    unsigned ids[URRT_FIELD_COUNT];
-    unsigned n = selected_fields(d, st, ids);
+}
+
+/* The values of one urrt_state field on a table line. */
+static void print_table_values(FILE *out, const urrt_state *st, unsigned id)
+{
+    const urrt_field_info *f = urrt_field((urrt_field_id)id);
+    const double *v = urrt_field_values(st, id);
+    urrt_enum_kind kind = urrt_field_enum((urrt_field_id)id, st->generation);
+    for (unsigned i = 0; i < f->count; i++) {
+        uint64_t mask;
+        if (kind != URRT_ENUM_NONE) {
+            fprintf(out, " %s(%g)", urrt_enum_name(kind, v[i]), v[i]);
+        } else if (is_bits(f) && urrt_bitmask(v[i], &mask) == URRT_OK) {
+            fprintf(out, " 0x%05" PRIx64 " [", mask);
+            bool any = false;
+            for (unsigned b = 0; b < 64; b++) {
+                if (mask >> b & 1u) {
+                    fprintf(out, any ? " %u" : "%u", b);
+                    any = true;
+                }
+            }
+            fputc(']', out);
+        } else if (id == URRT_F_TIME) {
+            fprintf(out, " %.3f", v[i]);
+        } else {
+            fprintf(out, " %10.6g", v[i]);
+        }
+    }
+}
+
+/* An RTDE-only value on a table line: integers exact, doubles as
+ * RealTime's are. */
+static void print_table_rtde(FILE *out, const urrt_rtde_values *vals, int var)
+{
+    urrt_rtde_type t = urrt_rtde_var_type(var);
+    bool doubles = t == URRT_RTDE_T_DOUBLE || t == URRT_RTDE_T_VECTOR3D || t == URRT_RTDE_T_VECTOR6D;
+    for (unsigned i = 0; i < rtde_elems(var); i++) {
+        if (doubles) {
+            fprintf(out, " %10.6g", ((const double *)urrt_rtde_value(vals, var))[i]);
+        } else {
+            fputc(' ', out);
+            print_rtde_elem(out, vals, var, i, false);
+        }
+    }
+}
+
+static void print_table(const dump *d, FILE *out, const sample *s)
+{
+    char buf[URRT_RTDE_NAME_MAX];
+    unsigned keys[KEY_COUNT];
+    unsigned n = selected_keys(d, s->st, keys);
+    print_table_head(d, out, s->st);
     for (unsigned k = 0; k < n; k++) {
-        unsigned id = ids[k];
-        const urrt_field_info *f = urrt_field((urrt_field_id)id);
-        const double *v = urrt_field_values(st, id);
-        urrt_enum_kind kind = urrt_field_enum((urrt_field_id)id, st->generation);
-        fprintf(out, "  %-22s %-10s", f->name, f->unit);
-        if (!urrt_has(st, id)) {
-            fputs(" (not in this packet)\n", out);
+        unsigned key = keys[k];
+        if (key < KEY_RTDE) {
+            fprintf(out, "  %-22s %-10s", key_name(key, buf, sizeof buf), urrt_field((urrt_field_id)key)->unit);
+        } else {
+            /* RTDE-only: the wire type where RealTime fields have a unit */
+            fprintf(out, "  %-22s %-10s", key_name(key, buf, sizeof buf),
+                    urrt_rtde_type_name(urrt_rtde_var_type((int)(key - KEY_RTDE))));
+        }
+        if (!key_present(s, key)) {
+            fputs(d->src != NULL ? " (not in this package)\n" : " (not in this packet)\n", out);
             continue;
         }
-        for (unsigned i = 0; i < f->count; i++) {
-            uint64_t mask;
-            if (kind != URRT_ENUM_NONE) {
-                fprintf(out, " %s(%g)", urrt_enum_name(kind, v[i]), v[i]);
-            } else if (is_bits(f) && urrt_bitmask(v[i], &mask) == URRT_OK) {
-                fprintf(out, " 0x%05" PRIx64 " [", mask);
-                bool any = false;
-                for (unsigned b = 0; b < 64; b++) {
-                    if (mask >> b & 1u) {
-                        fprintf(out, any ? " %u" : "%u", b);
-                        any = true;
-                    }
-                }
-                fputc(']', out);
-            } else if (id == URRT_F_TIME) {
-                fprintf(out, " %.3f", v[i]);
-            } else {
-                fprintf(out, " %10.6g", v[i]);
-            }
+        if (key < KEY_RTDE) {
+            print_table_values(out, s->st, key);
+        } else {
+            print_table_rtde(out, s->vals, (int)(key - KEY_RTDE));
         }
         fputc('\n', out);
     }
@@ -512,10 +808,35 @@ static void note_length(dump *d, uint32_t len)
     }
 }
 
+/* Prints a packet in the chosen format: a RealTime packet decoded here, an
+ * RTDE package as its source decoded it. */
+static void print_packet(dump *d, FILE *out, const uint8_t *pkt, size_t len)
+{
+    static urrt_state decoded;
+    sample s = {&decoded, NULL};
+    if (d->src != NULL) {
+        s.st = rtde_source_state(d->src);
+        s.vals = rtde_source_values(d->src);
+    } else if (d->opt.fmt != FORMAT_GNUPLOT) {
+        urrt_decode(pkt, len, &decoded);
+    }
+    switch (d->opt.fmt) {
+    case FORMAT_GNUPLOT:
+        if (d->src != NULL) {
+            print_gnuplot_rtde(d, out, s.st);
+        } else {
+            print_gnuplot(d, out, pkt, len);
+        }
+        break;
+    case FORMAT_CSV: print_csv(d, out, &s); break;
+    case FORMAT_JSON: print_json(d, out, &s); break;
+    default: print_table(d, out, &s); break;
+    }
+}
+
 static void on_packet(void *ctx, const uint8_t *pkt, size_t len, uint64_t rx_us)
 {
     dump *d = ctx;
-    urrt_state st;
     double t = NAN;
 
     if (d->done) {
@@ -527,8 +848,13 @@ static void on_packet(void *ctx, const uint8_t *pkt, size_t len, uint64_t rx_us)
     }
     d->packets++;
     note_length(d, (uint32_t)len);
-    d->gen_count[urrt_generation_of((uint32_t)len)]++;
-    if (urrt_read_column(pkt, len, 1, &t) == URRT_OK && isfinite(t)) {
+    if (d->src != NULL) {
+        t = rtde_source_state(d->src)->time[0]; /* NaN only if the recipe lacked it */
+    } else {
+        d->gen_count[urrt_generation_of((uint32_t)len)]++;
+        urrt_read_column(pkt, len, 1, &t);
+    }
+    if (isfinite(t)) {
         if (d->packets > 1 && isfinite(d->last_time)) {
             double gap = t - d->last_time;
             if (gap < 0) {
@@ -549,16 +875,7 @@ static void on_packet(void *ctx, const uint8_t *pkt, size_t len, uint64_t rx_us)
     d->last_rx_us = rx_us;
 
     if ((d->packets - 1) % d->opt.every == 0 && !d->output_failed) {
-        if (d->opt.fmt == FORMAT_GNUPLOT) {
-            print_gnuplot(d, stdout, pkt, len);
-        } else {
-            urrt_decode(pkt, len, &st);
-            switch (d->opt.fmt) {
-            case FORMAT_CSV: print_csv(d, stdout, &st); break;
-            case FORMAT_JSON: print_json(d, stdout, &st); break;
-            default: print_table(d, stdout, &st); break;
-            }
-        }
+        print_packet(d, stdout, pkt, len);
         if (ferror(stdout)) {
             d->output_failed = true;
             d->output_errno = errno;
@@ -568,6 +885,173 @@ static void on_packet(void *ctx, const uint8_t *pkt, size_t len, uint64_t rx_us)
     if (d->opt.count != 0 && d->packets >= d->opt.count) {
         d->done = true;
     }
+}
+
+/* ---- RTDE ------------------------------------------------------------------------ */
+
+/* Whether no source gives a version for var on any controller line: only
+ * the controller's answer to a setup tells (--list asks it). */
+static bool rtde_version_unstated(int var)
+{
+    return urrt_rtde_var_available(var, 3, 255, 255) == URRT_RTDE_UNKNOWN &&
+           urrt_rtde_var_available(var, 5, 255, 255) == URRT_RTDE_UNKNOWN &&
+           urrt_rtde_var_available(var, 10, 255, 255) == URRT_RTDE_UNKNOWN;
+}
+
+/* The recipe: the timestamp always, then what -k asks for (required: a
+ * controller without one ends the run), or without -k every field RTDE
+ * shares with RealTime, each only where the controller has it; for --list
+ * the variables only the controller can say it has. Returns the count. */
+static size_t rtde_recipe(const options *o, uint16_t *vars, bool *optional)
+{
+    size_t n = 0;
+    vars[n] = URRT_RTDE_V_TIMESTAMP;
+    optional[n++] = false;
+    for (int var = URRT_RTDE_V_TIMESTAMP + 1; var < (int)URRT_RTDE_VAR_COUNT; var++) {
+        int field = urrt_rtde_var_field(var);
+        bool asked;
+        if (o->list) {
+            asked = rtde_version_unstated(var);
+        } else if (o->fields_given) {
+            asked = o->key_on[field >= 0 ? (unsigned)field : KEY_RTDE + (unsigned)var];
+        } else {
+            asked = field >= 0;
+        }
+        if (asked) {
+            vars[n] = (uint16_t)var;
+            optional[n++] = !o->list && !o->fields_given;
+        }
+    }
+    return n;
+}
+
+static void version_text(const urrt_rtde *ses, char *out, size_t size)
+{
+    snprintf(out, size, "%" PRIu32 ".%" PRIu32 ".%" PRIu32 ".%" PRIu32, ses->controller[0], ses->controller[1],
+             ses->controller[2], ses->controller[3]);
+}
+
+/* The -k names (as RTDE names them) that the controller lacks: by the
+ * version table, and by its NOT_FOUND answer. */
+static void report_missing_fields(dump *d, const urrt_rtde_event *ev)
+{
+    const urrt_rtde *ses = rtde_source_session(d->src);
+    char version[48], name[URRT_RTDE_NAME_MAX];
+    for (unsigned k = 0; k < d->opt.nkeys; k++) {
+        int var = key_var(d->opt.key_order[k]);
+        bool lacking = urrt_rtde_var_available(var, ses->controller[0], ses->controller[1], ses->controller[2]) == 0;
+        for (size_t i = 0; ev->kind == URRT_RTDE_EV_CONFIG && urrt_rtde_not_found(ses, i) >= 0; i++) {
+            lacking = lacking || urrt_rtde_not_found(ses, i) == var;
+        }
+        if (lacking) {
+            char buf[URRT_RTDE_NAME_MAX];
+            urrt_rtde_var_name(var, name, sizeof name);
+            version_text(ses, version, sizeof version);
+            urrt_log(URRT_LOG_ERR, "-k %s: the controller (version %s) has no RTDE output %s: leave it out of -k "
+                     "(--rtde --list %s shows what this controller has)",
+                     key_name(d->opt.key_order[k], buf, sizeof buf), version, name, d->opt.host);
+            d->rtde_status = CLI_EXIT_RUNTIME;
+        }
+    }
+}
+
+/* --list: the controller's version, then each variable of lib's table with
+ * its type and whether this version has it; where the table cannot say,
+ * the controller's answer to the setup (not_found: its NOT_FOUND bits). */
+static void print_list(const dump *d, bool answered)
+{
+    const urrt_rtde *ses = rtde_source_session(d->src);
+    char version[48];
+    version_text(ses, version, sizeof version);
+    printf("controller %s, RTDE protocol %u\n", version, (unsigned)ses->protocol_accepted);
+    printf("%-40s %-14s %-22s %s\n", "variable", "type", "urrt field", "this controller");
+    for (int var = 0; var < (int)URRT_RTDE_VAR_COUNT; var++) {
+        char name[URRT_RTDE_NAME_MAX];
+        int field = urrt_rtde_var_field(var);
+        int has = urrt_rtde_var_available(var, ses->controller[0], ses->controller[1], ses->controller[2]);
+        const char *says = has == 1 ? "yes" : has == 0 ? "no" : "yes (asked: no version known)";
+        if (has == URRT_RTDE_UNKNOWN) {
+            bool not_found = false;
+            for (size_t i = 0; urrt_rtde_not_found(ses, i) >= 0; i++) {
+                not_found = not_found || urrt_rtde_not_found(ses, i) == var;
+            }
+            says = !answered ? "unknown (not asked)" : not_found ? "no (asked: NOT_FOUND)" : says;
+        }
+        urrt_rtde_var_name(var, name, sizeof name);
+        printf("%-40s %-14s %-22s %s\n", name, urrt_rtde_type_name(urrt_rtde_var_type(var)),
+               field >= 0 ? urrt_field((urrt_field_id)field)->name : "-", says);
+    }
+}
+
+/* A text message of the controller on stderr with its level. The source
+ * logs it already (exception and error as errors, warning as a warning,
+ * the rest as info); what that hides at this log level is shown here. */
+static void show_text(const dump *d, const urrt_rtde_event *ev)
+{
+    static const char *const level_names[] = {"exception", "error", "warning", "info"};
+    if (ev->level < URRT_RTDE_LEVEL_INFO || d->opt.log_level >= URRT_LOG_INFO) {
+        return;
+    }
+    urrt_log(URRT_LOG_NOTICE, "robot %s: controller says (%s)%s%.*s: %.*s", d->opt.host,
+             ev->level <= URRT_RTDE_LEVEL_INFO ? level_names[ev->level] : "level past info",
+             ev->source_len > 0 ? " from " : "", (int)ev->source_len, ev->source_len > 0 ? ev->source : "",
+             (int)ev->text_len, ev->text);
+}
+
+/* The session's events beside its data: what ends the run. */
+static void on_rtde_event(void *ctx, const urrt_rtde_event *ev, uint64_t rx_us)
+{
+    dump *d = ctx;
+    (void)rx_us;
+    if (ev->kind == URRT_RTDE_EV_TEXT) {
+        show_text(d, ev);
+        return;
+    }
+    if (d->done) {
+        return;
+    }
+    if (d->opt.list && (ev->kind == URRT_RTDE_EV_RECIPE ||
+                        (ev->kind == URRT_RTDE_EV_CONFIG && ev->error == URRT_RTDE_E_NOT_FOUND))) {
+        /* The controller answered: a NOT_FOUND is the answer here, not
+         * the error the link would log as it drops the connection. */
+        print_list(d, true);
+        d->done = true;
+        d->hush_drop = ev->kind == URRT_RTDE_EV_CONFIG;
+    } else if (!d->opt.list && d->opt.fields_given &&
+               (ev->kind == URRT_RTDE_EV_CONTROLLER || ev->kind == URRT_RTDE_EV_CONFIG)) {
+        report_missing_fields(d, ev);
+        d->done = d->hush_drop = d->rtde_status != CLI_EXIT_OK;
+    }
+    if (d->hush_drop) {
+        /* Said above in urrt-dump's words: the link's line as it drops the
+         * connection (for a gateway's configuration) would only confuse.
+         * run_link restores the level. */
+        urrt_log_set_level((urrt_log_level)(URRT_LOG_ERR - 1));
+    }
+    if (!d->done && ev->kind == URRT_RTDE_EV_CONFIG) {
+        /* The source logs why (names, version); a retry gets the same. */
+        d->rtde_status = CLI_EXIT_RUNTIME;
+        d->done = true;
+    }
+}
+
+/* The RTDE source of the run, set on the link; false (logged) when the
+ * recipe cannot be. */
+static bool open_rtde(dump *d, urrt_link *link)
+{
+    static uint16_t vars[URRT_RTDE_VAR_COUNT];
+    static bool optional[URRT_RTDE_VAR_COUNT];
+    char why[300];
+    rtde_source_config cfg = {.name = d->opt.host, .vars = vars, .optional = optional};
+    cfg.count = rtde_recipe(&d->opt, vars, optional);
+    d->src = rtde_source_new(&cfg, why, sizeof why);
+    if (d->src == NULL) {
+        urrt_log(URRT_LOG_ERR, "%s%s", why, d->opt.fields_given ? " (-k asks for too many values)" : "");
+        return false;
+    }
+    rtde_source_set_event_fn(d->src, on_rtde_event, d);
+    rtde_source_attach(d->src, link);
+    return true;
 }
 
 /* ---- sources ------------------------------------------------------------------ */
@@ -655,7 +1139,11 @@ static urrt_link *open_link(dump *d)
     cfg.silence_timeout_ms = d->opt.silence_timeout_ms;
     cfg.backoff_max_ms = d->opt.backoff_max_ms;
     link = urrt_link_new(&cfg);
-    if (link != NULL) {
+    if (link != NULL && d->opt.rtde && !open_rtde(d, link)) {
+        urrt_link_free(link);
+        return NULL;
+    }
+    if (link != NULL && !d->opt.rtde) {
         urrt_link_set_tap(link, on_bytes, d);
     }
     return link;
@@ -712,9 +1200,10 @@ static void watch_progress(dump *d, const urrt_link *link, progress *p, uint64_t
     }
     if (!d->done && now >= p->quiet_notice_at) {
         urrt_log(URRT_LOG_NOTICE, "%s: no packet for %.0f s (link %s, %" PRIu64 " connect failures): check the "
-                 "address and the port (30003, or the read-only 30013)%s", urrt_link_peer(link),
+                 "address and the port (%s)%s", urrt_link_peer(link),
                  (double)(now - p->last_us) / 1e6, urrt_link_state_name(urrt_link_get_state(link)),
-                 ls->connect_failures, d->opt.timeout_s > 0 ? "" : "; -t SEC gives up after SEC seconds");
+                 ls->connect_failures, d->opt.rtde ? RTDE_HINT : "30003, or the read-only 30013",
+                 d->opt.timeout_s > 0 ? "" : "; -t SEC gives up after SEC seconds");
         p->quiet_interval_us = p->quiet_interval_us * 2 < QUIET_NOTICE_MAX_US ? p->quiet_interval_us * 2
                                                                               : QUIET_NOTICE_MAX_US;
         p->quiet_notice_at = now + p->quiet_interval_us;
@@ -728,9 +1217,13 @@ static bool give_up(const dump *d, const urrt_link *link, const progress *p, uin
     const urrt_link_stats *ls = urrt_link_get_stats(link);
     if (d->opt.once && !d->done && (ls->disconnects > 0 || (ls->connect_failures > 0 && ls->connects == 0))) {
         if (d->packets == 0) {
-            urrt_log(URRT_LOG_ERR, "%s: no RealTime packet (%s, see above); check the address and port, "
-                     "or drop --once to keep trying",
-                     urrt_link_peer(link), ls->connects == 0 ? "no connection" : "the connection ended first");
+            urrt_log(URRT_LOG_ERR, "%s: no %s (%s, see above); check the address and port%s, "
+                     "or drop --once to keep trying", urrt_link_peer(link),
+                     d->opt.rtde ? "RTDE data package" : "RealTime packet",
+                     ls->connects > 0 ? "the connection ended first"
+                     : d->opt.rtde    ? "no connection, or no handshake"
+                                      : "no connection",
+                     d->opt.rtde ? " (" RTDE_HINT ")" : "");
             *status = CLI_EXIT_RUNTIME;
         }
         return true;
@@ -754,6 +1247,9 @@ static int run_link(dump *d)
     if (lc.link == NULL) {
         return CLI_EXIT_RUNTIME;
     }
+    if (d->opt.list) {
+        d->opt.once = true; /* a list, not a vigil: one attempt */
+    }
     p.last_us = urrt_port_monotonic_us();
     p.quiet_notice_at = p.last_us + p.quiet_interval_us;
     while (running && !d->done) {
@@ -772,11 +1268,29 @@ static int run_link(dump *d)
             break;
         }
     }
+    urrt_log_set_level(d->opt.log_level); /* after a hushed drop */
     urrt_link_free(lc.link);
-    return status;
+    return status != CLI_EXIT_OK ? status : d->rtde_status;
 }
 
 /* ---- summary ------------------------------------------------------------------ */
+
+/* The RTDE session: controller, protocol, the recipe asked for, and the
+ * packages that were no data. */
+static void print_summary_rtde(const dump *d, FILE *out)
+{
+    const urrt_rtde *ses = rtde_source_session(d->src);
+    static char recipe[URRT_RTDE_NAMES_MAX + 1];
+    char version[48];
+    version_text(ses, version, sizeof version);
+    if (ses->controller[0] == 0) {
+        snprintf(version, sizeof version, "unknown (no handshake)");
+    }
+    rtde_source_recipe_text(d->src, recipe, sizeof recipe);
+    fprintf(out, "summary: rtde: controller %s, protocol %u, text messages %" PRIu64 ", packages ignored %" PRIu64
+            "\n", version, (unsigned)ses->protocol_accepted, ses->stats.texts, ses->stats.ignored);
+    fprintf(out, "summary: rtde recipe: %s\n", recipe);
+}
 
 static void print_summary(const dump *d, bool from_link)
 {
@@ -784,7 +1298,7 @@ static void print_summary(const dump *d, bool from_link)
     fprintf(out, "summary: packets: %" PRIu64 "\n", d->packets);
     fprintf(out, "summary: lengths:");
     for (size_t i = 0; i < d->nlengths; i++) {
-        const char *v = urrt_versions_of(d->lengths[i]);
+        const char *v = d->src != NULL ? "RTDE data packages" : urrt_versions_of(d->lengths[i]);
         fprintf(out, "%s %" PRIu32 " x %" PRIu64 " (%s)", i > 0 ? ";" : "", d->lengths[i], d->length_count[i],
                 v != NULL ? v : "no known controller");
     }
@@ -792,8 +1306,12 @@ static void print_summary(const dump *d, bool from_link)
         fprintf(out, "; %" PRIu64 " of other lengths", d->other_lengths);
     }
     fprintf(out, "%s\n", d->nlengths == 0 ? " none" : "");
-    fprintf(out, "summary: generations: 1.x %" PRIu64 ", 3.x/5.x %" PRIu64 ", unknown %" PRIu64 "\n",
-            d->gen_count[URRT_GEN_1X], d->gen_count[URRT_GEN_3X], d->gen_count[URRT_GEN_UNKNOWN]);
+    if (d->src != NULL) {
+        print_summary_rtde(d, out);
+    } else {
+        fprintf(out, "summary: generations: 1.x %" PRIu64 ", 3.x/5.x %" PRIu64 ", unknown %" PRIu64 "\n",
+                d->gen_count[URRT_GEN_1X], d->gen_count[URRT_GEN_3X], d->gen_count[URRT_GEN_UNKNOWN]);
+    }
     if (from_link) {
         fprintf(out, "summary: resyncs: %" PRIu64 ", skipped bytes: %" PRIu64 "\n", d->lstats.resyncs,
                 d->lstats.skipped);
@@ -862,9 +1380,10 @@ int main(int argc, char **argv)
             status = CLI_EXIT_RUNTIME;
         }
     }
-    if (d.opt.summary) {
+    if (d.opt.summary && !d.opt.list) {
         print_summary(&d, d.opt.file_path == NULL);
     }
+    rtde_source_free(d.src);
     free(d.pending);
     return status;
 }
