@@ -11,9 +11,15 @@
  * packet of a given length holds, which sizes are plausible), the rule is
  * probed through lib/'s own functions, and the program fails rather than
  * print a table that would disagree with them. The tables come first; the
- * hand-written dissector (the file named on the command line) follows.
+ * hand-written dissectors (the files named on the command line) follow.
+ *
+ * For RTDE (TCP 30004) it prints lib/urrt_rtde.h's variable table (every
+ * name urrt_rtde_var_name() knows, its wire type, and for the variables that
+ * fill a RealTime field that field's unit and description) and its type
+ * table, so that the RTDE dissector names and decodes values as lib/ does.
  */
 #include "urrt.h"
+#include "urrt_rtde.h"
 #include "port.h"
 
 #include <stdio.h>
@@ -289,6 +295,83 @@ static void print_layout(unsigned gi)
     printf("    },\n");
 }
 
+/* How the dissector reads one element of an RTDE type; lib/ knows each
+ * type's name and size, this adds the element coding (checked against them). */
+static const struct {
+    urrt_rtde_type type;
+    const char *element; /* "double", "int32", "uint32", "uint64", "uint8", "bool" */
+    unsigned element_size, count;
+} rtde_codings[] = {
+    {URRT_RTDE_T_BOOL, "bool", 1, 1},        {URRT_RTDE_T_UINT8, "uint8", 1, 1},
+    {URRT_RTDE_T_UINT32, "uint32", 4, 1},    {URRT_RTDE_T_UINT64, "uint64", 8, 1},
+    {URRT_RTDE_T_INT32, "int32", 4, 1},      {URRT_RTDE_T_DOUBLE, "double", 8, 1},
+    {URRT_RTDE_T_VECTOR3D, "double", 8, 3},  {URRT_RTDE_T_VECTOR6D, "double", 8, 6},
+    {URRT_RTDE_T_VECTOR6INT32, "int32", 4, 6}, {URRT_RTDE_T_VECTOR6UINT32, "uint32", 4, 6},
+};
+#define RTDE_CODINGS (sizeof rtde_codings / sizeof rtde_codings[0])
+
+static void print_rtde_types(void)
+{
+    if (RTDE_CODINGS != URRT_RTDE_T_COUNT - 1u) {
+        die("lib/urrt_rtde.h has an RTDE type this program does not know");
+    }
+    printf("-- RTDE (urrt_rtde.h): port, header size, the package letters, and the wire\n"
+           "-- types (urrt_rtde_type_name, urrt_rtde_type_size): element coding, element\n"
+           "-- size, elements.\n");
+    printf("local RTDE_PORT, RTDE_HEADER, RTDE_PROTOCOL = %d, %d, %d\n", URRT_RTDE_PORT, URRT_RTDE_HEADER_SIZE,
+           URRT_RTDE_PROTOCOL);
+    printf("local RTDE_LETTER = { V = %d, v = %d, M = %d, U = %d, O = %d, S = %d, P = %d }\n",
+           URRT_RTDE_TYPE_PROTOCOL_VERSION, URRT_RTDE_TYPE_CONTROLLER_VERSION, URRT_RTDE_TYPE_TEXT_MESSAGE,
+           URRT_RTDE_TYPE_DATA, URRT_RTDE_TYPE_SETUP_OUTPUTS, URRT_RTDE_TYPE_START, URRT_RTDE_TYPE_PAUSE);
+    printf("local RTDE_TYPES = {\n");
+    for (unsigned i = 0; i < RTDE_CODINGS; i++) {
+        urrt_rtde_type t = rtde_codings[i].type;
+        const char *name = urrt_rtde_type_name(t);
+        if (name == NULL || rtde_codings[i].element_size * rtde_codings[i].count != urrt_rtde_type_size(t)) {
+            die("an RTDE type's size in lib/ is not its elements' here");
+        }
+        printf("    %s = { \"%s\", %u, %u },\n", name, rtde_codings[i].element, rtde_codings[i].element_size,
+               rtde_codings[i].count);
+    }
+    printf("}\n\n");
+}
+
+/* Every RTDE variable: name, wire type, and for a mapped one the urrt field's
+ * name, unit, description and (in 3.x/5.x numbering, RTDE's) enumeration. */
+static void print_rtde_vars(void)
+{
+    unsigned gi3 = 0;
+    while (gens[gi3].gen != URRT_GEN_3X) {
+        gi3++;
+    }
+    printf("-- RTDE variables (urrt_rtde_var_name, urrt_rtde_var_type, urrt_rtde_var_field):\n"
+           "-- name, type, and for those RealTime also has its field, unit, description,\n"
+           "-- enumeration.\nlocal RTDE_VARS = {\n");
+    for (int var = 0; var < (int)URRT_RTDE_VAR_COUNT; var++) {
+        char name[URRT_RTDE_NAME_MAX];
+        const char *type = urrt_rtde_type_name(urrt_rtde_var_type(var));
+        int field = urrt_rtde_var_field(var);
+        if (urrt_rtde_var_name(var, name, sizeof name) < 0 || type == NULL) {
+            die("an RTDE variable without a name or a type");
+        }
+        printf("    { \"%s\", \"%s\"", name, type);
+        if (field >= 0) {
+            const urrt_field_info *f = urrt_field((urrt_field_id)field);
+            printf(", \"%s\", ", f->name);
+            lua_string(f->unit);
+            printf(", ");
+            lua_string(f->description);
+            if (urrt_field_enum((urrt_field_id)field, URRT_GEN_3X) != URRT_ENUM_NONE) {
+                char e[64];
+                enum_name(e, sizeof e, (unsigned)field, gi3);
+                printf(", %s", e);
+            }
+        }
+        printf(" },\n");
+    }
+    printf("}\n\n");
+}
+
 static void copy_body(const char *path)
 {
     char line[1024];
@@ -307,15 +390,16 @@ static void copy_body(const char *path)
 
 int main(int argc, char **argv)
 {
-    if (argc != 2) {
-        fprintf(stderr, "usage: urrt_lua DISSECTOR.lua > urrt.lua\n");
+    if (argc < 2) {
+        fprintf(stderr, "usage: urrt_lua DISSECTOR.lua... > urrt.lua\n");
         return 2;
     }
     printf("-- SPDX-License-Identifier: MIT\n"
            "-- urrt.lua: Wireshark dissector for the Universal Robots RealTime interface\n"
-           "-- (TCP 30003 and 30013), urrt %s. Generated from lib/urrt.h by\n"
+           "-- (TCP 30003 and 30013) and its RTDE interface (TCP 30004), urrt %s.\n"
+           "-- Generated from lib/urrt.h and lib/urrt_rtde.h by\n"
            "-- gateway/wireshark/urrt_lua.c: do not edit; the tables come from lib/, the\n"
-           "-- code after them from gateway/wireshark/dissector.lua.\n\n",
+           "-- code after them from gateway/wireshark/dissector.lua and rtde.lua.\n\n",
            URRT_VERSION_STRING);
     print_size_rules();
     print_versions();
@@ -328,6 +412,10 @@ int main(int argc, char **argv)
         print_layout(gi);
     }
     printf("}\n\n");
-    copy_body(argv[1]);
+    print_rtde_types();
+    print_rtde_vars();
+    for (int i = 1; i < argc; i++) {
+        copy_body(argv[i]);
+    }
     return ferror(stdout) ? 1 : 0;
 }
