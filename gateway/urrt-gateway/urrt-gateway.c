@@ -21,6 +21,8 @@
 #include "dbc.h"
 #include "gateway.h"
 #include "lcm_out.h"
+#include "metrics.h"
+#include "notify.h"
 #include "port.h"
 #include "urrt.h"
 
@@ -98,6 +100,20 @@ static void usage(FILE *out)
         out);
 }
 
+/* What an RTDE robot asks its controller for: optional names in brackets. */
+static void print_recipe(const gw_robot_config *r)
+{
+    char rate[32];
+    snprintf(rate, sizeof rate, r->rtde_frequency > 0 ? "%g Hz" : "the controller's rate", r->rtde_frequency);
+    printf("  rtde: %zu values at %s ([optional]: where the controller has them):", r->recipe_count, rate);
+    for (size_t i = 0; i < r->recipe_count; i++) {
+        char name[URRT_RTDE_NAME_MAX];
+        urrt_rtde_var_name(r->recipe[i], name, sizeof name);
+        printf(r->recipe_optional[i] ? "%s[%s]" : "%s%s", i == 0 ? " " : ",", name);
+    }
+    printf("\n");
+}
+
 static void print_plan(const gw_config *cfg, const char *url)
 {
     printf("%s: valid\n", cfg->path);
@@ -122,8 +138,14 @@ static void print_plan(const gw_config *cfg, const char *url)
         printf("robot %s: %s, version %s, connect %u ms, silence %u ms, backoff %u..%u ms\n", r->name, peer,
                r->expected, (unsigned)r->link.connect_timeout_ms, (unsigned)r->link.silence_timeout_ms,
                (unsigned)r->link.backoff_initial_ms, (unsigned)r->link.backoff_max_ms);
+        if (r->source == GW_SOURCE_RTDE) {
+            print_recipe(r);
+        }
         for (unsigned k = 0; k < GW_KIND_COUNT; k++) {
             const gw_rate *rate = &cfg->lcm.rate[k];
+            if (k == GW_KIND_RTDE && r->rtde_value_count == 0) {
+                continue; /* nothing to publish there */
+            }
             printf("  %s.%s: ", r->name, cfg->lcm.channel[k]);
             if (rate->mode == GW_RATE_OFF) {
                 printf("off\n");
@@ -308,11 +330,35 @@ static int load_config(gw_config *cfg, const options *o)
     return -1;
 }
 
+/* The metrics file's writer ([gateway] metrics_file) and systemd's watchdog
+ * and status (when started by it), after the outputs they report on. False
+ * (logged) when out of memory. */
+static bool add_supervision(gateway *gw, const gw_config *cfg, lcm_out *lcm, can_out *can, gw_notify **notify)
+{
+    gw_output output;
+    if (cfg->metrics_file != NULL) {
+        gw_metrics *m = gw_metrics_new(gw, cfg, lcm, can);
+        if (m == NULL) {
+            return false;
+        }
+        output = gw_metrics_output(m);
+        gw_add_output(gw, &output);
+        urrt_log(URRT_LOG_NOTICE, "metrics: %s every %.1f s", cfg->metrics_file, cfg->metrics_interval_ms / 1000.0);
+    }
+    if ((*notify = gw_notify_new(gw, can)) != NULL) {
+        output = gw_notify_output(*notify);
+        gw_add_output(gw, &output);
+    }
+    return true;
+}
+
 /* The gateway itself: until SIGINT or SIGTERM. */
 static int run(gw_config *cfg, const options *o)
 {
     gateway gw;
     lcm_out *lcm;
+    can_out *can = NULL;
+    gw_notify *notify;
     gw_output output;
     cli_handle_signals(&running);
     if (!gw_init(&gw, cfg)) {
@@ -328,7 +374,7 @@ static int run(gw_config *cfg, const options *o)
     gw_add_output(&gw, &output);
     if (can_map_enabled(&cfg->can)) {
         char line[256];
-        can_out *can = can_out_new(&gw, &cfg->can, cfg->can_run, cfg->co_run);
+        can = can_out_new(&gw, &cfg->can, cfg->can_run, cfg->co_run);
         if (can == NULL) {
             urrt_log(URRT_LOG_ERR, "the CAN output cannot start (see above); fix [can] in %s", cfg->path);
             gw_close(&gw);
@@ -346,11 +392,18 @@ static int run(gw_config *cfg, const options *o)
             urrt_log(URRT_LOG_NOTICE, "CANopen %s", line);
         }
     }
+    if (!add_supervision(&gw, cfg, lcm, can, &notify)) {
+        gw_close(&gw);
+        return CLI_EXIT_RUNTIME;
+    }
     urrt_log(URRT_LOG_NOTICE, "started: %u robot%s, LCM %s", cfg->robot_count, cfg->robot_count == 1 ? "" : "s",
              cfg->lcm.url);
+    gw_notify_ready(notify);
     gw_run(&gw, &running);
     urrt_log(URRT_LOG_NOTICE, "stopping (signal %d)", cli_stop_signal());
+    gw_notify_stopping(notify);
     gw_close(&gw);
+    gw_notify_free(notify);
     return CLI_EXIT_OK;
 }
 

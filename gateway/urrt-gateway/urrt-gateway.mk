@@ -13,7 +13,7 @@ DEMO_LCM_URL ?= udpm://239.255.76.68:7668?ttl=0
 
 # ---- urrt-gateway ------------------------------------------------------------------
 GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/urrt-gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_out.o \
-                  can_out.o)
+                  can_out.o notify.o metrics.o)
 # Other folders append their objects (the CAN side); read at link time.
 GATEWAY_EXTRA_OBJS ?=
 GATEWAY_LIBS := -llcm -lm
@@ -26,9 +26,10 @@ $(BUILD)/gateway/urrt-gateway/%.o: gateway/urrt-gateway/%.c | $(LCMTYPES_H)
 -include $(GATEWAY_OBJS:.o=.d)
 
 .SECONDEXPANSION:
-$(BUILD)/bin/urrt-gateway: $(GATEWAY_OBJS) $(CLI_OBJ) $(LCMTYPES_OBJS) $$(GATEWAY_EXTRA_OBJS) $(LIBPORT) $(LIBURRT)
+$(BUILD)/bin/urrt-gateway: $(GATEWAY_OBJS) $(CLI_OBJ) $(RTDE_SOURCE_OBJ) $(LCMTYPES_OBJS) $$(GATEWAY_EXTRA_OBJS) $(LIBPORT) \
+                           $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(OPT) -o $@ $(GATEWAY_OBJS) $(CLI_OBJ) $(LCMTYPES_OBJS) $(GATEWAY_EXTRA_OBJS) $(LIBPORT) $(LIBURRT) \
+	$(CC) $(OPT) -o $@ $(GATEWAY_OBJS) $(CLI_OBJ) $(RTDE_SOURCE_OBJ) $(LCMTYPES_OBJS) $(GATEWAY_EXTRA_OBJS) $(LIBPORT) $(LIBURRT) \
 	  $(GATEWAY_LIBS)
 
 PROGRAMS += $(BUILD)/bin/urrt-gateway

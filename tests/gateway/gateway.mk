@@ -5,15 +5,21 @@
 #                   heartbeat down until data flows), the summary's rates,
 #                   mismatch, zero allocations, publish errors, bad configurations, jar
 #   check-freshness the age estimator and the summary's rate meter on a fake clock
+#   check-notify    systemd's notify protocol on the test's own NOTIFY_SOCKET: READY,
+#                   STATUS, WATCHDOG at half the period and none while SIGSTOPped, STOPPING
+#   check-metrics   the Prometheus textfile: promtool accepts it, values against the
+#                   simulator and the CAN log, renamed whole, write errors counted
 #   bench-gateway   latency robot -> subscriber and CPU per packet beside a
 #                   minimal relay (bench_relay.c), 1/10/50 robots, highest rate,
 #                   and the 500 Hz robots one core serves
 GWT := $(BUILD)/tests/gateway
 GWT_CFLAGS := $(PROG_WARN) $(OPT) $(CPPFLAGS) -I$(LCMGEN)
 
-CHECKS += check-freshness check-gateway
+CHECKS += check-freshness check-gateway check-notify check-metrics
 BENCHES += bench-gateway
-.PHONY: check-freshness check-gateway bench-gateway
+.PHONY: check-freshness check-gateway check-notify check-metrics bench-gateway
+# promtool, for check-metrics.
+DEB_DEPS += prometheus
 
 # The age estimator and the rate meter on a fake clock (gateway/urrt-gateway/freshness.h).
 $(GWT)/test_freshness: tests/gateway/test_freshness.c tests/check.h gateway/urrt-gateway/freshness.c gateway/urrt-gateway/freshness.h
@@ -41,6 +47,12 @@ $(GWT)/bench_relay: tests/gateway/bench_relay.c $(LIBURRT)
 
 check-gateway: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim $(GWT)/lcm_sub $(GWT)/alloc_shim.so $(LCMTYPES_JAR)
 	$(call suite,$@,$(PYTHON) tests/gateway/test_gateway.py --build $(BUILD))
+
+check-notify: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim
+	$(call suite,$@,$(PYTHON) tests/gateway/test_notify.py --build $(BUILD))
+
+check-metrics: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim
+	$(call suite,$@,$(PYTHON) tests/gateway/test_metrics.py --build $(BUILD))
 
 # The gateway beside the relay, every message at every packet, then the
 # focused messages at 50 Hz and no state; then one gateway against 1, 10 and
