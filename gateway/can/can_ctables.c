@@ -4,6 +4,7 @@
 
 #include <ctype.h>
 #include <inttypes.h>
+#include <string.h>
 
 /* Doubles as C constants that read back to the same bits. */
 static void put_double(FILE *out, double v)
@@ -17,17 +18,35 @@ static const char *const kind_names[] = {
     [URRT_CANTX_FILLED] = "URRT_CANTX_FILLED", [URRT_CANTX_FILLED_MASK] = "URRT_CANTX_FILLED_MASK",
 };
 
-/* A firmware reads RealTime, which has no RTDE-only value: a table that
- * names one would not build (its frame has no fill function there), so the
- * source says why instead, where the compiler stops. */
-static void put_rtde_refusal(FILE *out, const struct can_map *map)
+/* Whether robot i is read over RTDE. */
+static bool is_rtde(const struct can_ctables_robot *robots, const struct can_map *map, size_t i)
+{
+    return robots != NULL && i < map->robot_count && robots[i].rtde;
+}
+
+/* Whether frame f carries an RTDE-only value. */
+static bool has_rtde(const struct can_map_frame *f)
+{
+    for (size_t k = 0; k < f->count; k++) {
+        if (f->meta[k].role == CAN_MAP_ROLE_RTDE) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* A robot read over RealTime has no RTDE-only value: a table that names one
+ * would not build (its frame has no fill function there), so the source
+ * says why instead, where the compiler stops. (The configuration refuses
+ * such a signal already; this keeps the generated file honest on its own.) */
+static void put_rtde_refusal(FILE *out, const struct can_map *map, const struct can_ctables_robot *robots)
 {
     for (size_t i = 0; i < map->frame_count; i++) {
-        for (size_t k = 0; k < map->frames[i].count; k++) {
+        for (size_t k = 0; k < map->frames[i].count && !is_rtde(robots, map, map->frames[i].robot_index); k++) {
             const struct can_map_signal *m = &map->frames[i].meta[k];
             if (m->role == CAN_MAP_ROLE_RTDE) {
-                fprintf(out, "#error \"[frame %s] signal %s (line %d) is an RTDE-only value: a firmware reads "
-                             "RealTime, which has none; leave this frame to urrt-gateway or map RealTime fields\"\n",
+                fprintf(out, "#error \"[frame %s] signal %s (line %d) is an RTDE-only value: its robot is read over "
+                             "RealTime, which has none; give the robot source = rtde or map RealTime fields\"\n",
                         map->frames[i].name, m->name, m->loc.line);
             }
         }
@@ -107,8 +126,11 @@ static void put_frame_tables(FILE *out, const struct can_map_frame *f, const urr
     fprintf(out, "};\n\n");
 }
 
-static void put_frame(FILE *out, const char *name, const urrt_cantx_frame *t, bool heartbeat)
+/* fill: the frame has a fill function of put_rtde_fill's (frame_NAME_fill). */
+static void put_frame(FILE *out, const char *name, const urrt_cantx_frame *t, bool heartbeat, bool fill)
 {
+    char fill_name[CAN_MAP_NAME_MAX + 16];
+    snprintf(fill_name, sizeof fill_name, "frame_%s_fill", name);
     fprintf(out, "    {");
     if (heartbeat) {
         fprintf(out, "urrt_cantx_heartbeat_signals, urrt_cantx_heartbeat_sources, URRT_CANTX_HB_COUNT");
@@ -121,7 +143,193 @@ static void put_frame(FILE *out, const char *name, const urrt_cantx_frame *t, bo
             : t->flags == URRT_CANTX_FD                       ? "URRT_CANTX_FD"
                                                               : "0",
             t->id, t->period_us, t->stale_after_us, stale_names[t->stale], t->robot,
-            heartbeat ? "urrt_cantx_heartbeat_fill" : "NULL", name);
+            heartbeat ? "urrt_cantx_heartbeat_fill" : fill ? fill_name : "NULL", name);
+}
+
+/* ---- RTDE robots: the recipe and the RTDE-only values ------------------------------ */
+
+/* The trailing decimal index of an RTDE name ("output_int_register_24": 24
+ * at 20), or the name's length when it has none. */
+static size_t index_at(const char *name)
+{
+    size_t n = strlen(name);
+    while (n > 0 && isdigit((unsigned char)name[n - 1])) {
+        n--;
+    }
+    return n;
+}
+
+/* Whether vars a and b are names of one family (lib/urrt_rtde.h: a row of
+ * several names, "output_int_register_" 0..47, "standard_analog_input" 0..1):
+ * the same name but for the trailing index. */
+static bool same_family(int a, int b)
+{
+    char na[URRT_RTDE_NAME_MAX];
+    char nb[URRT_RTDE_NAME_MAX];
+    size_t ia;
+    if (a < URRT_RTDE_MAPPED_COUNT || b < URRT_RTDE_MAPPED_COUNT || b >= URRT_RTDE_VAR_COUNT ||
+        urrt_rtde_var_name(a, na, sizeof na) < 0 || urrt_rtde_var_name(b, nb, sizeof nb) < 0) {
+        return false;
+    }
+    ia = index_at(na);
+    return ia > 0 && ia < strlen(na) && ia == index_at(nb) && strncmp(na, nb, ia) == 0;
+}
+
+/* A variable as lib/urrt_rtde.h's enum names it: URRT_RTDE_V_ROBOT_STATUS_BITS,
+ * URRT_RTDE_V_OUTPUT_INT_REGISTER + 24 (a family: its first name's id plus
+ * the offset). Symbolic, so that the compiler checks it against lib/. */
+static void put_var_id(FILE *out, int var)
+{
+    char name[URRT_RTDE_NAME_MAX];
+    int first = var;
+    size_t len;
+    (void)urrt_rtde_var_name(var, name, sizeof name);
+    while (same_family(first - 1, var)) {
+        first--;
+    }
+    len = first != var || same_family(var + 1, var) ? index_at(name) : strlen(name);
+    len -= len < strlen(name) && name[len - 1] == '_'; /* the family's enum name has no trailing '_' */
+    fputs("URRT_RTDE_V_", out);
+    for (size_t i = 0; i < len; i++) {
+        fputc(toupper((unsigned char)name[i]), out);
+    }
+    if (len != strlen(name)) {
+        fprintf(out, " + %d", var - first);
+    }
+}
+
+/* The RTDE variable a signal needs: the one filling its field, its
+ * RTDE-only value, or -1 (alive counter, validity bit). */
+static int signal_var(const struct can_map_signal *m)
+{
+    return m->role == CAN_MAP_ROLE_FIELD  ? urrt_rtde_var_of_field((urrt_field_id)m->field)
+           : m->role == CAN_MAP_ROLE_RTDE ? m->var
+                                          : -1;
+}
+
+/* Robot r's recipe: the timestamp (the data's time) first, then what its
+ * frames' signals need, each once, in the configuration's order. This is
+ * what the gateway's CAN side asks for (its LCM messages and rtde_values
+ * are not the firmware's). */
+static size_t recipe_of(const struct can_map *map, size_t r, uint16_t *vars)
+{
+    size_t count = 0;
+    vars[count++] = URRT_RTDE_V_TIMESTAMP;
+    for (size_t i = 0; i < map->frame_count; i++) {
+        for (size_t k = 0; map->frames[i].robot_index == r && k < map->frames[i].count; k++) {
+            int var = signal_var(&map->frames[i].meta[k]);
+            size_t j = 0;
+            while (j < count && vars[j] != var) {
+                j++;
+            }
+            if (var >= 0 && j == count && count < URRT_RTDE_MAX_VARS) {
+                vars[count++] = (uint16_t)var;
+            }
+        }
+    }
+    return count;
+}
+
+static void put_rtde_recipes(FILE *out, const struct can_map *map, const struct can_ctables_robot *robots,
+                             size_t robot_count)
+{
+    uint16_t vars[URRT_RTDE_MAX_VARS];
+    fprintf(out, "\n/* The RTDE recipes: what urrt_rtde_begin asks each robot for. */\n");
+    for (size_t r = 0; r < robot_count; r++) {
+        size_t count;
+        if (!is_rtde(robots, map, r)) {
+            continue;
+        }
+        count = recipe_of(map, r, vars);
+        fprintf(out, "static const uint16_t urrt_gateway_rtde_vars_%zu[%zu] = {\n", r, count);
+        for (size_t i = 0; i < count; i++) {
+            char name[URRT_RTDE_NAME_MAX];
+            (void)urrt_rtde_var_name(vars[i], name, sizeof name);
+            fputs("    ", out);
+            put_var_id(out, vars[i]);
+            fprintf(out, ", /* %s */\n", name);
+        }
+        fprintf(out, "};\n");
+    }
+    fprintf(out, "const uint16_t *const urrt_gateway_rtde_vars[%zu] = {", robot_count);
+    for (size_t r = 0; r < robot_count; r++) {
+        fprintf(out, r ? ", " : "");
+        if (is_rtde(robots, map, r)) {
+            fprintf(out, "urrt_gateway_rtde_vars_%zu", r);
+        } else {
+            fputs("NULL", out);
+        }
+    }
+    fprintf(out, "};\nconst size_t urrt_gateway_rtde_var_count[%zu] = {", robot_count);
+    for (size_t r = 0; r < robot_count; r++) {
+        fprintf(out, "%s%zu", r ? ", " : "", is_rtde(robots, map, r) ? recipe_of(map, r, vars) : 0u);
+    }
+    fprintf(out, "};\nconst double urrt_gateway_rtde_frequency[%zu] = {", robot_count);
+    for (size_t r = 0; r < robot_count; r++) {
+        fputs(r ? ", " : "", out);
+        put_double(out, is_rtde(robots, map, r) ? robots[r].frequency : 0.0);
+    }
+    fprintf(out, "};\n\n"
+                 "void urrt_gateway_rtde_values(size_t robot, const urrt_rtde_values *values)\n{\n"
+                 "    if (robot < %zu) {\n        urrt_gateway_rtde[robot] = values;\n    }\n}\n",
+            robot_count);
+}
+
+/* What the fill functions read: each robot's latest package, NULL before
+ * the first; the helpers only where a fill function uses them (lib/'s
+ * warnings refuse an unused static function). */
+static void put_rtde_reading(FILE *out, const struct can_map *map, const struct can_ctables_robot *robots,
+                             size_t robot_count)
+{
+    bool signals = false;
+    bool quantities = false;
+    for (size_t i = 0; i < map->frame_count; i++) {
+        for (size_t k = 0; k < map->frames[i].count && is_rtde(robots, map, map->frames[i].robot_index); k++) {
+            const struct can_map_signal *m = &map->frames[i].meta[k];
+            signals = signals || m->role == CAN_MAP_ROLE_RTDE;
+            quantities = quantities || (m->role == CAN_MAP_ROLE_RTDE && !m->bitmask);
+        }
+    }
+    fprintf(out, "/* Each RTDE robot's latest package (urrt_gateway_rtde_values), NULL before its first. */\n"
+                 "static const urrt_rtde_values *urrt_gateway_rtde[%zu];\n\n",
+            robot_count);
+    if (quantities) {
+        fprintf(out, "static double urrt_gateway_nan(void)\n{\n"
+                     "    union {\n        uint64_t bits;\n        double value;\n    } nan = {UINT64_C(0x7FF8000000000000)};\n"
+                     "    return nan.value;\n}\n\n");
+    }
+    if (signals) {
+        fprintf(out, "static int urrt_gateway_rtde_has(const urrt_rtde_values *v, int var)\n{\n"
+                     "    return v != NULL && urrt_rtde_has(v, var);\n}\n\n");
+    }
+}
+
+/* Frame f's fill function: each RTDE-only signal's value from its robot's
+ * latest package, read as can_rtde.h reads it (the gateway's fill_rtde): a
+ * quantity as a double, NaN when the package lacks it; a mask (can_map set
+ * bitmask from can_rtde_is_mask) as its 64 bits, 0 when lacking. The C type
+ * of each is lib/'s (URRT_RTDE_CTYPE_ of the variable's wire type). */
+static void put_rtde_fill(FILE *out, const struct can_map_frame *f)
+{
+    fprintf(out, "/* [frame %s]: its RTDE-only values, from robot %zu's latest package. */\n"
+                 "static void frame_%s_fill(urrt_cantx *tx, size_t frame, uint64_t now_us, bool sending, double *values)\n"
+                 "{\n    const urrt_rtde_values *v = urrt_gateway_rtde[%zu];\n"
+                 "    (void)tx;\n    (void)frame;\n    (void)now_us;\n    (void)sending;\n",
+            f->name, f->robot_index, f->name, f->robot_index);
+    for (size_t k = 0; k < f->count; k++) {
+        const struct can_map_signal *m = &f->meta[k];
+        const char *type = urrt_rtde_type_name(urrt_rtde_var_type(m->var));
+        if (m->role != CAN_MAP_ROLE_RTDE) {
+            continue;
+        }
+        fprintf(out, "    values[%zu] = %surrt_gateway_rtde_has(v, ", k, m->bitmask ? "urrt_cantx_mask_value(" : "");
+        put_var_id(out, m->var);
+        fprintf(out, ")\n        ? (%s)((const URRT_RTDE_CTYPE_%s *)urrt_rtde_value(v, ", m->bitmask ? "uint64_t" : "double",
+                type);
+        put_var_id(out, m->var);
+        fprintf(out, "))[%u]\n        : %s; /* %s */\n", m->elem, m->bitmask ? "0u)" : "urrt_gateway_nan()", m->name);
+    }
+    fprintf(out, "}\n\n");
 }
 
 static void put_storage(FILE *out, const urrt_cantx_tables *t)
@@ -225,10 +433,20 @@ static void put_node(FILE *out, struct co_run *node)
             d->tpdo_count);
 }
 
+/* Whether frame i gets a fill function of put_rtde_fill's. */
+static bool rtde_filled(const struct can_map *map, const struct can_ctables_robot *robots, size_t i)
+{
+    return i < map->frame_count && has_rtde(&map->frames[i]) && is_rtde(robots, map, map->frames[i].robot_index);
+}
+
 int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run, struct co_run *node,
-                      const char *source)
+                      const struct can_ctables_robot *robots, const char *source)
 {
     const urrt_cantx_tables *t = can_run_tx(run)->tables;
+    bool rtde = false;
+    for (size_t i = 0; i < map->robot_count; i++) {
+        rtde = rtde || is_rtde(robots, map, i);
+    }
     fprintf(out, "/* SPDX-License-Identifier: MIT */\n"
                  "/*\n * Generated by urrt-gateway %s --print-c-tables from %s: its CAN frames as\n"
                  " * lib/urrt_cantx.h tables, for a firmware that sends what urrt-gateway sends.\n"
@@ -238,7 +456,18 @@ int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run,
                  " * (urrt_cantx_init and urrt_cantx_prepare over the storage below). Robots by index:",
             URRT_VERSION_STRING, source);
     for (size_t i = 0; i < map->robot_count; i++) {
-        fprintf(out, " %zu %s", i, map->robots[i].name);
+        fprintf(out, " %zu %s%s", i, map->robots[i].name, is_rtde(robots, map, i) ? " (RTDE)" : "");
+    }
+    if (rtde) {
+        fprintf(out, ".\n * Robots read over RTDE (lib/urrt_rtde.h; NULL and 0 for the others):\n"
+                     " *     extern const uint16_t *const urrt_gateway_rtde_vars[%zu];   the recipe of urrt_rtde_begin\n"
+                     " *     extern const size_t urrt_gateway_rtde_var_count[%zu];\n"
+                     " *     extern const double urrt_gateway_rtde_frequency[%zu];      Hz; 0: the controller's maximum\n"
+                     " *     void urrt_gateway_rtde_values(size_t robot, const urrt_rtde_values *values);\n"
+                     " * The last hands each data package's RTDE-only values to the frames, just before\n"
+                     " * urrt_cantx_on_packet with its state; they are read when a frame is sent, so\n"
+                     " * *values must stay as they are until the next package's",
+                t->robot_count, t->robot_count, t->robot_count);
     }
     if (node != NULL) {
         fprintf(out, ".\n * The CANopen node ([canopen]), over urrt_cantx_init's tx:\n"
@@ -247,19 +476,29 @@ int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run,
                      " *     int urrt_gateway_co_init(urrt_co *co, urrt_cantx *tx, size_t *bad_item)",
                 (int)CO_RUN_RX_IDS);
     }
-    fprintf(out, ".\n */\n#include <stddef.h>\n#include <stdint.h>\n\n#include \"%s\"\n\n",
-            node != NULL ? "urrt_co.h" : "urrt_cantx.h");
-    put_rtde_refusal(out, map);
+    fprintf(out, ".\n */\n#include <stdbool.h>\n#include <stddef.h>\n#include <stdint.h>\n\n#include \"%s\"\n%s\n",
+            node != NULL ? "urrt_co.h" : "urrt_cantx.h", rtde ? "#include \"urrt_rtde.h\"\n" : "");
+    put_rtde_refusal(out, map, robots);
+    if (rtde) {
+        put_rtde_reading(out, map, robots, t->robot_count);
+    }
     for (size_t i = 0; i < map->frame_count; i++) {
         put_frame_tables(out, &map->frames[i], &t->frames[i]);
+        if (rtde_filled(map, robots, i)) {
+            put_rtde_fill(out, &map->frames[i]);
+        }
     }
     fprintf(out, "static const urrt_cantx_frame urrt_gateway_frames[%zu] = {\n", t->frame_count);
     for (size_t i = 0; i < t->frame_count; i++) {
         bool hb = i == can_run_heartbeat_index(run);
-        put_frame(out, hb ? CAN_MAP_HEARTBEAT_NAME : map->frames[i].name, &t->frames[i], hb);
+        put_frame(out, hb ? CAN_MAP_HEARTBEAT_NAME : map->frames[i].name, &t->frames[i], hb,
+                  !hb && rtde_filled(map, robots, i));
     }
     fprintf(out, "};\n\n");
     put_storage(out, t);
+    if (rtde) {
+        put_rtde_recipes(out, map, robots, t->robot_count);
+    }
     if (node != NULL) {
         put_node(out, node);
     }

@@ -6,23 +6,36 @@
  * scales too) and an init function that checks the tables and prepares the
  * scales, so that a firmware sends the same frames, packed as cheaply,
  * without a mapping written by hand; with [canopen], the CANopen node's
- * urrt_co_desc too.
+ * urrt_co_desc too; for a robot read over RTDE (source = rtde), the
+ * recipe its firmware asks for and how its RTDE-only values reach the
+ * frames.
  * docs/firmware.md shows one in use.
  */
 #ifndef URRT_GATEWAY_CAN_CTABLES_H
 #define URRT_GATEWAY_CAN_CTABLES_H
 
+#include <stdbool.h>
 #include <stdio.h>
 
 #include "can_map.h"
 #include "can_run.h"
 #include "co_run.h"
 
+/* How a robot's data reaches the firmware. */
+struct can_ctables_robot {
+    bool rtde;        /* source = rtde: lib/urrt_rtde.h's client; else the RealTime stream */
+    double frequency; /* RTDE: Hz asked for, 0 for the controller's maximum */
+};
+
 /* Writes the C source of run, the tables of map, and with node (NULL:
  * none) the CANopen node's description over them (urrt_gateway_node,
  * urrt_gateway_co_init; source: the configuration's path, for the header
- * comment). 0, or -1 when the stream failed. */
+ * comment). robots: how each of map's robots is read, in map's order
+ * (NULL: all by RealTime); for an RTDE robot the source also holds the
+ * recipe a firmware asks for (the timestamp and what its CAN signals need)
+ * and the fill functions that read its RTDE-only values as can_rtde.h
+ * does. 0, or -1 when the stream failed. */
 int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run, struct co_run *node,
-                      const char *source);
+                      const struct can_ctables_robot *robots, const char *source);
 
 #endif

@@ -3,12 +3,15 @@
 #include "can_replay.h"
 
 #include <errno.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
+#include "can_rtde.h"
 #include "port.h"
+#include "rtde_capture.h"
 
 /* A received frame of the rx log, on the capture's clock. */
 struct rx_frame {
@@ -28,9 +31,11 @@ struct replay {
     uint64_t rx_frames;
     uint64_t rx_bad;       /* lines that are not a frame: skipped */
     urrt_canlink *link;
-    urrt_state state;
-    uint64_t packets;
+    urrt_state state;      /* the RealTime packet's decode */
+    uint64_t packets;      /* RealTime packets or RTDE data packages */
     uint64_t undated;      /* packets without a usable controller time: skipped */
+    uint64_t sessions;     /* an RTDE capture's connections */
+    uint64_t ended;        /* RTDE sessions the capture's client ended on an error */
     uint64_t frames;
     uint64_t refused;
 };
@@ -119,12 +124,16 @@ static void rx_until(struct replay *r, uint64_t t_us)
     }
 }
 
-static void packet_at(struct replay *r, uint64_t t_us)
+/* The frames due before the packet go out with the values before it; then
+ * the packet's state (and an RTDE package's RTDE-only values, handed over
+ * just before it, as can_out does) and what is due at its time. */
+static void packet_at(struct replay *r, uint64_t t_us, const urrt_state *st, const urrt_rtde_values *values)
 {
     if (r->node == NULL) {
         /* What a gateway waking at each deadline would have sent until now. */
         urrt_cantx_catch_up(can_run_tx(r->run), t_us, emit, r);
-        urrt_cantx_on_packet(can_run_tx(r->run), 0, &r->state, t_us);
+        can_run_rtde(r->run, 0, values);
+        urrt_cantx_on_packet(can_run_tx(r->run), 0, st, t_us);
         can_run_due(r->run, t_us, urrt_canlink_get_stats(r->link), emit, r);
         return;
     }
@@ -135,23 +144,34 @@ static void packet_at(struct replay *r, uint64_t t_us)
     }
     rx_until(r, t_us);
     node_catch_up(r, t_us);
-    urrt_cantx_on_packet(can_run_tx(r->run), 0, &r->state, t_us);
+    can_run_rtde(r->run, 0, values);
+    urrt_cantx_on_packet(can_run_tx(r->run), 0, st, t_us);
     can_run_set_link(r->run, urrt_canlink_get_stats(r->link));
     urrt_co_run(r->node, t_us, emit, r);
     r->node_us = t_us;
 }
 
-/* One packet at its own time: what a firmware does with each packet. */
-static void on_packet(struct replay *r, const uint8_t *pkt, size_t len)
+/* One packet (values NULL: RealTime's) at its own controller time: what a
+ * firmware does with each packet. */
+static void on_state(struct replay *r, const urrt_state *st, const urrt_rtde_values *values)
 {
     int64_t t_us;
     r->packets++;
-    if (urrt_decode(pkt, len, &r->state) < 0 || !urrt_has(&r->state, URRT_F_TIME) ||
-        urrt_time_us(r->state.time[0], &t_us) != URRT_OK) {
+    if (!urrt_has(st, URRT_F_TIME) || urrt_time_us(st->time[0], &t_us) != URRT_OK) {
         r->undated++;
         return;
     }
-    packet_at(r, (uint64_t)t_us);
+    packet_at(r, (uint64_t)t_us, st, values);
+}
+
+static void on_packet(struct replay *r, const uint8_t *pkt, size_t len)
+{
+    if (urrt_decode(pkt, len, &r->state) < 0) {
+        r->packets++;
+        r->undated++;
+        return;
+    }
+    on_state(r, &r->state, NULL);
 }
 
 static int pump(struct replay *r, FILE *in, const char *path)
@@ -183,6 +203,221 @@ static int pump(struct replay *r, FILE *in, const char *path)
     return CLI_EXIT_OK;
 }
 
+/* ---- what the configuration needs of an RTDE capture ----------------------- */
+
+/* A value the first robot's signals need, and the first signal needing it. */
+struct need {
+    int var;                /* urrt_rtde_var; -1: a field RTDE has no variable for */
+    int field;              /* with var -1: the field */
+    const struct can_map_frame *frame;
+    const struct can_map_signal *sig;
+};
+
+/* The capture's robot's (the first) signals: each RTDE variable once (a
+ * field's through urrt_rtde_var_of_field), each field RTDE lacks once.
+ * Returns how many, at most max. */
+static size_t needs_of(const struct can_map *map, struct need *out, size_t max)
+{
+    size_t n = 0;
+    for (size_t f = 0; f < map->frame_count; f++) {
+        const struct can_map_frame *frame = &map->frames[f];
+        for (size_t i = 0; frame->robot_index == 0 && i < frame->count; i++) {
+            const struct can_map_signal *m = &frame->meta[i];
+            int var = m->role == CAN_MAP_ROLE_RTDE    ? m->var
+                      : m->role == CAN_MAP_ROLE_FIELD ? urrt_rtde_var_of_field((urrt_field_id)m->field)
+                                                      : -2;
+            bool seen = var == -2;
+            for (size_t k = 0; k < n && !seen; k++) {
+                seen = out[k].var == var && (var >= 0 || out[k].field == m->field);
+            }
+            if (!seen && n < max) {
+                out[n++] = (struct need){var, m->field, frame, m};
+            }
+        }
+    }
+    return n;
+}
+
+/* A refusal's text: each missing value with a signal that needs it, and
+ * the names again for urrt-dump's -k. The log takes about 1000 characters
+ * a line: past DETAIL_MAX of details, values go by name only. */
+#define DETAIL_MAX 560
+struct missing {
+    char text[DETAIL_MAX + 96];
+    size_t len;
+    unsigned more;          /* values past DETAIL_MAX, named in names only */
+    char names[400];
+    size_t names_len;
+};
+
+static void put_text(char *buf, size_t size, size_t *len, const char *fmt, ...)
+{
+    va_list ap;
+    int n;
+    if (*len >= size) {
+        return;
+    }
+    va_start(ap, fmt);
+    n = vsnprintf(buf + *len, size - *len, fmt, ap);
+    va_end(ap);
+    *len = n < 0 ? size : *len + (size_t)n;
+}
+
+/* The configuration file's name without its folders: the user gave it. */
+static const char *base_name(const char *path)
+{
+    const char *slash = path != NULL ? strrchr(path, '/') : NULL;
+    return path == NULL ? "?" : slash != NULL ? slash + 1 : path;
+}
+
+/* "NAME (frame F, signal S, FILE:LINE)" into the text, NAME into names. */
+static void add_missing(struct missing *m, const char *name, const struct need *nd)
+{
+    if (m->len < DETAIL_MAX) {
+        put_text(m->text, sizeof m->text, &m->len, "%s%s (frame %s, signal %s, %s:%d)", m->len == 0 ? "" : ", ",
+                 name, nd->frame->name, nd->sig->name, base_name(nd->sig->loc.file), nd->sig->loc.line);
+    } else {
+        m->more++;
+    }
+    put_text(m->names, sizeof m->names, &m->names_len, "%s%s", m->names_len == 0 ? "" : ",", name);
+}
+
+static const char *more_text(const struct missing *m, char *buf, size_t size)
+{
+    buf[0] = '\0';
+    if (m->more > 0) {
+        snprintf(buf, size, " and %u more", m->more);
+    }
+    return buf;
+}
+
+/* A RealTime capture has no RTDE-only values: false (logged, naming every
+ * signal's value) when the configuration needs some. */
+static bool realtime_has_all(const struct can_map *map, const char *path)
+{
+    static struct need needs[URRT_RTDE_VAR_COUNT + URRT_FIELD_COUNT];
+    static struct missing m;
+    size_t n = needs_of(map, needs, sizeof needs / sizeof needs[0]);
+    char more[32];
+    memset(&m, 0, sizeof m);
+    for (size_t k = 0; k < n; k++) {
+        char name[URRT_RTDE_NAME_MAX];
+        if (needs[k].var >= 0 && can_rtde_only(needs[k].var)) {
+            (void)urrt_rtde_var_name(needs[k].var, name, sizeof name);
+            add_missing(&m, name, &needs[k]);
+        }
+    }
+    if (m.names_len == 0) {
+        return true;
+    }
+    urrt_log(URRT_LOG_ERR, "%s is a RealTime capture, which has no RTDE-only values, and the CAN side needs %s%s; "
+             "replay an RTDE capture of them: urrt-dump --rtde -w FILE -k %s", path, m.text,
+             more_text(&m, more, sizeof more), m.names);
+    return false;
+}
+
+/* The session's recipe against the needs: false (logged, every missing
+ * value with a signal that needs it, and what to do) if it lacks any. */
+static bool recipe_has_all(const rtde_replay *rp, const struct need *needs, size_t n, const char *path,
+                           uint64_t session)
+{
+    static struct missing m;
+    char more[32], fields[320] = "";
+    size_t fields_len = 0;
+    bool clock = rtde_replay_has(rp, URRT_RTDE_V_TIMESTAMP);
+    memset(&m, 0, sizeof m);
+    if (!clock) {
+        put_text(m.text, sizeof m.text, &m.len, "timestamp (the replay's clock, which urrt-dump --rtde -w always "
+                 "records)");
+    }
+    for (size_t k = 0; k < n; k++) {
+        char name[URRT_RTDE_NAME_MAX];
+        if (needs[k].var < 0) {
+            put_text(fields, sizeof fields, &fields_len, "%s%s (frame %s, signal %s, %s:%d)",
+                     fields_len == 0 ? "" : ", ", urrt_field((urrt_field_id)needs[k].field)->name,
+                     needs[k].frame->name, needs[k].sig->name, base_name(needs[k].sig->loc.file),
+                     needs[k].sig->loc.line);
+        } else if (needs[k].var != URRT_RTDE_V_TIMESTAMP && !rtde_replay_has(rp, needs[k].var)) {
+            (void)urrt_rtde_var_name(needs[k].var, name, sizeof name);
+            add_missing(&m, name, &needs[k]);
+        }
+    }
+    if (clock && m.names_len == 0 && fields_len == 0) {
+        return true;
+    }
+    urrt_log(URRT_LOG_ERR, "%s: the recipe of session %llu (%s) lacks what the CAN side needs: %s%s%s%s%s%s%s", path,
+             (unsigned long long)session, rtde_replay_peer(rp), m.text, more_text(&m, more, sizeof more),
+             m.names_len > 0 ? "; record them: urrt-dump --rtde -w FILE -k " : "", m.names,
+             fields_len == 0 ? "" : m.len > 0 ? "; RTDE has no " : "RTDE has no ", fields,
+             fields_len == 0 ? "" : ": replay a RealTime capture (urrt-dump -w FILE) for them");
+    return false;
+}
+
+/* The first pass: every session's recipe has what the first robot's
+ * signals need, and the capture is whole up to its end (a cut-off last
+ * record aside). Nothing is sent unless all of it can be. */
+static bool rtde_check(const struct can_map *map, FILE *in, const char *path)
+{
+    static struct need needs[URRT_RTDE_VAR_COUNT + URRT_FIELD_COUNT];
+    size_t n = needs_of(map, needs, sizeof needs / sizeof needs[0]);
+    char why[512];
+    urrt_rtde_event ev;
+    rtde_replay *rp = rtde_replay_open(in, path, why, sizeof why);
+    uint64_t sessions = 0;
+    int k = 0;
+    bool ok = true;
+    if (rp == NULL) {
+        urrt_log(URRT_LOG_ERR, "%s", why);
+        return false;
+    }
+    while (ok && (k = rtde_replay_next(rp, &ev, why, sizeof why)) > 0) {
+        if (k == RTDE_REPLAY_SESSION) {
+            sessions++;
+        } else if (k == URRT_RTDE_EV_RECIPE) {
+            ok = recipe_has_all(rp, needs, n, path, sessions);
+        }
+    }
+    if (ok && k < 0) {
+        urrt_log(URRT_LOG_ERR, "%s; nothing was replayed", why);
+        ok = false;
+    }
+    rtde_replay_free(rp);
+    return ok;
+}
+
+/* The second pass: each data package's state and RTDE-only values on the
+ * capture's clock. */
+static int rtde_pump(struct replay *r, FILE *in, const char *path)
+{
+    char why[512];
+    urrt_rtde_event ev;
+    rtde_replay *rp = rtde_replay_open(in, path, why, sizeof why);
+    int k;
+    if (rp == NULL) {
+        urrt_log(URRT_LOG_ERR, "%s", why);
+        return CLI_EXIT_RUNTIME;
+    }
+    while ((k = rtde_replay_next(rp, &ev, why, sizeof why)) > 0) {
+        if (k == RTDE_REPLAY_SESSION) {
+            r->sessions++;
+        } else if (k == URRT_RTDE_EV_DATA) {
+            on_state(r, rtde_replay_state(rp), rtde_replay_values(rp));
+        } else if (k == URRT_RTDE_EV_DROP || k == URRT_RTDE_EV_CONFIG) {
+            r->ended++;
+            urrt_log(URRT_LOG_INFO, "%s: session %llu ended: %s", path, (unsigned long long)r->sessions,
+                     urrt_rtde_strerror(ev.error));
+        }
+    }
+    if (k < 0) {
+        urrt_log(URRT_LOG_ERR, "%s", why); /* the first pass read it whole: the file changed */
+    } else if (rtde_replay_truncated(rp) > 0) {
+        urrt_log(URRT_LOG_WARNING, "%s ends inside a record (%zu bytes, the recorder stopped mid-write): replayed "
+                 "up to it", path, rtde_replay_truncated(rp));
+    }
+    rtde_replay_free(rp);
+    return k < 0 ? CLI_EXIT_RUNTIME : CLI_EXIT_OK;
+}
+
 static bool open_rx(struct replay *r, const char *rx_path)
 {
     if (rx_path == NULL) {
@@ -201,12 +436,31 @@ static bool open_rx(struct replay *r, const char *rx_path)
     return true;
 }
 
+/* Whether f holds an RTDE capture (by its first byte, never its name);
+ * f is back at its start. */
+static bool is_rtde_capture(FILE *f)
+{
+    int first = fgetc(f);
+    rewind(f);
+    return first == RTDE_CAPTURE_FIRST_BYTE;
+}
+
+static int close_all(struct replay *r, FILE *in, int rc)
+{
+    fclose(in);
+    if (r->rx != NULL) {
+        fclose(r->rx);
+    }
+    return rc;
+}
+
 int can_replay(const struct can_map *map, struct can_run *run, struct co_run *node, const char *capture_path,
                const char *rx_path)
 {
     struct replay r;
     urrt_canlink_config cfg;
     FILE *in;
+    bool rtde;
     int rc;
     memset(&r, 0, sizeof r);
     r.run = run;
@@ -225,17 +479,20 @@ int can_replay(const struct can_map *map, struct can_run *run, struct co_run *no
         }
         return CLI_EXIT_RUNTIME;
     }
+    /* Refusals come before the link opens: a refused replay leaves an
+     * earlier log as it was. */
+    rtde = is_rtde_capture(in);
+    if (rtde ? !rtde_check(map, in, capture_path) : !realtime_has_all(map, capture_path)) {
+        return close_all(&r, in, CLI_EXIT_RUNTIME);
+    }
+    rewind(in);
     urrt_canlink_config_defaults(&cfg);
     can_map_link_config(map, &cfg);
     cfg.log_caller_clock = true; /* each frame at its time on the capture's clock */
     if ((r.link = urrt_canlink_new(&cfg)) == NULL) {
-        fclose(in);
-        if (r.rx != NULL) {
-            fclose(r.rx);
-        }
-        return CLI_EXIT_RUNTIME;
+        return close_all(&r, in, CLI_EXIT_RUNTIME);
     }
-    rc = pump(&r, in, capture_path);
+    rc = rtde ? rtde_pump(&r, in, capture_path) : pump(&r, in, capture_path);
     fclose(in);
     if (r.rx != NULL) {
         if (r.has_next) {
@@ -246,8 +503,17 @@ int can_replay(const struct can_map *map, struct can_run *run, struct co_run *no
         fclose(r.rx);
     }
     urrt_canlink_free(r.link);
-    urrt_log(URRT_LOG_NOTICE, "replayed %s: %llu packets (%llu without a controller time, skipped), %llu frames sent%s",
-             capture_path, (unsigned long long)r.packets, (unsigned long long)r.undated,
-             (unsigned long long)r.frames, r.refused ? ", some refused by the link (see above)" : "");
+    if (rtde) {
+        urrt_log(URRT_LOG_NOTICE, "replayed %s (RTDE): %llu data packages in %llu session%s (%llu ended on an error, "
+                 "%llu packages without a controller time, skipped), %llu frames sent%s", capture_path,
+                 (unsigned long long)r.packets, (unsigned long long)r.sessions, r.sessions == 1 ? "" : "s",
+                 (unsigned long long)r.ended,
+                 (unsigned long long)r.undated, (unsigned long long)r.frames,
+                 r.refused ? ", some refused by the link (see above)" : "");
+    } else {
+        urrt_log(URRT_LOG_NOTICE, "replayed %s: %llu packets (%llu without a controller time, skipped), %llu frames "
+                 "sent%s", capture_path, (unsigned long long)r.packets, (unsigned long long)r.undated,
+                 (unsigned long long)r.frames, r.refused ? ", some refused by the link (see above)" : "");
+    }
     return r.refused ? CLI_EXIT_RUNTIME : rc;
 }

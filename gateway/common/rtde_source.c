@@ -19,6 +19,8 @@ struct rtde_source {
     urrt_rtde_values values;
     rtde_source_event_fn event_fn;
     void *event_ctx;
+    rtde_source_tap_fn tap_fn;
+    void *tap_ctx;
     bool dropped;                         /* this connection was dropped: ignore its bytes */
 };
 
@@ -99,6 +101,9 @@ static void flush(rtde_source *src)
             src->dropped = true;
             return;
         }
+        if (src->tap_fn != NULL) {
+            src->tap_fn(src->tap_ctx, RTDE_SOURCE_TAP_SENT, out, (size_t)n);
+        }
     }
 }
 
@@ -115,6 +120,9 @@ static void on_connected(void *ctx, urrt_link *link, uint64_t now_us)
     (void)now_us;
     src->link = link;
     src->dropped = false;
+    if (src->tap_fn != NULL) {
+        src->tap_fn(src->tap_ctx, RTDE_SOURCE_TAP_CONNECTED, NULL, 0);
+    }
     r = urrt_rtde_begin(&src->session, src->wanted, src->count, src->frequency);
     if (r < 0) { /* checked by rtde_source_new: cannot happen */
         char why[160];
@@ -234,6 +242,12 @@ static void on_received(void *ctx, urrt_link *link, const uint8_t *data, size_t 
         size_t used = 0;
         urrt_rtde_event ev;
         int k = urrt_rtde_feed(&src->session, data, len, &used, &ev, &src->state, &src->values);
+        /* Tapped as the session takes them, each piece before what it
+         * leads to: a recorder that stops at a package (urrt-dump -n N -w)
+         * holds exactly the bytes up to it. */
+        if (src->tap_fn != NULL && used > 0) {
+            src->tap_fn(src->tap_ctx, RTDE_SOURCE_TAP_RECEIVED, data, used);
+        }
         if (k <= 0) {
             break; /* all consumed (or the session already ended: the drop is on its way) */
         }
@@ -293,4 +307,10 @@ void rtde_source_set_event_fn(rtde_source *src, rtde_source_event_fn fn, void *c
 {
     src->event_fn = fn;
     src->event_ctx = ctx;
+}
+
+void rtde_source_set_tap(rtde_source *src, rtde_source_tap_fn fn, void *ctx)
+{
+    src->tap_fn = fn;
+    src->tap_ctx = ctx;
 }

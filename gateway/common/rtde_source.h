@@ -90,4 +90,17 @@ size_t rtde_source_recipe_text(const rtde_source *src, char *out, size_t size);
 typedef void (*rtde_source_event_fn)(void *ctx, const urrt_rtde_event *ev, uint64_t rx_us);
 void rtde_source_set_event_fn(rtde_source *src, rtde_source_event_fn fn, void *ctx);
 
+/* Optional: the session's bytes as they go (urrt-dump -w records them,
+ * rtde_capture.h): CONNECTED at each connect (data NULL), SENT with each
+ * request as queued, whole, RECEIVED with the bytes read as the session
+ * takes them (each piece before the events it leads to), in any split.
+ * NULL removes it. */
+typedef enum rtde_source_tap {
+    RTDE_SOURCE_TAP_CONNECTED,
+    RTDE_SOURCE_TAP_SENT,
+    RTDE_SOURCE_TAP_RECEIVED
+} rtde_source_tap;
+typedef void (*rtde_source_tap_fn)(void *ctx, rtde_source_tap what, const uint8_t *data, size_t len);
+void rtde_source_set_tap(rtde_source *src, rtde_source_tap_fn fn, void *ctx);
+
 #endif

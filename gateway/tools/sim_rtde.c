@@ -7,13 +7,19 @@
  */
 #include "sim_rtde.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "port.h"
+#include "rtde_capture.h"
 
 /* Package types. */
 #define RTDE_V_PROTOCOL 'V'
@@ -38,7 +44,9 @@
 #define UPPER3 VER(3, 9, 0) /* the range for RTDE clients, 24..47 and bits 64..127 */
 #define UPPER5 VER(5, 3, 0)
 
-typedef enum wire_type { W_BOOL, W_UINT8, W_UINT32, W_UINT64, W_INT32, W_DOUBLE, W_VECTOR3D, W_VECTOR6D, W_VECTOR6INT32 } wire_type;
+typedef enum wire_type {
+    W_BOOL, W_UINT8, W_UINT32, W_UINT64, W_INT32, W_DOUBLE, W_VECTOR3D, W_VECTOR6D, W_VECTOR6INT32, W_VECTOR6UINT32
+} wire_type;
 
 static const struct {
     const char *token;
@@ -48,6 +56,7 @@ static const struct {
     [W_BOOL] = {"BOOL", 1, 1},       [W_UINT8] = {"UINT8", 1, 1},       [W_UINT32] = {"UINT32", 1, 4},
     [W_UINT64] = {"UINT64", 1, 8},   [W_INT32] = {"INT32", 1, 4},       [W_DOUBLE] = {"DOUBLE", 1, 8},
     [W_VECTOR3D] = {"VECTOR3D", 3, 8}, [W_VECTOR6D] = {"VECTOR6D", 6, 8}, [W_VECTOR6INT32] = {"VECTOR6INT32", 6, 4},
+    [W_VECTOR6UINT32] = {"VECTOR6UINT32", 6, 4}, /* no variable of the model's has it; a capture may */
 };
 
 /* One cycle's values, every one as doubles (integers up to 2^53 exactly);
@@ -263,6 +272,7 @@ const char *sim_rtde_controller_parse(const char *text, sim_rtde_controller *c)
         return "no RTDE on this version (CB3 from 3.3, and e-Series 5.x)";
     }
     c->rate_hz = c->major >= 5 ? 500u : 125u;
+    c->cycle_hz = c->rate_hz;
     return NULL;
 }
 
@@ -306,19 +316,20 @@ static bool send_package(sim_rtde_session *s, uint8_t type, const uint8_t *paylo
 /* A text message in the layout of the protocol in force: v2 length-prefixed
  * message and source and a level; v1 (controller to client) the level and
  * the message to the end of the package. */
-static bool send_text(sim_rtde_session *s, uint8_t level, const char *msg)
+static bool send_text_from(sim_rtde_session *s, uint8_t level, const char *msg, size_t mlen, const char *source,
+                           size_t slen)
 {
-    static const char source[] = "urrt-sim";
     uint8_t p[600];
-    size_t n = 0, mlen = strlen(msg);
+    size_t n = 0;
     mlen = mlen > 255 ? 255 : mlen;
+    slen = slen > 255 ? 255 : slen;
     if (s->protocol >= 2) {
         p[n++] = (uint8_t)mlen;
         memcpy(p + n, msg, mlen);
         n += mlen;
-        p[n++] = (uint8_t)(sizeof source - 1);
-        memcpy(p + n, source, sizeof source - 1);
-        n += sizeof source - 1;
+        p[n++] = (uint8_t)slen;
+        memcpy(p + n, source, slen);
+        n += slen;
         p[n++] = level;
     } else {
         p[n++] = level;
@@ -327,6 +338,12 @@ static bool send_text(sim_rtde_session *s, uint8_t level, const char *msg)
     }
     s->texts_sent++;
     return send_package(s, RTDE_TEXT, p, n);
+}
+
+static bool send_text(sim_rtde_session *s, uint8_t level, const char *msg)
+{
+    static const char source[] = "urrt-sim";
+    return send_text_from(s, level, msg, strlen(msg), source, sizeof source - 1);
 }
 
 /* A protocol problem, told the client as the controller does (an error
@@ -368,6 +385,10 @@ static bool on_protocol_version(sim_rtde_session *s, const uint8_t *p, size_t le
     asked = (unsigned)p[0] << 8 | p[1];
     /* Protocol 2 came with 3.4; before it only 1. */
     accept = asked == 1 || (asked == 2 && version_number(s->ctl) >= VER(3, 4, 0) && !s->faults->refuse_v2);
+    if (s->ctl->recording != NULL && asked < 3 && s->ctl->recording->protocol_answer[asked] >= 0) {
+        /* The capture's controller's own answer. */
+        accept = s->ctl->recording->protocol_answer[asked] == 1 && !(asked == 2 && s->faults->refuse_v2);
+    }
     urrt_log(URRT_LOG_INFO, "RTDE client %s asks for protocol %u: %s", s->peer, asked, accept ? "accepted" : "refused");
     /* The reply in the layout of the protocol in force before it. */
     if (!reply_byte(s, RTDE_V_PROTOCOL, accept ? 1 : 0)) {
@@ -426,6 +447,18 @@ static bool find_variable(const sim_rtde_controller *c, const char *name, size_t
 {
     const variable *table = input ? inputs : outputs;
     size_t n = input ? COUNT(inputs) : COUNT(outputs);
+    if (c->recording != NULL && !input) {
+        /* A capture's controller has the variables recorded, no other. */
+        const sim_rtde_recording *r = c->recording;
+        for (size_t i = 0; i < r->nfields; i++) {
+            if (r->fields[i].len == len && memcmp(r->fields[i].name, name, len) == 0) {
+                f->type = r->fields[i].type;
+                f->value = (uint16_t)i;
+                return true;
+            }
+        }
+        return false;
+    }
     for (size_t i = 0; i < n; i++) {
         if (strlen(table[i].name) == len && memcmp(table[i].name, name, len) == 0) {
             if (!has_version(c, table[i].since3, table[i].since5)) {
@@ -529,9 +562,14 @@ static bool on_setup_outputs(sim_rtde_session *s, const uint8_t *p, size_t len)
         s->data_size += (size_t)wire[s->fields[i].type].count * wire[s->fields[i].type].size;
     }
     /* Every divisor-th cycle: a rate that does not divide the controller's
-     * rounds up to the next one that does. */
-    s->divisor = problem == NULL ? (uint32_t)floor((double)s->ctl->rate_hz / freq) : 1;
+     * rounds up to the next one that does (a capture's rate, read from its
+     * timestamps, is exact only to a few ulps). */
+    s->divisor = problem == NULL ? (uint32_t)floor(s->ctl->cycle_hz / freq + 1e-6) : 1;
     s->divisor = s->divisor ? s->divisor : 1;
+    if (problem == NULL && s->ctl->recording != NULL && freq > s->ctl->cycle_hz * (1.0 + 1e-6)) {
+        urrt_log(URRT_LOG_NOTICE, "RTDE client %s asks for %g Hz: the capture has %g Hz, it gets every package",
+                 s->peer, freq, s->ctl->cycle_hz);
+    }
     urrt_log(URRT_LOG_INFO, "RTDE client %s: output recipe of %zu variable%s%s, %s", s->peer, names,
              names == 1 ? "" : "s", found == names ? "" : " (some NOT_FOUND)",
              problem ? problem : s->recipe_valid ? "valid" : "invalid");
@@ -758,7 +796,8 @@ static size_t put_field(uint8_t *p, const sim_rtde_field *f, const double *vals)
         switch (f->type) {
         case W_BOOL: p[n++] = x[e] != 0.0 ? 1 : 0; break;
         case W_UINT8: p[n++] = (uint8_t)x[e]; break;
-        case W_UINT32: put_u32(p + n, (uint32_t)x[e]); n += 4; break;
+        case W_UINT32:
+        case W_VECTOR6UINT32: put_u32(p + n, (uint32_t)x[e]); n += 4; break;
         case W_INT32:
         case W_VECTOR6INT32: put_u32(p + n, (uint32_t)(int32_t)x[e]); n += 4; break;
         case W_UINT64: put_u64(p + n, (uint64_t)x[e]); n += 8; break;
@@ -772,48 +811,25 @@ static size_t put_field(uint8_t *p, const sim_rtde_field *f, const double *vals)
     return n;
 }
 
-/* The package for data package n (1-based) of the session, bad if the
- * fault says so: returns its type letter, the payload in p, *len. */
-static uint8_t data_package(sim_rtde_session *s, uint64_t n, const values *v, uint8_t *p, size_t *len)
+/* A data package's recipe id, in protocol 2: its bytes (0 or 1). */
+static size_t put_recipe_id(const sim_rtde_session *s, uint8_t *p)
 {
-    const sim_rtde_faults *f = s->faults;
-    bool bad = f->bad_every != 0 && n % f->bad_every == 0;
-    size_t off = 0;
-    if (s->protocol >= 2) {
-        p[off++] = bad && f->bad_kind == SIM_RTDE_BAD_RECIPE ? RTDE_OUTPUT_RECIPE_ID + 1 : RTDE_OUTPUT_RECIPE_ID;
+    if (s->protocol < 2) {
+        return 0;
     }
-    for (size_t i = 0; i < s->nfields; i++) {
-        off += put_field(p + off, &s->fields[i], (const double *)v);
-    }
-    *len = off;
-    if (!bad) {
-        return RTDE_DATA;
-    }
-    switch (f->bad_kind) {
-    case SIM_RTDE_BAD_TYPE: return 'X';
-    case SIM_RTDE_BAD_RECIPE:
-        if (s->protocol >= 2) {
-            return RTDE_DATA;
-        }
-        /* v1 packages carry no recipe id: one byte short instead. */
-        *len = off - 1;
-        return RTDE_DATA;
-    case SIM_RTDE_BAD_HEADER: *len = 0; return RTDE_DATA;
-    case SIM_RTDE_BAD_SIZE: *len = off - 1; return RTDE_DATA;
-    }
-    return RTDE_DATA;
+    p[0] = RTDE_OUTPUT_RECIPE_ID;
+    return 1;
 }
 
-bool sim_rtde_send_data(sim_rtde_session *s, uint64_t k, const urrt_state *st)
+/* Sends the session's next data package, its payload (recipe id and
+ * values) in p, len bytes: after a text message, or bad, when a fault says
+ * so. */
+static bool send_payload(sim_rtde_session *s, uint8_t *p, size_t len)
 {
-    static values v;
-    static uint8_t payload[RTDE_SIZE_MAX];
     const sim_rtde_faults *f = s->faults;
     uint64_t n = ++s->data_sent;
-    size_t len;
-    uint8_t type;
+    uint8_t type = RTDE_DATA;
 
-    _Static_assert(sizeof(values) == VALUES_COUNT * sizeof(double), "values is an array of doubles");
     if (f->text_every != 0 && n > 1 && (n - 1) % f->text_every == 0) {
         char msg[96];
         snprintf(msg, sizeof msg, "urrt-sim: text message %" PRIu64 " (fault rtde-text-every)", s->texts_sent + 1);
@@ -821,12 +837,489 @@ bool sim_rtde_send_data(sim_rtde_session *s, uint64_t k, const urrt_state *st)
             return false;
         }
     }
-    cycle_values(k, st, &v);
-    type = data_package(s, n, &v, payload, &len);
-    if (f->bad_every != 0 && n % f->bad_every == 0 && f->bad_kind == SIM_RTDE_BAD_HEADER) {
-        /* Size 2: below the header itself, so no reader can frame what follows. */
-        static const uint8_t broken[3] = {0x00, 0x02, RTDE_DATA};
-        return s->emit(s->emit_ctx, broken, sizeof broken);
+    if (f->bad_every != 0 && n % f->bad_every == 0) {
+        switch (f->bad_kind) {
+        case SIM_RTDE_BAD_HEADER: {
+            /* Size 2: below the header itself, so no reader can frame what follows. */
+            static const uint8_t broken[3] = {0x00, 0x02, RTDE_DATA};
+            return s->emit(s->emit_ctx, broken, sizeof broken);
+        }
+        case SIM_RTDE_BAD_TYPE: type = 'X'; break;
+        case SIM_RTDE_BAD_RECIPE:
+            if (s->protocol >= 2) {
+                p[0] = RTDE_OUTPUT_RECIPE_ID + 1;
+                break;
+            }
+            /* v1 packages carry no recipe id: one byte short instead. */
+            len--;
+            break;
+        case SIM_RTDE_BAD_SIZE: len--; break;
+        }
     }
-    return send_package(s, type, payload, len);
+    return send_package(s, type, p, len);
+}
+
+bool sim_rtde_send_data(sim_rtde_session *s, uint64_t k, const urrt_state *st)
+{
+    static values v;
+    static uint8_t payload[RTDE_SIZE_MAX];
+    size_t off = put_recipe_id(s, payload);
+
+    _Static_assert(sizeof(values) == VALUES_COUNT * sizeof(double), "values is an array of doubles");
+    cycle_values(k, st, &v);
+    for (size_t i = 0; i < s->nfields; i++) {
+        off += put_field(payload + off, &s->fields[i], (const double *)&v);
+    }
+    return send_payload(s, payload, off);
+}
+
+bool sim_rtde_send_recorded(sim_rtde_session *s, uint64_t k)
+{
+    static uint8_t payload[RTDE_SIZE_MAX];
+    const sim_rtde_recording *r = s->ctl->recording;
+    const uint8_t *vals = r->file + r->at[k % r->count];
+    size_t off = put_recipe_id(s, payload);
+
+    /* The texts recorded since this client's previous package (the
+     * divisor's worth of packages before this one), in its protocol. */
+    for (uint64_t j = k + 1 >= s->divisor ? k + 1 - s->divisor : 0; j <= k; j++) {
+        size_t i = (size_t)(j % r->count);
+        for (size_t t = r->text_first[i]; t < r->text_first[i + 1]; t++) {
+            const sim_rtde_recorded_text *x = &r->texts[t];
+            if (!send_text_from(s, x->level, x->message, x->mlen, x->source, x->slen)) {
+                return false;
+            }
+        }
+    }
+    /* Each variable's bytes as the controller sent them. */
+    for (size_t i = 0; i < s->nfields; i++) {
+        const sim_rtde_recorded_field *f = &r->fields[s->fields[i].value];
+        size_t size = (size_t)wire[f->type].count * wire[f->type].size;
+        memcpy(payload + off, vals + f->offset, size);
+        off += size;
+    }
+    return send_payload(s, payload, off);
+}
+
+/* ---- a capture as the controller ------------------------------------------------ */
+
+/* What is known of the capture's session being read. */
+typedef struct reading {
+    const char *path;
+    sim_rtde_recording *r;
+    sim_rtde_controller *ctl;
+    bool have_version;
+    bool recipe_fixed;        /* the recipe of the first session with an accepted one */
+    unsigned protocol;        /* this session's, 1 until V is accepted */
+    unsigned asked;           /* the version its last V asked for */
+    bool decided;             /* a session has had its recipe accepted: later ones do not answer V for the replay */
+    bool session_ok;          /* this session's recipe is the replay's */
+    bool started;             /* its start was accepted */
+    uint8_t recipe_id;
+    uint8_t *setup;           /* this session's last setup request */
+    size_t setup_size;
+    size_t texts_cap, at_cap;
+    uint64_t skipped, first_skipped;
+    bool other_recipe;        /* a later session asked for another recipe: the replay ends before it */
+} reading;
+
+/* The names of a setup request, past the frequency of protocol 2. */
+static const uint8_t *setup_names(const reading *rd, size_t *len)
+{
+    size_t skip = RTDE_HEADER + (rd->protocol >= 2 ? 8u : 0u);
+    *len = rd->setup_size > skip ? rd->setup_size - skip : 0;
+    return rd->setup + skip;
+}
+
+static int wire_of_token(const char *t, size_t len)
+{
+    for (size_t w = 0; w < COUNT(wire); w++) {
+        if (strlen(wire[w].token) == len && memcmp(wire[w].token, t, len) == 0) {
+            return (int)w;
+        }
+    }
+    return -1;
+}
+
+/* The tokens of a setup reply against the request's names: the recipe they
+ * make (into fields, up to max), or false when a name was refused. */
+static bool recorded_recipe(const reading *rd, const uint8_t *types, size_t tlen, sim_rtde_recorded_field *fields,
+                            size_t max, size_t *count)
+{
+    size_t nlen, n = 0, ni = 0, ti = 0, offset = 0;
+    const uint8_t *names = setup_names(rd, &nlen);
+    if (nlen == 0 || tlen == 0) {
+        return false;
+    }
+    while (ni <= nlen && ti <= tlen) {
+        size_t ne = ni, te = ti;
+        int w;
+        while (ne < nlen && names[ne] != ',') {
+            ne++;
+        }
+        while (te < tlen && types[te] != ',') {
+            te++;
+        }
+        w = wire_of_token((const char *)types + ti, te - ti);
+        if (w < 0 || n == max) {
+            return false; /* NOT_FOUND, IN_USE or a token the simulator does not know */
+        }
+        fields[n++] = (sim_rtde_recorded_field){(const char *)names + ni, ne - ni, (uint8_t)w, offset};
+        offset += (size_t)wire[w].count * wire[w].size;
+        ni = ne + 1;
+        ti = te + 1;
+        if ((ni > nlen) != (ti > tlen)) {
+            return false; /* as many types as names, or the reply is not this request's */
+        }
+    }
+    *count = n;
+    return true;
+}
+
+/* A setup reply: the session's recipe, the replay's if it is the first. */
+static bool on_recorded_setup(reading *rd, const rtde_capture_record *rec, char *why, size_t why_size)
+{
+    static sim_rtde_recorded_field fields[SIM_RTDE_RECIPE_MAX];
+    sim_rtde_recording *r = rd->r;
+    size_t idlen = rd->protocol >= 2 ? 1 : 0, count = 0, nlen;
+    const uint8_t *names = setup_names(rd, &nlen);
+
+    rd->session_ok = false;
+    if (rd->setup == NULL || rec->size < RTDE_HEADER + idlen ||
+        !recorded_recipe(rd, rec->pkg + RTDE_HEADER + idlen, rec->size - RTDE_HEADER - idlen, fields,
+                         COUNT(fields), &count)) {
+        return true; /* refused: this session sends no data */
+    }
+    rd->recipe_id = idlen ? rec->pkg[RTDE_HEADER] : 0;
+    if (rd->recipe_fixed) {
+        bool same = count == r->nfields && strlen(r->names) == nlen && memcmp(r->names, names, nlen) == 0;
+        for (size_t i = 0; same && i < count; i++) {
+            same = fields[i].type == r->fields[i].type;
+        }
+        if (!same) {
+            rd->other_recipe = true;
+            urrt_log(URRT_LOG_NOTICE, "capture %s: the session at byte %" PRIu64 " asks for another recipe: the "
+                     "replay ends before it (it serves the first session's recipe)", rd->path, rec->offset);
+        }
+        rd->session_ok = same;
+        if (same) {
+            r->sessions++;
+        }
+        return true;
+    }
+    r->names = malloc(nlen + 1);
+    r->fields = malloc(count * sizeof *r->fields);
+    if (r->names == NULL || r->fields == NULL) {
+        snprintf(why, why_size, "out of memory reading %s", rd->path);
+        return false;
+    }
+    memcpy(r->names, names, nlen);
+    r->names[nlen] = '\0';
+    r->nfields = count;
+    r->timestamp_at = SIZE_MAX;
+    for (size_t i = 0; i < count; i++) {
+        r->fields[i] = fields[i];
+        r->fields[i].name = r->names + (fields[i].name - (const char *)names);
+        if (fields[i].len == 9 && memcmp(fields[i].name, "timestamp", 9) == 0 && fields[i].type == W_DOUBLE &&
+            r->timestamp_at == SIZE_MAX) {
+            r->timestamp_at = fields[i].offset;
+        }
+        r->values_size = fields[i].offset + (size_t)wire[fields[i].type].count * wire[fields[i].type].size;
+    }
+    if (r->timestamp_at == SIZE_MAX) {
+        snprintf(why, why_size, "%s: its recipe (byte %" PRIu64 ") has no timestamp, the clock a replay is paced by; "
+                 "record the capture with urrt-dump --rtde -w FILE, whose recipe always has it", rd->path,
+                 rec->offset);
+        return false;
+    }
+    rd->recipe_fixed = rd->session_ok = rd->decided = true;
+    r->sessions = 1;
+    return true;
+}
+
+/* A data package of the session: its values' place in the file, when it
+ * matches the recipe (a client would drop one that does not). */
+static bool on_recorded_data(reading *rd, const rtde_capture_record *rec, char *why, size_t why_size)
+{
+    sim_rtde_recording *r = rd->r;
+    size_t idlen = rd->protocol >= 2 ? 1 : 0;
+    if (!rd->session_ok || rec->size != RTDE_HEADER + idlen + r->values_size ||
+        (idlen && rec->pkg[RTDE_HEADER] != rd->recipe_id)) {
+        if (rd->skipped++ == 0) {
+            rd->first_skipped = rec->offset;
+        }
+        return true;
+    }
+    if (r->count == rd->at_cap) {
+        size_t cap = rd->at_cap ? rd->at_cap * 2 : 4096;
+        uint64_t *at = realloc(r->at, cap * sizeof *at);
+        size_t *first = realloc(r->text_first, (cap + 1) * sizeof *first);
+        if (at != NULL) {
+            r->at = at;
+        }
+        if (first != NULL) {
+            r->text_first = first;
+        }
+        if (at == NULL || first == NULL) {
+            snprintf(why, why_size, "out of memory reading %s", rd->path);
+            return false;
+        }
+        if (r->count == 0) {
+            r->text_first[0] = 0;
+        }
+        rd->at_cap = cap;
+    }
+    r->at[r->count] = rec->offset + 1 + RTDE_HEADER + idlen;
+    r->text_first[++r->count] = r->ntexts;
+    return true;
+}
+
+/* A text message while data flowed: sent again before the next package. */
+static bool on_recorded_text(reading *rd, const rtde_capture_record *rec, char *why, size_t why_size)
+{
+    sim_rtde_recording *r = rd->r;
+    const uint8_t *p = rec->pkg + RTDE_HEADER;
+    size_t len = rec->size - RTDE_HEADER;
+    sim_rtde_recorded_text t;
+    if (!rd->session_ok || !rd->started || len < 1) {
+        return true; /* a text of a handshake is not replayed */
+    }
+    memset(&t, 0, sizeof t);
+    if (rd->protocol >= 2) {
+        size_t m = p[0], n;
+        if (len < 3 + m || len != 3 + m + p[1 + m]) {
+            return true;
+        }
+        n = p[1 + m];
+        t.mlen = (uint8_t)m;
+        t.slen = (uint8_t)n;
+        memcpy(t.message, p + 1, m);
+        memcpy(t.source, p + 2 + m, n);
+        t.level = p[2 + m + n];
+    } else {
+        t.level = p[0];
+        t.mlen = (uint8_t)(len - 1 > 255 ? 255 : len - 1);
+        memcpy(t.message, p + 1, t.mlen);
+    }
+    if (r->ntexts == rd->texts_cap) {
+        size_t cap = rd->texts_cap ? rd->texts_cap * 2 : 16;
+        sim_rtde_recorded_text *x = realloc(r->texts, cap * sizeof *x);
+        if (x == NULL) {
+            snprintf(why, why_size, "out of memory reading %s", rd->path);
+            return false;
+        }
+        r->texts = x;
+        rd->texts_cap = cap;
+    }
+    r->texts[r->ntexts++] = t;
+    return true;
+}
+
+/* A package the controller sent. */
+static bool on_recorded_reply(reading *rd, const rtde_capture_record *rec, char *why, size_t why_size)
+{
+    const uint8_t *p = rec->pkg + RTDE_HEADER;
+    switch (rec->type) {
+    case RTDE_V_PROTOCOL:
+        if (rec->size == RTDE_HEADER + 1) {
+            if (!rd->decided && rd->asked < 3 && rd->r->protocol_answer[rd->asked] < 0) {
+                rd->r->protocol_answer[rd->asked] = p[0] != 0;
+            }
+            if (p[0] != 0) {
+                rd->protocol = rd->asked;
+            }
+        }
+        return true;
+    case RTDE_V_URCONTROL:
+        if (rec->size == RTDE_HEADER + 16 && !rd->have_version) {
+            uint32_t v[4];
+            for (int i = 0; i < 4; i++) {
+                v[i] = (uint32_t)p[4 * i] << 24 | (uint32_t)p[4 * i + 1] << 16 | (uint32_t)p[4 * i + 2] << 8 |
+                       p[4 * i + 3];
+            }
+            rd->ctl->major = v[0];
+            rd->ctl->minor = v[1];
+            rd->ctl->bugfix = v[2];
+            rd->ctl->build = v[3];
+            rd->have_version = true;
+        }
+        return true;
+    case RTDE_SETUP_OUTPUTS: return on_recorded_setup(rd, rec, why, why_size);
+    case RTDE_START:
+        rd->started = rec->size == RTDE_HEADER + 1 && p[0] == 1;
+        return true;
+    case RTDE_DATA: return on_recorded_data(rd, rec, why, why_size);
+    case RTDE_TEXT: return on_recorded_text(rd, rec, why, why_size);
+    default: return true;
+    }
+}
+
+/* A request the client sent: what the next reply answers. */
+static bool on_recorded_request(reading *rd, const rtde_capture_record *rec)
+{
+    if (rec->type == RTDE_V_PROTOCOL && rec->size == RTDE_HEADER + 2) {
+        rd->asked = (unsigned)rec->pkg[3] << 8 | rec->pkg[4];
+    } else if (rec->type == RTDE_SETUP_OUTPUTS) {
+        memcpy(rd->setup, rec->pkg, rec->size);
+        rd->setup_size = rec->size;
+    } else if (rec->type == RTDE_PAUSE) {
+        rd->started = false;
+    }
+    return true;
+}
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The packages' rate: one over the median step of their timestamps (steps
+ * that run back, stand still or jump 10 s or more, reconnects, left out). */
+static double recorded_rate(const sim_rtde_recording *r)
+{
+    double *steps = malloc((r->count ? r->count : 1) * sizeof *steps), rate = 0.0;
+    size_t n = 0;
+    if (steps == NULL) {
+        return 0.0;
+    }
+    for (size_t i = 1; i < r->count; i++) {
+        double d = sim_rtde_recording_time(r, i) - sim_rtde_recording_time(r, i - 1);
+        if (isfinite(d) && d > 0.0 && d < 10.0) {
+            steps[n++] = d;
+        }
+    }
+    if (n > 0) {
+        qsort(steps, n, sizeof *steps, compare_doubles);
+        rate = 1.0 / steps[n / 2];
+    }
+    free(steps);
+    return rate;
+}
+
+/* Reads the records; false with the reason in why. */
+static bool read_recording(reading *rd, FILE *f, char *why, size_t why_size)
+{
+    rtde_capture *cap = rtde_capture_open(f, rd->path, why, why_size);
+    rtde_capture_record rec;
+    int got = 0;
+    if (cap == NULL) {
+        return false;
+    }
+    while (!rd->other_recipe && (got = rtde_capture_next(cap, &rec, why, why_size)) > 0) {
+        bool ok = true;
+        if (rec.kind == RTDE_CAPTURE_CONNECT) {
+            rd->protocol = 1;
+            rd->session_ok = rd->started = false;
+            rd->setup_size = 0;
+        } else if (rec.kind == RTDE_CAPTURE_SENT) {
+            ok = on_recorded_request(rd, &rec);
+        } else {
+            ok = on_recorded_reply(rd, &rec, why, why_size);
+        }
+        if (!ok) {
+            rtde_capture_free(cap);
+            return false;
+        }
+    }
+    if (got == 0 && rtde_capture_truncated(cap) > 0) {
+        urrt_log(URRT_LOG_NOTICE, "capture %s: its last record is cut short (%zu bytes, a recorder stopped "
+                 "mid-write): left out", rd->path, rtde_capture_truncated(cap));
+    }
+    rtde_capture_free(cap);
+    return got >= 0 || rd->other_recipe;
+}
+
+int sim_rtde_sniff(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    int c = f != NULL ? fgetc(f) : EOF;
+    if (f != NULL) {
+        fclose(f);
+    }
+    return f == NULL ? -1 : c == RTDE_CAPTURE_FIRST_BYTE;
+}
+
+bool sim_rtde_recording_load(const char *path, sim_rtde_recording *r, sim_rtde_controller *ctl, char *why,
+                             size_t why_size)
+{
+    reading rd = {.path = path, .r = r, .ctl = ctl, .protocol = 1};
+    struct stat st;
+    FILE *f = NULL;
+    void *map;
+    bool ok;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+
+    memset(r, 0, sizeof *r);
+    memset(ctl, 0, sizeof *ctl);
+    memset(r->protocol_answer, 0xff, sizeof r->protocol_answer);
+    if (fd < 0 || fstat(fd, &st) != 0 || st.st_size == 0) {
+        snprintf(why, why_size, "cannot read the capture %s: %s", path, fd < 0 ? strerror(errno) : "empty");
+        if (fd >= 0) {
+            close(fd);
+        }
+        return false;
+    }
+    map = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE, fd, 0);
+    close(fd);
+    if (map == MAP_FAILED) {
+        snprintf(why, why_size, "cannot map the capture %s: %s", path, strerror(errno));
+        return false;
+    }
+    r->file = map;
+    r->file_size = (size_t)st.st_size;
+    rd.setup = malloc(RTDE_SIZE_MAX);
+    f = fmemopen(map, r->file_size, "rb");
+    ok = rd.setup != NULL && f != NULL;
+    if (!ok) {
+        snprintf(why, why_size, "cannot read the capture %s: out of memory", path);
+    }
+    ok = ok && read_recording(&rd, f, why, why_size);
+    if (f != NULL) {
+        fclose(f);
+    }
+    free(rd.setup);
+    if (ok && !rd.have_version) {
+        snprintf(why, why_size, "%s has no reply to the controller version request ('v'): not a capture of a "
+                 "whole session; record one with urrt-dump --rtde -w FILE", path);
+        ok = false;
+    } else if (ok && !rd.recipe_fixed) {
+        snprintf(why, why_size, "%s has no output recipe its controller accepted: nothing to replay", path);
+        ok = false;
+    } else if (ok && r->count == 0) {
+        snprintf(why, why_size, "%s holds no data package of its recipe: nothing to replay", path);
+        ok = false;
+    }
+    if (!ok) {
+        sim_rtde_recording_free(r);
+        return false;
+    }
+    if (rd.skipped > 0) {
+        urrt_log(URRT_LOG_NOTICE, "capture %s: %" PRIu64 " data package%s that do%s not match the recipe (the first "
+                 "at byte %" PRIu64 "): left out, as its client dropped them", path, rd.skipped,
+                 rd.skipped == 1 ? "" : "s", rd.skipped == 1 ? "es" : "", rd.first_skipped);
+    }
+    ctl->rate_hz = ctl->major >= 5 ? 500u : 125u;
+    r->rate_hz = recorded_rate(r);
+    ctl->cycle_hz = r->rate_hz > 0.0 ? r->rate_hz : (double)ctl->rate_hz;
+    ctl->recording = r;
+    return true;
+}
+
+double sim_rtde_recording_time(const sim_rtde_recording *r, size_t i)
+{
+    return get_double(r->file + r->at[i] + r->timestamp_at);
+}
+
+void sim_rtde_recording_free(sim_rtde_recording *r)
+{
+    if (r->file != NULL) {
+        munmap((void *)(uintptr_t)r->file, r->file_size);
+    }
+    free(r->names);
+    free(r->fields);
+    free(r->at);
+    free(r->texts);
+    free(r->text_first);
+    memset(r, 0, sizeof *r);
 }

@@ -14,6 +14,11 @@
  * What depends on the controller version: the variables it knows (a newer
  * one is NOT_FOUND), the rate (125 Hz before 5.0, 500 Hz from 5.0), and the
  * protocol (1 only before 3.4).
+ *
+ * Or the controller is an RTDE capture (urrt-sim --replay): a
+ * sim_rtde_recording answers the handshake as the recorded controller did
+ * and has only the recorded variables; each data package copies, for the
+ * client's recipe, the bytes of the recorded package's values.
  */
 #ifndef URRT_SIM_RTDE_H
 #define URRT_SIM_RTDE_H
@@ -34,10 +39,14 @@
 /* Backlog past the socket's buffer after which a reader is disconnected. */
 #define SIM_RTDE_BACKLOG_DEFAULT (64u * 1024u)
 
+typedef struct sim_rtde_recording sim_rtde_recording;
+
 /* The controller behind the port. */
 typedef struct sim_rtde_controller {
     uint32_t major, minor, bugfix, build;
-    uint32_t rate_hz;     /* 125 before 5.0, 500 from 5.0 */
+    uint32_t rate_hz;     /* 125 before 5.0, 500 from 5.0: the highest frequency a client may ask */
+    double cycle_hz;      /* the cycles k counted by sim_rtde_due: rate_hz, or a capture's own rate */
+    const sim_rtde_recording *recording;   /* a capture's controller; NULL: the model's */
 } sim_rtde_controller;
 
 /* What a bad data package looks like (--fault rtde-bad-package). */
@@ -67,6 +76,57 @@ typedef struct sim_rtde_field {
     uint16_t value;           /* index into the cycle's values */
     uint8_t type;             /* wire type */
 } sim_rtde_field;
+
+/* ---- a capture as the controller ---------------------------------------------- */
+
+/* A variable of the recorded recipe. */
+typedef struct sim_rtde_recorded_field {
+    const char *name;         /* into the recording's names, not terminated */
+    size_t len;
+    uint8_t type;             /* wire type */
+    size_t offset;            /* of its bytes among a package's values */
+} sim_rtde_recorded_field;
+
+/* A text message the recorded controller sent while data flowed. */
+typedef struct sim_rtde_recorded_text {
+    uint8_t level;
+    uint8_t mlen, slen;
+    char message[255], source[255];
+} sim_rtde_recorded_text;
+
+struct sim_rtde_recording {
+    int8_t protocol_answer[3];     /* the recorded answer to V(1), V(2): 1, 0, or -1 never asked */
+    size_t nfields;
+    sim_rtde_recorded_field *fields;
+    char *names;                   /* the recipe's names, as the setup request gave them */
+    size_t values_size;            /* bytes of values in a data package (no recipe id) */
+    size_t timestamp_at;           /* the timestamp's offset among them */
+    const uint8_t *file;           /* the capture, mapped */
+    size_t file_size;
+    size_t count;                  /* data packages */
+    uint64_t *at;                  /* offset of package i's values in the file */
+    double rate_hz;                /* the packages' rate by their timestamps (0: unknown) */
+    sim_rtde_recorded_text *texts; /* texts[text_first[i] .. text_first[i + 1]) came just before package i */
+    size_t ntexts;
+    size_t *text_first;            /* count + 1 entries */
+    size_t sessions;               /* connections whose packages are served */
+};
+
+/* Whether the file at path is an RTDE capture (1), by its first byte,
+ * never its name (0: another file, a RealTime capture), or cannot be
+ * opened (-1). */
+int sim_rtde_sniff(const char *path);
+
+/* Reads the RTDE capture at path as the controller to serve: ctl from its
+ * version reply, r its recipe and packages. False with the reason in why
+ * (file and byte offset where it is damaged); notes what it leaves out in
+ * the log (a later session with another recipe, packages that do not
+ * match the recipe, a record cut short at the end). */
+bool sim_rtde_recording_load(const char *path, sim_rtde_recording *r, sim_rtde_controller *ctl, char *why,
+                             size_t why_size);
+/* The controller timestamp of data package i. */
+double sim_rtde_recording_time(const sim_rtde_recording *r, size_t i);
+void sim_rtde_recording_free(sim_rtde_recording *r);
 
 typedef struct sim_rtde_session {
     const sim_rtde_controller *ctl;
@@ -108,5 +168,10 @@ bool sim_rtde_due(const sim_rtde_session *s, uint64_t k);
  * replaced by a bad package, when a fault says so). False when it cannot be
  * queued. Call only when sim_rtde_due() said so. */
 bool sim_rtde_send_data(sim_rtde_session *s, uint64_t k, const urrt_state *st);
+
+/* The same for a capture's controller: data package k mod count of the
+ * recording, after the text messages it recorded since the client's
+ * previous package. */
+bool sim_rtde_send_recorded(sim_rtde_session *s, uint64_t k);
 
 #endif

@@ -13,11 +13,11 @@ $(BUILD)/gateway/tools/%.o: gateway/tools/%.c
 
 -include $(TOOLS_OBJS:.o=.d)
 
-$(BUILD)/bin/urrt-sim: $(BUILD)/gateway/tools/urrt-sim.o $(SIM_MODEL_OBJ) $(SIM_RTDE_OBJ) $(CLI_OBJ) $(LIBPORT) $(LIBURRT)
+$(BUILD)/bin/urrt-sim: $(BUILD)/gateway/tools/urrt-sim.o $(SIM_MODEL_OBJ) $(SIM_RTDE_OBJ) $(RTDE_CAPTURE_OBJ) $(CLI_OBJ) $(LIBPORT) $(LIBURRT)
 	@mkdir -p $(@D)
 	$(CC) $(OPT) -o $@ $^ -lm
 
-$(BUILD)/bin/urrt-dump: $(BUILD)/gateway/tools/urrt-dump.o $(CLI_OBJ) $(RTDE_SOURCE_OBJ) $(LIBPORT) $(LIBURRT)
+$(BUILD)/bin/urrt-dump: $(BUILD)/gateway/tools/urrt-dump.o $(CLI_OBJ) $(RTDE_SOURCE_OBJ) $(RTDE_CAPTURE_OBJ) $(LIBPORT) $(LIBURRT)
 	@mkdir -p $(@D)
 	$(CC) $(OPT) -o $@ $^ -lm
 

@@ -8,7 +8,10 @@
  * stream goes to stderr at the end. With --rtde the link carries an RTDE
  * session (gateway/common/rtde_source): the recipe is what the format and
  * -k need, and each data package prints like a RealTime packet, RTDE-only
- * values under their RTDE names. See usage() and docs/tools.md.
+ * values under their RTDE names. --rtde -w records the session as an RTDE
+ * capture (gateway/common/rtde_capture.h), which --file recognises by its
+ * first byte and replays through the same client, so that it prints as the
+ * session did live. See usage() and docs/tools.md.
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -24,6 +27,7 @@
 
 #include "cli.h"
 #include "port.h"
+#include "rtde_capture.h"
 #include "rtde_source.h"
 #include "urrt.h"
 #include "urrt_rtde.h"
@@ -98,15 +102,20 @@ typedef struct dump {
     size_t partial_at_end;
     /* csv */
     bool csv_header_done;
-    /* rtde */
+    /* rtde: a live session (src) or a capture read back (replay) */
     rtde_source *src;
+    rtde_replay *replay;
+    uint64_t sessions;    /* connections in the capture read back */
+    size_t cut_short;     /* bytes of its last record, cut short */
     int rtde_status;      /* CLI_EXIT_RUNTIME once the session refused what was asked */
     bool hush_drop;       /* the reason is told: keep the link's drop line out of the log */
-    /* recording */
+    urrt_link *link;      /* the robot's, for the peer a capture names */
+    /* recording: RealTime bytes (record, pending) or an RTDE capture */
     FILE *record;
     uint8_t *pending;
     size_t pending_len;
     bool record_failed;
+    rtde_capture_writer *capture;
 } dump;
 
 static void usage(FILE *out)
@@ -115,11 +124,12 @@ static void usage(FILE *out)
 "Usage: " PROGRAM " [options] HOST[:PORT]\n"
 "       " PROGRAM " [options] --file PATH|-\n"
 "       " PROGRAM " [options] --rtde HOST[:PORT]\n"
+"       " PROGRAM " [options] --rtde -w CAPTURE HOST[:PORT]\n"
 "       " PROGRAM " --rtde --list HOST[:PORT]\n"
 "\n"
 "Prints what a Universal Robots controller sends on its RealTime port\n"
 "(30003, or the read-only 30013), from the robot or simulator at HOST (port\n"
-"30003 unless given; IPv6 as [::1]:30003) or from a raw capture. It never\n"
+"30003 unless given; IPv6 as [::1]:30003) or from a capture. It never\n"
 "sends a byte to the RealTime port, and reconnects when the link drops.\n"
 "\n"
 "With --rtde it reads HOST over RTDE instead (port 30004 unless given): it\n"
@@ -127,6 +137,10 @@ static void usage(FILE *out)
 "RealTime set this controller has), plus the timestamp, and sends nothing\n"
 "but the handshake (protocol version, controller version, output setup,\n"
 "start). Text messages of the controller go to stderr with their level.\n"
+"With -w it records the session as an RTDE capture, which --file prints\n"
+"again as it printed live and urrt-sim --replay and urrt-gateway --replay\n"
+"play; the recipe then holds every RealTime value and every RTDE-only status\n"
+"value the controller has, and the -k names (registers, for instance).\n"
 "\n"
 "Output (stdout):\n"
 "  -F, --format FMT        table (default): names, units, enum names, bit masks\n"
@@ -137,18 +151,23 @@ static void usage(FILE *out)
 "                          \"Gnuplot col.\" N (column 1 is the time)\n"
 "  -k, --fields A,B,...    only these fields, in this order (table, csv, json);\n"
 "                          names as in the field table, e.g. time,q_actual;\n"
-"                          with --rtde also RTDE names: actual_q is q_actual,\n"
+"                          with --rtde (or an RTDE capture) also RTDE names:\n"
+"                          actual_q is q_actual,\n"
 "                          and RTDE-only values (output_int_register_24,\n"
 "                          safety_status_bits, ...) print under their names\n"
 "  -n, --count N           stop after N packets\n"
 "  -e, --every N           print every Nth packet only (all are counted)\n"
 "  -w, --record PATH       save the raw stream (every byte up to the last\n"
 "                          complete packet); it replays through --file and\n"
-"                          urrt-sim --replay\n"
+"                          urrt-sim --replay. With --rtde an RTDE capture:\n"
+"                          what urrt-dump sent and every package the\n"
+"                          controller sent, from each connect on\n"
 "      --no-summary        no summary on stderr at the end\n"
 "\n"
 "Source:\n"
-"  -f, --file PATH         read a raw capture instead of a robot; - is stdin\n"
+"  -f, --file PATH         read a capture instead of a robot; - is stdin: a raw\n"
+"                          RealTime stream or an RTDE capture (--rtde -w),\n"
+"                          told apart by its first byte (--rtde optional)\n"
 "      --rtde              read HOST over RTDE (port 30004 unless given)\n"
 "      --list              with --rtde: the controller's version, then every\n"
 "                          RTDE variable urrt knows, its type and whether this\n"
@@ -178,7 +197,8 @@ static void usage(FILE *out)
 "Exit status: 0 done (--count reached, end of file, SIGINT/SIGTERM, end of\n"
 "connection with --once), 1 runtime error (cannot open or write a file, a\n"
 "file without a packet, no packet within --timeout, --once without a\n"
-"packet, an RTDE controller without a -k field), 2 usage error.\n"
+"packet, an RTDE controller or capture without a -k field, a damaged RTDE\n"
+"capture), 2 usage error (--rtde with a RealTime capture too).\n"
 "\n"
 "Examples:\n"
 "  " PROGRAM " 192.168.1.10:30013 -n 1                # one packet, as a table\n"
@@ -187,7 +207,9 @@ static void usage(FILE *out)
 "  " PROGRAM " -F json --file capture.bin | head\n"
 "  nc robot 30013 | " PROGRAM " --file - -F gnuplot > live.dat\n"
 "  " PROGRAM " --rtde robot -F csv -k timestamp,actual_q,output_int_register_24\n"
-"  " PROGRAM " --rtde --list robot                    # what this controller has\n");
+"  " PROGRAM " --rtde --list robot                    # what this controller has\n"
+"  " PROGRAM " --rtde robot -w arm.rtde -k output_int_register_24 -n 5000\n"
+"  " PROGRAM " --file arm.rtde -F csv -k timestamp,output_int_register_24\n");
 }
 
 /* The key of a -k name: a urrt field name, or an RTDE name (a mapped one is
@@ -303,20 +325,27 @@ static int key_var(unsigned key)
     return key < KEY_RTDE ? urrt_rtde_var_of_field((urrt_field_id)key) : (int)(key - KEY_RTDE);
 }
 
-/* -k against the source: RTDE-only values need --rtde, and RTDE has no
- * value for some RealTime fields (test_value, the reserved ones). */
-static void check_keys(const options *o)
+/* -k against the source: RTDE-only values need RTDE, and RTDE has no
+ * value for some RealTime fields (test_value, the reserved ones). rtde:
+ * the source is RTDE; file: the capture that says which (NULL: a robot,
+ * the options say). */
+static void check_keys(const options *o, bool rtde, const char *file)
 {
     char buf[URRT_RTDE_NAME_MAX];
     for (unsigned k = 0; k < o->nkeys; k++) {
         unsigned key = o->key_order[k];
-        if (!o->rtde && key >= KEY_RTDE) {
+        if (!rtde && key >= KEY_RTDE && file != NULL) {
+            cli_usage_error(PROGRAM, "-k %s: only RTDE has this value, and %s is a RealTime capture: leave it "
+                            "out", key_name(key, buf, sizeof buf), file);
+        }
+        if (!rtde && key >= KEY_RTDE) {
             cli_usage_error(PROGRAM, "-k %s: only RTDE has this value: add --rtde (and the RTDE port, 30004, "
                             "is the default then)", key_name(key, buf, sizeof buf));
         }
-        if (o->rtde && key_var(key) < 0) {
-            cli_usage_error(PROGRAM, "-k %s: RTDE has no such value (RealTime only): leave it out, or read the "
-                            "RealTime port without --rtde", key_name(key, buf, sizeof buf));
+        if (rtde && key_var(key) < 0) {
+            cli_usage_error(PROGRAM, "-k %s: RTDE has no such value (RealTime only): leave it out, or read %s",
+                            key_name(key, buf, sizeof buf),
+                            file != NULL ? "a RealTime capture" : "the RealTime port without --rtde");
         }
     }
 }
@@ -330,10 +359,6 @@ static void check_source(int argc, char **argv, int operand, options *o)
     }
     if (o->list && (o->fields_given || o->count != 0 || o->record_path != NULL)) {
         cli_usage_error(PROGRAM, "--list prints the variables and ends: leave out -k, -n and -w");
-    }
-    if (o->rtde && (o->file_path != NULL || o->record_path != NULL)) {
-        cli_usage_error(PROGRAM, "--file and --record are for RealTime streams: with --rtde read HOST[:PORT] "
-                        "live (RTDE is a dialogue, a capture of it does not replay)");
     }
     if (o->file_path != NULL) {
         if (operand < argc) {
@@ -380,7 +405,9 @@ static void parse_options(int argc, char **argv, options *o)
     o->log_level = URRT_LOG_NOTICE;
     operand = cli_parse_options(&set, argc, argv, o);
     check_source(argc, argv, operand, o);
-    check_keys(o);
+    if (o->file_path == NULL || o->rtde) {
+        check_keys(o, o->rtde, o->file_path); /* else the capture says which source it holds */
+    }
     if (o->fmt == FORMAT_GNUPLOT && o->fields_given) {
         cli_usage_error(PROGRAM, "gnuplot output holds every column (column N is UR's col. N): use csv or json "
                                  "for --fields");
@@ -404,6 +431,16 @@ typedef struct sample {
     const urrt_state *st;
     const urrt_rtde_values *vals;
 } sample;
+
+/* The RTDE session the packets come from: the live source's, or the one a
+ * capture replays; NULL for RealTime. */
+static const urrt_rtde *rtde_session_of(const dump *d)
+{
+    if (d->src != NULL) {
+        return rtde_source_session(d->src);
+    }
+    return d->replay != NULL ? rtde_replay_session(d->replay) : NULL;
+}
 
 /* Elements of an RTDE-only variable's value (3 for a VECTOR3D, ...). */
 static unsigned rtde_elems(int var)
@@ -456,17 +493,18 @@ static void print_key_elem(FILE *out, const sample *s, unsigned key, unsigned i,
 }
 
 /* The keys to print: those asked for, in the order asked, or else the
- * packet's fields. */
-static unsigned selected_keys(const dump *d, const urrt_state *st, unsigned *keys)
+ * packet's fields, then its RTDE-only values (which an RTDE package has
+ * without -k only when recorded: --rtde -w asks for them). */
+static unsigned selected_keys(const dump *d, const sample *s, unsigned *keys)
 {
     unsigned n = 0;
     if (d->opt.fields_given) {
         memcpy(keys, d->opt.key_order, d->opt.nkeys * sizeof *keys);
         return d->opt.nkeys;
     }
-    for (unsigned id = 0; id < URRT_FIELD_COUNT; id++) {
-        if (urrt_has(st, id)) {
-            keys[n++] = id;
+    for (unsigned key = 0; key < KEY_COUNT; key++) {
+        if (key_present(s, key)) {
+            keys[n++] = key;
         }
     }
     return n;
@@ -490,46 +528,45 @@ static void print_gnuplot(const dump *d, FILE *out, const uint8_t *pkt, size_t l
 }
 
 /* An RTDE package has no column layout of UR's: every value of the recipe's
- * fields in field order (RealTime's order, so column 1 is the time), and a
- * first comment line that names the columns. */
-static void print_gnuplot_rtde(const dump *d, FILE *out, const urrt_state *st)
+ * fields in field order (RealTime's order, so column 1 is the time), then
+ * its RTDE-only values, and a first comment line that names the columns. */
+static void print_gnuplot_rtde(const dump *d, FILE *out, const sample *s)
 {
-    unsigned keys[URRT_FIELD_COUNT];
-    unsigned n = selected_keys(d, st, keys);
+    char buf[URRT_RTDE_NAME_MAX];
+    unsigned keys[KEY_COUNT];
+    unsigned n = selected_keys(d, s, keys);
     unsigned col = 1;
     if (d->packets == 1) {
         fputs("# urrt-dump --rtde: one line per data package; columns:", out);
         for (unsigned k = 0; k < n; k++) {
-            const urrt_field_info *f = urrt_field((urrt_field_id)keys[k]);
-            if (f->count > 1) {
-                fprintf(out, " %u-%u %s", col, col + f->count - 1u, f->name);
+            unsigned count = key_elems(keys[k]);
+            if (count > 1) {
+                fprintf(out, " %u-%u %s", col, col + count - 1u, key_name(keys[k], buf, sizeof buf));
             } else {
-                fprintf(out, " %u %s", col, f->name);
+                fprintf(out, " %u %s", col, key_name(keys[k], buf, sizeof buf));
             }
-            col += f->count;
+            col += count;
         }
         fputc('\n', out);
     }
     for (unsigned k = 0; k < n; k++) {
-        const urrt_field_info *f = urrt_field((urrt_field_id)keys[k]);
-        const double *v = urrt_field_values(st, keys[k]);
-        for (unsigned i = 0; i < f->count; i++) {
+        for (unsigned i = 0; i < key_elems(keys[k]); i++) {
             if (k > 0 || i > 0) {
                 fputc(' ', out);
             }
-            fprintf(out, "%.17g", v[i]);
+            print_key_elem(out, s, keys[k], i, false);
         }
     }
     fputc('\n', out);
 }
 
-static void print_csv_header(dump *d, FILE *out, const urrt_state *st)
+static void print_csv_header(dump *d, FILE *out, const sample *s)
 {
     char buf[URRT_RTDE_NAME_MAX];
     bool first = true;
     /* Without --fields the columns are those of the first packet. */
     if (!d->opt.fields_given) {
-        d->opt.nkeys = selected_keys(d, st, d->opt.key_order);
+        d->opt.nkeys = selected_keys(d, s, d->opt.key_order);
         d->opt.fields_given = true;
     }
     for (unsigned k = 0; k < d->opt.nkeys; k++) {
@@ -551,7 +588,7 @@ static void print_csv(dump *d, FILE *out, const sample *s)
 {
     bool first = true;
     if (!d->csv_header_done) {
-        print_csv_header(d, out, s->st);
+        print_csv_header(d, out, s);
     }
     for (unsigned k = 0; k < d->opt.nkeys; k++) {
         unsigned key = d->opt.key_order[k];
@@ -578,9 +615,9 @@ static bool is_bits(const urrt_field_info *f)
  * and the versions that send its length; RTDE: protocol and controller). */
 static void print_json_head(const dump *d, FILE *out, const urrt_state *st)
 {
+    const urrt_rtde *ses = rtde_session_of(d);
     fprintf(out, "{\"packet\":%" PRIu64 ",\"length\":%u", d->packets, (unsigned)st->length);
-    if (d->src != NULL) {
-        const urrt_rtde *ses = rtde_source_session(d->src);
+    if (ses != NULL) {
         fprintf(out, ",\"source\":\"rtde\",\"protocol\":%u,\"controller\":\"%" PRIu32 ".%" PRIu32 ".%" PRIu32
                 ".%" PRIu32 "\"", (unsigned)ses->protocol_accepted, ses->controller[0], ses->controller[1],
                 ses->controller[2], ses->controller[3]);
@@ -640,7 +677,7 @@ static void print_json(const dump *d, FILE *out, const sample *s)
 {
     char buf[URRT_RTDE_NAME_MAX];
     unsigned keys[KEY_COUNT];
-    unsigned n = selected_keys(d, s->st, keys);
+    unsigned n = selected_keys(d, s, keys);
     print_json_head(d, out, s->st);
     for (unsigned k = 0; k < n; k++) {
         unsigned key = keys[k];
@@ -668,8 +705,8 @@ static void print_json(const dump *d, FILE *out, const sample *s)
 
 static void print_table_head(const dump *d, FILE *out, const urrt_state *st)
 {
-    if (d->src != NULL) {
-        const urrt_rtde *ses = rtde_source_session(d->src);
+    const urrt_rtde *ses = rtde_session_of(d);
+    if (ses != NULL) {
         fprintf(out, "package %" PRIu64 ": %u bytes, RTDE protocol %u, controller %" PRIu32 ".%" PRIu32 ".%" PRIu32
                 ".%" PRIu32 "\n", d->packets, (unsigned)st->length, (unsigned)ses->protocol_accepted,
                 ses->controller[0], ses->controller[1], ses->controller[2], ses->controller[3]);
@@ -733,7 +770,7 @@ static void print_table(const dump *d, FILE *out, const sample *s)
 {
     char buf[URRT_RTDE_NAME_MAX];
     unsigned keys[KEY_COUNT];
-    unsigned n = selected_keys(d, s->st, keys);
+    unsigned n = selected_keys(d, s, keys);
     print_table_head(d, out, s->st);
     for (unsigned k = 0; k < n; k++) {
         unsigned key = keys[k];
@@ -745,7 +782,7 @@ static void print_table(const dump *d, FILE *out, const sample *s)
                     urrt_rtde_type_name(urrt_rtde_var_type((int)(key - KEY_RTDE))));
         }
         if (!key_present(s, key)) {
-            fputs(d->src != NULL ? " (not in this package)\n" : " (not in this packet)\n", out);
+            fputs(s->vals != NULL ? " (not in this package)\n" : " (not in this packet)\n", out);
             continue;
         }
         if (key < KEY_RTDE) {
@@ -758,6 +795,22 @@ static void print_table(const dump *d, FILE *out, const sample *s)
 }
 
 /* ---- recording ---------------------------------------------------------------- */
+
+/* -w of a RealTime stream: the file, and room for the bytes held back;
+ * false (logged) if either cannot be had. */
+static bool open_record(dump *d)
+{
+    if (d->opt.record_path == NULL) {
+        return true;
+    }
+    d->record = fopen(d->opt.record_path, "wb");
+    d->pending = malloc(RECORD_PENDING_MAX);
+    if (d->record == NULL || d->pending == NULL) {
+        urrt_log(URRT_LOG_ERR, "cannot create the recording %s: %s", d->opt.record_path, strerror(errno));
+        return false;
+    }
+    return true;
+}
 
 static bool record_write(dump *d, const uint8_t *data, size_t len)
 {
@@ -817,13 +870,16 @@ static void print_packet(dump *d, FILE *out, const uint8_t *pkt, size_t len)
     if (d->src != NULL) {
         s.st = rtde_source_state(d->src);
         s.vals = rtde_source_values(d->src);
+    } else if (d->replay != NULL) {
+        s.st = rtde_replay_state(d->replay);
+        s.vals = rtde_replay_values(d->replay);
     } else if (d->opt.fmt != FORMAT_GNUPLOT) {
         urrt_decode(pkt, len, &decoded);
     }
     switch (d->opt.fmt) {
     case FORMAT_GNUPLOT:
-        if (d->src != NULL) {
-            print_gnuplot_rtde(d, out, s.st);
+        if (s.vals != NULL) {
+            print_gnuplot_rtde(d, out, &s);
         } else {
             print_gnuplot(d, out, pkt, len);
         }
@@ -848,8 +904,9 @@ static void on_packet(void *ctx, const uint8_t *pkt, size_t len, uint64_t rx_us)
     }
     d->packets++;
     note_length(d, (uint32_t)len);
-    if (d->src != NULL) {
-        t = rtde_source_state(d->src)->time[0]; /* NaN only if the recipe lacked it */
+    if (d->src != NULL || d->replay != NULL) {
+        /* NaN only if the recipe lacked it */
+        t = (d->src != NULL ? rtde_source_state(d->src) : rtde_replay_state(d->replay))->time[0];
     } else {
         d->gen_count[urrt_generation_of((uint32_t)len)]++;
         urrt_read_column(pkt, len, 1, &t);
@@ -898,10 +955,101 @@ static bool rtde_version_unstated(int var)
            urrt_rtde_var_available(var, 10, 255, 255) == URRT_RTDE_UNKNOWN;
 }
 
+/* Whether var is a row of one name in lib's table of RTDE-only values
+ * (a status value such as safety_status_bits, not a register of a family). */
+static bool rtde_single(int var)
+{
+    switch (var) {
+#define X_SINGLE(ID, member, name, TYPE, first, names, split, since, since_hi) \
+    case URRT_RTDE_V_##ID: return (names) == 1;
+        URRT_RTDE_ONLY(X_SINGLE)
+#undef X_SINGLE
+    default: return false;
+    }
+}
+
+/* Whether a recording asks for var without -k: every value RealTime has
+ * too, and every RTDE-only status value, wherever the version table says
+ * which controllers have it (the source leaves out those this one lacks).
+ * Where no source gives a version the controller's NOT_FOUND would refuse
+ * the whole recipe: those only with -k. */
+static bool rtde_recorded(int var)
+{
+    static const uint32_t lines[] = {3, 5, 10}; /* CB3, e-Series, PolyScope X */
+    if (urrt_rtde_var_field(var) < 0 && !rtde_single(var)) {
+        return false;
+    }
+    for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++) {
+        if (urrt_rtde_var_available(var, lines[i], 255, 255) == URRT_RTDE_UNKNOWN) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/* Bytes of the recipe's name list: the names and the commas between them. */
+static size_t rtde_names_size(const uint16_t *vars, size_t n)
+{
+    size_t size = n > 0 ? n - 1 : 0;
+    for (size_t i = 0; i < n; i++) {
+        char name[URRT_RTDE_NAME_MAX];
+        int len = urrt_rtde_var_name(vars[i], name, sizeof name);
+        size += len > 0 ? (size_t)len : 0;
+    }
+    return size;
+}
+
+static bool rtde_recipe_fits(const uint16_t *vars, size_t n)
+{
+    return n <= URRT_RTDE_MAX_VARS && rtde_names_size(vars, n) <= URRT_RTDE_NAMES_MAX;
+}
+
+/* A recording's recipe past UR's bounds (2048 bytes of names, or more
+ * variables than a recipe holds): the last RTDE-only values not named by
+ * -k are left out, and a notice names them. Returns the new count; if
+ * even that does not fit, the recipe as it was (rtde_source_new refuses
+ * it, and the -k names are what to shorten). */
+static size_t rtde_recipe_fit(uint16_t *vars, bool *optional, size_t n)
+{
+    char left_out[URRT_RTDE_NAMES_MAX + 1];
+    uint16_t kept[URRT_RTDE_VAR_COUNT];
+    size_t len = 0, nkept = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!optional[i] || urrt_rtde_var_field(vars[i]) >= 0) {
+            kept[nkept++] = vars[i];
+        }
+    }
+    if (rtde_recipe_fits(vars, n) || !rtde_recipe_fits(kept, nkept)) {
+        return n;
+    }
+    left_out[0] = '\0';
+    for (size_t i = n; i-- > 0 && !rtde_recipe_fits(vars, n);) {
+        char name[URRT_RTDE_NAME_MAX];
+        if (!optional[i] || urrt_rtde_var_field(vars[i]) >= 0) {
+            continue;
+        }
+        urrt_rtde_var_name(vars[i], name, sizeof name);
+        if (len + 2 + strlen(name) < sizeof left_out) { /* fits: at most 2048 bytes are left out */
+            len += (size_t)snprintf(left_out + len, sizeof left_out - len, "%s%s", len > 0 ? ", " : "", name);
+        }
+        memmove(vars + i, vars + i + 1, (n - i - 1) * sizeof *vars);
+        memmove(optional + i, optional + i + 1, (n - i - 1) * sizeof *optional);
+        n--;
+    }
+    if (len > 0) {
+        urrt_log(URRT_LOG_NOTICE, "the recording leaves out %s: the recipe holds %d names in %d bytes at most "
+                 "(fewer -k names make room)", left_out, URRT_RTDE_MAX_VARS, URRT_RTDE_NAMES_MAX);
+    }
+    return n;
+}
+
 /* The recipe: the timestamp always, then what -k asks for (required: a
  * controller without one ends the run), or without -k every field RTDE
- * shares with RealTime, each only where the controller has it; for --list
- * the variables only the controller can say it has. Returns the count. */
+ * shares with RealTime, each only where the controller has it; a recording
+ * (-w) asks for those and the RTDE-only status values too, so that its
+ * capture serves any configuration that needs only those, and -k adds
+ * what else it should hold (registers); for --list the variables only the
+ * controller can say it has. Returns the count. */
 static size_t rtde_recipe(const options *o, uint16_t *vars, bool *optional)
 {
     size_t n = 0;
@@ -909,20 +1057,23 @@ static size_t rtde_recipe(const options *o, uint16_t *vars, bool *optional)
     optional[n++] = false;
     for (int var = URRT_RTDE_V_TIMESTAMP + 1; var < (int)URRT_RTDE_VAR_COUNT; var++) {
         int field = urrt_rtde_var_field(var);
+        bool named = o->fields_given && o->key_on[field >= 0 ? (unsigned)field : KEY_RTDE + (unsigned)var];
         bool asked;
         if (o->list) {
             asked = rtde_version_unstated(var);
+        } else if (o->record_path != NULL) {
+            asked = named || rtde_recorded(var);
         } else if (o->fields_given) {
-            asked = o->key_on[field >= 0 ? (unsigned)field : KEY_RTDE + (unsigned)var];
+            asked = named;
         } else {
             asked = field >= 0;
         }
         if (asked) {
             vars[n] = (uint16_t)var;
-            optional[n++] = !o->list && !o->fields_given;
+            optional[n++] = !o->list && !named;
         }
     }
-    return n;
+    return o->record_path != NULL ? rtde_recipe_fit(vars, optional, n) : n;
 }
 
 static void version_text(const urrt_rtde *ses, char *out, size_t size)
@@ -986,13 +1137,13 @@ static void print_list(const dump *d, bool answered)
 /* A text message of the controller on stderr with its level. The source
  * logs it already (exception and error as errors, warning as a warning,
  * the rest as info); what that hides at this log level is shown here. */
-static void show_text(const dump *d, const urrt_rtde_event *ev)
+static void show_text(const dump *d, const char *robot, const urrt_rtde_event *ev)
 {
     static const char *const level_names[] = {"exception", "error", "warning", "info"};
     if (ev->level < URRT_RTDE_LEVEL_INFO || d->opt.log_level >= URRT_LOG_INFO) {
         return;
     }
-    urrt_log(URRT_LOG_NOTICE, "robot %s: controller says (%s)%s%.*s: %.*s", d->opt.host,
+    urrt_log(URRT_LOG_NOTICE, "robot %s: controller says (%s)%s%.*s: %.*s", robot,
              ev->level <= URRT_RTDE_LEVEL_INFO ? level_names[ev->level] : "level past info",
              ev->source_len > 0 ? " from " : "", (int)ev->source_len, ev->source_len > 0 ? ev->source : "",
              (int)ev->text_len, ev->text);
@@ -1004,7 +1155,7 @@ static void on_rtde_event(void *ctx, const urrt_rtde_event *ev, uint64_t rx_us)
     dump *d = ctx;
     (void)rx_us;
     if (ev->kind == URRT_RTDE_EV_TEXT) {
-        show_text(d, ev);
+        show_text(d, d->opt.host, ev);
         return;
     }
     if (d->done) {
@@ -1035,6 +1186,27 @@ static void on_rtde_event(void *ctx, const urrt_rtde_event *ev, uint64_t rx_us)
     }
 }
 
+/* The session's bytes into the capture (-w), up to the package that ends
+ * the run; a failed write is told once and ends the recording, not the run. */
+static void on_rtde_tap(void *ctx, rtde_source_tap what, const uint8_t *data, size_t len)
+{
+    dump *d = ctx;
+    bool ok = true;
+    if (d->capture == NULL || d->record_failed || d->done) {
+        return;
+    }
+    switch (what) {
+    case RTDE_SOURCE_TAP_CONNECTED: ok = rtde_capture_connected(d->capture, urrt_link_peer(d->link)); break;
+    case RTDE_SOURCE_TAP_SENT: ok = rtde_capture_sent(d->capture, data, len); break;
+    default: ok = rtde_capture_received(d->capture, data, len); break;
+    }
+    if (!ok) {
+        urrt_log(URRT_LOG_ERR, "cannot write the capture %s: %s; it ends at the last record written, the run goes "
+                 "on", d->opt.record_path, strerror(errno));
+        d->record_failed = true;
+    }
+}
+
 /* The RTDE source of the run, set on the link; false (logged) when the
  * recipe cannot be. */
 static bool open_rtde(dump *d, urrt_link *link)
@@ -1046,31 +1218,48 @@ static bool open_rtde(dump *d, urrt_link *link)
     cfg.count = rtde_recipe(&d->opt, vars, optional);
     d->src = rtde_source_new(&cfg, why, sizeof why);
     if (d->src == NULL) {
-        urrt_log(URRT_LOG_ERR, "%s%s", why, d->opt.fields_given ? " (-k asks for too many values)" : "");
+        urrt_log(URRT_LOG_ERR, "%s%s", why, !d->opt.fields_given ? ""
+                 : d->opt.record_path != NULL ? " (-k asks for too many values beside the RealTime set a recording "
+                                                "asks for)"
+                                              : " (-k asks for too many values)");
         return false;
     }
     rtde_source_set_event_fn(d->src, on_rtde_event, d);
+    if (d->capture != NULL) {
+        rtde_source_set_tap(d->src, on_rtde_tap, d);
+    }
     rtde_source_attach(d->src, link);
     return true;
 }
 
 /* ---- sources ------------------------------------------------------------------ */
 
-static int run_file(dump *d)
+/* The name of the file read, for messages. */
+static const char *file_name(const dump *d)
 {
-    int fd = strcmp(d->opt.file_path, "-") == 0 ? STDIN_FILENO : open(d->opt.file_path, O_RDONLY | O_CLOEXEC);
+    return strcmp(d->opt.file_path, "-") == 0 ? "the input" : d->opt.file_path;
+}
+
+/* A RealTime capture: the framer over the file's bytes, first the byte
+ * read to tell the kind (if any). */
+static int run_realtime_file(dump *d, int fd, const uint8_t *first, size_t first_len)
+{
     static uint8_t buf[65536];
     urrt_framer fr;
     int status = CLI_EXIT_OK;
+    bool at_first = true;
 
-    if (fd < 0) {
-        urrt_log(URRT_LOG_ERR, "cannot open %s: %s", d->opt.file_path, strerror(errno));
-        return CLI_EXIT_RUNTIME;
-    }
     urrt_framer_init(&fr);
     while (running && !d->done) {
-        ssize_t n = read(fd, buf, sizeof buf);
+        ssize_t n;
         const uint8_t *p = buf;
+        if (at_first) {
+            memcpy(buf, first, first_len);
+            n = (ssize_t)first_len;
+            at_first = false;
+        } else {
+            n = read(fd, buf, sizeof buf);
+        }
         if (n < 0) {
             if (errno == EINTR) {
                 continue;
@@ -1098,14 +1287,171 @@ static int run_file(dump *d)
         }
     }
     d->fstats = fr.stats;
-    if (fd != STDIN_FILENO) {
-        close(fd);
-    }
     if (status == CLI_EXIT_OK && running && d->packets == 0) {
         urrt_log(URRT_LOG_ERR, "%s holds no RealTime packet (%" PRIu64 " bytes): give a raw capture of port 30003 "
-                 "or 30013 (nc robot 30003 > FILE, urrt-dump -w FILE)",
-                 strcmp(d->opt.file_path, "-") == 0 ? "the input" : d->opt.file_path, fr.stats.bytes);
+                 "or 30013 (nc robot 30003 > FILE, urrt-dump -w FILE) or an RTDE capture (urrt-dump --rtde -w FILE)",
+                 file_name(d), fr.stats.bytes);
         status = CLI_EXIT_RUNTIME;
+    }
+    return status;
+}
+
+/* A text message of the recorded controller, at the level rtde_source
+ * gives it live. */
+static void replay_text(const dump *d, const char *robot, const urrt_rtde_event *ev)
+{
+    urrt_log_level level = ev->level <= URRT_RTDE_LEVEL_ERROR     ? URRT_LOG_ERR
+                           : ev->level == URRT_RTDE_LEVEL_WARNING ? URRT_LOG_WARNING
+                                                                  : URRT_LOG_INFO;
+    urrt_log(level, "robot %s: controller says%s%.*s: %.*s", robot, ev->source_len > 0 ? " from " : "",
+             (int)ev->source_len, ev->source_len > 0 ? ev->source : "", (int)ev->text_len, ev->text);
+    show_text(d, robot, ev);
+}
+
+/* -k against the recipe of a session of the capture: a name it lacks was
+ * not recorded; false (logged) if any. */
+static bool capture_has_keys(const dump *d)
+{
+    char buf[URRT_RTDE_NAME_MAX], name[URRT_RTDE_NAME_MAX];
+    bool ok = true;
+    for (unsigned k = 0; k < d->opt.nkeys; k++) {
+        int var = key_var(d->opt.key_order[k]);
+        if (!rtde_replay_has(d->replay, var)) {
+            urrt_rtde_var_name(var, name, sizeof name);
+            urrt_log(URRT_LOG_ERR, "-k %s: the capture %s holds no %s (its session with %s did not ask for it): "
+                     "leave it out of -k, or record it with urrt-dump --rtde -w FILE -k %s", key_name(d->opt.key_order[k], buf, sizeof buf),
+                     file_name(d), name, rtde_replay_peer(d->replay), name);
+            ok = false;
+        }
+    }
+    return ok;
+}
+
+/* An RTDE capture, f positioned at its first byte: replayed through
+ * lib/urrt_rtde's client (rtde_replay), each data package printed as the
+ * live session printed it, each connection's events logged as they were. */
+static int run_rtde_file(dump *d, FILE *f)
+{
+    char why[600];
+    int status = CLI_EXIT_OK;
+    urrt_rtde_event ev;
+
+    if (d->opt.record_path != NULL) {
+        cli_usage_error(PROGRAM, "%s is an RTDE capture: -w records a robot (urrt-dump --rtde -w FILE HOST); "
+                        "to keep the capture, copy it", file_name(d));
+    }
+    if (!d->opt.rtde) {
+        check_keys(&d->opt, true, file_name(d));
+    }
+    d->replay = rtde_replay_open(f, file_name(d), why, sizeof why);
+    if (d->replay == NULL) {
+        urrt_log(URRT_LOG_ERR, "%s", why);
+        return CLI_EXIT_RUNTIME;
+    }
+    while (running && !d->done) {
+        int k = rtde_replay_next(d->replay, &ev, why, sizeof why);
+        const char *robot = rtde_replay_peer(d->replay);
+        if (k == 0) {
+            d->cut_short = rtde_replay_truncated(d->replay);
+            if (d->cut_short > 0) {
+                urrt_log(URRT_LOG_NOTICE, "%s: the last record is cut short (%zu bytes, the recording ended while "
+                         "writing it): left out", file_name(d), d->cut_short);
+            }
+            break;
+        }
+        if (k < 0) {
+            urrt_log(URRT_LOG_ERR, "%s", why);
+            status = CLI_EXIT_RUNTIME;
+            break;
+        }
+        switch (k) {
+        case RTDE_REPLAY_SESSION:
+            d->sessions++;
+            urrt_log(d->sessions > 1 ? URRT_LOG_NOTICE : URRT_LOG_INFO, "%s: session %" PRIu64 ": connected to %s",
+                     file_name(d), d->sessions, robot);
+            break;
+        case URRT_RTDE_EV_FALLBACK:
+            urrt_log(URRT_LOG_NOTICE, "robot %s: the controller refuses RTDE protocol %d: asking for %u", robot,
+                     URRT_RTDE_PROTOCOL, (unsigned)ev.protocol);
+            break;
+        case URRT_RTDE_EV_RECIPE:
+            if (!capture_has_keys(d)) {
+                status = CLI_EXIT_RUNTIME;
+                d->done = true;
+            }
+            break;
+        case URRT_RTDE_EV_TEXT: replay_text(d, robot, &ev); break;
+        case URRT_RTDE_EV_DATA: {
+            size_t size;
+            const uint8_t *pkg = rtde_replay_package(d->replay, &size);
+            on_packet(d, pkg, size, 0);
+            break;
+        }
+        case URRT_RTDE_EV_DROP:
+            urrt_log(URRT_LOG_WARNING, "robot %s: the recorded session broke the RTDE protocol (%s): the client "
+                     "dropped the connection", robot, urrt_rtde_strerror(ev.error));
+            break;
+        case URRT_RTDE_EV_CONFIG:
+            urrt_log(URRT_LOG_ERR, "robot %s: the recorded session was refused: %s; the client ended it there",
+                     robot, urrt_rtde_strerror(ev.error));
+            status = CLI_EXIT_RUNTIME;
+            break;
+        default: break;
+        }
+    }
+    if (status == CLI_EXIT_OK && running && !d->done && d->packets == 0) {
+        urrt_log(URRT_LOG_ERR, "%s holds no RTDE data package (%" PRIu64 " sessions): record one with urrt-dump "
+                 "--rtde -w FILE HOST", file_name(d), d->sessions);
+        status = CLI_EXIT_RUNTIME;
+    }
+    return status;
+}
+
+/* A capture: its first byte says which kind (rtde_capture.h: 'U' starts an
+ * RTDE capture, a RealTime stream starts with a size's high byte, 0). */
+static int run_file(dump *d)
+{
+    bool from_stdin = strcmp(d->opt.file_path, "-") == 0;
+    int fd = from_stdin ? STDIN_FILENO : open(d->opt.file_path, O_RDONLY | O_CLOEXEC);
+    uint8_t first = 0;
+    ssize_t n;
+    FILE *f;
+    int status;
+
+    if (fd < 0) {
+        urrt_log(URRT_LOG_ERR, "cannot open %s: %s", d->opt.file_path, strerror(errno));
+        return CLI_EXIT_RUNTIME;
+    }
+    while ((n = read(fd, &first, 1)) < 0 && errno == EINTR && running) {
+    }
+    if (n < 0) {
+        urrt_log(URRT_LOG_ERR, "cannot read %s: %s", d->opt.file_path, strerror(errno));
+        status = CLI_EXIT_RUNTIME;
+    } else if (n == 1 && first == RTDE_CAPTURE_FIRST_BYTE) {
+        /* The capture reader takes the file from its first byte. */
+        f = from_stdin ? stdin : fdopen(fd, "rb");
+        if (f == NULL || ungetc(first, f) == EOF) {
+            urrt_log(URRT_LOG_ERR, "cannot read %s: %s", d->opt.file_path, strerror(errno));
+            status = CLI_EXIT_RUNTIME;
+        } else {
+            status = run_rtde_file(d, f);
+            if (!from_stdin) {
+                fclose(f);
+                fd = -1;
+            }
+        }
+    } else if (d->opt.rtde) {
+        cli_usage_error(PROGRAM, "--rtde --file %s: %s is no RTDE capture (%s; an RTDE capture starts with "
+                        "\"%.*s\"): drop --rtde to read a RealTime capture", d->opt.file_path, file_name(d),
+                        n == 0 ? "it is empty" : first == 0 ? "it starts as a RealTime capture does, with 0x00"
+                                                            : "its first byte is no capture's",
+                        RTDE_CAPTURE_MAGIC_LEN - 1, RTDE_CAPTURE_MAGIC);
+    } else {
+        check_keys(&d->opt, false, file_name(d));
+        status = open_record(d) ? run_realtime_file(d, fd, &first, (size_t)n) : CLI_EXIT_RUNTIME;
+    }
+    if (fd >= 0 && !from_stdin) {
+        close(fd);
     }
     return status;
 }
@@ -1139,6 +1485,7 @@ static urrt_link *open_link(dump *d)
     cfg.silence_timeout_ms = d->opt.silence_timeout_ms;
     cfg.backoff_max_ms = d->opt.backoff_max_ms;
     link = urrt_link_new(&cfg);
+    d->link = link;
     if (link != NULL && d->opt.rtde && !open_rtde(d, link)) {
         urrt_link_free(link);
         return NULL;
@@ -1270,6 +1617,7 @@ static int run_link(dump *d)
     }
     urrt_log_set_level(d->opt.log_level); /* after a hushed drop */
     urrt_link_free(lc.link);
+    d->link = NULL;
     return status != CLI_EXIT_OK ? status : d->rtde_status;
 }
 
@@ -1279,17 +1627,32 @@ static int run_link(dump *d)
  * packages that were no data. */
 static void print_summary_rtde(const dump *d, FILE *out)
 {
-    const urrt_rtde *ses = rtde_source_session(d->src);
+    const urrt_rtde *ses = rtde_session_of(d);
     static char recipe[URRT_RTDE_NAMES_MAX + 1];
     char version[48];
     version_text(ses, version, sizeof version);
     if (ses->controller[0] == 0) {
         snprintf(version, sizeof version, "unknown (no handshake)");
     }
-    rtde_source_recipe_text(d->src, recipe, sizeof recipe);
+    if (d->src != NULL) {
+        rtde_source_recipe_text(d->src, recipe, sizeof recipe);
+    } else {
+        /* The capture's last session: its setup request's names. */
+        size_t len = 0;
+        recipe[0] = '\0';
+        for (size_t i = 0; i < ses->var_count && len < sizeof recipe - 1; i++) {
+            char name[URRT_RTDE_NAME_MAX];
+            urrt_rtde_var_name(ses->vars[i], name, sizeof name);
+            len += (size_t)snprintf(recipe + len, sizeof recipe - len, "%s%s", i > 0 ? "," : "", name);
+        }
+    }
     fprintf(out, "summary: rtde: controller %s, protocol %u, text messages %" PRIu64 ", packages ignored %" PRIu64
             "\n", version, (unsigned)ses->protocol_accepted, ses->stats.texts, ses->stats.ignored);
     fprintf(out, "summary: rtde recipe: %s\n", recipe);
+    if (d->replay != NULL) {
+        fprintf(out, "summary: rtde capture: sessions %" PRIu64 ", last record cut short: %zu bytes\n", d->sessions,
+                d->cut_short);
+    }
 }
 
 static void print_summary(const dump *d, bool from_link)
@@ -1298,7 +1661,7 @@ static void print_summary(const dump *d, bool from_link)
     fprintf(out, "summary: packets: %" PRIu64 "\n", d->packets);
     fprintf(out, "summary: lengths:");
     for (size_t i = 0; i < d->nlengths; i++) {
-        const char *v = d->src != NULL ? "RTDE data packages" : urrt_versions_of(d->lengths[i]);
+        const char *v = rtde_session_of(d) != NULL ? "RTDE data packages" : urrt_versions_of(d->lengths[i]);
         fprintf(out, "%s %" PRIu32 " x %" PRIu64 " (%s)", i > 0 ? ";" : "", d->lengths[i], d->length_count[i],
                 v != NULL ? v : "no known controller");
     }
@@ -1306,7 +1669,7 @@ static void print_summary(const dump *d, bool from_link)
         fprintf(out, "; %" PRIu64 " of other lengths", d->other_lengths);
     }
     fprintf(out, "%s\n", d->nlengths == 0 ? " none" : "");
-    if (d->src != NULL) {
+    if (rtde_session_of(d) != NULL) {
         print_summary_rtde(d, out);
     } else {
         fprintf(out, "summary: generations: 1.x %" PRIu64 ", 3.x/5.x %" PRIu64 ", unknown %" PRIu64 "\n",
@@ -1322,7 +1685,7 @@ static void print_summary(const dump *d, bool from_link)
                 ", silences %" PRIu64 ", connect failures %" PRIu64 "\n",
                 d->lstats.connects, d->lstats.reconnects, d->lstats.disconnects, d->lstats.silences,
                 d->lstats.connect_failures);
-    } else {
+    } else if (d->replay == NULL) { /* an RTDE capture's own line said where it ends */
         fprintf(out, "summary: resyncs: %" PRIu64 ", skipped bytes: %" PRIu64 "\n", d->fstats.resyncs,
                 d->fstats.skipped);
         fprintf(out, "summary: partial packet dropped at end: %zu bytes\n", d->partial_at_end);
@@ -1352,13 +1715,15 @@ int main(int argc, char **argv)
     cli_handle_signals(&running);
     d.first_time = NAN;
     d.last_time = NAN;
-    if (d.opt.record_path != NULL) {
-        d.record = fopen(d.opt.record_path, "wb");
-        d.pending = malloc(RECORD_PENDING_MAX);
-        if (d.record == NULL || d.pending == NULL) {
-            urrt_log(URRT_LOG_ERR, "cannot create the recording %s: %s", d.opt.record_path, strerror(errno));
+    if (d.opt.record_path != NULL && d.opt.rtde && d.opt.file_path == NULL) {
+        char why[400];
+        d.capture = rtde_capture_create(d.opt.record_path, why, sizeof why);
+        if (d.capture == NULL) {
+            urrt_log(URRT_LOG_ERR, "%s", why);
             return CLI_EXIT_RUNTIME;
         }
+    } else if (d.opt.file_path == NULL && !open_record(&d)) {
+        return CLI_EXIT_RUNTIME; /* a file's kind is known once it is open: run_file opens it */
     }
     if (d.opt.file_path == NULL) {
         setvbuf(stdout, NULL, _IOLBF, 0); /* live: each packet as it comes */
@@ -1380,10 +1745,23 @@ int main(int argc, char **argv)
             status = CLI_EXIT_RUNTIME;
         }
     }
+    if (d.capture != NULL) {
+        char why[400];
+        size_t held = 0;
+        /* It ends on a record: a package the run did not see whole is left out. */
+        if (!rtde_capture_close(d.capture, &held, why, sizeof why)) {
+            urrt_log(URRT_LOG_ERR, "%s", why);
+            status = CLI_EXIT_RUNTIME;
+        } else if (held > 0) {
+            urrt_log(URRT_LOG_INFO, "the capture %s ends at the last whole package (%zu bytes of the next left out)",
+                     d.opt.record_path, held);
+        }
+    }
     if (d.opt.summary && !d.opt.list) {
         print_summary(&d, d.opt.file_path == NULL);
     }
     rtde_source_free(d.src);
+    rtde_replay_free(d.replay);
     free(d.pending);
     return status;
 }

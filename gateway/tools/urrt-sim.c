@@ -5,8 +5,9 @@
  *
  * One packet per period on an absolute monotonic schedule, to every
  * connected client, from a deterministic model of a moving UR5e-like arm
- * (gateway/tools/sim_model.c) or from a raw capture. Fault modes reproduce what
- * real links do to the stream. See usage() and docs/tools.md.
+ * (gateway/tools/sim_model.c) or from a raw capture; or an RTDE capture's
+ * data packages on the RTDE port alone. Fault modes reproduce what real
+ * links do to the stream. See usage() and docs/tools.md.
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -37,6 +38,7 @@
 
 #define PROGRAM "urrt-sim"
 #define DEFAULT_LISTEN "127.0.0.1:30003"
+#define DEFAULT_RTDE_LISTEN "127.0.0.1:30004"
 #define DEFAULT_LENGTH 1116
 #define MAX_CLIENTS_LIMIT 64
 /* A client whose socket stays full this long, or whose queue grows past
@@ -89,6 +91,7 @@ typedef struct options {
     uint16_t listen_port;
     const char *port_file;
     bool rtde;                /* serve RTDE too */
+    bool rtde_replay;         /* --replay of an RTDE capture: RTDE alone, from it */
     char rtde_host[256];
     uint16_t rtde_port;
     const char *rtde_port_file;
@@ -114,7 +117,7 @@ typedef struct options {
  * once every option is in. */
 typedef struct command_line {
     options opt;
-    const char *listen_arg;
+    const char *listen_arg;    /* --listen HOST:PORT, NULL: not given */
     const char *rtde_arg;      /* --rtde HOST:PORT */
     const char *version_arg;   /* --controller V, or --version V */
     bool length_given;
@@ -178,6 +181,7 @@ typedef struct sim {
     replay rp;
     bool replaying;
     urrt_state state;         /* the model's state at the current packet */
+    sim_rtde_recording recording; /* --replay of an RTDE capture: the controller served */
     uint8_t packet[URRT_PACKET_MAX];
     uint8_t odd_packet[URRT_PACKET_MAX];
     FILE *record;
@@ -247,15 +251,30 @@ static void usage(FILE *out)
 "      --replay PATH        send a raw capture (e.g. `nc robot 30003 > PATH`),\n"
 "                           paced by its time column; bytes between packets\n"
 "                           are sent as they are, a partial packet at the end\n"
-"                           is not; it starts when the first client connects\n"
+"                           is not; it starts when the first client connects.\n"
+"                           An RTDE capture (urrt-dump --rtde -w PATH, told by\n"
+"                           its first byte) is served on the RTDE port alone:\n"
+"                           see RTDE below\n"
 "      --loop               replay again and again (default: exit at the end)\n"
 "\n"
-"RTDE (the Real-Time Data Exchange of TCP port 30004, from the same arm):\n"
+"RTDE (the Real-Time Data Exchange of TCP port 30004, from the same arm, or\n"
+"from an RTDE capture):\n"
 "      --rtde HOST:PORT     serve RTDE there too (port 0: any free port), as the\n"
 "                           controller version of --controller (default 3.10)\n"
 "                           does: its variables, 125 Hz before 5.0 and 500 Hz\n"
-"                           from 5.0, protocol 1 only before 3.4\n"
+"                           from 5.0, protocol 1 only before 3.4; with\n"
+"                           --replay of an RTDE capture, where to serve it\n"
+"                           (default " DEFAULT_RTDE_LISTEN ")\n"
 "      --rtde-port-file FILE  once listening, write the RTDE port to FILE\n"
+"  An RTDE capture replayed is the controller it recorded: protocol versions\n"
+"  and version answered as recorded; the recorded variables, with their\n"
+"  recorded types, and no other (NOT_FOUND); a client's frequency f served as\n"
+"  every floor(capture rate / f)th package; each package copied byte for byte\n"
+"  for the client's recipe, paced by the capture's timestamp from the first\n"
+"  client's start; the text messages recorded while data flowed sent again.\n"
+"  The capture's sessions with its first recipe are served one after the\n"
+"  other; one with another recipe ends the replay. The faults below apply.\n"
+"  No RealTime port: -l, --port-file and -w are refused.\n"
 "\n"
 "Faults (repeat --fault to combine them; N counts packets per client):\n"
 "  -f, --fault close-after=N          close the connection after N packets\n"
@@ -304,7 +323,8 @@ static void usage(FILE *out)
 "or more behind), skipped ones, and the lateness (mean, p99, max).\n"
 "\n"
 "Exit status: 0 done (signal, --clients, end of replay), 1 runtime error\n"
-"(cannot listen, cannot read the capture), 2 usage error.\n"
+"(cannot listen, cannot read the capture, a damaged or unusable capture),\n"
+"2 usage error.\n"
 "\n"
 "Examples:\n"
 "  " PROGRAM "                                   # CB3 3.10 layout, 125 Hz, 127.0.0.1:30003\n"
@@ -314,6 +334,7 @@ static void usage(FILE *out)
 "  " PROGRAM " --start-on-connect -n 1000 -w capture.bin --clients 1\n"
 "  " PROGRAM " -l 127.0.0.1:0 --port-file sim.port --fault freeze-every=2500,for=1500\n"
 "  " PROGRAM " --replay capture.bin --loop\n"
+"  " PROGRAM " --replay session.rtde --rtde 127.0.0.1:0 --rtde-port-file rtde.port\n"
 "  " PROGRAM " -c 5.12.3.1234 -l 127.0.0.1:0 --port-file rt.port \\\n"
 "           --rtde 127.0.0.1:0 --rtde-port-file rtde.port --fault rtde-text-every=500\n",
             URRT_PACKET_MAX, DEFAULT_LENGTH);
@@ -604,8 +625,26 @@ static void check_combinations(command_line *cl)
     if (o->loop && o->replay_path == NULL) {
         cli_usage_error(PROGRAM, "--loop goes with --replay");
     }
+    /* The kind of capture, by its first byte (a file that cannot be read
+     * is the runtime error of loading it). */
+    o->rtde_replay = o->replay_path != NULL && sim_rtde_sniff(o->replay_path) == 1;
+    if (o->rtde_replay) {
+        const char *rt = cl->listen_arg != NULL ? "--listen" : o->port_file != NULL ? "--port-file"
+                         : o->record_path != NULL                            ? "--record"
+                         : o->fault.garbage_every != 0                       ? "fault garbage-every"
+                         : o->fault.odd_every != 0                           ? "fault odd-length"
+                                                                             : NULL;
+        if (rt != NULL) {
+            cli_usage_error(PROGRAM, "%s is an RTDE capture, served on the RTDE port alone (no RealTime stream): "
+                            "drop %s", o->replay_path, rt);
+        }
+        return;
+    }
     if (o->fault.odd_every != 0 && o->fault.odd_length == 0) {
         o->fault.odd_length = o->length + 8;
+    }
+    if (cl->listen_arg == NULL) {
+        cl->listen_arg = DEFAULT_LISTEN;
     }
     if ((err = cli_parse_listen_address(cl->listen_arg, URRT_LINK_PORT_RW, o->listen_host, sizeof o->listen_host,
                                         &o->listen_port)) != NULL) {
@@ -613,20 +652,41 @@ static void check_combinations(command_line *cl)
     }
 }
 
+/* --rtde with --replay of an RTDE capture: where; the capture is the
+ * controller (read when the program starts). */
+static void resolve_rtde_replay(command_line *cl)
+{
+    options *o = &cl->opt;
+    const char *why, *where = cl->rtde_arg != NULL ? cl->rtde_arg : DEFAULT_RTDE_LISTEN;
+    if ((why = cli_parse_listen_address(where, SIM_RTDE_PORT, o->rtde_host, sizeof o->rtde_host, &o->rtde_port)) !=
+        NULL) {
+        cli_usage_error(PROGRAM, "--rtde %s: %s", where, why);
+    }
+    if (o->fault.rtde_backlog == 0) {
+        o->fault.rtde_backlog = SIM_RTDE_BACKLOG_DEFAULT;
+    }
+    o->rtde = true;
+}
+
 /* --rtde: where, and the controller version whose RTDE to serve. */
 static void resolve_rtde(command_line *cl)
 {
     options *o = &cl->opt;
     const char *why, *version = cl->version_arg != NULL ? cl->version_arg : "3.10";
+    if (o->rtde_replay) {
+        resolve_rtde_replay(cl);
+        return;
+    }
     if (cl->rtde_arg == NULL) {
         if (o->rtde_port_file != NULL || o->fault.rtde_given) {
-            cli_usage_error(PROGRAM, "%s goes with --rtde HOST:PORT",
+            cli_usage_error(PROGRAM, "%s goes with --rtde HOST:PORT or --replay of an RTDE capture",
                             o->rtde_port_file != NULL ? "--rtde-port-file" : "an rtde-* fault");
         }
         return;
     }
     if (o->replay_path != NULL) {
-        cli_usage_error(PROGRAM, "--rtde serves the simulated arm, not a capture: drop --replay or --rtde");
+        cli_usage_error(PROGRAM, "--rtde serves the simulated arm or an RTDE capture; %s is no RTDE capture (a "
+                        "RealTime capture has no RTDE to serve): drop --rtde", o->replay_path);
     }
     if (cl->length_given) {
         cli_usage_error(PROGRAM, "--rtde serves a controller version's variables: give --controller V, not --length");
@@ -652,7 +712,7 @@ static void parse_options(int argc, char **argv, options *o)
 {
     static const cli_options set = {PROGRAM, option_table, sizeof option_table / sizeof option_table[0], usage,
                                     NULL};
-    command_line cl = {.listen_arg = DEFAULT_LISTEN, .argc = argc, .argv = argv};
+    command_line cl = {.argc = argc, .argv = argv};
     int operand;
 
     cl.opt.length = DEFAULT_LENGTH;
@@ -674,6 +734,75 @@ static void parse_options(int argc, char **argv, options *o)
 
 /* ---- capture loading ---------------------------------------------------------- */
 
+/* A capture's schedule by its own clock: each packet due one period after
+ * the one before, the period read from the time column; a column that
+ * stands still, runs back or jumps (a reconnect in the capture) keeps the
+ * last sensible period. */
+typedef struct pacer {
+    double prev_time;
+    double period;    /* seconds */
+    uint64_t due;     /* ns after the first packet */
+    bool any;
+} pacer;
+
+/* When the packet timed t is due. */
+static uint64_t pace(pacer *p, double t)
+{
+    if (p->any) {
+        double d = t - p->prev_time;
+        if (isfinite(d) && d > 0.0 && d < 10.0) {
+            p->period = d;
+        }
+        p->due += (uint64_t)llround(p->period * 1e9);
+    }
+    p->any = true;
+    p->prev_time = t;
+    return p->due;
+}
+
+/* The replay's arrays for count packets; false (logged) without memory. */
+static bool replay_room(replay *rp, size_t count, const char *path)
+{
+    size_t *end = realloc(rp->end, count * sizeof *rp->end);
+    uint64_t *due = end != NULL ? realloc(rp->due_ns, count * sizeof *rp->due_ns) : NULL;
+    if (end != NULL) {
+        rp->end = end;
+    }
+    if (due == NULL) {
+        urrt_log(URRT_LOG_ERR, "capture %s: out of memory", path);
+        return false;
+    }
+    rp->due_ns = due;
+    return true;
+}
+
+/* An RTDE capture: the controller of the RTDE port, its packages' schedule
+ * by their timestamps. */
+static bool load_rtde_replay(sim *s, const char *path)
+{
+    sim_rtde_recording *r = &s->recording;
+    replay *rp = &s->rp;
+    char why[512];
+    pacer pc = {.any = false};
+
+    if (!sim_rtde_recording_load(path, r, &s->opt.rtde_controller, why, sizeof why)) {
+        urrt_log(URRT_LOG_ERR, "%s", why);
+        return false;
+    }
+    if (!replay_room(rp, r->count, path)) {
+        return false;
+    }
+    pc.period = 1.0 / s->opt.rtde_controller.cycle_hz;
+    for (size_t i = 0; i < r->count; i++) {
+        rp->due_ns[i] = pace(&pc, sim_rtde_recording_time(r, i));
+        rp->end[i] = 0; /* no RealTime bytes */
+    }
+    rp->count = r->count;
+    rp->span_ns = pc.due + (uint64_t)llround(pc.period * 1e9);
+    s->opt.rate_hz = s->opt.rtde_controller.cycle_hz;
+    return true;
+}
+
 static bool load_replay(sim *s, const char *path)
 {
     replay *rp = &s->rp;
@@ -681,9 +810,7 @@ static bool load_replay(sim *s, const char *path)
     struct stat st;
     urrt_framer fr;
     size_t off = 0, cap = 0;
-    double prev_time = NAN;
-    double delta = 0.008;
-    uint64_t due = 0;
+    pacer pc = {.period = 0.008};
 
     if (fd < 0) {
         urrt_log(URRT_LOG_ERR, "cannot open capture %s: %s", path, strerror(errno));
@@ -711,26 +838,13 @@ static bool load_replay(sim *s, const char *path)
             double t = NAN;
             if (rp->count == cap) {
                 cap = cap ? cap * 2 : 4096;
-                rp->end = realloc(rp->end, cap * sizeof *rp->end);
-                rp->due_ns = realloc(rp->due_ns, cap * sizeof *rp->due_ns);
-                if (rp->end == NULL || rp->due_ns == NULL) {
-                    urrt_log(URRT_LOG_ERR, "capture %s: out of memory", path);
+                if (!replay_room(rp, cap, path)) {
                     return false;
                 }
             }
             (void)urrt_read(pkt, len, URRT_F_TIME, 0, &t);
-            /* A time column that stands still, runs back or jumps (a
-             * reconnect in the capture) keeps the last sensible period. */
-            if (rp->count > 0) {
-                double d = t - prev_time;
-                if (isfinite(d) && d > 0.0 && d < 10.0) {
-                    delta = d;
-                }
-                due += (uint64_t)llround(delta * 1e9);
-            }
-            prev_time = t;
             rp->end[rp->count] = off;
-            rp->due_ns[rp->count] = due;
+            rp->due_ns[rp->count] = pace(&pc, t);
             rp->count++;
         }
     }
@@ -738,9 +852,10 @@ static bool load_replay(sim *s, const char *path)
         urrt_log(URRT_LOG_ERR, "capture %s holds no RealTime packet (is it a raw port-30003 capture?)", path);
         return false;
     }
-    rp->span_ns = due + (uint64_t)llround(delta * 1e9);
+    rp->span_ns = pc.due + (uint64_t)llround(pc.period * 1e9);
     urrt_log(URRT_LOG_INFO, "capture %s: %zu packet%s over %.3f s; %" PRIu64 " bytes skipped, %zu trailing bytes dropped",
-             path, rp->count, plural(rp->count), (double)due / 1e9, fr.stats.skipped, rp->size - rp->end[rp->count - 1]);
+             path, rp->count, plural(rp->count), (double)pc.due / 1e9, fr.stats.skipped,
+             rp->size - rp->end[rp->count - 1]);
     return true;
 }
 
@@ -795,6 +910,10 @@ static double clock_column(const sim *s, uint64_t k, uint64_t due)
 /* The bytes of packet k of the schedule, due at monotonic instant due. */
 static const uint8_t *packet_bytes(sim *s, uint64_t k, uint64_t due, size_t *len)
 {
+    if (s->opt.rtde_replay) {
+        *len = 0;
+        return NULL;
+    }
     if (s->replaying) {
         size_t i = (size_t)(k % s->rp.count);
         size_t start = i == 0 ? 0 : s->rp.end[i - 1];
@@ -879,6 +998,14 @@ static bool rtde_attach(sim *s, client *c)
     return true;
 }
 
+/* Packet 0 of the schedule is due now. */
+static void start_schedule(sim *s, uint64_t now)
+{
+    s->started = true;
+    s->t0_ns = now;
+    s->next = 0;
+}
+
 /* New clients of a listener: the RealTime one, or the RTDE one (rtde). */
 static void accept_clients(sim *s, int listen_fd, bool rtde, uint64_t now)
 {
@@ -907,6 +1034,12 @@ static void accept_clients(sim *s, int listen_fd, bool rtde, uint64_t now)
             close(fd);
             continue;
         }
+        if (s->replay_done) {
+            /* Nothing more will come: the program ends once the last clients have their data. */
+            urrt_log(URRT_LOG_INFO, "refusing client %s:%s: the replay has ended", host, serv);
+            close(fd);
+            continue;
+        }
         /* A controller sends each packet as it is made, and keeps little
          * buffered: a reader that falls behind is seen as one. */
         setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on);
@@ -925,10 +1058,8 @@ static void accept_clients(sim *s, int listen_fd, bool rtde, uint64_t now)
             s->record_taken = true;
             c->recording = true;
         }
-        if (!s->started) {
-            s->started = true;
-            s->t0_ns = now;
-            s->next = 0;
+        if (!s->started && !s->opt.rtde_replay) {
+            start_schedule(s, now);
         }
         urrt_log(URRT_LOG_INFO, "%sclient %s connected%s", rtde ? "RTDE " : "", c->peer,
                  c->recording ? " (recorded)" : "");
@@ -987,7 +1118,7 @@ static void rtde_to_client(sim *s, client *c, uint64_t k, uint64_t now)
         return;
     }
     n = ++c->packets;
-    if (!sim_rtde_send_data(c->rtde, k, &s->state)) {
+    if (!(s->opt.rtde_replay ? sim_rtde_send_recorded(c->rtde, k) : sim_rtde_send_data(c->rtde, k, &s->state))) {
         c->close_when_drained = true;
         c->len = 0;
         return;
@@ -1144,6 +1275,11 @@ static bool read_client(sim *s, size_t i)
                 return false;
             }
             c->releasable = c->len; /* replies go at once */
+            if (s->opt.rtde_replay && !s->started && c->rtde->started) {
+                /* A capture starts from its first package for the first
+                 * client whose data starts. */
+                start_schedule(s, now_ns());
+            }
             continue;
         }
         if (n > 0) {
@@ -1395,6 +1531,18 @@ static void set_priority(const options *o)
 static void log_serving(const sim *s)
 {
     char where[300];
+    if (s->opt.rtde_replay) {
+        const sim_rtde_controller *c = &s->opt.rtde_controller;
+        const sim_rtde_recording *r = &s->recording;
+        cli_format_host_port(s->opt.rtde_host, s->opt.rtde_port, where, sizeof where);
+        urrt_log(URRT_LOG_NOTICE, "replaying the RTDE capture %s on %s%s: controller %" PRIu32 ".%" PRIu32 ".%" PRIu32
+                 ".%" PRIu32 ", %zu data package%s at %.6g Hz over %.3f s from %zu session%s, a recipe of %zu "
+                 "variable%s (a client gets these, any other name is NOT_FOUND); no RealTime stream (the capture "
+                 "holds RTDE alone)", s->opt.replay_path, where, s->opt.loop ? " in a loop" : "", c->major, c->minor,
+                 c->bugfix, c->build, r->count, plural(r->count), c->cycle_hz, (double)s->rp.span_ns / 1e9,
+                 r->sessions, plural(r->sessions), r->nfields, plural(r->nfields));
+        return;
+    }
     cli_format_host_port(s->opt.listen_host, s->opt.listen_port, where, sizeof where);
     if (s->replaying) {
         urrt_log(URRT_LOG_NOTICE, "replaying %s on %s%s", s->opt.replay_path, where, s->opt.loop ? " in a loop" : "");
@@ -1416,7 +1564,13 @@ static void log_serving(const sim *s)
  * one of them cannot be had. */
 static bool sim_start(sim *s)
 {
-    if (s->opt.replay_path != NULL) {
+    s->listen_fd = s->rtde_fd = -1;
+    if (s->opt.rtde_replay) {
+        if (!load_rtde_replay(s, s->opt.replay_path)) {
+            return false;
+        }
+        s->replaying = true;
+    } else if (s->opt.replay_path != NULL) {
         if (!load_replay(s, s->opt.replay_path)) {
             return false;
         }
@@ -1433,12 +1587,13 @@ static bool sim_start(sim *s)
             return false;
         }
     }
-    s->listen_fd = open_listener(s->opt.listen_host, s->opt.listen_port, "--listen");
-    s->rtde_fd = -1;
-    if (s->listen_fd < 0) {
-        return false;
+    if (!s->opt.rtde_replay) {
+        s->listen_fd = open_listener(s->opt.listen_host, s->opt.listen_port, "--listen");
+        if (s->listen_fd < 0) {
+            return false;
+        }
+        s->opt.listen_port = bound_port(s->listen_fd);
     }
-    s->opt.listen_port = bound_port(s->listen_fd);
     if (s->opt.rtde) {
         s->rtde_fd = open_listener(s->opt.rtde_host, s->opt.rtde_port, "--rtde");
         if (s->rtde_fd < 0) {
@@ -1580,9 +1735,14 @@ static int sim_stop(sim *s, int status)
         urrt_log(URRT_LOG_ERR, "cannot write the recording %s: %s", s->opt.record_path, strerror(errno));
         status = CLI_EXIT_RUNTIME;
     }
-    close(s->listen_fd);
+    if (s->listen_fd >= 0) {
+        close(s->listen_fd);
+    }
     if (s->rtde_fd >= 0) {
         close(s->rtde_fd);
+    }
+    if (s->opt.rtde_replay) {
+        sim_rtde_recording_free(&s->recording);
     }
     return status;
 }

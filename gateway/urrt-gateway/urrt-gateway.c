@@ -56,10 +56,15 @@ static void usage(FILE *out)
         "      --print-keys       every configuration key, one per line: section, key,\n"
         "                         form, default, bounds, help (tab-separated), exit;\n"
         "                         no CONFIG (check-man holds the documents to it)\n"
-        "      --replay CAPTURE   send a raw capture's packets through the CAN side,\n"
+        "      --replay CAPTURE   send a capture's packets through the CAN side,\n"
         "                         clocked by their controller time, and exit: the\n"
         "                         frames a PLC would have received (interface =\n"
-        "                         log:PATH); the capture is the first robot's\n"
+        "                         log:PATH); the capture is the first robot's. A raw\n"
+        "                         RealTime capture (urrt-dump -w) or an RTDE one\n"
+        "                         (urrt-dump --rtde -w), told apart by its first\n"
+        "                         byte; the capture decides, not the robot's source.\n"
+        "                         An RTDE capture whose recipe lacks a value the\n"
+        "                         CAN side needs is refused with the names\n"
         "      --replay-rx FILE   with --replay and [canopen]: the frames the node\n"
         "                         received (candump -l lines timed on the capture's\n"
         "                         clock), fed to it between the packets\n"
@@ -93,6 +98,7 @@ static void usage(FILE *out)
         "  urrt-gateway --print-c-tables -o can_tables.c gateway.ini\n"
         "  urrt-gateway --print-eds -o urrt.eds canopen.ini\n"
         "  urrt-gateway --replay capture.bin gateway.ini\n"
+        "  urrt-gateway --replay session.rtde rtde-plc.ini\n"
         "\n"
         "Exit status: 0 stopped by a signal (or the configuration is valid, the DBC,\n"
         "C tables or EDS were written, the capture was replayed),\n"
@@ -169,8 +175,13 @@ static int dbc_writer(FILE *out, gw_config *cfg, const char *path)
 
 static int c_tables_writer(FILE *out, gw_config *cfg, const char *path)
 {
+    struct can_ctables_robot robots[GW_MAX_ROBOTS];
     (void)path;
-    return can_ctables_write(out, &cfg->can, cfg->can_run, cfg->co_run, cfg->path);
+    for (unsigned i = 0; i < cfg->robot_count && i < GW_MAX_ROBOTS; i++) {
+        robots[i].rtde = cfg->robots[i].source == GW_SOURCE_RTDE;
+        robots[i].frequency = cfg->robots[i].rtde_frequency;
+    }
+    return can_ctables_write(out, &cfg->can, cfg->can_run, cfg->co_run, robots, cfg->path);
 }
 
 static int eds_writer(FILE *out, gw_config *cfg, const char *path)

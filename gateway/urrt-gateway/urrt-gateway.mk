@@ -26,10 +26,10 @@ $(BUILD)/gateway/urrt-gateway/%.o: gateway/urrt-gateway/%.c | $(LCMTYPES_H)
 -include $(GATEWAY_OBJS:.o=.d)
 
 .SECONDEXPANSION:
-$(BUILD)/bin/urrt-gateway: $(GATEWAY_OBJS) $(CLI_OBJ) $(RTDE_SOURCE_OBJ) $(LCMTYPES_OBJS) $$(GATEWAY_EXTRA_OBJS) $(LIBPORT) \
+$(BUILD)/bin/urrt-gateway: $(GATEWAY_OBJS) $(CLI_OBJ) $(RTDE_SOURCE_OBJ) $(RTDE_CAPTURE_OBJ) $(LCMTYPES_OBJS) $$(GATEWAY_EXTRA_OBJS) $(LIBPORT) \
                            $(LIBURRT)
 	@mkdir -p $(@D)
-	$(CC) $(OPT) -o $@ $(GATEWAY_OBJS) $(CLI_OBJ) $(RTDE_SOURCE_OBJ) $(LCMTYPES_OBJS) $(GATEWAY_EXTRA_OBJS) $(LIBPORT) $(LIBURRT) \
+	$(CC) $(OPT) -o $@ $(GATEWAY_OBJS) $(CLI_OBJ) $(RTDE_SOURCE_OBJ) $(RTDE_CAPTURE_OBJ) $(LCMTYPES_OBJS) $(GATEWAY_EXTRA_OBJS) $(LIBPORT) $(LIBURRT) \
 	  $(GATEWAY_LIBS)
 
 PROGRAMS += $(BUILD)/bin/urrt-gateway

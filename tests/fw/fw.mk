@@ -15,12 +15,20 @@
 #                     its clock (tests/fw/vm-master.log: NMT, SYNC, SDO; via --replay-rx and the
 #                     image's receive table), whose SDO answers must be the live node's
 #                     (tests/fw/vm-node.log); prints the canopen image's footprint.
+#                     RTDE (-DFW_RTDE: lib/urrt_rtde's client with the generated recipe):
+#                     rtde-plc (docs/examples/rtde-plc.ini, a CANopen node) and rtde-types
+#                     (tests/fw/rtde-types.ini, plain CAN, every wire type), fed an RTDE capture
+#                     (tests/fw/make_rtde_capture.py) through urrt-gateway --replay, and the image
+#                     the bytes tests/fw/rtde_controller.py plays as the controller of that capture
+#                     to the recipe the tables carry; its requests are checked too (V, v, O, S only,
+#                     the recipe's names); prints the rtde-plc image's footprint.
 #   record-fw-master  make check-canopen, then that recording from its run (tests/fw/record_master.py)
 # The rules use target.mk's toolchain variables in recipes only (it is included after this file).
 
 FW := $(BUILD)/tests/fw
-FW_CONFIGS := canopen canopen-vm fd j1939
-FW_CANOPEN := canopen canopen-vm
+FW_CONFIGS := canopen canopen-vm fd j1939 rtde-plc rtde-types
+FW_CANOPEN := canopen canopen-vm rtde-plc
+FW_RTDE := rtde-plc rtde-types
 FW_LIB_OBJS = $(LIB_SRCS:lib/%.c=$(FW)/lib/%.o)
 
 CHECKS += check-fw-gateway
@@ -29,6 +37,14 @@ CHECKS += check-fw-gateway
 $(FW)/capture.bin: tests/fw/make_capture.py tests/ref/urrt_ref.py
 	@mkdir -p $(@D)
 	$(PYTHON) tests/fw/make_capture.py $@
+
+$(FW)/rtde-capture.bin: tests/fw/make_rtde_capture.py tests/ref/rtde_ref.py
+	@mkdir -p $(@D)
+	$(PYTHON) tests/fw/make_rtde_capture.py $@
+
+# What the scripted controller of that capture sends the image, which asks for the tables' recipe.
+$(FW)/%/controller.bin: $(FW)/rtde-capture.bin $(FW)/%/tables.c tests/fw/rtde_controller.py tests/ref/rtde_ref.py
+	$(PYTHON) tests/fw/rtde_controller.py stream $< $(FW)/$*/tables.c $@
 
 # The manager's frames, for --replay-rx (rx.log) and the image (rx.c): canopen-vm's were
 # recorded; a node with no manager gets none.
@@ -62,6 +78,8 @@ $(FW)/%/gateway.ini: docs/examples/%.ini
 	$(fw_log_ini)
 $(FW)/canopen-vm/gateway.ini: tests/canopen/canopen.ini
 	$(fw_log_ini)
+$(FW)/rtde-types/gateway.ini: tests/fw/rtde-types.ini
+	$(fw_log_ini)
 
 $(FW)/%/tables.c: $(FW)/%/gateway.ini $(BUILD)/bin/urrt-gateway
 	$(BUILD)/bin/urrt-gateway --print-c-tables -o $@ $<
@@ -76,18 +94,20 @@ $(FW)/%/tables.o: $(FW)/%/tables.c $(LIB_HDRS)
 
 # Kept between runs (make deletes what pattern rules make along the way).
 .PRECIOUS: $(FW)/%/gateway.ini $(FW)/%/tables.c $(FW)/%/tables.o $(FW)/lib/%.o $(FW)/%/rx.log $(FW)/%/rx.c \
-  $(FW)/%/rx.o
+  $(FW)/%/rx.o $(FW)/%/controller.bin
 
 .SECONDEXPANSION:
 $(FW)/%/fw_gateway.elf: tests/fw/fw_gateway.c tests/fw/fw_rx.h tests/target/cm.c tests/target/target.h \
   tests/target/an386.ld $(FW)/%/tables.o $$(if $$(filter $$*,$$(FW_CANOPEN)),$(FW)/%/rx.o $(FW)/%/rx.log) \
   $$(FW_LIB_OBJS)
 	$(TGT_CM) $(TGT_M4) -Os $(TGT_FLAGS) -DURRT_TARGET_CORTEX_M $(if $(filter $*,$(FW_CANOPEN)),-DFW_CANOPEN) \
+	  $(if $(filter $*,$(FW_RTDE)),-DFW_RTDE) \
 	  -Itests/fw tests/target/cm.c tests/fw/fw_gateway.c $(FW)/$*/tables.o \
 	  $(if $(filter $*,$(FW_CANOPEN)),$(FW)/$*/rx.o) $(FW_LIB_OBJS) -T tests/target/an386.ld $(TGT_LINK) -o $@
 
 check-fw-gateway: $(foreach c,$(FW_CONFIGS),$(FW)/$(c)/fw_gateway.elf $(FW)/$(c)/gateway.ini) $(FW)/capture.bin \
-  $(FW)/canopen-vm/capture.bin $(FW)/canopen-vm/node.log tests/fw/run.sh tests/fw/compare.sh
+  $(FW)/canopen-vm/capture.bin $(FW)/canopen-vm/node.log $(foreach c,$(FW_RTDE),$(FW)/$(c)/controller.bin) \
+  $(FW)/rtde-capture.bin tests/fw/run.sh tests/fw/compare.sh tests/fw/rtde_controller.py
 	$(call suite,check-fw-gateway,sh tests/fw/run.sh $(BUILD) $(FW) $(FW_CONFIGS))
 
 # Writes tests/fw/vm-capture.bin.xz, vm-master.log and vm-node.log from a passing check-canopen run.

@@ -23,6 +23,15 @@
  * manager's frames (tests/fw/fw_rx.h: what a board's CAN receive interrupt
  * would hand over) go to urrt_co_on_frame at their time, between the
  * packets, as `urrt-gateway --replay-rx` feeds the same frames.
+ *
+ * Built with -DFW_RTDE for a robot read over RTDE (source = rtde): lib's
+ * RTDE client (lib/urrt_rtde.h) in place of the framer, with the recipe the
+ * generated tables carry (urrt_gateway_rtde_vars). Its requests go to the
+ * TCP stack, here printed as "rtde> HEX" lines for run.sh to check; the
+ * controller's bytes (a scripted controller's, tests/fw/rtde_controller.py)
+ * come through semihosting in the same chunks; each data package's state,
+ * and its RTDE-only values through urrt_gateway_rtde_values, go to the CAN
+ * core at the package's controller time.
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -34,6 +43,9 @@
 #include "fw_rx.h"
 #include "urrt_co.h"
 #endif
+#ifdef FW_RTDE
+#include "urrt_rtde.h"
+#endif
 
 /* From the generated tables. */
 extern const urrt_cantx_tables urrt_gateway_tables;
@@ -41,10 +53,27 @@ int urrt_gateway_cantx_init(urrt_cantx *tx, size_t *bad_frame, size_t *bad_signa
 #ifdef FW_CANOPEN
 int urrt_gateway_co_init(urrt_co *co, urrt_cantx *tx, size_t *bad_item);
 #endif
+#ifdef FW_RTDE
+extern const uint16_t *const urrt_gateway_rtde_vars[];
+extern const size_t urrt_gateway_rtde_var_count[];
+extern const double urrt_gateway_rtde_frequency[];
+void urrt_gateway_rtde_values(size_t robot, const urrt_rtde_values *values);
+#endif
 
 #define CHUNK 1460 /* one TCP segment on Ethernet */
 
+#ifdef FW_RTDE
+static urrt_rtde session; /* URRT_RTDE_RAM */
+/* Two, because this clock jumps: a package is decoded before the frames due
+ * since the last one are caught up, and those must still read the last
+ * one's values. A board that wakes at every deadline decodes into one. */
+static urrt_rtde_values rtde_values[2];
+static unsigned rtde_decoding;
+static uint8_t request[URRT_RTDE_REQUEST_MAX];
+static uint32_t rtde_packages;
+#else
 static urrt_framer framer;
+#endif
 static urrt_state state;
 static urrt_cantx tx;
 static uint8_t chunk[CHUNK];
@@ -85,6 +114,16 @@ static void can_transmit(void *ctx, const urrt_can_frame *f, uint64_t now_us)
 }
 
 /* ---- the gateway: the same for every board ------------------------------------ */
+
+/* The package's RTDE-only values to the frames, just before its state, as
+ * urrt-gateway's CAN output hands them over (RealTime has none). */
+static void values_to_tables(void)
+{
+#ifdef FW_RTDE
+    urrt_gateway_rtde_values(0, &rtde_values[rtde_decoding]);
+    rtde_decoding ^= 1u;
+#endif
+}
 
 #ifdef FW_CANOPEN
 static urrt_co node;
@@ -131,6 +170,7 @@ static void packet_at(uint64_t now_us)
     }
     rx_until(now_us);
     node_catch_up(now_us);
+    values_to_tables();
     urrt_cantx_on_packet(&tx, 0, &state, now_us);
     urrt_co_run(&node, now_us, can_transmit, NULL);
     node_us = now_us;
@@ -141,11 +181,76 @@ static void packet_at(uint64_t now_us)
     /* A board wakes at every deadline (urrt_cantx_deadline) on its timer;
      * here the clock jumps from packet to packet, so catch up first. */
     urrt_cantx_catch_up(&tx, now_us, can_transmit, NULL);
+    values_to_tables();
     urrt_cantx_on_packet(&tx, 0, &state, now_us);
     urrt_cantx_run(&tx, now_us, can_transmit, NULL);
 }
 #endif
 
+#ifdef FW_RTDE
+/* The TCP stack's send: here one line per request, "rtde> " and its bytes in hex. */
+static void tcp_send(const uint8_t *p, size_t n)
+{
+    char hex[2 * 32 + 1];
+    target_puts("rtde> ");
+    while (n > 0) {
+        size_t k = n < 32u ? n : 32u;
+        for (size_t i = 0; i < k; i++) {
+            put_hex(hex + 2 * i, p[i], 2);
+        }
+        hex[2 * k] = '\0';
+        target_puts(hex);
+        p += k;
+        n -= k;
+    }
+    target_puts("\n");
+}
+
+/* Every request the session has due (whenever the socket may be written). */
+static void send_requests(void)
+{
+    int n;
+    while ((n = urrt_rtde_output(&session, request, sizeof request)) > 0) {
+        tcp_send(request, (size_t)n);
+    }
+}
+
+/* A data package: its state and RTDE-only values, on its controller time. */
+static void on_data(void)
+{
+    int64_t now_us;
+    rtde_packages++;
+    if (!urrt_has(&state, URRT_F_TIME) || urrt_time_us(state.time[0], &now_us) != URRT_OK) {
+        return; /* the recipe has the timestamp: only a broken one has none */
+    }
+    packet_at((uint64_t)now_us);
+}
+
+/* Bytes as the TCP stack hands them over, in any chunking: 0, or -1 when
+ * the session ended (a board closes the socket; after EV_DROP it reconnects
+ * soon, after EV_CONFIG it backs off long: the controller refused the recipe). */
+static int on_tcp_bytes(const uint8_t *p, size_t n)
+{
+    while (n > 0) {
+        size_t used = 0;
+        urrt_rtde_event ev;
+        int k = urrt_rtde_feed(&session, p, n, &used, &ev, &state, &rtde_values[rtde_decoding]);
+        p += used;
+        n -= used;
+        if (k == URRT_RTDE_EV_DATA) {
+            on_data();
+        } else if (k == URRT_RTDE_EV_DROP || k == URRT_RTDE_EV_CONFIG || k < 0) {
+            target_puts("fw_gateway: the RTDE session ended: ");
+            target_puts(urrt_rtde_strerror(k < 0 ? k : ev.error));
+            target_puts("\n");
+            urrt_rtde_finish(&session);
+            return -1;
+        }
+        send_requests();
+    }
+    return 0;
+}
+#else
 /* One complete packet: its values to the CAN core, then whatever is due. */
 static void on_packet(const uint8_t *pkt, size_t len)
 {
@@ -158,7 +263,7 @@ static void on_packet(const uint8_t *pkt, size_t len)
 }
 
 /* Bytes as the TCP stack hands them over, in any chunking. */
-static void on_tcp_bytes(const uint8_t *p, size_t n)
+static int on_tcp_bytes(const uint8_t *p, size_t n)
 {
     while (n > 0) {
         size_t used = 0;
@@ -170,7 +275,9 @@ static void on_tcp_bytes(const uint8_t *p, size_t n)
         p += used;
         n -= used;
     }
+    return 0;
 }
+#endif
 
 int main(void)
 {
@@ -197,10 +304,28 @@ int main(void)
         return 1;
     }
 #endif
-    urrt_framer_init(&framer);
-    while ((n = target_read(capture, chunk, sizeof chunk)) > 0) {
-        on_tcp_bytes(chunk, n);
+#ifdef FW_RTDE
+    /* The TCP connection is up: the handshake with the generated recipe. */
+    urrt_rtde_init(&session);
+    if (urrt_rtde_begin(&session, urrt_gateway_rtde_vars[0], urrt_gateway_rtde_var_count[0],
+                        urrt_gateway_rtde_frequency[0]) != URRT_OK) {
+        target_puts("fw_gateway: urrt_rtde_begin refuses the generated recipe (urrt_gateway_rtde_vars)\n");
+        return 1;
     }
+    send_requests();
+#else
+    urrt_framer_init(&framer);
+#endif
+    while ((n = target_read(capture, chunk, sizeof chunk)) > 0) {
+        if (on_tcp_bytes(chunk, n) != 0) {
+            return 1;
+        }
+    }
+#ifdef FW_RTDE
+    target_puts("fw_gateway: RTDE data packages: ");
+    target_put_uint(rtde_packages);
+    target_puts("\n");
+#endif
     target_puts("fw_gateway: frames sent: ");
     target_put_uint(frames_sent);
     target_puts("\n");

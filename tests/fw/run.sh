@@ -2,7 +2,10 @@
 # SPDX-License-Identifier: MIT
 # check-fw-gateway's run: for each configuration, the capture through
 # urrt-gateway --replay and through its firmware image on qemu's Cortex-M4,
-# then the comparison; the results added up.
+# then the comparison; the results added up. An RTDE configuration (fw.mk
+# wrote DIR/controller.bin for it) replays the RTDE capture, and its image
+# reads what the scripted controller of that capture sends it; the requests
+# the image sent are checked too.
 #   run.sh BUILD_DIR FW_DIR CONFIG...
 set -u
 build=$1; fw=$2; shift 2
@@ -14,18 +17,26 @@ for name in "$@"; do
   # A recorded configuration has its own capture; a CANopen node is fed the manager's frames
   # (fw.mk writes rx.log for it: empty when no manager talks to it).
   capture=$fw/capture.bin; [ -f "$dir/capture.bin" ] && capture=$dir/capture.bin
+  stream=$capture; [ -f "$dir/controller.bin" ] && { capture=$fw/rtde-capture.bin; stream=$dir/controller.bin; }
   rx=; [ -s "$dir/rx.log" ] && rx="--replay-rx $dir/rx.log"
   # shellcheck disable=SC2086
   "$build/bin/urrt-gateway" --replay "$capture" $rx "$ini" 2> "$dir/replay.err" || {
     echo "FAIL: $name: urrt-gateway --replay: $(cat "$dir/replay.err")"; failed=$((failed + 1)); continue; }
   qemu-system-arm -nographic -monitor none -serial none \
-    -semihosting-config "enable=on,target=native,arg=$capture" \
+    -semihosting-config "enable=on,target=native,arg=$stream" \
     -M mps2-an386 -kernel "$dir/fw_gateway.elf" > "$dir/firmware.out" 2>&1
   # What the configuration says: its frames and the heartbeat, as the log writes their ids.
   # A CANopen node: its heartbeat 0x700 + node id and its EMCY 0x080 + node id, no status
   # TPDO (off until enabled), and without a manager's frames no SYNC-driven TPDO either.
   node=$(sed -n 's/^node_id = //p' "$ini")
   want=
+  if [ -f "$dir/controller.bin" ]; then
+    # The image's side of the handshake: only V, v, O, S, the O naming the tables' recipe.
+    /usr/bin/python3 tests/fw/rtde_controller.py check "$dir/firmware.out" "$dir/tables.c" "$dir/controller.bin" \
+      > "$dir/requests.log"
+    sed "s/^/$name: /" "$dir/requests.log" | grep -v ' failed$'
+    passed=$((passed + $(grep -c '^ok: ' "$dir/requests.log"))); failed=$((failed + $(grep -c '^FAIL: ' "$dir/requests.log")))
+  fi
   if [ -n "$node" ] && [ -n "$rx" ]; then
     # A recorded manager: which ids come depends on what it did when, so the ids are not
     # counted; what the frames it sent ask for is: a boot-up at power-on and after each
@@ -51,7 +62,8 @@ for name in "$@"; do
   fi
   echo "== $name: $ids ids, heartbeat $hb"
   # shellcheck disable=SC2086
-  sh tests/fw/compare.sh "$dir/gateway.log" "$dir/firmware.out" "$ids" "$hb" "$name" $want > "$dir/compare.log"
+  sh tests/fw/compare.sh "$dir/gateway.log" "$dir/firmware.out" "$ids" "$hb" "$name" "${node:--}" $want \
+    > "$dir/compare.log"
   grep -v ' passed, ' "$dir/compare.log"
   line=$(tail -n 1 "$dir/compare.log")
   passed=$((passed + ${line%% *})); f=${line#* passed, }; failed=$((failed + ${f%% *}))
@@ -67,19 +79,49 @@ for name in "$@"; do
       diff "$dir/answers.live" "$dir/answers.replay" | head -n 5; failed=$((failed + 1))
     fi
   fi
-  # The comparison must be able to fail: one payload digit changed in the middle frame.
+  # The comparison must be able to fail: one payload digit changed in the middle frame (in an
+  # RTDE configuration the middle frame of the first id that carries an RTDE-only value, in
+  # that value), and the refusal must name that frame.
   frame='^[0-9A-F]+##?[0-9A-F]*$'
-  awk -v frame="$frame" -v k=$(( $(grep -cE "$frame" "$dir/firmware.out") / 2 )) '
-    $0 ~ frame && ++n == k { c = substr($0, length($0)); $0 = substr($0, 1, length($0) - 1) (c == "0" ? "1" : "0") }
+  only=
+  [ -f "$dir/controller.bin" ] &&
+    only=$(sed -n 's/.*_sources, [0-9]*, [0-9]*, [^,]*, 0x\([0-9A-F]*\), .*_fill}, .*/\1/p' "$dir/tables.c" | head -n 1)
+  k=$(grep -E "$frame" "$dir/firmware.out" | awk -v id="$only" '
+    { split($0, f, "#"); if (id == "" || f[1] ~ ("^0*" id "$")) at[++m] = NR }
+    END { print at[int((m + 1) / 2)] }')
+  # The last payload digit; in an RTDE configuration the first, where its first signal (an
+  # RTDE-only value in both) starts.
+  awk -v frame="$frame" -v k="$k" -v first="$only" '
+    $0 ~ frame && ++n == k {
+      at = first == "" ? length($0) : index($0, "#") + 1
+      c = substr($0, at, 1); $0 = substr($0, 1, at - 1) (c == "0" ? "1" : "0") substr($0, at + 1) }
     1' "$dir/firmware.out" > "$dir/firmware.changed"
   # shellcheck disable=SC2086
-  if sh tests/fw/compare.sh "$dir/gateway.log" "$dir/firmware.changed" "$ids" "$hb" "$name" $want > /dev/null; then
+  if sh tests/fw/compare.sh "$dir/gateway.log" "$dir/firmware.changed" "$ids" "$hb" "$name" "${node:--}" $want \
+       > "$dir/compare.changed"; then
     echo "FAIL: $name: compare.sh accepts a firmware output with one payload digit changed"; failed=$((failed + 1))
+  elif ! grep -q "^frame $k: " "$dir/compare.changed"; then
+    echo "FAIL: $name: compare.sh refuses a changed firmware output without naming frame $k:"
+    head -n 3 "$dir/compare.changed"; failed=$((failed + 1))
   else
-    echo "ok: $name: compare.sh refuses a firmware output with one payload digit changed"; passed=$((passed + 1))
+    echo "ok: $name: compare.sh refuses a firmware output with one payload digit changed: $(grep "^frame $k: " "$dir/compare.changed")"
+    passed=$((passed + 1))
   fi
 done
 echo "footprint of the canopen image on the Cortex-M4 at -Os (arm-none-eabi-size): the image; its tables; lib/"
 arm-none-eabi-size "$fw/canopen/fw_gateway.elf" "$fw/canopen/tables.o" "$fw"/lib/*.o
+echo "footprint of the rtde-plc image (RTDE, a CANopen node) on the Cortex-M4 at -Os: the image; its tables"
+arm-none-eabi-size "$fw/rtde-plc/fw_gateway.elf" "$fw/rtde-plc/tables.o"
+# docs/footprint.md's figures of that image, and the check shown to fail on a RAM figure one byte off.
+sh tests/fw/footprint.sh docs/footprint.md "$fw/rtde-plc/fw_gateway.elf" "$fw/rtde-plc/tables.o" > "$fw/footprint.log"
+cat "$fw/footprint.log"
+passed=$((passed + $(grep -c '^ok: ' "$fw/footprint.log"))); failed=$((failed + $(grep -c '^FAIL: ' "$fw/footprint.log")))
+awk '/<!-- fw-footprint:begin/ { on = 1 } on && !done && $NF == "|" && $(NF - 1) ~ /^[0-9]+$/ { $(NF - 1) += 1; done = 1 } 1' \
+  docs/footprint.md > "$fw/footprint.wrong.md"
+if sh tests/fw/footprint.sh "$fw/footprint.wrong.md" "$fw/rtde-plc/fw_gateway.elf" "$fw/rtde-plc/tables.o" > /dev/null; then
+  echo "FAIL: footprint.sh accepts a RAM figure one byte off"; failed=$((failed + 1))
+else
+  echo "ok: footprint.sh refuses a RAM figure one byte off"; passed=$((passed + 1))
+fi
 echo "$passed passed, $failed failed"
 [ "$failed" = 0 ]

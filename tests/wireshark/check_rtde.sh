@@ -9,12 +9,15 @@
 # tests/gateway/tools/rtde_peer.py, which asks for a name the controller
 # lacks (NOT_FOUND), sends setup inputs, pauses and sends a text message.
 # tshark captures them all at once on loopback while the clients record
-# what they decoded (urrt-dump's JSON); then it dissects the capture (one
-# pass, and two passes, where every frame is dissected again from the
-# session state kept for it) and compare_rtde.py matches every data package
-# by its controller timestamp with a client record, value by value.
-# urrt-dump cannot read an RTDE capture back (--file is for RealTime), so
-# its live output of the same session is the independent decode.
+# what they decoded: urrt-dump records its session (--rtde -w) and
+# afterwards prints it from that capture (--file, JSON, which must equal
+# what it printed live); then tshark dissects the pcap (one pass, and two
+# passes, where every frame is dissected again from the session state kept
+# for it) and compare_rtde.py matches every data package by its controller
+# timestamp with a client record, value by value. The capture's recipe holds
+# more than the client's -k (a recording asks for the RealTime set and the
+# status values too), so --file prints without -k: every value of every
+# package.
 # Every process runs under timeout; every wait is for an event, with a bound.
 set -u
 BUILD=${BUILD:-build}
@@ -66,7 +69,7 @@ KEYS=timestamp,actual_q,target_TCP_pose,robot_mode,joint_mode,actual_digital_inp
 output_int_register_24,output_bit_register_64,tool_output_mode,robot_status_bits,output_double_register_3,\
 actual_tool_accelerometer,safety_status_bits,speed_scaling
 # Cases: NAME, protocol, fewest text messages, client (all: urrt-dump's
-# default recipe, keys: -k KEYS, peer: rtde_peer.py), expert infos, sim
+# recording recipe, keys: that and -k KEYS, peer: rtde_peer.py), expert infos, sim
 # options. edges: tests/wireshark/rtde_controller.py serves the extremes of
 # every type instead of urrt-sim and records what it sent; rtde_peer.py asks.
 cat > "$T/cases" <<'EOF'
@@ -154,10 +157,10 @@ while read -r name proto texts client experts opts; do
   case $client in
     peer) timeout -k 3 60 $PYTHON -c "$PEER" "$port" "$T/$name.json" $N 2> "$T/$name.client" & ;;
     edges) timeout -k 3 60 $PYTHON -c "$EDGES" "$port" $N 2> "$T/$name.client" & ;;
-    keys) timeout -k 3 60 "$DUMP" --rtde "127.0.0.1:$port" --once -t 10 -F json --no-summary -k "$KEYS" \
-            > "$T/$name.json" 2> "$T/$name.client" & ;;
-    *) timeout -k 3 60 "$DUMP" --rtde "127.0.0.1:$port" --once -t 10 -F json --no-summary \
-         > "$T/$name.json" 2> "$T/$name.client" & ;;
+    keys) timeout -k 3 60 "$DUMP" --rtde "127.0.0.1:$port" -w "$T/$name.rtde" --once -t 10 -F json --no-summary \
+            -k "$KEYS" > "$T/$name.live" 2> "$T/$name.client" & ;;
+    *) timeout -k 3 60 "$DUMP" --rtde "127.0.0.1:$port" -w "$T/$name.rtde" --once -t 10 -F json --no-summary \
+         > "$T/$name.live" 2> "$T/$name.client" & ;;
   esac
   CLIENTS="$CLIENTS $!"
 done < "$T/cases"
@@ -171,6 +174,18 @@ kill "$TSHARK" 2>/dev/null; wait "$TSHARK" 2>/dev/null
 chmod 644 "$T/cap.pcapng"
 
 # ---- the clients' records ---------------------------------------------------------
+# urrt-dump's: its capture printed by urrt-dump --file, every value; with the
+# client's own -k it prints what the session printed live.
+while read -r name proto texts client experts opts; do
+  case $client in keys|all) ;; *) continue ;; esac
+  [ "$client" = keys ] && k="-k $KEYS" || k=
+  timeout -k 3 60 "$DUMP" --file "$T/$name.rtde" -F json --no-summary > "$T/$name.json" 2> "$T/$name.file"
+  check "$name: urrt-dump --file reads its capture" [ $? = 0 ]
+  # shellcheck disable=SC2086 # k is "-k LIST" or nothing
+  timeout -k 3 60 "$DUMP" --file "$T/$name.rtde" -F json --no-summary $k > "$T/$name.again" 2>> "$T/$name.file"
+  check "$name: urrt-dump --file of the capture prints what it printed live" cmp -s "$T/$name.again" "$T/$name.live"
+  [ -s "$T/$name.json" ] || sed 's/^/    file: /' "$T/$name.file" >&2
+done < "$T/cases"
 specs=""
 while read -r name proto texts client experts opts; do
   port=$(cat "$T/$name.port" 2>/dev/null) || continue

@@ -6,6 +6,9 @@
 #   check-can-map-san  the same under ASan + UBSan, lib/ and gateway/ compiled with them
 #   check-can-dbc      DBCs and payloads against python3-canmatrix and an independent
 #                      Python reference; the example configurations in docs/examples/
+#   check-replay-rtde  urrt-gateway --replay of RTDE captures of urrt-sim's sessions: the frames
+#                      against canmatrix and against the RealTime capture's, CANopen with
+#                      --replay-rx, the refusals (check_replay_rtde.py; processes: a timing suite)
 #   bench-can          ns per packet for the CAN mapping beside urrt_decode of the same packet
 
 CANT := $(BUILD)/tests/gateway/can
@@ -15,9 +18,9 @@ CAN_TEST_SRCS = $(CAN_GATEWAY_OBJS:$(BUILD)/%.o=%.c) gateway/common/conf.c gatew
 CAN_TEST_OBJS := $(CAN_GATEWAY_OBJS) $(BUILD)/gateway/urrt-gateway/config.o $(CONF_OBJ)
 CAN_TEST_CFLAGS := $(PROG_WARN) $(CPPFLAGS) $(GATEWAY_INC) -Itests
 
-CHECKS += check-can-map check-can-map-san check-can-dbc
+CHECKS += check-can-map check-can-map-san check-can-dbc check-replay-rtde
 BENCHES += bench-can
-.PHONY: check-can-map check-can-map-san check-can-dbc bench-can
+.PHONY: check-can-map check-can-map-san check-can-dbc check-replay-rtde bench-can
 
 # test_can_map, can_tool and bench_can: one source each, the same objects.
 $(CANT)/%: tests/gateway/can/%.c tests/check.h tests/testutil.h tests/gateway/bench.h $(CAN_TEST_OBJS) $(LIBPORT) $(LIBURRT)
@@ -38,6 +41,9 @@ check-can-map-san: $(CANT)/test_can_map_san
 
 check-can-dbc: $(CANT)/can_tool
 	$(call suite,$@,$(PYTHON) tests/gateway/can/test_dbc.py --tool $< --work $(CANT)/work)
+
+check-replay-rtde: $(BUILD)/bin/urrt-sim $(BUILD)/bin/urrt-gateway
+	$(call suite,$@,timeout -k 5 120 $(PYTHON) tests/gateway/can/check_replay_rtde.py $(BUILD))
 
 bench-can: $(CANT)/bench_can
 	@$< docs/examples/canopen.ini

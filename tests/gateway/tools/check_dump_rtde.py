@@ -8,7 +8,12 @@ time and the RTDE-only values against the simulator's documented model
 (docs/tools.md, computed here from the timestamp), a -k field the controller
 lacks (by the version table and by its NOT_FOUND), --list on 3.x and 5.x,
 protocol 1 and 2, text messages, and a recording proxy that holds that
-urrt-dump sends only V, v, O, S (and P) packages.
+urrt-dump sends only V, v, O, S (and P) packages. RTDE captures (--rtde -w,
+read back by --file): read by tests/ref/rtde_capture.py, a reader written
+from the format; the recipe recorded, by UR's version table as typed here;
+--file printing what the recording run printed live in every format; a
+capture cut short, a damaged one, a wrong header, a RealTime capture beside
+them, and sessions across reconnects.
 
 Every server takes its port from the system (port 0, port files); every wait
 is for an event (a port file, the end of a process, a connection) with a
@@ -27,6 +32,10 @@ import sys
 import tempfile
 import threading
 import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'ref'))
+import rtde_capture  # noqa: E402  the independent reader of the format
+from rtde_ref import MAPPED  # noqa: E402  the RTDE names RealTime has too, from the protocol
 
 BUILD = sys.argv[1] if len(sys.argv) > 1 else 'build'
 SIM = os.path.join(BUILD, 'bin', 'urrt-sim')
@@ -117,8 +126,8 @@ def usage_errors():
         (['--rtde', '-k', 'test_value', '127.0.0.1'], 'RTDE has no such value (RealTime only)'),
         (['--list', '127.0.0.1'], 'give --rtde --list HOST[:PORT]'),
         (['--rtde', '--list', '-k', 'actual_q', '127.0.0.1'], '--list prints the variables and ends'),
-        (['--rtde', '--file', '/dev/null'], 'with --rtde read HOST[:PORT] live'),
-        (['--rtde', '-w', os.path.join(TMP, 'x'), '127.0.0.1'], 'with --rtde read HOST[:PORT] live'),
+        (['--rtde', '--file', '/dev/null'], 'is no RTDE capture (it is empty'),
+        (['--rtde', '--file', '/dev/null', '-k', 'test_value'], 'RTDE has no such value (RealTime only)'),
         (['--rtde', '-k', 'nosuch', '127.0.0.1'], '"nosuch"'),
         (['--rtde', '127.0.0.1:30003'], 'port 30003 is not RTDE'),
         (['--rtde', '--list', '[::1]:30013'], 'port 30013 is not RTDE'),
@@ -412,6 +421,222 @@ def no_rtde():
     check(rc == 1 and out == '', '--list of a refused port: exit 1, nothing listed', err)
 
 
+# ---- captures: --rtde -w, --file ------------------------------------------------------
+# What a recording asks for without -k, from UR's version table (typed here
+# from UR's RTDE guide, not from lib/): (CB3 since, e-Series since), None
+# for never. Every other RealTime value and these RTDE-only status values
+# have no version (all versions of RTDE).
+VERSIONED = {
+    'elbow_position': ((3, 5), (5, 0)), 'elbow_velocity': ((3, 5), (5, 0)),
+    'safety_status': ((3, 10), (5, 4)), 'payload': ((3, 11), (5, 5, 1)), 'payload_cog': ((3, 11), (5, 5, 1)),
+    'payload_inertia': ((3, 15), (5, 11)),
+    'input_bit_registers0_to_31': ((3, 4), (5, 0)), 'input_bit_registers32_to_63': ((3, 4), (5, 0)),
+    'script_control_line': ((3, 14), (5, 9)), 'ft_raw_wrench': (None, (5, 9)),
+    'collision_detection_ratio': (None, (5, 15)), 'time_scale_source': (None, (5, 17)),
+    'actual_current_as_torque': (None, (5, 23)), 'actual_robot_energy_consumed': (None, (5, 23)),
+    'target_gravity': (None, (5, 26)), 'target_base_acceleration': (None, (5, 26)),
+    'control_step': (None, (5, 26)), 'target_base_wrench': (None, (5, 26)),
+}
+STATUS_ALWAYS = ['target_speed_fraction', 'robot_status_bits', 'safety_status_bits', 'output_bit_registers0_to_31',
+                 'output_bit_registers32_to_63', 'analog_io_types', 'io_current', 'euromap67_input_bits',
+                 'euromap67_output_bits', 'euromap67_24V_voltage', 'euromap67_24V_current', 'tool_mode',
+                 'tool_analog_input_types', 'tool_output_voltage', 'tool_output_current', 'tool_temperature',
+                 'tcp_force_scalar']
+STATUS_VERSIONED = [n for n in VERSIONED if n not in MAPPED]
+
+
+def recorded_names(version, keys):
+    """The recipe urrt-dump --rtde -w -k KEYS asks a controller of version
+    (a tuple) for: as a set, the timestamp apart."""
+    line = 0 if version[0] == 3 else 1
+
+    def has(name):
+        since = VERSIONED.get(name, ((0,), (0,)))[line]
+        return since is not None and version >= since
+    return {n for n in list(MAPPED) + STATUS_ALWAYS + STATUS_VERSIONED if has(n)} | set(keys)
+
+
+KEYS = ['timestamp', 'actual_q', 'robot_mode', 'output_int_register_24', 'output_double_register_3',
+        'safety_status_bits']
+
+
+def cut(path, name, data):
+    out = os.path.join(TMP, name)
+    with open(out, 'wb') as f:
+        f.write(data)
+    return out
+
+
+def recording(sim, name, *args, n=100):
+    """urrt-dump --rtde -w: (status, live stdout, stderr, capture path)."""
+    path = os.path.join(TMP, name)
+    rc, out, err = dump('--rtde', sim.addr, '-w', path, '-n', str(n), *args)
+    return rc, out, err, path
+
+
+def capture_read_back():
+    """A recording read by the independent reader: the recipe of the version,
+    the client's requests, every data package as urrt-dump printed it live;
+    --file gives the live output again, with either name of a value, from a
+    pipe and with --rtde."""
+    keys = ','.join(KEYS)
+    with Sim('-c', '5.12.3.1234') as sim:
+        rc, live, err, path = recording(sim, 'c1.rtde', '-F', 'json', '-k', keys, n=200)
+    check(rc == 0 and len(live.splitlines()) == 200, 'a recording run prints its 200 packages live', err)
+    cap = rtde_capture.read_file(path)
+    ses = rtde_capture.sessions(cap)
+    check(cap.truncated == 0 and len(ses) == 1 and ses[0].peer == sim.addr,
+          'the capture: one session, whole, its "C" record naming the peer', (cap.truncated, [s.peer for s in ses]))
+    s = ses[0]
+    check([t for t, _ in s.requests] == ['V', 'v', 'O', 'S'] and s.protocol == 2 and
+          s.controller == (5, 12, 3, 1234), 'the capture holds the client\'s requests and the controller\'s replies',
+          ([t for t, _ in s.requests], s.protocol, s.controller))
+    want = recorded_names((5, 12, 3), KEYS)
+    check(s.names[0] == 'timestamp' and len(set(s.names)) == len(s.names) and set(s.names) == want,
+          'the recipe recorded on 5.12: the RealTime set, the status values 5.12 has, the -k names',
+          (sorted(set(s.names) - want), sorted(want - set(s.names))))
+    check(len(s.types) == len(s.names) and 'NOT_FOUND' not in s.types, 'the controller has every name recorded',
+          s.types)
+    objs = [json.loads(ln) for ln in live.splitlines()]
+    same = len(s.data) == len(objs) and all(
+        d['timestamp'] == o['time'] and list(d['actual_q']) == o['q_actual'] and d['robot_mode'] == o['robot_mode']
+        and d['output_int_register_24'] == o['output_int_register_24'] and
+        d['output_double_register_3'] == o['output_double_register_3'] and
+        d['safety_status_bits'] == o['safety_status_bits'] for d, o in zip(s.data, objs))
+    check(same, 'the capture holds exactly the 200 packages printed live, value for value', (len(s.data), len(objs)))
+
+    rc, out, err = dump('--file', path, '-F', 'json', '-k', keys)
+    check(rc == 0 and out == live, '--file prints what the recording run printed live (json, -k)', err)
+    rc, out2, _ = dump('--file', path, '-F', 'json', '-k', 'time,q_actual,robot_mode,output_int_register_24,'
+                       'output_double_register_3,safety_status_bits')
+    check(rc == 0 and out2 == live, '-k takes urrt names and RTDE names alike', out2[:300])
+    rc, out3, _ = dump('--rtde', '--file', path, '-F', 'json', '-k', keys)
+    check(rc == 0 and out3 == live, '--rtde --file: the same', out3[:300])
+    with open(path, 'rb') as f:
+        r = subprocess.run(['timeout', '-k', '3', '30', DUMP, '--file', '-', '-F', 'json', '-k', keys], stdin=f,
+                           capture_output=True, text=True)
+    check(r.returncode == 0 and r.stdout == live, '--file - reads a capture from a pipe', r.stderr)
+    check('summary: packets: 200' in err and 'summary: rtde: controller 5.12.3.1234, protocol 2' in err and
+          'summary: rtde recipe: timestamp,' in err and 'output_int_register_24' in err and
+          'summary: rtde capture: sessions 1, last record cut short: 0 bytes' in err,
+          '--file\'s summary: packages, controller, protocol, recipe, sessions', err)
+    rc, _, err = dump('--file', path, '-k', 'time,output_int_register_5')
+    check(rc == 1 and '-k output_int_register_5: the capture' in err and
+          'record it with urrt-dump --rtde -w FILE -k output_int_register_5' in err,
+          '-k of a value the capture lacks: exit 1, saying how to record it', err)
+
+    # Cut short inside its last record (a data package), and damaged.
+    with open(path, 'rb') as f:
+        data = f.read()
+    last = cap.records[-1]
+    check(last.kind == '<' and last.type == 'U', 'the capture ends with the last data package printed', last)
+    short = cut(path, 'short.rtde', data[:last.offset + 10])
+    rc, out, err = dump('--file', short, '-F', 'json', '-k', keys)
+    check(rc == 0 and out.splitlines() == live.splitlines()[:-1] and 'cut short (10 bytes' in err and
+          'last record cut short: 10 bytes' in err,
+          'a record cut short: a notice with its bytes, every package before it, exit 0', err)
+    data_records = [r for r in cap.records if r.type == 'U']
+    bad_at = data_records[99].offset
+    bad = cut(path, 'bad.rtde', data[:bad_at] + b'X' + data[bad_at + 1:])
+    rc, out, err = dump('--file', bad, '-F', 'json', '-k', keys)
+    check(rc == 1 and out.splitlines() == live.splitlines()[:99] and
+          ('byte %d: record kind 0x58' % bad_at) in err, 'a damaged record: its byte offset, exit 1, the packages '
+          'before it', (rc, len(out.splitlines()), err))
+    try:
+        rtde_capture.read(data[:bad_at] + b'X' + data[bad_at + 1:])
+        check(False, 'the reference reader refuses the damaged copy')
+    except rtde_capture.CaptureError as e:
+        check(e.offset == bad_at, 'the reference reader finds the damage at the same byte', e)
+    header = cut(path, 'header.rtde', b'URRT RTDE capture 2\n' + data[20:])
+    rc, out, err = dump('--file', header)
+    check(rc == 1 and out == '' and 'not an RTDE capture' in err and 'URRT RTDE capture 1' in err,
+          'a file starting with "U" but another header: refused, naming the header', err)
+
+
+def capture_formats():
+    """Every format, live while recording and from the capture: the same."""
+    with Sim('-c', '5.12.3.1234') as sim:
+        for fmt, args in (('table', ()), ('table', ('-k', 'time,actual_q,output_int_register_2,tcp_force_scalar')),
+                          ('csv', ('-k', ','.join(KEYS))), ('csv', ()), ('json', ()), ('gnuplot', ())):
+            name = 'f-%s-%d.rtde' % (fmt, len(args))
+            rc, live, err, path = recording(sim, name, '-F', fmt, *args, n=30)
+            rc2, out, err2 = dump('--file', path, '-F', fmt, *args)
+            check(rc == 0 and rc2 == 0 and live and out == live, '%s%s: --file prints what the recording printed'
+                  % (fmt, ' -k' if args else ''), (err2, out[:300], live[:300]))
+        check('output_bit_registers32_to_63' in live.splitlines()[0] and 'ft_raw_wrench' in live.splitlines()[0],
+              'gnuplot of a recording names its RTDE-only columns too', live.splitlines()[0])
+
+
+def capture_3x():
+    """3.10 in protocol 1: the recipe without what 3.10 lacks, printed again."""
+    with Sim('-c', '3.10', '--fault', 'rtde-refuse-v2') as sim:
+        rc, live, err, path = recording(sim, 'c310.rtde', '-F', 'csv', n=50)
+    ses = rtde_capture.sessions(rtde_capture.read_file(path))
+    s = ses[0] if ses else None
+    want = recorded_names((3, 10, 0), ['timestamp'])
+    check(rc == 0 and s is not None and s.protocol == 1 and [t for t, _ in s.requests] == ['V', 'V', 'v', 'O', 'S'],
+          '3.10: the capture holds the refused protocol 2 and protocol 1', s and [t for t, _ in s.requests])
+    check(s is not None and set(s.names) == want, 'the recipe recorded on 3.10: no payload*, no script_control_line',
+          s and (sorted(set(s.names) - want), sorted(want - set(s.names))))
+    check(s is not None and len(s.data) == 50 and s.data[0]['safety_status_bits'] == 1,
+          '3.10: the reference decodes protocol 1\'s packages', s and len(s.data))
+    rc, out, err = dump('--file', path, '-F', 'csv')
+    check(rc == 0 and out == live and 'refuses RTDE protocol 2: asking for 1' in err,
+          '3.10: --file prints the live csv again, and says protocol 2 was refused', err)
+
+
+def capture_sessions():
+    """A recording across reconnects (the simulator closes every 40 packages):
+    one session per connection, printed as they were live."""
+    with Sim('-c', '5.12.3.1234', '--fault', 'close-after=40') as sim:
+        rc, live, err, path = recording(sim, 'c2.rtde', '-F', 'csv', '-k', ','.join(KEYS), n=100)
+    ses = rtde_capture.sessions(rtde_capture.read_file(path))
+    check(rc == 0 and len(rows(live)) == 101 and 'reconnecting' in err, 'a recording across reconnects: 100 rows live',
+          err)
+    check(len(ses) == 3 and [len(s.data) for s in ses] == [40, 40, 20] and
+          all([t for t, _ in s.requests] == ['V', 'v', 'O', 'S'] for s in ses),
+          'three sessions, each with its whole handshake and its packages', [(len(s.data), s.requests) for s in ses])
+    rc, out, err = dump('--file', path, '-F', 'csv', '-k', ','.join(KEYS))
+    check(rc == 0 and out == live, 'its sessions print as they did live (one header, every row)', err)
+    check('session 2: connected to %s' % sim.addr in err and 'session 3: connected to' in err and
+          'sessions 3' in err, 'each new session is told on stderr, the summary counts them', err)
+
+
+def capture_budget():
+    """-k names that leave no room: the recording drops the last status values
+    not named, says which, and keeps within UR's 2048 bytes and 128 names."""
+    keys = ['output_int_register_%d' % i for i in range(48)] + ['output_double_register_%d' % i for i in range(3)]
+    with Sim('-c', '5.12.3.1234') as sim:
+        rc, live, err, path = recording(sim, 'budget.rtde', '-F', 'csv', '-k', ','.join(keys), n=5)
+    ses = rtde_capture.sessions(rtde_capture.read_file(path))
+    names = ses[0].names if ses else []
+    dropped = err.split('the recording leaves out ')[1].split(':')[0].split(', ') if 'leaves out' in err else []
+    check(rc == 0 and len(rows(live)) == 6, 'a recording with 51 registers in -k runs', err)
+    check(len(names) <= 128 and len(','.join(names)) <= 2048 and set(keys) <= set(names) and
+          set(MAPPED) & recorded_names((5, 12, 3), []) <= set(names),
+          'its recipe: within 128 names and 2048 bytes, every -k name and the RealTime set',
+          (len(names), len(','.join(names))))
+    check(dropped and 'safety_status_bits' not in dropped and not set(dropped) & set(names) and
+          set(names) | set(dropped) >= recorded_names((5, 12, 3), keys),
+          'the notice names the status values left out (the last ones first)', dropped)
+
+
+def capture_realtime():
+    """A RealTime capture beside them: still read as RealTime; --rtde refuses it."""
+    with Sim('-c', '5.12.3.1234') as sim:
+        path = os.path.join(TMP, 'rt.bin')
+        rc, live, err = dump('127.0.0.1:%d' % sim.rt_port, '-w', path, '-n', '20', '-F', 'json')
+    rc2, out, err2 = dump('--file', path, '-F', 'json')
+    check(rc == 0 and rc2 == 0 and out == live and '"generation":"3.x/5.x"' in out,
+          'a RealTime capture reads as RealTime', err2)
+    rc, out, err = dump('--rtde', '--file', path)
+    check(rc == 2 and out == '' and 'is no RTDE capture (it starts as a RealTime capture does' in err and
+          'drop --rtde' in err, '--rtde --file of a RealTime capture: refused, saying what to do', err)
+    rc, out, err = dump('--file', path, '-k', 'output_int_register_24')
+    check(rc == 2 and 'only RTDE has this value, and %s is a RealTime capture' % path in err,
+          '-k of an RTDE-only value on a RealTime capture: refused', err)
+
+
 def run(group, *args):
     try:
         group(*args)
@@ -429,6 +654,12 @@ def main():
     run(lists)
     run(texts)
     run(no_rtde)
+    run(capture_read_back)
+    run(capture_formats)
+    run(capture_3x)
+    run(capture_sessions)
+    run(capture_budget)
+    run(capture_realtime)
     print('%d passed, %d failed' % (PASSED, FAILED))
     return 1 if FAILED else 0
 

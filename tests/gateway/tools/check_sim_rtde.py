@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: MIT
 """check-sim-rtde: urrt-sim's RTDE port against an RTDE client written from
-the protocol's description (rtde_peer.py), and against its own RealTime port.
+the protocol's description (rtde_peer.py), and against its own RealTime port;
+and urrt-sim --replay of RTDE captures (urrt-dump --rtde -w recordings, read
+back by the independent reader tests/ref/rtde_capture.py).
 
 Every simulator takes its ports from the system (port 0, port files); every
 wait is for an event (a port file, a package, a log line, the end of a
@@ -18,8 +20,10 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'ref'))
 import rt  # noqa: E402  the RealTime reference: column table
-from rtde_peer import Peer, Closed, Unframable, M, U  # noqa: E402
+import rtde_capture as ref_capture  # noqa: E402  the independent reader of RTDE captures
+from rtde_peer import Peer, CaptureWriter, Closed, Unframable, M, U, TYPES  # noqa: E402
 
 BUILD = sys.argv[1] if len(sys.argv) > 1 else 'build'
 SIM = os.path.join(BUILD, 'bin', 'urrt-sim')
@@ -102,7 +106,8 @@ def regular(steps, d):
 # ---- usage -------------------------------------------------------------------------
 def usage_errors():
     cases = [
-        (['--rtde', '127.0.0.1:0', '--replay', '/dev/null'], 'drop --replay or --rtde'),
+        (['--rtde', '127.0.0.1:0', '--replay', '/dev/null'], 'no RTDE capture (a RealTime capture has no RTDE to '
+                                                              'serve): drop --rtde'),
         (['--rtde', '127.0.0.1:0', '--length', '1116'], 'give --controller V, not --length'),
         (['--rtde', '127.0.0.1:0', '-c', '3.2'], 'no RTDE on this version'),
         (['--rtde', '127.0.0.1:0', '-c', '5.10', '--rate', '125'], 'runs at 500 Hz on both ports: drop --rate'),
@@ -536,6 +541,343 @@ def slow_reader(extra, bound, what):
               sim.log()[-300:])
 
 
+# ---- --replay of an RTDE capture ------------------------------------------------------------
+# The captures are urrt-dump --rtde -w recordings of the simulator's model,
+# and, for what urrt-dump never writes (a recipe without timestamp, a later
+# session with another recipe), sessions that rtde_peer's CaptureWriter
+# records. What the replay must serve is read from the files by the
+# independent reader tests/ref/rtde_capture.py: each recorded package's
+# values, sliced by the recorded types.
+DUMP = os.path.join(BUILD, 'bin', 'urrt-dump')
+
+
+class Capture:
+    """A capture as the replay serves it: its first session's recipe, then
+    the data packages of the sessions with that recipe, up to the first
+    with another (values past the recipe id), and the text messages
+    between them: [(packages before it, (level, message))]."""
+
+    def __init__(self, path):
+        self.path = path
+        self.sessions = ref_capture.sessions(ref_capture.read_file(path))
+        first = self.sessions[0]
+        self.names, self.types = first.names, first.types
+        self.packages, self.texts = [], []
+        for sess in self.sessions:
+            if (sess.names, sess.types) != (self.names, self.types):
+                break
+            texts = iter(sess.texts)
+            for kind, payload in sess.replies:
+                if kind == 'U':
+                    self.packages.append(payload[1:] if sess.protocol >= 2 else payload)
+                elif kind == 'M':
+                    self.texts.append((len(self.packages), next(texts)[:2]))
+
+    def slices(self, i):
+        """{name: the bytes of its value} of package i."""
+        out, off = {}, 0
+        for name, t in zip(self.names, self.types):
+            fmt, n = TYPES[t]
+            size = struct.calcsize('>' + fmt) * n
+            out[name] = self.packages[i][off:off + size]
+            off += size
+        return out
+
+    def timestamp(self, i):
+        return struct.unpack('>d', self.slices(i)['timestamp'])[0]
+
+
+def dump_capture(name, version, count, faults=(), keys=()):
+    """urrt-dump --rtde -w TMP/name of count packages from the model of version."""
+    path = os.path.join(TMP, name)
+    with Sim('-c', version, *faults) as sim:
+        args = [DUMP, '--rtde', '127.0.0.1:%d' % sim.port, '-w', path, '-n', str(count)]
+        if keys:
+            args += ['-k', ','.join(('timestamp',) + tuple(keys))]
+        r = subprocess.run(args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, timeout=30)
+    if r.returncode != 0:
+        raise RuntimeError('urrt-dump -w failed: ' + r.stderr[-300:])
+    return Capture(path)
+
+
+def record(path, version, count, names, rate=500.0, append=False):
+    """A session of count data packages with the model of version, recorded
+    by rtde_peer into path (appended: one more session)."""
+    w = CaptureWriter(path, append=append)
+    with Sim('-c', version) as sim:
+        p = Peer(sim.port, capture=w)
+        p.protocol_version(2)
+        p.controller_version()
+        p.setup_outputs(list(names), rate)
+        if p.start() != 1:
+            raise RuntimeError('the recorded session did not start: %s' % p.types)
+        p.data(count)
+        p.close()
+    w.close()
+
+
+class Replay:
+    """urrt-sim --replay CAPTURE on an RTDE port of the system's choosing."""
+    count = 0
+
+    def __init__(self, path, *args):
+        Replay.count += 1
+        base = os.path.join(TMP, 'replay%d' % Replay.count)
+        self.log_path, self.rtde_pf = base + '.log', base + '.rtde'
+        with open(self.log_path, 'w') as log:
+            self.proc = subprocess.Popen(['timeout', '-k', '3', '60', SIM, '--replay', path, '--rtde', '127.0.0.1:0',
+                                          '--rtde-port-file', self.rtde_pf, '-v'] + list(args), stderr=log)
+        if not wait_for('the replay\'s port file', lambda: os.path.exists(self.rtde_pf), self.proc):
+            raise RuntimeError('replay did not start: ' + self.log())
+        self.port = int(open(self.rtde_pf).read())
+
+    def log(self):
+        return open(self.log_path).read()
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.proc.terminate()
+        self.proc.wait(timeout=10)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.stop()
+
+
+def client(port, names, rate=500.0, protocol=2):
+    p = Peer(port)
+    if protocol == 2:
+        p.protocol_version(2)
+        p.setup_outputs(list(names), rate)
+    else:
+        p.setup_outputs(list(names))
+    if p.start() != 1:
+        raise RuntimeError('start refused')
+    return p
+
+
+def replayed(p, limit=100000):
+    """Data packages until the connection ends: (payloads past the recipe
+    id, [(packages before it, text)], how it ended)."""
+    pk, texts = [], []
+    try:
+        while len(pk) < limit:
+            kind, payload = p.package()
+            if kind == U:
+                p.decode(payload)  # the size and recipe id the recipe makes
+                pk.append(payload[1:] if p.protocol >= 2 else payload)
+            elif kind == M:
+                texts.append((len(pk), p.texts[-1]))
+    except Closed:
+        return pk, texts, 'closed'
+    except TimeoutError:
+        return pk, texts, 'timeout'
+    return pk, texts, 'limit'
+
+
+def matches(cap, names, pk):
+    """The indices of the capture's packages that pk's are, by timestamp
+    (names[0] is timestamp), and the packages whose bytes are not the
+    capture's values for names, in order."""
+    by_ts = {cap.timestamp(i): i for i in range(len(cap.packages))}
+    idx, bad = [], []
+    for got in pk:
+        i = by_ts.get(struct.unpack_from('>d', got)[0])
+        want = None if i is None else b''.join(cap.slices(i)[n] for n in names)
+        if want != got:
+            bad.append((i, got[:16], (want or b'')[:16]))
+        idx.append(i)
+    return idx, bad
+
+
+def replay_usage():
+    cap = dump_capture('usage.rtde', '5.10', 5)
+    rt = os.path.join(TMP, 'rt.bin')
+    with open(rt, 'wb') as f:
+        f.write(struct.pack('>i', 1116) + b'\0' * 1112)
+    cases = [
+        (['--replay', cap.path, '-l', '127.0.0.1:0'], 'is an RTDE capture, served on the RTDE port alone (no RealTime '
+                                                      'stream): drop --listen'),
+        (['--replay', cap.path, '--port-file', 'x'], 'drop --port-file'),
+        (['--replay', cap.path, '-w', 'x'], 'drop --record'),
+        (['--replay', cap.path, '--fault', 'garbage-every=3'], 'drop fault garbage-every'),
+        (['--replay', cap.path, '-c', '5.10'], 'drop --controller'),
+        (['--replay', rt, '--rtde', '127.0.0.1:0'], 'a RealTime capture has no RTDE to serve): drop --rtde'),
+        (['--replay', rt, '--fault', 'rtde-refuse-v2'], 'an rtde-* fault goes with --rtde HOST:PORT or --replay of an '
+                                                        'RTDE capture'),
+    ]
+    for args, text in cases:
+        r = subprocess.run([SIM] + args, capture_output=True, text=True, timeout=10)
+        check(r.returncode == 2 and text in r.stderr, 'replay usage error: %s' % ' '.join(args), r.stderr.strip())
+
+
+def replay_handshake_and_values():
+    cap = dump_capture('full.rtde', '5.10.2.77', 300, faults=('--fault', 'rtde-text-every=100,level=3'),
+                       keys=('output_int_register_24', 'output_bit_register_64'))
+    check(len(cap.packages) == 300 and [t[0] for t in cap.texts] == [100, 200],
+          'urrt-dump -w: 300 packages and 2 text messages among them', cap.texts)
+    with Replay(cap.path) as sim:
+        check('no RealTime stream' in sim.log() and '300 data packages at 500 Hz' in sim.log() and
+              'a recipe of %d variables' % len(cap.names) in sim.log(),
+              'replay: says what it serves, and that there is no RealTime stream', sim.log()[-500:])
+        p = Peer(sim.port)
+        check(p.protocol_version(1) == 1, 'replay: protocol 1 accepted, as a controller does')
+        p.close()
+        p = Peer(sim.port)
+        check(p.protocol_version(2) == 1, 'replay: protocol 2 accepted, as recorded')
+        check(p.controller_version() == (5, 10, 2, 77), 'replay: the recorded controller version')
+        rid, types = p.setup_outputs(['actual_q', 'timestamp', 'tcp_offset', 'output_int_register_25', 'payload'],
+                                     500.0)
+        check(rid == 0 and types == ['VECTOR6D', 'DOUBLE', 'NOT_FOUND', 'NOT_FOUND', 'DOUBLE'],
+              'replay: recorded names get their recorded types, unrecorded ones (that 5.10 has) NOT_FOUND',
+              (rid, types))
+        check(p.start() == 0, 'replay: start refused without a valid recipe')
+        names = ['timestamp', 'output_int_register_24', 'joint_mode', 'output_bit_register_64', 'actual_q']
+        rid, types = p.setup_outputs(names, 500.0)
+        want = [cap.types[cap.names.index(n)] for n in names]
+        check(rid == 1 and types == want, 'replay: a subset in another order: recipe id 1, the recorded types',
+              (rid, types))
+        check(p.start() == 1, 'replay: start accepted')
+        pk, texts, how = replayed(p)
+        p.close()
+        idx, bad = matches(cap, names, pk)
+        check(how == 'closed' and idx[:1] == [0] and regular([b - a for a, b in zip(idx, idx[1:])], 1),
+              'replay: every package from the capture\'s first, in its order (by the timestamps), then the end '
+              '(%d of 300)' % len(pk), (how, idx[:3], idx[-3:]))
+        check(not bad, 'replay: each variable\'s bytes exactly the recorded ones', bad[:3])
+        check([t[1][:2] for t in texts] == [t[1] for t in cap.texts] and
+              [t[0] for t in texts] == [idx.index(t[0]) if t[0] in idx else None for t in cap.texts],
+              'replay: the recorded text messages, before the package they preceded', (texts, cap.texts))
+        check(wait_for('the end of the replay', lambda: sim.proc.poll() is not None, timeout=10) and
+              sim.proc.returncode == 0 and 'end of capture' in sim.log(),
+              'replay: at the end of the capture the program exits with 0', (sim.proc.returncode, sim.log()[-300:]))
+
+
+def replay_clients_and_rates():
+    cap = dump_capture('rates.rtde', '5.10', 400, keys=('actual_q', 'robot_mode', 'output_bit_registers0_to_31',
+                                                       'output_int_register_24', 'runtime_state'))
+    with Replay(cap.path) as sim:
+        a_names = ['timestamp', 'actual_q']
+        b_names = ['timestamp', 'robot_mode', 'output_bit_registers0_to_31']
+        c_names = ['timestamp', 'output_int_register_24']
+        d_names = ['timestamp', 'runtime_state']
+        a = client(sim.port, a_names)
+        b = client(sim.port, b_names, protocol=1)
+        c = client(sim.port, c_names, rate=125.0)
+        d = client(sim.port, d_names, rate=200.0)
+        e = Peer(sim.port)
+        e.protocol_version(2)
+        rid, _ = e.setup_outputs(['timestamp'], 501.0)
+        check(rid == 0 and e.texts and e.texts[-1][0] == 1, 'replay of 5.10: 501 Hz refused as its controller does',
+              (rid, e.texts))
+        e.close()
+        got = {}
+        for name, p, names, d_ in (('a', a, a_names, 1), ('b', b, b_names, 1), ('c', c, c_names, 4),
+                                   ('d', d, d_names, 2)):
+            pk, _, how = replayed(p)
+            p.close()
+            idx, bad = matches(cap, names, pk)
+            steps = [y - x for x, y in zip(idx, idx[1:])]
+            got[name] = len(pk)
+            check(how == 'closed' and not bad and None not in idx and regular(steps, d_) and
+                  all(i % d_ == 0 for i in idx),
+                  'replay, several clients: %s (%s, protocol %d) every %d package%s, the recorded bytes' %
+                  (name, ','.join(names), p.protocol, d_, '' if d_ == 1 else 's'), (how, bad[:2], steps[:5]))
+        check(got['a'] >= 390, 'replay: the first client got the capture from its start', got)
+
+
+def replay_loop():
+    cap = dump_capture('loop.rtde', '3.10', 40)
+    with Replay(cap.path, '--loop') as sim:
+        p = client(sim.port, ['timestamp', 'actual_q'], rate=125.0)
+        pk, _, _ = replayed(p, limit=100)
+        p.close()
+    idx, bad = matches(cap, ['timestamp', 'actual_q'], pk)
+    check(not bad and (idx == [i % 40 for i in range(100)] or
+                       regular([(y - x) % 40 for x, y in zip(idx, idx[1:])], 1)),
+          '--loop: the capture again and again, its own timestamps each time (as a RealTime replay)', idx[35:45])
+
+
+def replay_protocol1_capture():
+    """A 3.3 controller: protocol 2 refused, 1 accepted; its packages carry
+    no recipe id."""
+    cap = dump_capture('v1.rtde', '3.3', 30)
+    check(cap.sessions[0].protocol == 1, 'urrt-dump -w of a 3.3 controller: a protocol 1 session')
+    with Replay(cap.path) as sim:
+        p = Peer(sim.port)
+        check(p.protocol_version(2) == 0, 'replay of a protocol 1 capture: protocol 2 refused, as recorded')
+        check(p.protocol_version(1) == 1, 'then protocol 1 accepted')
+        check(p.controller_version() == (3, 3, 0, 0), 'the recorded version 3.3')
+        p.setup_outputs(['robot_mode', 'timestamp'])
+        p.start()
+        pk, _, how = replayed(p)
+        p.close()
+    idx, bad = matches(cap, ['timestamp'], [x[4:] for x in pk])
+    check(how == 'closed' and not bad and idx[:1] == [0] and regular([y - x for x, y in zip(idx, idx[1:])], 1) and
+          all(x[:4] == cap.slices(i)['robot_mode'] for x, i in zip(pk, idx)),
+          'replay of a protocol 1 capture: protocol 1 packages, the recorded bytes', (how, bad[:2]))
+
+
+def replay_sessions():
+    """urrt-dump reconnects after the simulator closes every 20 packages:
+    3 sessions of one recipe, served one after the other; a fourth with
+    another recipe (appended) ends the replay before it."""
+    cap = dump_capture('sessions.rtde', '5.10', 50, faults=('--fault', 'close-after=20'))
+    record(cap.path, '5.10', 10, ['timestamp', 'actual_qd'], append=True)
+    cap = Capture(cap.path)
+    check(len(cap.sessions) == 4 and len(cap.packages) == 50, 'a capture of 4 sessions, 50 packages in the first 3',
+          (len(cap.sessions), len(cap.packages)))
+    with Replay(cap.path) as sim:
+        check('50 data packages' in sim.log() and 'from 3 sessions' in sim.log() and
+              'asks for another recipe: the replay ends before it' in sim.log(),
+              'replay: the 3 sessions with its first recipe served, the log says why not the fourth',
+              sim.log()[-600:])
+        p = client(sim.port, ['timestamp', 'actual_q'])
+        pk, _, how = replayed(p)
+        p.close()
+    want = [b''.join(cap.slices(i)[n] for n in ('timestamp', 'actual_q')) for i in range(50)]
+    check(how == 'closed' and pk == want, 'replay: the 3 sessions\' packages one after the other',
+          (len(pk), len(want)))
+
+
+def replay_refusals():
+    path = os.path.join(TMP, 'nots.rtde')
+    record(path, '5.10', 5, ['actual_q', 'robot_mode'])
+    r = subprocess.run([SIM, '--replay', path, '--rtde', '127.0.0.1:0'], capture_output=True, text=True, timeout=10)
+    check(r.returncode == 1 and 'has no timestamp, the clock a replay is paced by' in r.stderr and
+          'urrt-dump --rtde -w' in r.stderr, 'a capture without timestamp: refused at start (exit 1), says why',
+          r.stderr.strip())
+    good = dump_capture('damage.rtde', '5.10', 20)
+    data = open(good.path, 'rb').read()
+    records = ref_capture.read(data).records
+    off = records[10].offset
+    for what, damaged, text in (
+            ('kind', data[:off] + b'?' + data[off + 1:], 'byte %d: record kind 0x3F' % off),
+            ('size', data[:off + 1] + b'\x00\x02' + data[off + 3:], 'byte %d: a package of 2 bytes' % (off + 1))):
+        bad_path = os.path.join(TMP, 'damaged-%s.rtde' % what)
+        open(bad_path, 'wb').write(damaged)
+        r = subprocess.run([SIM, '--replay', bad_path, '--rtde', '127.0.0.1:0'], capture_output=True, text=True,
+                           timeout=10)
+        check(r.returncode == 1 and text in r.stderr, 'a damaged capture (%s): refused, the message names the offset'
+              % what, r.stderr.strip())
+    cut = os.path.join(TMP, 'cut.rtde')
+    open(cut, 'wb').write(data[:-7])
+    with Replay(cut) as sim:
+        check('last record is cut short' in sim.log() and '19 data packages' in sim.log(),
+              'a capture cut short mid-record: served up to its last whole record, said so', sim.log()[-400:])
+    # The RTDE faults apply to a replay too.
+    with Replay(good.path, '--fault', 'rtde-refuse-v2', '--fault', 'close-after=5') as sim:
+        p = Peer(sim.port)
+        check(p.protocol_version(2) == 0, 'replay with rtde-refuse-v2: protocol 2 refused')
+        p.setup_outputs(['timestamp'])
+        p.start()
+        pk, _, how = replayed(p)
+        check(len(pk) == 5 and how == 'closed', 'replay with close-after=5: 5 packages, then closed', (len(pk), how))
+        p.close()
+
+
 def run(group, *args):
     """One group of checks; an exception (a reply that never came, a package
     that does not parse) fails the group instead of ending the suite."""
@@ -564,6 +906,13 @@ def main():
     run(faults_connection)
     run(slow_reader, [], 65536, 'default backlog')
     run(slow_reader, ['--fault', 'rtde-backlog=2048'], 2048, 'rtde-backlog=2048')
+    run(replay_usage)
+    run(replay_handshake_and_values)
+    run(replay_clients_and_rates)
+    run(replay_loop)
+    run(replay_protocol1_capture)
+    run(replay_sessions)
+    run(replay_refusals)
     print('%d passed, %d failed' % (PASSED, FAILED))
     return 1 if FAILED else 0
 

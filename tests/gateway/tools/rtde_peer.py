@@ -22,6 +22,33 @@ TYPES = {
 }
 
 
+CAPTURE_MAGIC = b'URRT RTDE capture 1\n'
+
+
+class CaptureWriter:
+    """Writes urrt's RTDE capture format (docs/rtde.md, "Captures"), from
+    its description: the 20-byte header, then records, each a kind byte
+    ('C' a connection began, '>' a request the client sent, '<' a package
+    the controller sent) and a whole package (uint16 size incl. the 3-byte
+    header, type, payload); a 'C' record's package is of type 'C' and holds
+    the peer as text."""
+
+    def __init__(self, path, append=False):
+        """append: one more session at the end of a capture."""
+        self.f = open(path, 'ab' if append else 'wb')
+        if not append:
+            self.f.write(CAPTURE_MAGIC)
+
+    def record(self, kind, package):
+        self.f.write(kind + package)
+
+    def connected(self, peer):
+        self.record(b'C', struct.pack('>HB', 3 + len(peer), ord('C')) + peer)
+
+    def close(self):
+        self.f.close()
+
+
 class Closed(Exception):
     """The controller ended the connection (orderly: EOF)."""
 
@@ -31,13 +58,16 @@ class Unframable(Exception):
 
 
 class Peer:
-    def __init__(self, port, host='127.0.0.1', rcvbuf=None, timeout=5.0):
+    def __init__(self, port, host='127.0.0.1', rcvbuf=None, timeout=5.0, capture=None):
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         if rcvbuf is not None:
             self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, rcvbuf)
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self.sock.settimeout(timeout)
         self.sock.connect((host, port))
+        self.capture = capture  # a CaptureWriter: the session is recorded into it
+        if capture is not None:
+            capture.connected(b'%s:%d' % (host.encode(), port))
         self.buf = b''
         self.received = 0     # bytes read from the socket
         self.protocol = 1
@@ -52,7 +82,10 @@ class Peer:
 
     # ---- framing ----
     def send(self, letter, payload=b''):
-        self.sock.sendall(struct.pack('>HB', 3 + len(payload), letter[0]) + payload)
+        package = struct.pack('>HB', 3 + len(payload), letter[0]) + payload
+        if self.capture is not None:
+            self.capture.record(b'>', package)
+        self.sock.sendall(package)
 
     def send_raw(self, data):
         self.sock.sendall(data)
@@ -81,6 +114,8 @@ class Peer:
             raise Unframable('size field %d' % size)
         self._fill(size, deadline)
         payload = self.buf[3:size]
+        if self.capture is not None:
+            self.capture.record(b'<', self.buf[:size])
         self.buf = self.buf[size:]
         letter = bytes([kind])
         if letter == M:

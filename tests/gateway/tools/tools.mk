@@ -3,7 +3,7 @@
 #   check-tools       urrt-sim and urrt-dump end to end (shell + Python reference)
 #   check-tools-asan  check-link (tests/port), check-tools, check-sim-rtde and check-dump-rtde again, everything built with ASan and UBSan
 #   check-sim-rtde    urrt-sim's RTDE port against a client written from the protocol (rtde_peer.py)
-#   check-dump-rtde   urrt-dump --rtde against urrt-sim's RTDE port and its RealTime output
+#   check-dump-rtde   urrt-dump --rtde against urrt-sim's RTDE port and its RealTime output; its RTDE captures (-w, --file)
 #   bench-tools       the simulator's schedule at 500 Hz: lateness, late packets
 # No fixed TCP port: every server takes one from the system, so that runs in
 # two build directories at once (or -j) do not meet.
@@ -11,7 +11,7 @@
 check-tools: $(BUILD)/bin/urrt-sim $(BUILD)/bin/urrt-dump
 	$(call suite,$@,BUILD=$(BUILD) PYTHON=$(PYTHON) timeout -k 5 110 sh tests/gateway/tools/check_tools.sh)
 
-check-sim-rtde: $(BUILD)/bin/urrt-sim
+check-sim-rtde: $(BUILD)/bin/urrt-sim $(BUILD)/bin/urrt-dump
 	$(call suite,$@,timeout -k 5 200 $(PYTHON) tests/gateway/tools/check_sim_rtde.py $(BUILD))
 
 check-dump-rtde: $(BUILD)/bin/urrt-sim $(BUILD)/bin/urrt-dump
