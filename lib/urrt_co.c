@@ -288,7 +288,29 @@ int urrt_co_init(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urrt_co_
     co->heartbeat_due_us = URRT_CANTX_NEVER;
     co->sdo_busy = false;
     co->error_passive = false;
+    co->sync_cob_id = SYNC_DEFAULT; /* urrt_co_rx_ids holds before urrt_co_start */
+    co->rx_changes = 0;
     return 0;
+}
+
+/* The SYNC id becomes id: a change of the received set when it is new. */
+static void sync_id_set(urrt_co *co, uint32_t cob_id)
+{
+    if (((co->sync_cob_id ^ cob_id) & ID_MASK) != 0u) {
+        co->rx_changes++;
+    }
+    co->sync_cob_id = cob_id;
+}
+
+size_t urrt_co_rx_ids(const urrt_co *co, uint32_t ids[URRT_CO_RX_IDS_MAX])
+{
+    if (co == NULL || co->desc == NULL) {
+        return 0;
+    }
+    ids[0] = 0x000u; /* NMT */
+    ids[1] = co->sync_cob_id & ID_MASK;
+    ids[2] = SDO_RX_BASE + co->desc->node_id;
+    return URRT_CO_RX_IDS_MAX;
 }
 
 /* ---- frames out ------------------------------------------------------------------- */
@@ -729,7 +751,7 @@ static size_t boot(urrt_co *co, uint64_t now_us, bool whole_node, urrt_cantx_emi
     co->state = (uint8_t)URRT_CO_INITIALISING;
     co->sdo_busy = false;
     co->heartbeat_ms = d->heartbeat_ms;
-    co->sync_cob_id = SYNC_DEFAULT;
+    sync_id_set(co, SYNC_DEFAULT);
     co->emcy_cob_id = EMCY_BASE + d->node_id;
     co->emcy_inhibit_100us = 0;
     errors_reset(co);
@@ -828,7 +850,9 @@ static uint32_t write_errors(urrt_co *co, size_t n, uint8_t sub, uint32_t value,
     return 0;
 }
 
-/* SYNC consumer only: bit 30 (generate) and 29-bit ids are refused. */
+/* SYNC consumer only: bit 30 (generate) and 29-bit ids are refused; bit
+ * 31 is CiA 301's "do not care", kept as written. A new id changes the set
+ * urrt_co_rx_ids gives. */
 static uint32_t write_sync(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
 {
     (void)n;
@@ -837,7 +861,7 @@ static uint32_t write_sync(urrt_co *co, size_t n, uint8_t sub, uint32_t value, u
     if ((value & ~(URRT_CO_COB_INVALID | ID_MASK)) != 0u || id_restricted(value & ID_MASK)) {
         return URRT_CO_ABORT_VALUE;
     }
-    co->sync_cob_id = value;
+    sync_id_set(co, value);
     return 0;
 }
 

@@ -18,6 +18,7 @@
  *     urrt_cantx_init(&tx, ...);
  *     urrt_co_init(&co, &node, &tx, tpdo_states, vars, TABLE_VARS, &bad);
  *     urrt_co_start(&co, now, send_frame, ctx);        boot-up; starts tx too
+ *     the receive filter:   urrt_co_rx_ids(&co, ids);  again when co.rx_changes moves (see there)
  *     on a received frame:  urrt_co_on_frame(&co, id, flags, data, len, now, send_frame, ctx);
  *     on a decoded packet:  urrt_cantx_on_packet(&tx, 0, &state, now);   then run
  *     every loop:           urrt_co_run(&co, now, send_frame, ctx);      runs tx too
@@ -218,6 +219,7 @@ typedef struct urrt_co {
     uint64_t overrun_until_us;    /* counter conditions hold until then */
     uint64_t bus_off_until_us;
     uint32_t sync_cob_id;         /* 0x1005 */
+    uint32_t rx_changes;          /* changes of urrt_co_rx_ids' set since urrt_co_init (see there) */
     uint32_t emcy_cob_id;         /* 0x1014 */
     uint32_t errors[URRT_CO_HISTORY]; /* 0x1003 sub 1..: newest first */
     uint32_t sdo_size;            /* segmented upload: the string, its length, bytes sent */
@@ -345,6 +347,34 @@ size_t urrt_co_start(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void
  */
 size_t urrt_co_on_frame(urrt_co *co, uint32_t id, unsigned flags, const uint8_t *data, size_t len, uint64_t now_us,
                         urrt_cantx_emit_fn emit, void *ctx);
+
+/*
+ * The ids the node receives. It acts on the frames of URRT_CO_RX_IDS_MAX
+ * 11-bit ids only: NMT 0x000, SYNC (0x1005's id: 0x080 after a reset) and
+ * its SDO requests 0x600 + node id, so that a CAN controller's acceptance
+ * filter (a socket's filter on Linux) need let nothing else in. The set
+ * changes when a manager writes 0x1005 a new id, and when a reset (an NMT
+ * command, or urrt_co_start again) takes it back to 0x080. Each change adds
+ * one to co->rx_changes; the caller keeps the count its filter was set at
+ * and, when they differ, sets the filter again. The place to compare is the emit
+ * function, before the frame goes out: the change is made before the frame
+ * that follows it (the SDO answer confirming the write, the boot-up after a
+ * reset), so the filter is in place before the manager can send a SYNC on
+ * the new id.
+ *
+ *     after urrt_co_init:   n = urrt_co_rx_ids(&co, ids);  set the filter;  seen = co.rx_changes;
+ *     in the emit function: if (co.rx_changes != seen) { the same again }  then send the frame
+ *
+ * No write takes the SYNC id out of the set: 0x1005's bit 31 is "do not
+ * care" in CiA 301 (a write may set it; SYNCs are still consumed) and bit 30
+ * (the node produces SYNC) is refused.
+ */
+#define URRT_CO_RX_IDS_MAX 3u
+
+/* Writes the ids the node receives now (NMT, SYNC, SDO request) to ids and
+ * returns their number, URRT_CO_RX_IDS_MAX (0 for a NULL co). After
+ * urrt_co_init. */
+size_t urrt_co_rx_ids(const urrt_co *co, uint32_t ids[URRT_CO_RX_IDS_MAX]);
 
 /* Heartbeat, SDO timeout, EMCY, then urrt_cantx_run. Call it at
  * urrt_co_deadline, and after urrt_cantx_on_packet or urrt_cantx_robot_link

@@ -11,7 +11,7 @@
  * timer, or drops the parts it has no use for (docs/porting.md).
  *
  * It is not everything the programs take from the system. urrt-gateway,
- * urrt-dump and urrt-sim are POSIX programs: they run their own poll() loop,
+ * urrt-dump and urrt-sim are POSIX programs: they run their own wait loop,
  * handle signals, read and write files, urrt-gateway publishes on LCM, and
  * urrt-sim opens its listening sockets and reads the clocks itself. A
  * firmware does not port those programs; it keeps lib/, writes its own main
@@ -142,6 +142,8 @@ typedef struct urrt_link_stats {
     uint64_t last_packet_us; /* monotonic time of the last packet, 0 if none */
     uint64_t partial_bytes;  /* bytes of those incomplete packets */
     uint32_t last_length;    /* size of the last packet, 0 if none */
+    uint64_t sockets;        /* sockets opened (one per address tried): a new socket may
+                                get a closed one's descriptor number, this tells them apart */
 } urrt_link_stats;
 
 typedef struct urrt_link urrt_link;
@@ -158,8 +160,11 @@ void urrt_link_free(urrt_link *link);
 
 /* The descriptor to wait on and the poll events to wait for (POLLOUT while
  * connecting; POLLIN once connected, with POLLOUT while a source's bytes
- * wait to be written), or -1 when there is none (waiting out the backoff).
- * It changes across reconnects: ask again before each wait. */
+ * wait to be written), or -1 when there is none (waiting out the backoff:
+ * the socket is closed). It and its events change only in
+ * urrt_link_service and urrt_link_send: a loop that registers it once
+ * (epoll) asks again after those, and registers anew when the descriptor,
+ * the events or stats.sockets changed. */
 int urrt_link_poll_fd(const urrt_link *link, short *events);
 
 /* Monotonic time by which urrt_link_service must run again at the latest. */
@@ -285,10 +290,10 @@ void urrt_link_drop(urrt_link *link, urrt_link_drop_kind kind, const char *reaso
  * is up again, which is reported once too. Error frames (bus-off,
  * restarted, controller problems, ...) are received and counted; data frames
  * are received only for the configured rx_ids (CAN_RAW_FILTER, kept across
- * reopens; remote requests and 29-bit frames never), handed to the rx
- * function from urrt_canlink_service, at most URRT_CANLINK_RX_BURST per
- * call. Frames the kernel dropped because the socket's queue was full are
- * counted (SO_RXQ_OVFL).
+ * reopens, replaced by urrt_canlink_set_rx_ids; remote requests and 29-bit
+ * frames never), handed to the rx function from urrt_canlink_service, at
+ * most URRT_CANLINK_RX_BURST per call. Frames the kernel dropped because the
+ * socket's queue was full are counted (SO_RXQ_OVFL).
  *
  * The interface string:
  *   "can0"                      a SocketCAN interface: it must exist when the
@@ -379,6 +384,16 @@ void urrt_canlink_free(urrt_canlink *can);
  * URRT_E_ARG for a frame the link can never send (FD frame on a classic
  * link, a length FD does not have, an ID out of range). */
 int urrt_canlink_send(urrt_canlink *can, const urrt_can_frame *frame, uint64_t now_us);
+
+/* Replaces the ids the link receives (as urrt_canlink_config's rx_ids:
+ * 11-bit, at most URRT_CANLINK_RX_IDS_MAX, copied; none: receive nothing):
+ * an open socket's filter at once, and every reopen's after, so that a
+ * CANopen node whose manager moves an id (0x1005, the SYNC) keeps hearing it.
+ * Frames the socket queued under the old ids may still be handed. It may be
+ * called from the rx function. 0; URRT_E_ARG for ids the link cannot take
+ * (logged; the link keeps its ids). A socket that refuses the new filter
+ * goes down (logged as an outage) and its reopen sets it. */
+int urrt_canlink_set_rx_ids(urrt_canlink *can, const uint32_t *ids, size_t count);
 
 /* Received frames are handed to fn from urrt_canlink_service, at most
  * URRT_CANLINK_RX_BURST per call, so that a flooded bus never starves the

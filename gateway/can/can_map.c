@@ -82,6 +82,8 @@ static const char *intern_file(struct can_map *map, const char *file)
 void can_map_init(struct can_map *map)
 {
     memset(map, 0, sizeof *map);
+    map->frames_name = "frames";
+    map->hb_name = "heartbeat";
     /* The table's defaults parse: test_config checks every table's. */
     (void)conf_key_defaults(can_map_can_keys, CAN_MAP_CK_COUNT, map, NULL, 0);
 }
@@ -125,15 +127,36 @@ void can_map_link_config(const struct can_map *map, urrt_canlink_config *cfg)
     cfg->fd_brs = map->fd && map->data_bitrate > map->bitrate;
 }
 
+bool can_map_add_traffic(struct can_map *map, const char *name, unsigned len, double per_second)
+{
+    if (map->traffic_count == CAN_MAP_TRAFFIC_MAX) {
+        return false;
+    }
+    map->traffic[map->traffic_count++] = (struct can_map_traffic){name, len, per_second, 0.0};
+    return true;
+}
+
+/* "frames 7.43% + heartbeat 0.14% + ...": what the load counts, part by part. */
+static void load_parts(const struct can_map *map, char *buf, size_t size)
+{
+    int n = snprintf(buf, size, "%s %.2f%% + %s %.2f%%", map->frames_name, map->frames_load * 100.0, map->hb_name,
+                     map->hb_load * 100.0);
+    for (size_t i = 0; i < map->traffic_count && n >= 0 && (size_t)n < size; i++) {
+        n += snprintf(buf + n, size - (size_t)n, " + %s %.2f%%", map->traffic[i].name, map->traffic[i].load * 100.0);
+    }
+}
+
 int can_map_describe(const struct can_map *map, char *buf, size_t size)
 {
+    char parts[256];
     if (!can_map_enabled(map)) {
         return snprintf(buf, size, "no CAN output configured");
     }
-    return snprintf(buf, size, "%zu frame%s + heartbeat 0x%X on %s, worst-case bus load %.1f%% of %u bit/s%s (max %u%%)",
-                    map->frame_count, map->frame_count == 1 ? "" : "s", (unsigned)map->hb_id,
+    load_parts(map, parts, sizeof parts);
+    return snprintf(buf, size, "%zu frame%s + %s 0x%X on %s, worst-case bus load %.1f%% of %u bit/s%s (max %u%%): %s",
+                    map->frame_count, map->frame_count == 1 ? "" : "s", map->hb_name, (unsigned)map->hb_id,
                     map->interface ? map->interface : "?", map->load * 100.0, (unsigned)map->bitrate,
-                    map->data_bitrate > map->bitrate ? " with an FD data phase" : "", map->max_load_percent);
+                    map->data_bitrate > map->bitrate ? " with an FD data phase" : "", map->max_load_percent, parts);
 }
 
 /* What the DBC says of each heartbeat signal (dbc.c). */
@@ -1259,8 +1282,14 @@ static void compute_load(struct can_map *map)
         f->load = period_us > 0 ? can_map_frame_time_us(map, len, f->extended, f->fd) / period_us : 0;
         map->load += f->load;
     }
+    map->frames_load = map->load;
     map->hb_load = can_map_frame_time_us(map, URRT_CANTX_HB_LEN, map->hb_extended, false) / (map->hb_period_ms * 1000.0);
     map->load += map->hb_load;
+    for (size_t i = 0; i < map->traffic_count; i++) {
+        struct can_map_traffic *t = &map->traffic[i];
+        t->load = can_map_frame_time_us(map, t->len, false, false) * t->per_second / 1e6;
+        map->load += t->load;
+    }
 }
 
 /* "a 2.7%, b 1.2%, c 0.3%": the three heaviest frames say where to act. */
@@ -1301,15 +1330,17 @@ static void check_load(struct finish *fin, struct can_map_loc can_loc)
 {
     struct can_map *map = fin->map;
     char top[256];
+    char parts[256];
     compute_load(map);
     if (map->load * 100.0 <= map->max_load_percent + 1e-9) {
         return;
     }
     heaviest(map, top, sizeof top);
+    load_parts(map, parts, sizeof parts);
     problem(fin, loc_or(map->key_loc[CAN_MAP_CK_MAX_LOAD], loc_or(map->key_loc[CAN_MAP_CK_BITRATE], can_loc)),
-            "worst-case bus load %.1f%% at %u bit/s is over max_bus_load = %u%% (heaviest: %s): lengthen "
+            "worst-case bus load %.1f%% at %u bit/s is over max_bus_load = %u%% (%s; heaviest: %s): lengthen "
             "periods, shorten frames or raise the bit rate",
-            map->load * 100.0, (unsigned)map->bitrate, map->max_load_percent, top);
+            map->load * 100.0, (unsigned)map->bitrate, map->max_load_percent, parts, top);
 }
 
 /* ---- notices: bits of a mask that no signal carries ---------------------------------- */

@@ -150,6 +150,18 @@ struct can_map_robot_rt {
 extern const struct conf_key can_map_can_keys[CAN_MAP_CK_COUNT];
 extern const struct conf_key can_map_frame_keys[CAN_MAP_FK_COUNT];
 
+/* Traffic the bus carries beside the map's frames and its heartbeat, which
+ * another front end adds before can_map_finish (canopen_map: the CANopen
+ * node's heartbeat, EMCY and SDO): counted in the worst-case bus load and
+ * named, part by part, where the load is printed. */
+#define CAN_MAP_TRAFFIC_MAX 4
+struct can_map_traffic {
+    const char *name;                       /* "heartbeat", "EMCY", ...: a string that outlives the map */
+    unsigned len;                           /* data bytes of each frame: classic, 11-bit id */
+    double per_second;                      /* frames a second, at most */
+    double load;                            /* its share of the bus, set by can_map_finish */
+};
+
 /* Receives each problem can_map_finish finds, as file, line and reason
  * (without "FILE:LINE: "), for a caller with its own error list. */
 typedef void (*can_map_report_fn)(void *ctx, const char *file, int line, const char *reason);
@@ -183,8 +195,14 @@ struct can_map {
     /* Robots (copied by can_map_finish). */
     struct can_map_robot_rt *robots;
     size_t robot_count;
-    double load;                            /* worst-case bus load, 0.5 = 50 % (heartbeat included) */
+    double load;                            /* worst-case bus load, 0.5 = 50 % (heartbeat, traffic included) */
     double hb_load;
+    double frames_load;                     /* the frames' share of load */
+    /* The load's parts as printed: the frames, the heartbeat frame, then the traffic. */
+    const char *frames_name;                /* "frames" (canopen_map: "TPDOs") */
+    const char *hb_name;                    /* "heartbeat" (canopen_map: "status TPDO") */
+    struct can_map_traffic traffic[CAN_MAP_TRAFFIC_MAX];
+    size_t traffic_count;
     /* File names seen, each stored once (struct can_map_loc points here). */
     char **files;
     size_t file_count;
@@ -246,8 +264,14 @@ const char *can_map_notice(const struct can_map *map, size_t i);
  * and the DBC. */
 void can_map_link_config(const struct can_map *map, urrt_canlink_config *cfg);
 
-/* One line for the log at start: "4 frames + heartbeat 0x705 on can0,
- * worst-case bus load 7.6% of 500000 bit/s (max 40%)". Returns snprintf's. */
+/* Adds traffic beside the map's frames (see struct can_map_traffic), before
+ * can_map_finish. false when CAN_MAP_TRAFFIC_MAX parts are there already. */
+bool can_map_add_traffic(struct can_map *map, const char *name, unsigned len, double per_second);
+
+/* One line for --check-config and the log at start: "4 frames + heartbeat
+ * 0x705 on can0, worst-case bus load 7.6% of 500000 bit/s (max 40%): frames
+ * 7.43% + heartbeat 0.14%", the traffic's parts after the heartbeat's.
+ * Returns snprintf's. */
 int can_map_describe(const struct can_map *map, char *buf, size_t size);
 
 /* Worst-case bus time of one frame in microseconds at the map's bit rates. */

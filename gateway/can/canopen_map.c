@@ -340,6 +340,19 @@ static int status_id(struct canopen_map *co, struct can_map *can)
     return 0;
 }
 
+/* What the bus load counts for the node beside its TPDOs (canopen_map.h). */
+static void node_traffic(const struct canopen_map *co, struct can_map *can)
+{
+    can->frames_name = "TPDOs";
+    can->hb_name = "status TPDO";
+    can->traffic_count = 0;
+    if (co->heartbeat_ms != 0) {
+        (void)can_map_add_traffic(can, "heartbeat", 1, 1000.0 / co->heartbeat_ms);
+    }
+    (void)can_map_add_traffic(can, "EMCY", URRT_CAN_CLASSIC_MAX_LEN, CANOPEN_EMCY_PER_S);
+    (void)can_map_add_traffic(can, "SDO", URRT_CAN_CLASSIC_MAX_LEN, 2.0 * 1000.0 / CANOPEN_SDO_POLL_MS);
+}
+
 int canopen_map_prepare(struct canopen_map *co, struct can_map *can)
 {
     int errors = 0;
@@ -358,6 +371,7 @@ int canopen_map_prepare(struct canopen_map *co, struct can_map *can)
     for (size_t i = 0; i < can->frame_count && co->tpdo_of != NULL; i++) {
         errors += frame_id(co, can, i, has_node);
     }
+    node_traffic(co, can);
     return errors + status_id(co, can);
 }
 

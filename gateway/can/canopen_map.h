@@ -38,6 +38,13 @@
 #define CANOPEN_VALUES_INDEX 0x2100u  /* TPDO n's values: 0x2100 + n - 1, one sub per signal */
 #define CANOPEN_DUMMY_U8 0x0005u      /* CiA 301's UNSIGNED8 dummy: a byte no signal owns */
 #define CANOPEN_STATUS_ID_BASE 0x680u /* the status TPDO's id past TPDO4: 0x680 + node id */
+/* The node's traffic beside its TPDOs in the worst-case bus load
+ * (docs/canopen.md, "Bus load"): its heartbeat every heartbeat_ms (1 byte);
+ * EMCYs (8 bytes), each of the node's conditions starting and ending once
+ * a second; SDO, a manager's request and the node's answer (8 bytes each)
+ * every CANOPEN_SDO_POLL_MS. The manager's SYNC is not the node's: not counted. */
+#define CANOPEN_EMCY_PER_S (2.0 * URRT_CO_CONDITIONS)
+#define CANOPEN_SDO_POLL_MS 10u
 
 /* Keys of [canopen], in canopen_map_keys' order. */
 enum canopen_key {
@@ -98,8 +105,10 @@ bool canopen_map_frame_set(struct canopen_map *co, size_t frame, const struct co
 /*
  * Before can_map_finish: TPDO numbers (unique, 1..n without a gap), each
  * frame's id from the node id (TPDO1..4: 0x180/0x280/0x380/0x480 + node id;
- * any other id needs own_id = yes), the [can] keys a node replaces, and the
- * status TPDO's id. Problems go to can's reporter. Returns the number found.
+ * any other id needs own_id = yes), the [can] keys a node replaces, the
+ * status TPDO's id, and the node's heartbeat, EMCY and SDO as traffic for
+ * the bus load (can_map_add_traffic; the parts named TPDOs and status TPDO).
+ * Problems go to can's reporter. Returns the number found.
  */
 int canopen_map_prepare(struct canopen_map *co, struct can_map *can);
 

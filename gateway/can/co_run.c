@@ -9,7 +9,6 @@
 
 #define TYPE_EVENT 254u
 #define SDO_RX_BASE 0x600u
-#define SYNC_DEFAULT 0x080u
 
 struct co_run {
     urrt_co co;
@@ -149,9 +148,6 @@ static void describe(struct co_run *r, const struct canopen_map *co, const struc
     d->tpdo_count = tpdos;
     d->objects = r->objects;
     d->object_count = objects;
-    r->rx_ids[0] = 0x000u;
-    r->rx_ids[1] = SYNC_DEFAULT;
-    r->rx_ids[2] = SDO_RX_BASE + co->node_id;
 }
 
 static int node_init(struct co_run *r, struct can_run *run, char *err, size_t errlen)
@@ -193,6 +189,7 @@ struct co_run *co_run_build(const struct canopen_map *co, const struct can_map *
         co_run_free(r);
         return NULL;
     }
+    (void)urrt_co_rx_ids(&r->co, r->rx_ids);
     return r;
 }
 

@@ -32,7 +32,7 @@
 #include "canopen_map.h"
 #include "urrt_co.h"
 
-#define CO_RUN_RX_IDS 3u /* NMT 0x000, SYNC 0x080, SDO request 0x600 + node id */
+#define CO_RUN_RX_IDS URRT_CO_RX_IDS_MAX /* NMT 0x000, SYNC 0x080, SDO request 0x600 + node id */
 
 struct co_run;
 
@@ -45,7 +45,9 @@ void co_run_free(struct co_run *run);
 
 urrt_co *co_run_node(struct co_run *run);
 const urrt_co_desc *co_run_desc(const struct co_run *run);
-/* The ids the node receives: what the CAN link lets through its filter. */
+/* The ids the node receives after a reset (urrt_co_rx_ids): what the CAN
+ * link's filter starts with. A manager's write to 0x1005 changes them on the
+ * running node (urrt_co.rx_changes), which can_out follows. */
 const uint32_t *co_run_rx_ids(const struct co_run *run, size_t *count);
 
 /* Whether a TPDO's mapping names the object (the EDS's PDOMapping). */

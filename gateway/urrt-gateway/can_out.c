@@ -2,6 +2,7 @@
 /* can_out.c: see can_out.h. */
 #include "can_out.h"
 
+#include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -11,15 +12,36 @@ struct can_out {
     urrt_cantx *tx;         /* run's CAN core */
     urrt_co *node;          /* the CANopen node over tx, or NULL: tx runs alone */
     uint64_t node_us;       /* the node's latest time: a frame received earlier is handed over at it */
+    uint32_t rx_seen;       /* the node's rx_changes the link's filter was set at */
     urrt_canlink *link;
+    gw_watch watch;         /* the link's socket, in the loop's wait */
     uint64_t refused;       /* frames the link refused (cannot happen with a checked map) */
     uint64_t emcys;         /* EMCY frames the node sent (metrics.h) */
     bool robot_up[GW_MAX_ROBOTS];
 };
 
+/* The link's filter follows the node's ids: a manager moved the SYNC
+ * (0x1005), or a reset moved it back. */
+static void follow_rx_ids(can_out *out)
+{
+    uint32_t ids[URRT_CO_RX_IDS_MAX];
+    size_t n = urrt_co_rx_ids(out->node, ids);
+    if (urrt_canlink_set_rx_ids(out->link, ids, n) == 0) {
+        out->rx_seen = out->node->rx_changes;
+        urrt_log(URRT_LOG_NOTICE, "CANopen: SYNC now on 0x%03X (0x1005); the CAN link receives 0x%03X 0x%03X 0x%03X",
+                 (unsigned)ids[1], (unsigned)ids[0], (unsigned)ids[1], (unsigned)ids[2]);
+    }
+}
+
 static void emit(void *ctx, const urrt_can_frame *frame, uint64_t now_us)
 {
     can_out *out = ctx;
+    /* Before the frame: the SDO answer that confirms a write to 0x1005 (or
+     * the boot-up after a reset) leaves only once the filter lets the new
+     * SYNC id in, so that a manager's SYNC right after it is heard. */
+    if (out->node != NULL && out->node->rx_changes != out->rx_seen) {
+        follow_rx_ids(out);
+    }
     if (out->node != NULL && !frame->extended && frame->id == (out->node->emcy_cob_id & 0x7FFu)) {
         out->emcys++;
     }
@@ -67,6 +89,15 @@ static void on_frame(void *ctx, const urrt_can_frame *frame, uint64_t rx_us)
     urrt_co_on_frame(out->node, frame->id, flags, frame->data, frame->len, out->node_us, emit, out);
 }
 
+/* After each call into the link: its socket (reopened, or waiting to
+ * write) stays the one the loop waits on. */
+static void keep_watch(can_out *out)
+{
+    short events = 0;
+    int fd = urrt_canlink_poll_fd(out->link, &events);
+    gw_watch_set(out->gw, &out->watch, fd, events, urrt_canlink_get_stats(out->link)->opens);
+}
+
 static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
 {
     can_out *out = ctx;
@@ -78,6 +109,7 @@ static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
     urrt_cantx_on_packet(out->tx, robot->index, pkt->state, pkt->data_us);
     out->robot_up[robot->index] = true;
     run_due(out, urrt_port_monotonic_us());
+    keep_watch(out);
 }
 
 static void on_tick(void *ctx, uint64_t now_us)
@@ -92,27 +124,14 @@ static void on_tick(void *ctx, uint64_t now_us)
     }
     urrt_canlink_service(out->link, now_us);
     run_due(out, now_us);
+    keep_watch(out);
 }
 
-static unsigned on_poll_fds(void *ctx, struct pollfd *fds, unsigned max)
+static void on_ready(void *ctx, uint64_t now_us)
 {
     can_out *out = ctx;
-    short events = 0;
-    int fd = urrt_canlink_poll_fd(out->link, &events);
-    if (fd < 0 || max == 0) {
-        return 0;
-    }
-    fds[0].fd = fd;
-    fds[0].events = events;
-    return 1;
-}
-
-static void on_service(void *ctx, const struct pollfd *fds, unsigned count, uint64_t now_us)
-{
-    can_out *out = ctx;
-    if (count > 0 && fds[0].revents != 0) {
-        urrt_canlink_service(out->link, now_us);
-    }
+    urrt_canlink_service(out->link, now_us);
+    keep_watch(out);
 }
 
 static uint64_t on_deadline(void *ctx)
@@ -187,11 +206,13 @@ can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run
         return NULL;
     }
     out->gw = gw;
+    gw_watch_init(&out->watch, on_ready, out);
     out->run = run;
     out->tx = can_run_tx(run);
     out->node = node != NULL ? co_run_node(node) : NULL;
     if (out->node != NULL) {
         urrt_canlink_set_rx(out->link, on_frame, out);
+        out->rx_seen = out->node->rx_changes; /* the ids the link was opened with */
         out->node_us = urrt_port_monotonic_us();
         urrt_co_start(out->node, out->node_us, emit, out); /* boot-up; starts tx */
     } else {
@@ -216,8 +237,6 @@ gw_output can_out_output(can_out *out)
         .ctx = out,
         .packet = on_packet,
         .tick = on_tick,
-        .poll_fds = on_poll_fds,
-        .service = on_service,
         .deadline = on_deadline,
         .counters = on_counters,
         .summary = on_summary,

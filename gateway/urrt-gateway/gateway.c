@@ -1,17 +1,29 @@
 /* SPDX-License-Identifier: MIT */
-/* gateway.c: robots, outputs and the poll loop of urrt-gateway (gateway.h). */
+/* gateway.c: robots, outputs and the wait loop of urrt-gateway (gateway.h). */
 #define _GNU_SOURCE
 #include "gateway.h"
 
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
+#include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/epoll.h>
+#include <unistd.h>
 
 /* A wrong-length stream is logged at once, then at most this often. */
 #define GW_MISMATCH_LOG_US (10u * 1000000u)
+/* Ready descriptors taken per wait: more wait for the next one. */
+#define GW_WAIT_EVENTS 64
+
+/* A robot link's deadline, and the loop that last serviced it (a link is
+ * serviced at most once a loop: its read budget is its share). */
+struct gw_link_due {
+    uint64_t due_us;
+    uint64_t loop;
+};
 
 static uint64_t bound_us(const gw_robot *robot)
 {
@@ -209,14 +221,30 @@ static bool rtde_attach(gw_robot *robot)
     return true;
 }
 
+/* A robot's link: serviced, its socket kept registered, its deadline
+ * noted, and a change of its state or freshness made news for the outputs. */
+static void service_robot(gw_robot *robot, uint64_t now);
+
+static void robot_ready(void *ctx, uint64_t now_us)
+{
+    service_robot(ctx, now_us);
+}
+
 bool gw_init(gateway *gw, const gw_config *cfg)
 {
     memset(gw, 0, sizeof *gw);
     gw->cfg = cfg;
     gw->summary = cfg->summary;
+    gw->epoll_fd = epoll_create1(EPOLL_CLOEXEC);
+    if (gw->epoll_fd < 0) {
+        urrt_log(URRT_LOG_ERR, "epoll_create1: %s; raise the limit on open files (ulimit -n)", strerror(errno));
+        return false;
+    }
     gw->robots = calloc(cfg->robot_count, sizeof *gw->robots);
-    if (gw->robots == NULL) {
+    gw->link_due = calloc(cfg->robot_count, sizeof *gw->link_due);
+    if (gw->robots == NULL || gw->link_due == NULL) {
         urrt_log(URRT_LOG_ERR, "out of memory");
+        gw_close(gw);
         return false;
     }
     gw->robot_count = cfg->robot_count;
@@ -226,6 +254,7 @@ bool gw_init(gateway *gw, const gw_config *cfg)
         robot->index = i;
         robot->cfg = &cfg->robots[i];
         urrt_state_clear(&robot->state);
+        gw_watch_init(&robot->watch, robot_ready, robot);
         robot->link = urrt_link_new(&robot->cfg->link);
         if (robot->link == NULL || (robot->cfg->source == GW_SOURCE_RTDE && !rtde_attach(robot))) {
             gw_close(gw);
@@ -276,41 +305,65 @@ static void print_summary(gateway *gw, uint64_t now_us)
     fflush(stdout);
 }
 
-/* One wait's descriptors: each link's (or none) and each output's run. */
-typedef struct gw_poll {
-    struct pollfd fds[GW_MAX_POLL];
-    unsigned nfds;
-    unsigned link_fd[GW_MAX_ROBOTS]; /* index in fds, UINT32_MAX for none */
-    unsigned output_first[GW_MAX_OUTPUTS], output_count[GW_MAX_OUTPUTS];
-} gw_poll;
-
-/* Fills p from the links and outputs; returns the earliest of their
- * deadlines, the summary's and the tick's. */
-static uint64_t poll_set(gateway *gw, gw_poll *p, uint64_t now)
+void gw_watch_init(gw_watch *w, void (*ready)(void *ctx, uint64_t now_us), void *ctx)
 {
-    uint64_t deadline = now + GW_TICK_MAX_US;
-    p->nfds = 0;
-    for (unsigned i = 0; i < gw->robot_count; i++) {
-        short events = 0;
-        int fd = urrt_link_poll_fd(gw->robots[i].link, &events);
-        uint64_t d = urrt_link_deadline(gw->robots[i].link);
-        p->link_fd[i] = UINT32_MAX;
-        if (fd >= 0 && p->nfds < GW_MAX_POLL) {
-            p->link_fd[i] = p->nfds;
-            p->fds[p->nfds++] = (struct pollfd){.fd = fd, .events = events};
-        }
-        deadline = d < deadline ? d : deadline;
+    *w = (gw_watch){.ready = ready, .ctx = ctx, .fd = -1};
+}
+
+void gw_watch_set(gateway *gw, gw_watch *w, int fd, short events, uint64_t opened)
+{
+    struct epoll_event ev = {.events = ((events & POLLIN) != 0 ? (uint32_t)EPOLLIN : 0u) |
+                                       ((events & POLLOUT) != 0 ? (uint32_t)EPOLLOUT : 0u),
+                             .data.ptr = w};
+    bool registered = w->fd >= 0 && fd == w->fd && opened == w->opened;
+    if (registered && events == w->events) {
+        return;
     }
+    /* Level-triggered: a link that stops at its read budget, or CAN at its
+     * receive burst, is reported again at the next wait, whatever its owner
+     * noted of what it left. Edge-triggered would spare one readiness check
+     * per ready socket and wait: bench-gateway sees no difference. */
+    if (fd >= 0 && epoll_ctl(gw->epoll_fd, registered ? EPOLL_CTL_MOD : EPOLL_CTL_ADD, fd, &ev) != 0 &&
+        (registered || errno != EEXIST || epoll_ctl(gw->epoll_fd, EPOLL_CTL_MOD, fd, &ev) != 0)) {
+        /* Still serviced at its deadlines, later than it could be. */
+        urrt_log(URRT_LOG_ERR, "epoll_ctl (descriptor %d): %s", fd, strerror(errno));
+    }
+    w->fd = fd;
+    w->events = events;
+    w->opened = opened;
+}
+
+static void service_robot(gw_robot *robot, uint64_t now)
+{
+    gateway *gw = robot->gw;
+    urrt_link_state state = urrt_link_get_state(robot->link);
+    bool fresh = gw_robot_fresh(robot, now);
+    short events = 0;
+    int fd;
+
+    urrt_link_service(robot->link, now, on_packet, robot);
+    fd = urrt_link_poll_fd(robot->link, &events);
+    gw_watch_set(gw, &robot->watch, fd, events, urrt_link_get_stats(robot->link)->sockets);
+    gw->link_due[robot->index].due_us = urrt_link_deadline(robot->link);
+    gw->link_due[robot->index].loop = gw->loops;
+    if (gw->link_due[robot->index].due_us < gw->links_due_us) {
+        gw->links_due_us = gw->link_due[robot->index].due_us;
+    }
+    if (state != urrt_link_get_state(robot->link) || fresh != gw_robot_fresh(robot, now)) {
+        gw->news = true;
+    }
+}
+
+/* The earliest deadline of the links, the outputs, the summary and the
+ * ticks. The outputs' are kept for tick_outputs. */
+static uint64_t next_deadline(gateway *gw)
+{
+    /* At most GW_TICK_MAX_US ahead: the wait's timeout fits an int. */
+    uint64_t deadline = gw->tick_all_us < gw->links_due_us ? gw->tick_all_us : gw->links_due_us;
     for (unsigned o = 0; o < gw->output_count; o++) {
         const gw_output *out = &gw->outputs[o];
-        p->output_first[o] = p->nfds;
-        p->output_count[o] = out->poll_fds != NULL ? out->poll_fds(out->ctx, p->fds + p->nfds, GW_MAX_POLL - p->nfds)
-                                                   : 0;
-        p->nfds += p->output_count[o];
-        if (out->deadline != NULL) {
-            uint64_t d = out->deadline(out->ctx);
-            deadline = d < deadline ? d : deadline;
-        }
+        gw->output_due[o] = out->deadline != NULL ? out->deadline(out->ctx) : UINT64_MAX;
+        deadline = gw->output_due[o] < deadline ? gw->output_due[o] : deadline;
     }
     if (gw->summary && gw->next_summary_us < deadline) {
         deadline = gw->next_summary_us;
@@ -318,42 +371,56 @@ static uint64_t poll_set(gateway *gw, gw_poll *p, uint64_t now)
     return deadline;
 }
 
-/* Waits until something is ready or the deadline; after a failed poll
- * nothing counts as ready. */
-static void wait_ready(gw_poll *p, uint64_t deadline, uint64_t now)
+/* Waits until a descriptor is ready or the deadline, and runs the ready
+ * ones' owners; returns the time read after the wait. */
+static uint64_t wait_and_service(gateway *gw, uint64_t deadline, uint64_t now)
 {
+    struct epoll_event events[GW_WAIT_EVENTS];
     /* Round up: waking a little late is harmless, early wakes spin. */
     int timeout_ms = deadline <= now ? 0 : (int)((deadline - now + 999u) / 1000u);
-    if (poll(p->fds, p->nfds, timeout_ms) < 0) {
-        if (errno != EINTR) {
-            urrt_log(URRT_LOG_ERR, "poll: %s", strerror(errno));
-        }
-        for (unsigned i = 0; i < p->nfds; i++) {
-            p->fds[i].revents = 0;
-        }
+    int n = epoll_wait(gw->epoll_fd, events, GW_WAIT_EVENTS, timeout_ms);
+    if (n < 0 && errno != EINTR) {
+        urrt_log(URRT_LOG_ERR, "epoll_wait: %s", strerror(errno));
     }
+    now = urrt_port_monotonic_us();
+    for (int i = 0; i < n; i++) {
+        gw_watch *w = events[i].data.ptr;
+        w->ready(w->ctx, now);
+    }
+    return now;
 }
 
-static void service_links(gateway *gw, const gw_poll *p, uint64_t now)
+/* The links whose deadline has passed and that no event brought, looked
+ * for only once the earliest deadline noted has come; then that deadline
+ * anew. A link's deadline moves later with every read (its silence
+ * timeout) and is not followed there: the earliest noted is never later
+ * than the true one, and a wake-up costs nothing per robot. */
+static void service_due_links(gateway *gw, uint64_t now)
 {
+    uint64_t earliest = UINT64_MAX;
+    if (now < gw->links_due_us) {
+        return;
+    }
     for (unsigned i = 0; i < gw->robot_count; i++) {
-        gw_robot *robot = &gw->robots[i];
-        bool signalled = p->link_fd[i] != UINT32_MAX && p->fds[p->link_fd[i]].revents != 0;
-        if (signalled || urrt_link_deadline(robot->link) <= now ||
-            urrt_link_get_state(robot->link) != URRT_LINK_UP) {
-            urrt_link_service(robot->link, now, on_packet, robot);
+        if (gw->link_due[i].due_us <= now && gw->link_due[i].loop != gw->loops) {
+            service_robot(&gw->robots[i], now);
         }
+        earliest = gw->link_due[i].due_us < earliest ? gw->link_due[i].due_us : earliest;
     }
+    gw->links_due_us = earliest;
 }
 
-static void service_outputs(gateway *gw, gw_poll *p, uint64_t now)
+static void tick_outputs(gateway *gw, uint64_t now)
 {
+    bool all = gw->news || now >= gw->tick_all_us;
     for (unsigned o = 0; o < gw->output_count; o++) {
-        const gw_output *out = &gw->outputs[o];
-        if (out->service != NULL) {
-            out->service(out->ctx, p->fds + p->output_first[o], p->output_count[o], now);
+        if (all || now >= gw->output_due[o]) {
+            gw->outputs[o].tick(gw->outputs[o].ctx, now);
         }
-        out->tick(out->ctx, now);
+    }
+    if (all) {
+        gw->news = false;
+        gw->tick_all_us = now + GW_TICK_MAX_US;
     }
 }
 
@@ -370,17 +437,18 @@ static void summary_if_due(gateway *gw, uint64_t now)
 
 void gw_run(gateway *gw, volatile sig_atomic_t *running)
 {
-    gw_poll p;
     uint64_t now = urrt_port_monotonic_us();
 
     gw->next_summary_us = now + 1000000u;
+    gw->tick_all_us = now; /* every output ticks once at the start */
+    gw->loops = 1;         /* link_due[].loop 0: not serviced yet */
+    gw->links_due_us = 0;  /* every link is serviced at the start */
     while (*running) {
-        wait_ready(&p, poll_set(gw, &p, now), now);
-        service_links(gw, &p, urrt_port_monotonic_us());
+        service_due_links(gw, wait_and_service(gw, next_deadline(gw), now));
         /* The outputs judge freshness after the reads: a report must not
          * say "stale" about an instant before the packets just read. */
         now = urrt_port_monotonic_us();
-        service_outputs(gw, &p, now);
+        tick_outputs(gw, now);
         summary_if_due(gw, now);
         gw->loops++;
     }
@@ -399,6 +467,12 @@ void gw_close(gateway *gw)
         rtde_source_free(gw->robots[i].rtde);
     }
     free(gw->robots);
+    free(gw->link_due);
     gw->robots = NULL;
+    gw->link_due = NULL;
     gw->robot_count = 0;
+    if (gw->epoll_fd >= 0) {
+        close(gw->epoll_fd);
+        gw->epoll_fd = -1;
+    }
 }

@@ -1,15 +1,15 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * gateway.h: the core of urrt-gateway: robots, outputs, one poll loop.
+ * gateway.h: the core of urrt-gateway: robots, outputs, one wait loop.
  *
  * Each robot has a link (port.h), reading RealTime or, with source = rtde,
  * an RTDE session through the link's source seam (rtde_source.h). Every
  * complete packet of the expected length (every RTDE data package) is
  * decoded once and handed to every output through one dispatch
- * (gw_output.packet); every output also gets a periodic tick, may add
- * descriptors to the poll set and counters to each robot's status. The
- * outputs are LCM (lcm_out.h) and CAN (can_out.h), each registered with
- * gw_add_output().
+ * (gw_output.packet); every output also gets a tick when it is due, may
+ * register a descriptor of its own (gw_watch) and adds counters to each
+ * robot's status. The outputs are LCM (lcm_out.h) and CAN (can_out.h), each
+ * registered with gw_add_output().
  *
  * Nothing here allocates after gw_init(): the per-packet path only reads
  * and writes memory the gateway already owns.
@@ -17,7 +17,6 @@
 #ifndef URRT_GATEWAY_H
 #define URRT_GATEWAY_H
 
-#include <poll.h>
 #include <signal.h>
 #include <stdbool.h>
 #include <stddef.h>
@@ -30,18 +29,44 @@
 #include "urrt.h"
 
 #define GW_MAX_OUTPUTS 8
-#define GW_MAX_POLL 256
-/* An output's tick runs at least this often, and whenever its deadline has
- * passed. */
+/* An output's tick runs at least this often, whenever its deadline has
+ * passed, and when a robot's link state or freshness changed. */
 #define GW_TICK_MAX_US 100000u
 
 typedef struct gateway gateway;
+
+/*
+ * A descriptor the loop waits on: a robot's link, or an output's. The loop
+ * waits with epoll, level-triggered, on a set that changes only when a
+ * descriptor does: the owner reports its descriptor with gw_watch_set after
+ * each call that may change it (an open, a close, the events it waits for),
+ * and the loop makes a system call only when something changed. After a
+ * wait that found the descriptor ready (readable, writable, an error, a
+ * hang-up), the loop calls ready().
+ */
+typedef struct gw_watch {
+    void (*ready)(void *ctx, uint64_t now_us);
+    void *ctx;
+    /* As registered (gateway.c's): */
+    int fd;
+    short events;
+    uint64_t opened;
+} gw_watch;
+
+void gw_watch_init(gw_watch *w, void (*ready)(void *ctx, uint64_t now_us), void *ctx);
+/* fd: the descriptor to wait on now, -1 for none; events: poll's (POLLIN,
+ * POLLOUT); opened: the owner's count of descriptors opened, so that a new
+ * socket that got a closed one's number is registered anew. The owner
+ * holds one descriptor at a time and reports -1 only once it has closed it
+ * (a closed descriptor leaves the epoll set by itself). */
+void gw_watch_set(gateway *gw, gw_watch *w, int fd, short events, uint64_t opened);
 
 typedef struct gw_robot {
     gateway *gw;
     unsigned index;
     const gw_robot_config *cfg;
     urrt_link *link;
+    gw_watch watch;            /* the link's socket */
     rtde_source *rtde;         /* source = rtde: the session on link; NULL for RealTime */
     urrt_state state;          /* the last packet decoded */
     uint64_t sequence;         /* packets dispatched to the outputs */
@@ -83,13 +108,14 @@ typedef struct gw_output {
     void *ctx;
     /* Every packet of every robot, in order. Must not block or allocate. */
     void (*packet)(void *ctx, gw_robot *robot, const gw_packet *pkt);
-    /* Periodic work (status reports, retries); now is monotonic. */
+    /* Periodic work (status reports, retries); now is monotonic. Runs when
+     * its deadline has passed, after a wake-up in which a robot's link
+     * state or gw_robot_fresh changed, and at least every GW_TICK_MAX_US:
+     * not at every wake-up. An output with a descriptor of its own (the CAN
+     * socket) keeps it registered with a gw_watch. */
     void (*tick)(void *ctx, uint64_t now_us);
-    /* Optional: descriptors to wait on (at most max), their number. */
-    unsigned (*poll_fds)(void *ctx, struct pollfd *fds, unsigned max);
-    /* Optional: after the wait, with the descriptors it gave (revents set). */
-    void (*service)(void *ctx, const struct pollfd *fds, unsigned count, uint64_t now_us);
-    /* Optional: monotonic time its tick is due at the latest. */
+    /* Optional: monotonic time its tick is due at the latest. Asked at
+     * every wake-up: its cost must not grow with the robots. */
     uint64_t (*deadline)(void *ctx);
     /* Optional: counters for a robot's status (at most max), their number. */
     unsigned (*counters)(void *ctx, const gw_robot *robot, gw_counter *out, unsigned max);
@@ -108,6 +134,13 @@ struct gateway {
     bool summary;              /* print one line per robot each second on stdout */
     uint64_t next_summary_us;
     uint64_t loops;
+    /* The loop's (gateway.c): */
+    int epoll_fd;
+    struct gw_link_due *link_due; /* per robot, apart from gw_robot */
+    uint64_t links_due_us;     /* never later than the earliest link_due */
+    uint64_t output_due[GW_MAX_OUTPUTS];
+    uint64_t tick_all_us;      /* every output ticks by then */
+    bool news;                 /* a robot's link state or freshness changed: every output ticks */
 };
 
 /* Creates a link per robot. False (logged) when one cannot be created. */

@@ -64,6 +64,11 @@ struct lcm_out {
     uint64_t errors_logged;
     uint64_t error_log_us;
     lcm_robot *robots;
+    /* The robots' earliest report or stale moment as of the last tick,
+     * lowered by each packet: never later than the true one, so that the
+     * deadline the loop asks at every wake-up costs nothing per robot (a
+     * tick that comes early finds nothing due and looks again). */
+    uint64_t robots_due_us;
     uint8_t *buf;
     /* Messages are filled in place, so that nothing is built per packet. */
     urrt_state_t state;
@@ -418,6 +423,13 @@ static bool name_rtde_values(lcm_robot *lr, const gw_robot_config *cfg)
     return true;
 }
 
+/* When a robot's data goes stale (UINT64_MAX: it has none). */
+static uint64_t stale_us(const gw_robot *robot)
+{
+    return robot->data_us != 0 ? robot->data_us + (uint64_t)robot->cfg->link.silence_timeout_ms * 1000u + 1u
+                               : UINT64_MAX;
+}
+
 static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
 {
     lcm_out *out = ctx;
@@ -446,6 +458,10 @@ static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
         publish_data(out, robot, GW_KIND_RTDE, encode_rtde(out, robot, pkt), pkt);
     }
     lr->last_time_us = t_us;
+    if (lr->reported_fresh) {
+        uint64_t stale = stale_us(robot);
+        out->robots_due_us = stale < out->robots_due_us ? stale : out->robots_due_us;
+    }
 }
 
 /* ---- the gateway report ---------------------------------------------------------- */
@@ -544,27 +560,22 @@ static void on_tick(void *ctx, uint64_t now_us)
                                                                       : now_us + period_us;
         }
     }
+    out->robots_due_us = UINT64_MAX;
+    for (unsigned i = 0; i < out->gw->robot_count; i++) {
+        const lcm_robot *lr = &out->robots[i];
+        /* The moment the data goes stale is news too. */
+        uint64_t stale = lr->reported_fresh ? stale_us(&out->gw->robots[i]) : UINT64_MAX;
+        uint64_t d = lr->report_due_us < stale ? lr->report_due_us : stale;
+        out->robots_due_us = d < out->robots_due_us ? d : out->robots_due_us;
+    }
 }
 
 static uint64_t on_deadline(void *ctx)
 {
     lcm_out *out = ctx;
     uint64_t d = out->lcm == NULL ? out->retry_us : UINT64_MAX;
-    if (out->cfg->rate[GW_KIND_GATEWAY].mode == GW_RATE_HZ) {
-        for (unsigned i = 0; i < out->gw->robot_count; i++) {
-            gw_robot *robot = &out->gw->robots[i];
-            lcm_robot *lr = &out->robots[i];
-            if (lr->report_due_us < d) {
-                d = lr->report_due_us;
-            }
-            /* The moment the data goes stale is news too. */
-            if (lr->reported_fresh && robot->data_us != 0) {
-                uint64_t stale = robot->data_us + (uint64_t)robot->cfg->link.silence_timeout_ms * 1000u + 1u;
-                if (stale < d) {
-                    d = stale;
-                }
-            }
-        }
+    if (out->cfg->rate[GW_KIND_GATEWAY].mode == GW_RATE_HZ && out->robots_due_us < d) {
+        d = out->robots_due_us;
     }
     return d;
 }

@@ -72,6 +72,7 @@ static const char REASON_REMOVED[] = "interface removed";
 static const char REASON_MTU[] = "FD frames configured but the MTU is no longer 72";
 static const char REASON_REOPEN[] = "reopen failed";
 static const char REASON_NOT_CAN[] = "the name now belongs to an interface that is not CAN";
+static const char REASON_FILTER[] = "the socket refused the new receive ids";
 
 typedef struct held_frame {
     urrt_can_frame frame;
@@ -516,15 +517,20 @@ static int check_interface(urrt_canlink *can, int sock, bool at_creation, unsign
  * request with the same number does not pass; no ids: an empty list, no data
  * frames at all), every error frame, the kernel's receive time and its
  * count of frames dropped on a full receive queue. NULL, or what failed. */
-static const char *configure_receive(const urrt_canlink *can, int sock)
+static bool set_filter(const urrt_canlink *can, int sock)
 {
     struct can_filter filters[URRT_CANLINK_RX_IDS_MAX];
     for (size_t i = 0; i < can->rx_count; i++) {
         filters[i].can_id = can->rx_ids[i];
         filters[i].can_mask = CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG;
     }
-    if (setsockopt(sock, SOL_CAN_RAW, CAN_RAW_FILTER, can->rx_count ? filters : NULL,
-                   (socklen_t)(can->rx_count * sizeof(filters[0]))) < 0)
+    return setsockopt(sock, SOL_CAN_RAW, CAN_RAW_FILTER, can->rx_count ? filters : NULL,
+                      (socklen_t)(can->rx_count * sizeof(filters[0]))) == 0;
+}
+
+static const char *configure_receive(const urrt_canlink *can, int sock)
+{
+    if (!set_filter(can, sock))
         return "set the receive filter";
     can_err_mask_t err_mask = CAN_ERR_MASK;
     if (setsockopt(sock, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &err_mask, sizeof(err_mask)) < 0)
@@ -848,30 +854,34 @@ static void read_socket(urrt_canlink *can, uint64_t now_us)
 
 /* ---- the API ------------------------------------------------------------------- */
 
-/* The rx ids, checked and copied: the socket filter of every (re)open. */
-static bool copy_rx_ids(urrt_canlink *can, const urrt_canlink_config *cfg)
+/* The rx ids, checked and copied: the socket filter of every (re)open.
+ * false (logged, naming the link) leaves the ids the link had. */
+static bool copy_rx_ids(urrt_canlink *can, const char *name, const uint32_t *ids, size_t count)
 {
-    size_t n = cfg->rx_ids != NULL ? cfg->rx_id_count : 0;
+    size_t n = ids != NULL ? count : 0;
     if (n > URRT_CANLINK_RX_IDS_MAX) {
         urrt_log(URRT_LOG_ERR, "CAN link %s: %zu receive ids, more than the kernel's filter takes (%d); "
-                 "receive fewer ids", cfg->interface, n, URRT_CANLINK_RX_IDS_MAX);
+                 "receive fewer ids", name, n, URRT_CANLINK_RX_IDS_MAX);
         return false;
     }
     for (size_t i = 0; i < n; i++) {
-        if (cfg->rx_ids[i] > CAN_SFF_MASK) {
+        if (ids[i] > CAN_SFF_MASK) {
             urrt_log(URRT_LOG_ERR, "CAN link %s: receive id 0x%X is not an 11-bit standard id (0 to 0x7FF)",
-                     cfg->interface, (unsigned)cfg->rx_ids[i]);
+                     name, (unsigned)ids[i]);
             return false;
         }
     }
-    if (n == 0)
-        return true;
-    can->rx_ids = malloc(n * sizeof(can->rx_ids[0]));
-    if (can->rx_ids == NULL) {
-        urrt_log(URRT_LOG_ERR, "CAN link %s: out of memory for the receive ids", cfg->interface);
-        return false;
+    uint32_t *copy = NULL;
+    if (n > 0) {
+        copy = malloc(n * sizeof(copy[0]));
+        if (copy == NULL) {
+            urrt_log(URRT_LOG_ERR, "CAN link %s: out of memory for the receive ids", name);
+            return false;
+        }
+        memcpy(copy, ids, n * sizeof(copy[0]));
     }
-    memcpy(can->rx_ids, cfg->rx_ids, n * sizeof(can->rx_ids[0]));
+    free(can->rx_ids);
+    can->rx_ids = copy;
     can->rx_count = n;
     return true;
 }
@@ -890,7 +900,7 @@ urrt_canlink *urrt_canlink_new(const urrt_canlink_config *cfg)
     can->cfg.rx_ids = NULL;    /* not owned; copied into rx_ids */
     can->fd = -1;
     can->state = URRT_CANLINK_DOWN;
-    if (!copy_rx_ids(can, cfg)) {
+    if (!copy_rx_ids(can, cfg->interface, cfg->rx_ids, cfg->rx_id_count)) {
         free(can);
         return NULL;
     }
@@ -948,6 +958,20 @@ void urrt_canlink_set_rx(urrt_canlink *can, urrt_canlink_rx_fn fn, void *ctx)
         return;
     can->rx_fn = fn;
     can->rx_ctx = ctx;
+}
+
+int urrt_canlink_set_rx_ids(urrt_canlink *can, const uint32_t *ids, size_t count)
+{
+    if (can == NULL || (count > 0 && ids == NULL))
+        return URRT_E_ARG;
+    if (!copy_rx_ids(can, can->log_path != NULL ? can->log_path : can->ifname, ids, count))
+        return URRT_E_ARG;
+    /* A socket that will not take them is an outage: the reopen sets them. */
+    if (can->log_path == NULL && can->state == URRT_CANLINK_UP && !set_filter(can, can->fd)) {
+        int err = errno;
+        go_down(can, urrt_port_monotonic_us(), REASON_FILTER, err);
+    }
+    return 0;
 }
 
 int urrt_canlink_send(urrt_canlink *can, const urrt_can_frame *frame, uint64_t now_us)

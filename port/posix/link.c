@@ -477,6 +477,7 @@ static void try_next_address(urrt_link *link, uint64_t now_us)
             link->last_errno = errno;
             continue;
         }
+        link->stats.sockets++;
         set_keepalive(link->fd);
         if (connect(link->fd, ai->ai_addr, ai->ai_addrlen) == 0) {
             became_connected(link, now_us);

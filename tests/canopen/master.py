@@ -5,7 +5,7 @@ with urrt-gateway's node, step by step, and checks every answer:
 
   1 boot-up            2 identity reads     3 heartbeat time and event timer
   4 bad SDO requests   5 operational: TPDOs decoded by the EDS's mapping
-  6 SYNC counting      7 stopped: only heartbeats
+  6 SYNC counting, and the SYNC moved (0x1005)      7 stopped: only heartbeats
   8 reset node / communication: boot-up again
   9 the robot link cut (--cut) and back (--restore): EMCY, 0x1001, 0x1003
 
@@ -62,7 +62,7 @@ class Master:
         self.frames = []      # (time, id, data) of everything seen from the node
         self.passed = self.failed = 0
         # What the run must show on the bus, for the host's tshark check (expect.json).
-        self.expect = {'aborts': [], 'emcy': [], 'bootups': 0, 'pdo_ids': []}
+        self.expect = {'aborts': [], 'emcy': [], 'bootups': 0, 'pdo_ids': [], 'sync_ids': []}
 
     # ---- counting ----
     def check(self, desc, ok, detail=''):
@@ -459,7 +459,36 @@ def step_sync(m, tps, record):
                     record(fr)
         m.check('TPDO%d, transmission type %d: %d frames for %d SYNCs' % (t['n'], every, syncs // every, syncs),
                 count == syncs // every, '%d frames' % count)
+    m.write_u(index, 2, 1, 1)
+    step_sync_moved(m, cob, record)
     m.write_u(index, 2, t['type'], 1)
+
+
+def step_sync_moved(m, cob, record):
+    """0x1005 moved to 0x081 (CiA 301: the SYNC's COB-ID is the manager's to set): a
+    SYNC there gets the synchronous TPDO (type 1), one on 0x080 none; then back."""
+    def tpdos_after_sync(sync_id, rounds):
+        count = 0
+        for _ in range(rounds):
+            m.send(sync_id, [])
+            m.send(0x600 + m.node, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0])  # the fence after it
+            for fr in m.collect_until(lambda f: f[1] == 0x580 + m.node):
+                if fr[1] == cob:
+                    count += 1
+                    record(fr)
+        return count
+    moved = 0x081
+    m.write_u(0x1005, 0, moved, 4)  # the SYNC id leaves 0x080 at once: the node's filter follows
+    m.expect['sync_ids'].append(moved)
+    got = m.read_u(0x1005, 0)
+    m.check('0x1005 read back 0x%08X' % moved, got == moved, '0x%08X' % got)
+    n = tpdos_after_sync(moved, 5)
+    m.check('SYNC on the new id 0x%03X: the TPDO each time (%d of 5)' % (moved, n), n == 5)
+    n = tpdos_after_sync(SYNC_ID, 5)
+    m.check('SYNC on the old id 0x%03X: no TPDO (%d)' % (SYNC_ID, n), n == 0)
+    m.write_u(0x1005, 0, SYNC_ID, 4)
+    n = tpdos_after_sync(SYNC_ID, 3)
+    m.check('0x1005 back to 0x%03X: the TPDO each time (%d of 3)' % (SYNC_ID, n), n == 3)
 
 
 def step_stopped(m, cp):

@@ -24,6 +24,11 @@
  *   bench_gateway --gateway PATH --robots N [--focused-hz N] [--seconds S]
  *       One gateway against N robots, every message at every packet, or
  *       the focused ones at N Hz and no state.
+ *   bench_gateway --gateway PATH --robots N --versus M [--rounds R] ...
+ *       The CPU per packet at M robots against N: R rounds (3) of one
+ *       session with N robots and one with M, in turn; prints each round's
+ *       ratio and their median. A loop whose cost per wake-up grows with the
+ *       robots (a poll over every socket) shows here.
  *
  * Each subject's CPU per packet also gives how many 500 Hz robots one core
  * would serve at that cost: robots_per_core = 1 / (cpu_seconds_per_packet *
@@ -673,6 +678,28 @@ static void scaling(subject *gw)
     printf("%swarmup_messages_lost: %llu\n", who, (unsigned long long)r.warmup_lost);
 }
 
+/* The CPU per packet at vs->robots against gw->robots, round by round. */
+static void versus(subject *gw, subject *vs, int rounds)
+{
+    double ratio[MAX_ROUNDS], base[MAX_ROUNDS], other[MAX_ROUNDS];
+    char who[48];
+    snprintf(who, sizeof who, "%srobots_%d_vs_%d_", gw->focused_hz != NULL ? "decimated_" : "", vs->robots,
+             gw->robots);
+    for (int i = 0; i < rounds; i++) {
+        result a, b;
+        if (!run(gw, &a) || !run(vs, &b)) exit(1);
+        base[i] = a.cpu_per_packet_us;
+        other[i] = b.cpu_per_packet_us;
+        ratio[i] = b.cpu_per_packet_us / a.cpu_per_packet_us;
+        printf("%sround_%d_cpu_per_packet_us: %.2f vs %.2f (%.2fx)\n", who, i + 1, other[i], base[i], ratio[i]);
+    }
+    printf("%scpu_per_packet_us_median: %.2f vs %.2f\n", who, median(other, rounds), median(base, rounds));
+    double m = median(ratio, rounds);
+    printf("%scpu_per_packet_ratio: %.2f\n", who, m);
+    printf("bench-gateway: %s%d robots vs %d: per-packet cost %.2fx (median of %d rounds)\n",
+           gw->focused_hz != NULL ? "focused messages, " : "", vs->robots, gw->robots, m, rounds);
+}
+
 /* As fast as the gateway takes packets: TCP back-pressure paces the writes,
  * so the rate written is the rate the gateway reads. Nobody subscribes. */
 static void max_rate(const subject *sj)
@@ -738,7 +765,7 @@ int main(int argc, char **argv)
     /* Sleeps of tens of microseconds between robots' packets: no 50 us slack. */
     prctl(PR_SET_TIMERSLACK, 1000UL);
     subject gw = {.robots = 0, .seconds = 4}, relay = {.relay = true, .robots = 1};
-    int rounds = 3;
+    int rounds = 3, versus_robots = 0;
     bool max = false;
     for (int i = 1; i < argc; i++) {
         const char *v = i + 1 < argc ? argv[i + 1] : "";
@@ -748,18 +775,26 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--focused-hz") == 0) gw.focused_hz = argv[++i];
         else if (strcmp(argv[i], "--rounds") == 0) rounds = atoi(v), i++;
         else if (strcmp(argv[i], "--robots") == 0) gw.robots = atoi(v), i++;
+        else if (strcmp(argv[i], "--versus") == 0) versus_robots = atoi(v), i++;
         else if (strcmp(argv[i], "--max-rate") == 0) max = true;
     }
     bool scale = gw.robots > 0;
     if (gw.path == NULL || (!scale && relay.path == NULL) || gw.robots > MAX_ROBOTS || rounds < 1 ||
+        versus_robots < 0 || versus_robots > MAX_ROBOTS || (versus_robots > 0 && !scale) ||
         rounds > MAX_ROUNDS || (gw.focused_hz != NULL && (atoi(gw.focused_hz) < 1 || HZ % atoi(gw.focused_hz)))) {
-        fprintf(stderr, "usage: bench_gateway --gateway PATH (--relay PATH [--rounds R] [--max-rate] | --robots N) "
-                        "[--focused-hz N] [--seconds S]\n");
+        fprintf(stderr, "usage: bench_gateway --gateway PATH (--relay PATH [--rounds R] [--max-rate] | --robots N "
+                        "[--versus M [--rounds R]]) [--focused-hz N] [--seconds S]\n");
         return 2;
     }
     signal(SIGPIPE, SIG_IGN);
     relay.seconds = gw.seconds;
     relay.focused_hz = gw.focused_hz;
+    if (scale && versus_robots > 0) {
+        subject vs = gw;
+        vs.robots = versus_robots;
+        versus(&gw, &vs, rounds);
+        return 0;
+    }
     if (scale) {
         scaling(&gw);
         return 0;

@@ -10,8 +10,9 @@
 #   check-metrics   the Prometheus textfile: promtool accepts it, values against the
 #                   simulator and the CAN log, renamed whole, write errors counted
 #   bench-gateway   latency robot -> subscriber and CPU per packet beside a
-#                   minimal relay (bench_relay.c), 1/10/50 robots, highest rate,
-#                   and the 500 Hz robots one core serves
+#                   minimal relay (bench_relay.c), 1/10/50 robots, the CPU per
+#                   packet at 50 robots against 10, highest rate, and the 500 Hz
+#                   robots one core serves
 GWT := $(BUILD)/tests/gateway
 GWT_CFLAGS := $(PROG_WARN) $(OPT) $(CPPFLAGS) -I$(LCMGEN)
 
@@ -57,7 +58,9 @@ check-metrics: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim
 # The gateway beside the relay, every message at every packet, then the
 # focused messages at 50 Hz and no state; then one gateway against 1, 10 and
 # 50 robots at 500 Hz each, every message at every packet, and again with the
-# focused messages. Each CPU per packet also says how many robots one core serves.
+# focused messages; then the CPU per packet at 50 robots against 10, three
+# rounds of each in turn, both ways. Each CPU per packet also says how many
+# robots one core serves.
 BENCH_GATEWAY_ROBOTS ?= 1 10 50
 bench-gateway: $(BUILD)/bin/urrt-gateway $(GWT)/bench_gateway $(GWT)/bench_relay
 	@echo "bench-gateway: *robots_per_core = 1 / (cpu_per_packet_us * 1e-6 * 500): the 500 Hz robots one core"
@@ -73,3 +76,6 @@ bench-gateway: $(BUILD)/bin/urrt-gateway $(GWT)/bench_gateway $(GWT)/bench_relay
 	@echo "bench-gateway: one gateway, many robots at 500 Hz, focused messages at 50 Hz, no state"
 	@for n in $(BENCH_GATEWAY_ROBOTS); do \
 	  $(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --robots $$n --focused-hz 50 || exit 1; done
+	@echo "bench-gateway: CPU per packet at 50 robots against 10 (the loop's cost per wake-up must not grow with the robots)"
+	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --robots 10 --versus 50 --rounds 3
+	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --robots 10 --versus 50 --rounds 3 --focused-hz 50

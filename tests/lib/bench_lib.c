@@ -2,10 +2,13 @@
 /*
  * Benchmark of lib/ (make bench): nanoseconds per packet, each beside floors
  * measured in the same run, and the ratios to them. The decode's floors, in
- * the order docs/performance.md gives them: the store floor (a memset of a
- * urrt_state: the bytes the decode must write whatever it reads), the plain
- * byte-swap loop, and memcpy of the packet's bytes (context only: it moves
- * with the memory layout). Never a test: it prints `name: value` lines and
+ * the order docs/performance.md gives them: the copy floor (what the decode
+ * cannot avoid: the packet's doubles byte-swapped into a urrt_state-sized
+ * buffer and the rest of it set, in the widest vectors the CPU has), the
+ * store floor (a memset of a urrt_state: the bytes the decode must write
+ * whatever it reads), the plain byte-swap loop, and memcpy of the packet's
+ * bytes (context only: it moves with the memory layout); at every length of
+ * lib's controller table. Never a test: it prints `name: value` lines and
  * asserts nothing.
  *
  * Each ns figure is the best of several batches (the least disturbed by the
@@ -94,6 +97,37 @@ static void measure(bench_fn subject, void *sctx, bench_fn baseline, void *bctx,
     *ratio = ratios[BATCHES / 2];
 }
 
+/* The subject against the faster of two floors, all three interleaved: the
+ * ratio is the median of the per-batch ratios to the faster floor of that
+ * batch; f_ns[k] is floor k's best. */
+static void measure_min(bench_fn subject, void *sctx, bench_fn floor0, void *f0ctx, bench_fn floor1, void *f1ctx,
+                        double *s_ns, double f_ns[2], double *ratio)
+{
+    bench_fn floors[2] = {floor0, floor1};
+    void *fctx[2] = {f0ctx, f1ctx};
+    size_t ns = calibrate(subject, sctx), nf[2] = {calibrate(floor0, f0ctx), calibrate(floor1, f1ctx)};
+    double ratios[BATCHES];
+    *s_ns = f_ns[0] = f_ns[1] = 1e300;
+    for (int i = 0; i < BATCHES; i++) {
+        double t0 = now_ns();
+        size_t ds = subject(sctx, ns);
+        double s = (now_ns() - t0) / (double)ds, f = 1e300;
+        /* alternate which floor runs next to the subject */
+        for (int k = 0; k < 2; k++) {
+            int j = (i + k) & 1;
+            double t1 = now_ns();
+            size_t df = floors[j](fctx[j], nf[j]);
+            double t = (now_ns() - t1) / (double)df;
+            if (t < f_ns[j]) f_ns[j] = t;
+            if (t < f) f = t;
+        }
+        if (s < *s_ns) *s_ns = s;
+        ratios[i] = s / f;
+    }
+    qsort(ratios, BATCHES, sizeof ratios[0], compare_doubles);
+    *ratio = ratios[BATCHES / 2];
+}
+
 /* ---- subjects ------------------------------------------------------------- */
 
 #define VARIANTS 8 /* distinct packets, so that no result is the same twice */
@@ -162,6 +196,175 @@ static size_t bench_store(void *ctx, size_t n)
         USE(&state);
     }
     checksum += state.present;
+    return n;
+}
+
+/* The copy floor: what the decode cannot avoid, a byte-swapping copy of the
+ * packet's doubles into a buffer of sizeof(urrt_state) bytes and a memset
+ * of the rest. Two ways, each measured beside the decode in every batch and
+ * the faster taken, batch by batch, as the floor: the widest vectors this
+ * CPU has (chosen at run time as the decode's own dispatch chooses:
+ * AVX-512BW, AVX2, SSSE3), their stores aligned, the vector where the
+ * packet ends loaded masked (zeros past its end) so that it is one store;
+ * and the plain loop with the C library's memset of the rest. */
+static uint8_t copy_floor_target[sizeof(urrt_state)] __attribute__((aligned(64)));
+_Static_assert(sizeof(urrt_state) % 8 == 0, "the fill's tail is whole doubles");
+
+typedef void (*copy_floor_fn)(uint8_t *dst, const uint8_t *src, size_t doubles);
+
+static __attribute__((noinline)) void copy_floor_plain(uint8_t *dst, const uint8_t *src, size_t doubles)
+{
+    plain_swap((double *)(void *)dst, src, doubles);
+    store_fn(dst + 8 * doubles, 0, sizeof(urrt_state) - 8 * doubles);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+
+/* Each 16-byte lane: its two doubles' bytes reversed (PSHUFB is per lane). */
+#define SWAP_LANE_R 7, 6, 5, 4, 3, 2, 1, 0, 15, 14, 13, 12, 11, 10, 9, 8
+
+static __attribute__((noinline, target("avx512bw"))) void copy_floor_64(uint8_t *dst, const uint8_t *src,
+                                                                          size_t doubles)
+{
+    const __m512i swap = _mm512_broadcast_i32x4(_mm_setr_epi8(SWAP_LANE_R));
+    const __m512i zero = _mm512_setzero_si512();
+    size_t bytes = 8 * doubles, i = 0;
+    for (; i + 128 <= bytes; i += 128) {
+        __m512i a = _mm512_loadu_si512(src + i), b = _mm512_loadu_si512(src + i + 64);
+        _mm512_store_si512(dst + i, _mm512_shuffle_epi8(a, swap));
+        _mm512_store_si512(dst + i + 64, _mm512_shuffle_epi8(b, swap));
+    }
+    if (i + 64 <= bytes) {
+        _mm512_store_si512(dst + i, _mm512_shuffle_epi8(_mm512_loadu_si512(src + i), swap));
+        i += 64;
+    }
+    if (i < bytes) {
+        __mmask8 m = (__mmask8)((1u << ((bytes - i) / 8)) - 1u);
+        _mm512_store_si512(dst + i, _mm512_shuffle_epi8(_mm512_maskz_loadu_epi64(m, src + i), swap));
+        i += 64;
+    }
+    for (; i + 64 <= sizeof(urrt_state); i += 64) {
+        _mm512_store_si512(dst + i, zero);
+    }
+    if (i < sizeof(urrt_state)) {
+        _mm512_mask_storeu_epi64(dst + i, (__mmask8)((1u << ((sizeof(urrt_state) - i) / 8)) - 1u), zero);
+    }
+}
+
+static __attribute__((noinline, target("avx2"))) void copy_floor_32(uint8_t *dst, const uint8_t *src,
+                                                                      size_t doubles)
+{
+    const __m256i swap = _mm256_setr_epi8(SWAP_LANE_R, SWAP_LANE_R);
+    const __m256i zero = _mm256_setzero_si256();
+    const __m256i lanes = _mm256_setr_epi64x(0, 1, 2, 3);
+    size_t bytes = 8 * doubles, i = 0;
+    for (; i + 64 <= bytes; i += 64) {
+        __m256i a = _mm256_loadu_si256((const void *)(src + i)), b = _mm256_loadu_si256((const void *)(src + i + 32));
+        _mm256_store_si256((void *)(dst + i), _mm256_shuffle_epi8(a, swap));
+        _mm256_store_si256((void *)(dst + i + 32), _mm256_shuffle_epi8(b, swap));
+    }
+    if (i + 32 <= bytes) {
+        _mm256_store_si256((void *)(dst + i), _mm256_shuffle_epi8(_mm256_loadu_si256((const void *)(src + i)), swap));
+        i += 32;
+    }
+    if (i < bytes) {
+        __m256i m = _mm256_cmpgt_epi64(_mm256_set1_epi64x((long long)((bytes - i) / 8)), lanes);
+        _mm256_store_si256((void *)(dst + i),
+                           _mm256_shuffle_epi8(_mm256_maskload_epi64((const long long *)(const void *)(src + i), m), swap));
+        i += 32;
+    }
+    for (; i + 32 <= sizeof(urrt_state); i += 32) {
+        _mm256_store_si256((void *)(dst + i), zero);
+    }
+    if (i < sizeof(urrt_state)) {
+        __m256i m = _mm256_cmpgt_epi64(_mm256_set1_epi64x((long long)((sizeof(urrt_state) - i) / 8)), lanes);
+        _mm256_maskstore_epi64((long long *)(void *)(dst + i), m, zero);
+    }
+}
+
+static __attribute__((noinline, target("ssse3"))) void copy_floor_16(uint8_t *dst, const uint8_t *src,
+                                                                       size_t doubles)
+{
+    const __m128i swap = _mm_setr_epi8(SWAP_LANE_R);
+    const __m128i zero = _mm_setzero_si128();
+    size_t bytes = 8 * doubles, i = 0;
+    for (; i + 32 <= bytes; i += 32) {
+        __m128i a = _mm_loadu_si128((const void *)(src + i)), b = _mm_loadu_si128((const void *)(src + i + 16));
+        _mm_store_si128((void *)(dst + i), _mm_shuffle_epi8(a, swap));
+        _mm_store_si128((void *)(dst + i + 16), _mm_shuffle_epi8(b, swap));
+    }
+    if (i + 16 <= bytes) {
+        _mm_store_si128((void *)(dst + i), _mm_shuffle_epi8(_mm_loadu_si128((const void *)(src + i)), swap));
+        i += 16;
+    }
+    if (i < bytes) { /* one double: the load zeroes the upper one */
+        _mm_store_si128((void *)(dst + i), _mm_shuffle_epi8(_mm_loadl_epi64((const void *)(src + i)), swap));
+        i += 16;
+    }
+    for (; i + 16 <= sizeof(urrt_state); i += 16) {
+        _mm_store_si128((void *)(dst + i), zero);
+    }
+    if (i < sizeof(urrt_state)) {
+        _mm_storel_epi64((void *)(dst + i), zero);
+    }
+}
+
+/* The vector ways this CPU runs, widest first, tested in the decode's order. */
+static size_t copy_floor_ways(copy_floor_fn fn[3], unsigned bytes[3])
+{
+    size_t n = 0;
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx512bw")) {
+        fn[n] = copy_floor_64;
+        bytes[n++] = 64;
+    }
+    if (__builtin_cpu_supports("avx2")) {
+        fn[n] = copy_floor_32;
+        bytes[n++] = 32;
+    }
+    if (__builtin_cpu_supports("ssse3")) {
+        fn[n] = copy_floor_16;
+        bytes[n++] = 16;
+    }
+    return n;
+}
+#else
+static size_t copy_floor_ways(copy_floor_fn fn[3], unsigned bytes[3])
+{
+    (void)fn;
+    (void)bytes;
+    return 0; /* no vector floor written for this target: the plain loop alone */
+}
+#endif
+
+/* The widest way this CPU has; the plain loop (0 bytes) where it has none. */
+static copy_floor_fn copy_floor_widest(unsigned *bytes)
+{
+    copy_floor_fn fn[3];
+    unsigned b[3];
+    if (copy_floor_ways(fn, b) == 0) {
+        *bytes = 0;
+        return copy_floor_plain;
+    }
+    *bytes = b[0];
+    return fn[0];
+}
+
+typedef struct copy_floor_bench {
+    const packets *p;
+    copy_floor_fn fn;
+} copy_floor_bench;
+
+static size_t bench_copy_floor(void *ctx, size_t n)
+{
+    const copy_floor_bench *c = ctx;
+    size_t doubles = (c->p->length - URRT_HEADER_SIZE) / 8;
+    for (size_t i = 0; i < n; i++) {
+        c->fn(copy_floor_target, c->p->bytes[i % VARIANTS] + URRT_HEADER_SIZE, doubles);
+        USE(copy_floor_target);
+    }
+    checksum += copy_floor_target[11];
     return n;
 }
 
@@ -394,9 +597,49 @@ static void decode_versus(const char *name, const char *floor, bench_fn floor_fn
     printf("%s%s_vs_%s_of_best: %.2f\n", URRT_BENCH_PREFIX, name, floor, s / f);
 }
 
+/* Every vector way must write what the plain loop does, or it is no floor. */
+static void check_copy_floor(const packets *p)
+{
+    static uint8_t plain[sizeof(urrt_state)];
+    copy_floor_fn fn[3];
+    unsigned bytes[3];
+    size_t ways = copy_floor_ways(fn, bytes);
+    size_t doubles = (p->length - URRT_HEADER_SIZE) / 8;
+    memset(plain, 0xAA, sizeof plain);
+    copy_floor_plain(plain, p->bytes[1] + URRT_HEADER_SIZE, doubles);
+    for (size_t w = 0; w < ways; w++) {
+        memset(copy_floor_target, 0x55, sizeof copy_floor_target);
+        fn[w](copy_floor_target, p->bytes[1] + URRT_HEADER_SIZE, doubles);
+        if (memcmp(copy_floor_target, plain, sizeof plain) != 0) {
+            fprintf(stderr, "bench: the %u-byte vector copy floor differs from the plain loop at %u bytes: "
+                            "fix copy_floor_%u in tests/lib/bench_lib.c\n",
+                    bytes[w], (unsigned)p->length, bytes[w]);
+            exit(1);
+        }
+    }
+}
+
+/* The decode against the copy floor, the faster of its two ways in each
+ * batch: `decode_LEN_ALIGN_vs_copy_floor`, `_of_best`, and both ways' best
+ * ns (`_copy_floor_ns`: the vector way; `_copy_floor_plain_ns`). */
+static void decode_versus_copy_floor(const char *name, packets *p)
+{
+    static copy_floor_bench vector, plain;
+    double s, f[2], r;
+    unsigned bytes;
+    vector.p = plain.p = p;
+    vector.fn = copy_floor_widest(&bytes);
+    plain.fn = copy_floor_plain;
+    measure_min(bench_decode, p, bench_copy_floor, &vector, bench_copy_floor, &plain, &s, f, &r);
+    printf("%s%s_copy_floor_ns: %.1f\n", URRT_BENCH_PREFIX, name, f[0]);
+    printf("%s%s_copy_floor_plain_ns: %.1f\n", URRT_BENCH_PREFIX, name, f[1]);
+    printf("%s%s_vs_copy_floor: %.2f\n", URRT_BENCH_PREFIX, name, r);
+    printf("%s%s_vs_copy_floor_of_best: %.2f\n", URRT_BENCH_PREFIX, name, s / (f[0] < f[1] ? f[0] : f[1]));
+}
+
 /* The full decode of one length, its packets 64-byte aligned ("a64") and 4
- * bytes past that ("a64p4"): against the store floor, the plain loop, and
- * memcpy of the packet. */
+ * bytes past that ("a64p4"): against the copy floor, the store floor, the
+ * plain loop, and memcpy of the packet. */
 static void bench_decode_at(uint32_t length)
 {
     static packets p;
@@ -406,7 +649,9 @@ static void bench_decode_at(uint32_t length)
         char name[64];
         double s, b, r;
         make_packets(&p, length, offsets[a]);
+        check_copy_floor(&p);
         snprintf(name, sizeof name, "decode_%u_%s", (unsigned)length, names[a]);
+        decode_versus_copy_floor(name, &p);
         decode_versus(name, "store", bench_store, &p);
         decode_versus(name, "plain", bench_plain, &p);
         measure(bench_decode, &p, bench_memcpy, &p, &s, &b, &r);
@@ -422,12 +667,14 @@ int main(void)
     static packets p1116;
     static stream streams[3];
     static const size_t chunks[3] = {1, 64, 65536};
-    static const uint32_t lengths[3] = {1060, 1116, 1220};
     double s, b, r;
 
     make_packets(&p1116, 1116, 4);
     printf("bench: ns per packet, best of %d batches, each beside a floor measured in the same run;\n"
-           "bench: *_vs_store: the decode against the store floor (*_store_ns: a memset of sizeof(urrt_state)\n"
+           "bench: *_vs_copy_floor: the decode against the copy floor (*_copy_floor_ns: the packet's doubles\n"
+           "bench: byte-swapped by the widest vectors this CPU has into sizeof(urrt_state) bytes, the rest\n"
+           "bench: zeroed; each batch takes the faster of that and *_copy_floor_plain_ns, the plain loop and\n"
+           "bench: memset); *_vs_store: against the store floor (*_store_ns: a memset of sizeof(urrt_state)\n"
            "bench: = %zu bytes, what the decode must write); *_vs_plain: against a byte-swap loop (8-byte load,\n"
            "bench: bswap, store per double; *_plain_ns); *_ratio: against memcpy of the packet's bytes\n"
            "bench: (*_memcpy_ns; context: it moves with the memory layout). A ratio is the median of the\n"
@@ -454,8 +701,17 @@ int main(void)
 #if defined(__x86_64__)
     printf("bench_decode_vector_bytes: %u\n", urrt_x86_vector_bytes());
 #endif
-    for (int i = 0; i < 3; i++) {
-        bench_decode_at(lengths[i]);
+    {
+        unsigned bytes;
+        (void)copy_floor_widest(&bytes);
+        printf("bench_copy_floor_vector_bytes: %u\n", bytes);
+    }
+    { /* every length a controller sends, from lib's table */
+        size_t rows;
+        const urrt_controller *c = urrt_controllers(&rows);
+        for (size_t i = 0; i < rows; i++) {
+            bench_decode_at(c[i].length);
+        }
     }
     measure(bench_read10, &p1116, bench_memcpy, &p1116, &s, &b, &r);
     report("read10_1116", s, b, r);

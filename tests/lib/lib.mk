@@ -11,8 +11,11 @@
 #                   page; mixing URRT_MAX_DOUBLES values fails to link
 # Executed on emulated Cortex-M and big-endian CPUs: tests/target/target.mk.
 #   check-docs      docs/protocol.md's generated tables are current (make docs rewrites them)
-#   bench-lib       ns/packet against the store floor (memset of a urrt_state), the plain
-#                   byte-swap loop and memcpy of the packet (docs/performance.md)
+#   bench-lib       ns/packet at every length of lib's controller table against the copy
+#                   floor (the packet's doubles byte-swapped by the CPU's widest vectors into
+#                   a urrt_state-sized buffer, the rest set), the store floor (memset of a
+#                   urrt_state), the plain byte-swap loop and memcpy of the packet
+#                   (docs/performance.md)
 # Every lib-level rule takes lib/*.c by wildcard (LIB_SRCS, or LIB_HOST_SRCS: the same with
 # lib/vector/urrt_vector.c in place of lib/urrt.c, lib/lib.mk), so new modules are covered.
 

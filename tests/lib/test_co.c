@@ -34,11 +34,13 @@ static uint32_t vars[2];
 #define MAX_OUT 16
 static urrt_can_frame out[MAX_OUT];
 static size_t out_count;
+static uint32_t rx_changes_at_emit; /* co.rx_changes as the latest frame went out */
 
 static void capture(void *ctx, const urrt_can_frame *f, uint64_t now_us)
 {
     (void)ctx;
     (void)now_us;
+    rx_changes_at_emit = co.rx_changes;
     if (out_count < MAX_OUT) {
         out[out_count] = *f;
     }
@@ -638,6 +640,81 @@ static void test_sync(void)
     EQ(rx(0x081, NULL, 0, 200000), 0);
 }
 
+/* ---- the ids the node receives: 0x1005 moves the SYNC one ------------------------------ */
+
+/* urrt_co_rx_ids: NMT 0x000, SYNC, the SDO request 0x60A; and the change count. */
+static void expect_rx_ids(int line, uint32_t sync_id, uint32_t changes)
+{
+    uint32_t ids[URRT_CO_RX_IDS_MAX] = {0xFFFF, 0xFFFF, 0xFFFF};
+    size_t n = urrt_co_rx_ids(&co, ids);
+    CHECK(n == 3u && ids[0] == 0x000u && ids[1] == sync_id && ids[2] == 0x60Au && co.rx_changes == changes,
+          "line %d: %zu ids 0x%03X 0x%03X 0x%03X after %u changes, want 0x000 0x%03X 0x60A after %u", line, n,
+          (unsigned)ids[0], (unsigned)ids[1], (unsigned)ids[2], (unsigned)co.rx_changes, (unsigned)sync_id,
+          (unsigned)changes);
+}
+#define RX_IDS(sync_id, changes) expect_rx_ids(__LINE__, (sync_id), (changes))
+
+/* A manager moves the SYNC to 0x081 (0x1005 = 0x81, CiA 301's expedited
+ * 4-byte download 0x23): the set the caller filters on changes once, before
+ * the answer goes out; a SYNC on 0x081 runs the synchronous TPDO, one on
+ * 0x080 no longer does.
+ * Refused writes (producer bit 30, bit 29, a restricted id, a wrong size:
+ * checked in the order exists, access, size, value) leave the set; bit 31
+ * ("do not care") neither moves it nor stops the SYNCs; a reset brings
+ * 0x080 back, a second change. */
+static void test_rx_ids(void)
+{
+    size_t bad = 0;
+    desc_defaults();
+    desc.heartbeat_ms = 0;
+    memset(frame_states, 0, sizeof frame_states);
+    EQ(urrt_cantx_init(&tx, &tables, frame_states, robots, values, 8, NULL, NULL), 0);
+    EQ(urrt_co_init(&co, &desc, &tx, tpdo_states, vars, 2, &bad), 0);
+    RX_IDS(0x080, 0); /* before the boot-up: a filter is set before the node speaks */
+    EQ(urrt_co_start(&co, 0, capture, NULL), 1);
+    RX_IDS(0x080, 0);
+    EQ(urrt_co_rx_ids(NULL, NULL), 0);
+    SDO(1000, 0x2F, 0x01, 0x18, 0x02, 0x01, 0, 0, 0); /* TPDO2 on every SYNC */
+    ANSWER(0x60, 0x01, 0x18, 0x02, 0, 0, 0, 0);
+    nmt(0x01, NODE, 1000);
+    packet(2000, 0.25, 7);
+    EQ(rx(0x080, NULL, 0, 2000), 1);
+    EXPECT(0, 0x28A, 0xFA, 0x00);
+
+    SDO(2000, 0x23, 0x05, 0x10, 0x00, 0x81, 0x00, 0x00, 0x00);
+    ANSWER(0x60, 0x05, 0x10, 0x00, 0, 0, 0, 0);
+    RX_IDS(0x081, 1);
+    EQ(rx_changes_at_emit, 1); /* changed before the answer went out: a filter set in emit is in time */
+    EQ(rx(0x081, NULL, 0, 3000), 1);
+    EXPECT(0, 0x28A, 0xFA, 0x00);
+    EQ(rx(0x080, NULL, 0, 3000), 0);
+    SDO(3000, 0x40, 0x05, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x43, 0x05, 0x10, 0x00, 0x81, 0x00, 0x00, 0x00);
+
+    SDO(3000, 0x23, 0x05, 0x10, 0x00, 0x81, 0x00, 0x00, 0x80); /* bit 31: do not care */
+    ANSWER(0x60, 0x05, 0x10, 0x00, 0, 0, 0, 0);
+    RX_IDS(0x081, 1);
+    EQ(rx(0x081, NULL, 0, 4000), 1);
+    SDO(4000, 0x23, 0x05, 0x10, 0x00, 0x81, 0x00, 0x00, 0x00);
+    ANSWER(0x60, 0x05, 0x10, 0x00, 0, 0, 0, 0);
+    RX_IDS(0x081, 1); /* the same id again: no change */
+
+    ABORT(4000, 0x06090030, 0x23, 0x05, 0x10, 0x00, 0x82, 0x00, 0x00, 0x40); /* producer: not this node */
+    ABORT(4000, 0x06090030, 0x23, 0x05, 0x10, 0x00, 0x82, 0x00, 0x00, 0x20); /* bit 29: 29-bit id */
+    ABORT(4000, 0x06090030, 0x23, 0x05, 0x10, 0x00, 0x05, 0x06, 0x00, 0x00); /* 0x605: an SDO id */
+    ABORT(4000, 0x06070013, 0x2B, 0x05, 0x10, 0x00, 0x82, 0x00, 0x00, 0x00); /* 2 bytes: size first */
+    RX_IDS(0x081, 1);
+    EQ(rx(0x081, NULL, 0, 5000), 1);
+
+    nmt(0x82, NODE, 6000); /* reset communication: 0x1005 back to 0x080 */
+    RX_IDS(0x080, 2);
+    EQ(rx_changes_at_emit, 2); /* before the boot-up */
+    SDO(6000, 0x40, 0x05, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x43, 0x05, 0x10, 0x00, 0x80, 0x00, 0x00, 0x00);
+    nmt(0x81, NODE, 7000); /* reset node with the default id: no change */
+    RX_IDS(0x080, 2);
+}
+
 /* ---- TPDO timing: inhibit time and event timer, in frames per interval ------------------- */
 
 /* The node from t0 for span_us as a loop would run it: woken at every
@@ -1069,6 +1146,7 @@ int main(void)
     test_sdo_download();
     test_tpdo_gating();
     test_sync();
+    test_rx_ids();
     test_inhibit_time();
     test_event_timer_zero();
     test_cob_move();

@@ -8,7 +8,8 @@
  *                              an independent reader (python-can, canplayer);
  *                              and log:- to a pipe, a socket and a terminal
  *                              whose reader stalls, and under a replay's
- *                              clock (it waits for a slow reader)
+ *                              clock (it waits for a slow reader); receive
+ *                              ids replaced and refused on a log link
  *   can_link_test frames DIR   sends a known set of frames through SocketCAN
  *                              links on vcan0 (FD MTU) and vcan1 (classic
  *                              MTU), checks them with its own receiving
@@ -21,7 +22,9 @@
  *                              error frames, a full transmit queue (ENOBUFS
  *                              with the plug qdisc; EAGAIN with a tiny socket
  *                              buffer), interface down/up, removal and
- *                              re-creation, MTU change
+ *                              re-creation, MTU change; receive ids
+ *                              replaced on an open link and kept across a
+ *                              reopen (urrt_canlink_set_rx_ids)
  *
  * The socket tests run in the VM of tests/vm/run.sh as root, with vcan0
  * (MTU 72) and vcan1 (MTU 16) up, sch_plug loaded and iproute2's ip and tc
@@ -791,6 +794,30 @@ static void test_log_replay_waits(void)
     }
 }
 
+/* urrt_canlink_set_rx_ids on a log link, which receives nothing: the
+ * same rules as at creation (11-bit ids, at most the kernel's list), the
+ * refusals naming the link and the id, and the link sending on. */
+static void test_log_rx_ids(urrt_canlink *cc)
+{
+    static uint32_t many[URRT_CANLINK_RX_IDS_MAX + 1];
+    static const uint32_t node[] = {0x000, 0x081, 0x605};
+    static const uint32_t wide[] = {0x000, 0x800};
+    CHECK_EQ_INT(urrt_canlink_set_rx_ids(cc, node, 3), 0);
+    CHECK_EQ_INT(urrt_canlink_set_rx_ids(cc, NULL, 0), 0);
+    messages_clear();
+    CHECK_EQ_INT(urrt_canlink_set_rx_ids(cc, wide, 2), URRT_E_ARG);
+    CHECK(strstr(messages, "log-classic.log: receive id 0x800 is not an 11-bit standard id") != NULL,
+          "the refusal names the link and the id: %s", messages);
+    messages_clear();
+    CHECK_EQ_INT(urrt_canlink_set_rx_ids(cc, many, URRT_CANLINK_RX_IDS_MAX + 1), URRT_E_ARG);
+    CHECK(strstr(messages, "513 receive ids, more than the kernel's filter takes (512)") != NULL, "reason: %s",
+          messages);
+    CHECK_EQ_INT(urrt_canlink_set_rx_ids(cc, many, URRT_CANLINK_RX_IDS_MAX), 0);
+    CHECK_EQ_INT(urrt_canlink_set_rx_ids(cc, NULL, 1), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_canlink_set_rx_ids(NULL, node, 3), URRT_E_ARG);
+    CHECK_EQ_INT(urrt_canlink_get_state(cc), URRT_CANLINK_UP);
+}
+
 static int test_log(const char *dir)
 {
     char path_fd[512], path_cc[512], path_out[512], path_expect[512], spec[600];
@@ -851,6 +878,7 @@ static int test_log(const char *dir)
     bad = make_frame(0x20000000, true, false, 1, 0);
     CHECK_EQ_INT(urrt_canlink_send(cc, &bad, now_us()), URRT_E_ARG);
     CHECK_EQ_INT(urrt_canlink_send(cc, NULL, now_us()), URRT_E_ARG);
+    test_log_rx_ids(cc);
     CHECK_EQ_INT(urrt_canlink_get_stats(fd)->sent, N_FD);
     CHECK_EQ_INT(urrt_canlink_get_stats(cc)->sent, N_CC);
     CHECK_EQ_INT(urrt_canlink_get_stats(cc)->dropped, 0);
@@ -1326,10 +1354,99 @@ static void test_down_up(void)
     urrt_canlink_free(can);
 }
 
+/* What a link's rx function was handed. */
+typedef struct rx_seen {
+    uint32_t ids[64];
+    size_t count;
+} rx_seen;
+
+static void on_rx(void *ctx, const urrt_can_frame *frame, uint64_t rx_us)
+{
+    rx_seen *s = ctx;
+    (void)rx_us;
+    if (s->count < sizeof s->ids / sizeof s->ids[0])
+        s->ids[s->count] = frame->id;
+    s->count++;
+}
+
+/* Sends 0x080, 0x081 and 0x7E0 (a third id, handed in every round) in that
+ * order and pumps until 0x7E0 arrives (bounded): frames on one bus reach a
+ * socket in order, so whatever of the first two the filter lets in came
+ * before it. Returns what was handed, 0x7E0 the last. */
+static size_t sync_round(urrt_canlink *can, int tx, rx_seen *s)
+{
+    static const canid_t ids[] = {0x080, 0x081, 0x7E0};
+    s->count = 0;
+    for (size_t i = 0; i < 3; i++) {
+        struct can_frame f = {.can_id = ids[i], .can_dlc = 0};
+        CHECK(write(tx, &f, sizeof(f)) == (ssize_t)sizeof(f), "sender write: %s", strerror(errno));
+    }
+    for (unsigned waited = 0; (s->count == 0 || s->ids[s->count - 1] != 0x7E0) && waited < 5000; waited += 10)
+        pump(can, 10);
+    CHECK(s->count > 0 && s->ids[s->count - 1] == 0x7E0, "the round's last frame 0x7E0 arrived (%zu handed)",
+          s->count);
+    return s->count;
+}
+
+/* urrt_canlink_set_rx_ids on vcan1: the kernel's filter replaced at once
+ * (a CANopen node's SYNC moved from 0x080 to 0x081), kept across the
+ * interface going down and up, set while down for the reopen; ids the link
+ * cannot take refused, the filter kept. */
+static void test_set_rx_ids(void)
+{
+    static const uint32_t at_080[] = {0x000, 0x080, 0x7E0}, at_081[] = {0x000, 0x081, 0x7E0};
+    static const uint32_t wide[] = {0x081, 0x800};
+    urrt_canlink_config cfg;
+    rx_seen s = {{0}, 0};
+    urrt_canlink_config_defaults(&cfg);
+    cfg.interface = "vcan1";
+    cfg.reopen_interval_ms = 50;
+    cfg.rx_ids = at_080;
+    cfg.rx_id_count = 3;
+    urrt_canlink *can = urrt_canlink_new(&cfg);
+    int tx = rx_open("vcan1");
+    CHECK(can != NULL && tx >= 0, "link and sender");
+    if (can == NULL || tx < 0)
+        return;
+    urrt_canlink_set_rx(can, on_rx, &s);
+    CHECK(sync_round(can, tx, &s) == 2 && s.ids[0] == 0x080, "ids 0x080: 0x080 handed, 0x081 not (%zu)", s.count);
+    CHECK_EQ_INT(urrt_canlink_set_rx_ids(can, at_081, 3), 0);
+    CHECK(sync_round(can, tx, &s) == 2 && s.ids[0] == 0x081, "ids 0x081: 0x081 handed, 0x080 not (%zu)", s.count);
+    messages_clear();
+    CHECK_EQ_INT(urrt_canlink_set_rx_ids(can, wide, 2), URRT_E_ARG);
+    CHECK(strstr(messages, "receive id 0x800") != NULL, "the refusal names the id: %s", messages);
+    CHECK(sync_round(can, tx, &s) == 2 && s.ids[0] == 0x081, "a refused set keeps 0x081 (%zu)", s.count);
+
+    RUN("ip", "link", "set", "vcan1", "down");
+    pump_until_state(can, URRT_CANLINK_DOWN, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_DOWN);
+    RUN("ip", "link", "set", "vcan1", "up");
+    pump_until_state(can, URRT_CANLINK_UP, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
+    close(tx);
+    tx = rx_open("vcan1"); /* the old sender lost its binding with the interface */
+    CHECK(tx >= 0 && sync_round(can, tx, &s) == 2 && s.ids[0] == 0x081, "0x081 after the reopen (%zu)", s.count);
+
+    RUN("ip", "link", "set", "vcan1", "down");
+    pump_until_state(can, URRT_CANLINK_DOWN, 2000);
+    CHECK_EQ_INT(urrt_canlink_set_rx_ids(can, at_080, 3), 0); /* while down: for the reopen */
+    RUN("ip", "link", "set", "vcan1", "up");
+    pump_until_state(can, URRT_CANLINK_UP, 2000);
+    CHECK_EQ_INT(urrt_canlink_get_state(can), URRT_CANLINK_UP);
+    close(tx);
+    tx = rx_open("vcan1");
+    CHECK(tx >= 0 && sync_round(can, tx, &s) == 2 && s.ids[0] == 0x080, "ids set while down: 0x080 (%zu)", s.count);
+    CHECK_EQ_INT(urrt_canlink_get_stats(can)->opens, 3);
+    if (tx >= 0)
+        close(tx);
+    urrt_canlink_free(can);
+}
+
 static int test_socket(void)
 {
     test_refusals();
     test_no_data_frames();
+    test_set_rx_ids();
     test_error_frames();
     test_queue_full();
     test_socket_buffer_full();

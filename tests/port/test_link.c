@@ -338,6 +338,9 @@ static void test_refused_backoff(void)
               (unsigned long long)delays[i], (unsigned long long)want[i]);
     }
     CHECK_EQ_INT(urrt_link_get_stats(l)->connects, 0);
+    /* One address: a socket per attempt, each a new one for a loop that
+     * registers descriptors once (port.h). */
+    CHECK_EQ_INT(urrt_link_get_stats(l)->sockets, urrt_link_get_stats(l)->connect_failures);
     CHECK_EQ_INT(lines_with("warning: robot arm1: cannot connect to"), 1);
     CHECK_EQ_INT(lines_with("still cannot connect"), 1);
     CHECK_EQ_INT(lines_with("after 10 attempts"), 1);
@@ -409,6 +412,7 @@ static void test_session(void)
         CHECK_EQ_INT(st->partial_bytes, 558);
         CHECK_EQ_INT(st->connects, 1);
         CHECK_EQ_INT(st->disconnects, 1);
+        CHECK_EQ_INT(st->sockets, 1);
         CHECK_EQ_INT(st->last_length, 1116);
         CHECK(st->last_packet_us != 0, "time of the last packet");
     }
@@ -439,6 +443,7 @@ static void test_session(void)
         CHECK_EQ_INT(st->skipped, 5);
         CHECK_EQ_INT(st->silences, 1);
         CHECK_EQ_INT(st->reconnects, 1);
+        CHECK_EQ_INT(st->sockets, 2); /* a reconnect is a new socket, whatever its number */
         CHECK_EQ_INT(st->partial_drops, 1);
     }
     CHECK_EQ_INT(lines_with("lost (no data for 100 ms); reconnecting"), 1);

@@ -122,8 +122,10 @@ static void test_config_good(void)
         CHECK(cfg.interface == map.interface && !cfg.fd && !cfg.fd_brs && cfg.reopen_interval_ms == 1234,
               "link configuration");
         can_map_describe(&map, line, sizeof line);
-        CHECK_EQ_STR(line, "2 frames + heartbeat 0x701 on vcan0, worst-case bus load 6.0% of 500000 bit/s (max 50%)");
-        /* 2.7 % + 29-bit 4 bytes (54+32+13+21 = 120 bits, 240 us) every 8 ms 3.0 % + 0.27 % */
+        /* 2.7 % + 29-bit 4 bytes (54+32+13+21 = 120 bits, 240 us) every 8 ms 3.0 % + 0.27 %, the parts
+         * after the colon */
+        CHECK_EQ_STR(line, "2 frames + heartbeat 0x701 on vcan0, worst-case bus load 6.0% of 500000 bit/s (max 50%): "
+                           "frames 5.70% + heartbeat 0.27%");
     }
     CHECK_EQ_STR(map.interface, "vcan0");
     CHECK_EQ_INT(map.frame_count, 2);
@@ -447,7 +449,8 @@ static void test_bus_load(void)
         }
         rc = load(&map, cfg, fast, 1, err, sizeof err);
         CHECK(rc == -1 && strstr(err, "t.ini:1: worst-case bus load 54.3% at 500000 bit/s is over max_bus_load = 50% "
-                                      "(heaviest: f0 13.5%, f1 13.5%, f2 13.5%)") == err,
+                                      "(frames 54.00% + heartbeat 0.27%; heaviest: f0 13.5%, f1 13.5%, f2 13.5%)") ==
+                              err,
               "bus load rejection: %s", err);
         unload(&map);
         /* The same at max_bus_load = 60 passes, and the message points at

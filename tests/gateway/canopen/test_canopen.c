@@ -119,6 +119,65 @@ static void test_causes_first(void)
     free(messages);
 }
 
+/* ---- the worst-case bus load: the node's traffic beside its TPDOs ---------------------------- */
+
+/* A classic 11-bit frame of `bytes` data bytes, worst-case stuffed (Davis, Burns, Bril and
+ * Lukkien 2007: 34 + 8s + 13 + floor((34 + 8s - 1) / 4) bits), in microseconds. */
+static double frame_us(unsigned bytes, double bitrate)
+{
+    unsigned g = 34u + 8u * bytes;
+    return (double)(g + 13u + (g - 1u) / 4u) * 1e6 / bitrate;
+}
+
+/* --check-config's line for a node with one 2-byte TPDO every 10 ms, the status TPDO (8 bytes
+ * every heartbeat_period_ms, 100 by default), the NMT heartbeat (1 byte every heartbeat_ms),
+ * EMCY (8 bytes, 10 a second: five conditions starting and ending once a second) and SDO (8
+ * bytes, a request and its answer every 10 ms): at 500 kbit/s 150 us / 10 ms = 1.50 %,
+ * 270 us / 100 ms = 0.27 %, 130 us / 100 ms = 0.13 %, 2.7 ms/s = 0.27 %, 54 ms/s = 5.40 %. */
+static void test_bus_load(void)
+{
+    struct { const char *bitrate, *heartbeat, *max; double rate; unsigned hb_ms; } cases[] = {
+        {"500000", "100", "50", 500000.0, 100},
+        {"125000", "0", "50", 125000.0, 0},  /* heartbeat off: no part of it */
+        {"125000", "0", "25", 125000.0, 0},  /* over: the error names the parts */
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char text[1024], want[512], parts[256], line[512];
+        char *messages = NULL;
+        gw_config cfg;
+        double tpdo = frame_us(2, cases[i].rate) / 10000.0, status = frame_us(8, cases[i].rate) / 100000.0;
+        double hb = cases[i].hb_ms ? frame_us(1, cases[i].rate) / (cases[i].hb_ms * 1000.0) : 0.0;
+        double emcy = 10.0 * frame_us(8, cases[i].rate) / 1e6, sdo = 200.0 * frame_us(8, cases[i].rate) / 1e6;
+        int n = snprintf(parts, sizeof parts, "TPDOs %.2f%% + status TPDO %.2f%%", tpdo * 100, status * 100);
+        if (cases[i].hb_ms) {
+            n += snprintf(parts + n, sizeof parts - (size_t)n, " + heartbeat %.2f%%", hb * 100);
+        }
+        snprintf(parts + n, sizeof parts - (size_t)n, " + EMCY %.2f%% + SDO %.2f%%", emcy * 100, sdo * 100);
+        snprintf(text, sizeof text,
+                 "[robot a]\nhost = h\n[can]\ninterface = log:-\nbitrate = %s\nmax_bus_load = %s\n[canopen]\n"
+                 "node_id = 5\nheartbeat_ms = %s\n[frame a]\nperiod_ms = 10\nlength = 2\n"
+                 "signal = q_actual[0] @0|16 intel signed\n", cases[i].bitrate, cases[i].max, cases[i].heartbeat);
+        int errors = load(&cfg, text, &messages);
+        double total = (tpdo + status + hb + emcy + sdo) * 100;
+        if (i < 2) {
+            snprintf(want, sizeof want, "1 frame + status TPDO 0x285 on log:-, worst-case bus load %.1f%% of %s bit/s "
+                     "(max %s%%): %s", total, cases[i].bitrate, cases[i].max, parts);
+            CHECK(errors == 0, "case %zu loads: %s", i, messages);
+            if (errors == 0) {
+                can_map_describe(&cfg.can, line, sizeof line);
+                CHECK_EQ_STR(line, want);
+            }
+        } else {
+            snprintf(want, sizeof want, "t.ini:6: worst-case bus load %.1f%% at %s bit/s is over max_bus_load = %s%% "
+                     "(%s; heaviest: a %.1f%%): lengthen periods", total, cases[i].bitrate, cases[i].max, parts,
+                     tpdo * 100);
+            CHECK(errors == 1 && strstr(messages, want) == messages, "want \"%s\" in:\n%s", want, messages);
+        }
+        gw_config_free(&cfg);
+        free(messages);
+    }
+}
+
 /* ---- the example's description -------------------------------------------------------- */
 
 static void test_description(const gw_config *cfg)
@@ -585,6 +644,7 @@ int main(int argc, char **argv)
     }
     test_rejections();
     test_causes_first();
+    test_bus_load();
     test_rtde_node();
     CHECK(gw_config_load(&cfg, argv[1], stderr) == 0 && cfg.co_run != NULL, "%s loads, with its node", argv[1]);
     if (cfg.co_run != NULL) {
