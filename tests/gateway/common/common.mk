@@ -22,10 +22,12 @@ $(GCT)/test_rtde_capture_san: tests/gateway/common/test_rtde_capture.c gateway/c
 	@mkdir -p $(@D)
 	$(CC) $(GW_CFLAGS) -O1 -g $(SAN_FLAGS) -Itests $< gateway/common/rtde_capture.c $(LIB_SRCS) -lm -o $@
 
-check-rtde-capture: $(GCT)/test_rtde_capture $(RTDE_VECTORS)
+# tests/lib/rtde.mk, which names the vectors, is read after this file: $$ defers the name
+# to the second expansion (.SECONDEXPANSION is on since gateway/urrt-gateway/urrt-gateway.mk).
+check-rtde-capture: $(GCT)/test_rtde_capture $$(RTDE_VECTORS)
 	@mkdir -p $(GCT)/scratch
 	$(call suite,$@,$(GCT)/test_rtde_capture $(RTDE_VECTORS) $(GCT)/scratch)
 
-check-rtde-capture-san: $(GCT)/test_rtde_capture_san $(RTDE_VECTORS)
+check-rtde-capture-san: $(GCT)/test_rtde_capture_san $$(RTDE_VECTORS)
 	@mkdir -p $(GCT)/scratch-san
 	$(call suite,$@,ASAN_OPTIONS=detect_leaks=1 $(GCT)/test_rtde_capture_san $(RTDE_VECTORS) $(GCT)/scratch-san)
