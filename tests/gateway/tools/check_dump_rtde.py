@@ -25,6 +25,7 @@ import csv
 import io
 import json
 import os
+import signal
 import socket
 import struct
 import subprocess
@@ -69,6 +70,16 @@ def wait_for(what, cond, proc=None, timeout=10.0):
     return False
 
 
+def end_group(proc):
+    """Kills what is left of proc's process group (timeout leads one): a
+    simulator that outlived its timeout must not keep running, nor hold a
+    pipe of the suite's open (check-stress once hung on one that did)."""
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
 class Sim:
     count = 0
 
@@ -79,7 +90,7 @@ class Sim:
         with open(self.log_path, 'w') as log:
             self.proc = subprocess.Popen(['timeout', '-k', '3', '90', SIM, '-l', '127.0.0.1:0', '--port-file', rt_pf,
                                           '--rtde', '127.0.0.1:0', '--rtde-port-file', rtde_pf, '-v'] + list(args),
-                                         stderr=log)
+                                         stdout=log, stderr=log)
         if not wait_for('the simulator\'s port files', lambda: os.path.exists(rtde_pf), self.proc):
             raise RuntimeError('simulator did not start: ' + open(self.log_path).read())
         self.rt_port = int(open(rt_pf).read())
@@ -92,6 +103,7 @@ class Sim:
     def __exit__(self, *exc):
         self.proc.terminate()
         self.proc.wait(timeout=10)
+        end_group(self.proc)
 
 
 def dump(*args, timeout=30):

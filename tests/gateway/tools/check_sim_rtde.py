@@ -12,6 +12,7 @@ connection) with a bound, never a sleep for something to have happened.
   check_sim_rtde.py BUILD
 """
 import os
+import signal
 import socket
 import struct
 import subprocess
@@ -56,6 +57,16 @@ def wait_for(what, cond, proc=None, timeout=10.0):
     return False
 
 
+def end_group(proc):
+    """Kills what is left of proc's process group (timeout leads one): a
+    simulator that outlived its timeout must not keep running, nor hold a
+    pipe of the suite's open (check-stress once hung on one that did)."""
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
 class Sim:
     count = 0
 
@@ -66,7 +77,7 @@ class Sim:
         with open(self.log_path, 'w') as log:
             self.proc = subprocess.Popen(['timeout', '-k', '3', '60', SIM, '-l', '127.0.0.1:0', '--port-file', self.rt_pf,
                                           '--rtde', '127.0.0.1:0', '--rtde-port-file', self.rtde_pf, '-v'] + list(args),
-                                         stderr=log)
+                                         stdout=log, stderr=log)
         if not wait_for('the simulator\'s port files', lambda: os.path.exists(self.rtde_pf), self.proc):
             raise RuntimeError('simulator did not start: ' + self.log())
         self.rt_port = int(open(self.rt_pf).read())
@@ -78,6 +89,7 @@ class Sim:
     def stop(self):
         self.proc.terminate()
         self.proc.wait(timeout=10)
+        end_group(self.proc)
 
     def __enter__(self):
         return self
@@ -626,7 +638,7 @@ class Replay:
         self.log_path, self.rtde_pf = base + '.log', base + '.rtde'
         with open(self.log_path, 'w') as log:
             self.proc = subprocess.Popen(['timeout', '-k', '3', '60', SIM, '--replay', path, '--rtde', '127.0.0.1:0',
-                                          '--rtde-port-file', self.rtde_pf, '-v'] + list(args), stderr=log)
+                                          '--rtde-port-file', self.rtde_pf, '-v'] + list(args), stdout=log, stderr=log)
         if not wait_for('the replay\'s port file', lambda: os.path.exists(self.rtde_pf), self.proc):
             raise RuntimeError('replay did not start: ' + self.log())
         self.port = int(open(self.rtde_pf).read())
@@ -638,6 +650,7 @@ class Replay:
         if self.proc.poll() is None:
             self.proc.terminate()
         self.proc.wait(timeout=10)
+        end_group(self.proc)
 
     def __enter__(self):
         return self
