@@ -144,6 +144,7 @@ typedef struct urrt_link_stats {
     uint32_t last_length;    /* size of the last packet, 0 if none */
     uint64_t sockets;        /* sockets opened (one per address tried): a new socket may
                                 get a closed one's descriptor number, this tells them apart */
+    uint64_t read_waits;     /* urrt_link_service_waiting calls that waited in the read */
 } urrt_link_stats;
 
 typedef struct urrt_link urrt_link;
@@ -174,6 +175,22 @@ uint64_t urrt_link_deadline(const urrt_link *link);
  * (bounded per call), framing, timeouts, backoff. Calls fn for each
  * complete packet (with a source: each package it reports). Never blocks. */
 void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void *ctx);
+
+/*
+ * urrt_link_service for a loop whose only descriptor is this link's: the
+ * read is the wait, one system call a packet where a wait and a read are
+ * two. It waits in the socket's first read, ending by until_us (monotonic)
+ * at the latest, and then does what urrt_link_service does; the stamps
+ * (rx_us, the empty queue) mean what they mean there, the empty queue
+ * taken from the kernel's receive time of the bytes the wait returned
+ * (SO_TIMESTAMPNS). It waits only while the link is connected with nothing
+ * to write and nothing left to read, and until_us leaves room for the
+ * read's timeout (a kernel tick and twice URRT_LINK_WAIT_MIN_US, about
+ * 6 ms at 250 Hz); otherwise it does nothing and returns false, and the
+ * loop waits its own way (poll, epoll). A signal ends the wait (EINTR).
+ */
+#define URRT_LINK_WAIT_MIN_US 1000u /* the shortest timeout the read is given */
+bool urrt_link_service_waiting(urrt_link *link, uint64_t until_us, urrt_packet_fn fn, void *ctx);
 
 urrt_link_state urrt_link_get_state(const urrt_link *link);
 const urrt_link_stats *urrt_link_get_stats(const urrt_link *link);

@@ -222,12 +222,14 @@ static bool rtde_attach(gw_robot *robot)
 }
 
 /* A robot's link: serviced, its socket kept registered, its deadline
- * noted, and a change of its state or freshness made news for the outputs. */
-static void service_robot(gw_robot *robot, uint64_t now);
+ * noted, and a change of its state or freshness made news for the outputs.
+ * With wait_until, the service waits in the link's read until then at most,
+ * or, where the link cannot, does nothing and returns false. */
+static bool service_robot(gw_robot *robot, uint64_t now, uint64_t wait_until);
 
 static void robot_ready(void *ctx, uint64_t now_us)
 {
-    service_robot(ctx, now_us);
+    (void)service_robot(ctx, now_us, 0);
 }
 
 bool gw_init(gateway *gw, const gw_config *cfg)
@@ -319,6 +321,8 @@ void gw_watch_set(gateway *gw, gw_watch *w, int fd, short events, uint64_t opene
     if (registered && events == w->events) {
         return;
     }
+    gw->watched -= w->fd >= 0 && w->events != 0 ? 1u : 0u;
+    gw->watched += fd >= 0 && events != 0 ? 1u : 0u;
     /* Level-triggered: a link that stops at its read budget, or CAN at its
      * receive burst, is reported again at the next wait, whatever its owner
      * noted of what it left. Edge-triggered would spare one readiness check
@@ -333,7 +337,7 @@ void gw_watch_set(gateway *gw, gw_watch *w, int fd, short events, uint64_t opene
     w->opened = opened;
 }
 
-static void service_robot(gw_robot *robot, uint64_t now)
+static bool service_robot(gw_robot *robot, uint64_t now, uint64_t wait_until)
 {
     gateway *gw = robot->gw;
     urrt_link_state state = urrt_link_get_state(robot->link);
@@ -341,7 +345,13 @@ static void service_robot(gw_robot *robot, uint64_t now)
     short events = 0;
     int fd;
 
-    urrt_link_service(robot->link, now, on_packet, robot);
+    if (wait_until == 0) {
+        urrt_link_service(robot->link, now, on_packet, robot);
+    } else if (urrt_link_service_waiting(robot->link, wait_until, on_packet, robot)) {
+        now = urrt_port_monotonic_us();
+    } else {
+        return false;
+    }
     fd = urrt_link_poll_fd(robot->link, &events);
     gw_watch_set(gw, &robot->watch, fd, events, urrt_link_get_stats(robot->link)->sockets);
     gw->link_due[robot->index].due_us = urrt_link_deadline(robot->link);
@@ -352,6 +362,17 @@ static void service_robot(gw_robot *robot, uint64_t now)
     if (state != urrt_link_get_state(robot->link) || fresh != gw_robot_fresh(robot, now)) {
         gw->news = true;
     }
+    return true;
+}
+
+/* The robot whose socket, waiting for input alone, is all the loop waits
+ * on, or NULL. */
+static gw_robot *sole_reader(gateway *gw)
+{
+    gw_robot *robot = &gw->robots[0];
+    return gw->robot_count == 1 && gw->watched == 1 && robot->watch.fd >= 0 && robot->watch.events == POLLIN
+               ? robot
+               : NULL;
 }
 
 /* The earliest deadline of the links, the outputs, the summary and the
@@ -376,9 +397,14 @@ static uint64_t next_deadline(gateway *gw)
 static uint64_t wait_and_service(gateway *gw, uint64_t deadline, uint64_t now)
 {
     struct epoll_event events[GW_WAIT_EVENTS];
+    gw_robot *sole = sole_reader(gw);
     /* Round up: waking a little late is harmless, early wakes spin. */
     int timeout_ms = deadline <= now ? 0 : (int)((deadline - now + 999u) / 1000u);
-    int n = epoll_wait(gw->epoll_fd, events, GW_WAIT_EVENTS, timeout_ms);
+    int n;
+    if (sole != NULL && service_robot(sole, now, deadline)) {
+        return urrt_port_monotonic_us();
+    }
+    n = epoll_wait(gw->epoll_fd, events, GW_WAIT_EVENTS, timeout_ms);
     if (n < 0 && errno != EINTR) {
         urrt_log(URRT_LOG_ERR, "epoll_wait: %s", strerror(errno));
     }
@@ -403,7 +429,7 @@ static void service_due_links(gateway *gw, uint64_t now)
     }
     for (unsigned i = 0; i < gw->robot_count; i++) {
         if (gw->link_due[i].due_us <= now && gw->link_due[i].loop != gw->loops) {
-            service_robot(&gw->robots[i], now);
+            (void)service_robot(&gw->robots[i], now, 0);
         }
         earliest = gw->link_due[i].due_us < earliest ? gw->link_due[i].due_us : earliest;
     }

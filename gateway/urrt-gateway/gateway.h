@@ -42,7 +42,10 @@ typedef struct gateway gateway;
  * each call that may change it (an open, a close, the events it waits for),
  * and the loop makes a system call only when something changed. After a
  * wait that found the descriptor ready (readable, writable, an error, a
- * hang-up), the loop calls ready().
+ * hang-up), the loop calls ready(). Where a robot's socket, waiting for
+ * input, is all there is to wait on (one robot, no output descriptor
+ * waiting), the loop waits in that socket's read instead
+ * (urrt_link_service_waiting): one system call a packet, not two.
  */
 typedef struct gw_watch {
     void (*ready)(void *ctx, uint64_t now_us);
@@ -136,6 +139,7 @@ struct gateway {
     uint64_t loops;
     /* The loop's (gateway.c): */
     int epoll_fd;
+    unsigned watched;          /* watches registered with events: one robot's alone waits in its read */
     struct gw_link_due *link_due; /* per robot, apart from gw_robot */
     uint64_t links_due_us;     /* never later than the earliest link_due */
     uint64_t output_due[GW_MAX_OUTPUTS];

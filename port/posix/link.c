@@ -25,6 +25,7 @@
  */
 #define _GNU_SOURCE
 #include <errno.h>
+#include <fcntl.h>
 #include <inttypes.h>
 #include <netdb.h>
 #include <netinet/in.h>
@@ -34,6 +35,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/time.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "port.h"
@@ -94,6 +97,10 @@ struct urrt_link {
     int write_errno;          /* a write failed: the connection ends at the next service */
     size_t out_head, out_len; /* queued bytes: out[out_head .. out_head + out_len) */
     uint8_t out[URRT_LINK_SEND_MAX];
+    /* urrt_link_service_waiting: the socket blocks unless a call says
+     * MSG_DONTWAIT (every other call does), and its SO_RCVTIMEO, 0 if unset. */
+    bool reads_can_wait;
+    uint64_t wait_timeout_us;
 };
 
 void urrt_link_config_defaults(urrt_link_config *cfg)
@@ -327,6 +334,14 @@ static void became_connected(urrt_link *link, uint64_t now_us)
     link->write_errno = 0;
     link->drop_pending = false;
     urrt_framer_reset(&link->framer);
+    /* Opened non-blocking for the connect; from here every call but
+     * urrt_link_service_waiting's read passes MSG_DONTWAIT. */
+    {
+        int flags = fcntl(link->fd, F_GETFL), on = 1;
+        link->reads_can_wait = flags >= 0 && fcntl(link->fd, F_SETFL, flags & ~O_NONBLOCK) == 0;
+        (void)setsockopt(link->fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on); /* without: before_us */
+    }
+    link->wait_timeout_us = 0;
     urrt_log(URRT_LOG_DEBUG, "robot %s: TCP connection to %s established; waiting for data", link->name, link->peer);
     if (link->has_source && link->source.connected != NULL) {
         link->source.connected(link->source.ctx, link, now_us);
@@ -623,11 +638,53 @@ void urrt_link_source_packet(urrt_link *link, const uint8_t *packet, size_t len,
     packet_arrived(link, packet, len, rx_us);
 }
 
+/* The read urrt_link_service_waiting waits in. *arrived_us: the kernel's
+ * receive time of the last bytes it returns (SO_TIMESTAMPNS, on the
+ * realtime clock, in microseconds), 0 if it gave none. */
+static ssize_t read_waiting(urrt_link *link, uint8_t *buf, size_t size, uint64_t *arrived_us)
+{
+    union {
+        struct cmsghdr align;
+        uint8_t bytes[CMSG_SPACE(sizeof(struct timespec))];
+    } control;
+    struct iovec iov = {.iov_base = buf, .iov_len = size};
+    struct msghdr msg = {.msg_iov = &iov, .msg_iovlen = 1, .msg_control = &control, .msg_controllen = sizeof control};
+    ssize_t n = recvmsg(link->fd, &msg, 0);
+    *arrived_us = 0;
+    for (struct cmsghdr *c = n > 0 ? CMSG_FIRSTHDR(&msg) : NULL; c != NULL; c = CMSG_NXTHDR(&msg, c)) {
+        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
+            struct timespec ts;
+            memcpy(&ts, CMSG_DATA(c), sizeof ts);
+            *arrived_us = ts.tv_sec > 0 ? (uint64_t)ts.tv_sec * 1000000u + (uint64_t)ts.tv_nsec / 1000u : 0;
+        }
+    }
+    return n;
+}
+
+/* The later of before_us and the kernel's receive stamp (realtime) moved
+ * onto the monotonic clock by the clocks' offset just after read_us (the
+ * realtime clock is read a little later, so the stamp comes out a little
+ * early: the safe side for a time the queue was empty). A stamp after
+ * read_us, or none, leaves before_us: the realtime clock was set since. */
+static uint64_t arrival_or(uint64_t arrived_real_us, uint64_t before_us, uint64_t read_us)
+{
+    uint64_t real_us = urrt_port_realtime_us();
+    uint64_t ago_us = real_us - arrived_real_us;
+    if (arrived_real_us == 0 || arrived_real_us > real_us || ago_us > read_us - before_us) {
+        return before_us;
+    }
+    return read_us - ago_us;
+}
+
 /* Each read is stamped with the clock taken just after it returns, so a
  * packet's rx_us is when its last bytes left the socket, whatever the loop
  * did since it woke up. A read shorter than asked emptied the queue: the
- * clock taken just before it is then a time the queue was empty. */
-static void read_available(urrt_link *link)
+ * clock taken just before it is then a time the queue was empty (every
+ * byte after what it took came later). A first read that waited (`wait`)
+ * took what was there when it returned, after the last of its bytes
+ * arrived: that arrival, as the kernel stamped it, is the later such time;
+ * its timeout (EAGAIN) means nothing came since the clock was read. */
+static void read_available(urrt_link *link, bool wait)
 {
     uint8_t buf[LINK_READ_CHUNK];
     size_t budget = LINK_READ_BUDGET;
@@ -635,8 +692,15 @@ static void read_available(urrt_link *link)
     link->more_to_read = false;
     while (connected(link) && !link->drop_pending) {
         uint64_t before_us = urrt_port_monotonic_us();
-        ssize_t n = recv(link->fd, buf, sizeof buf, MSG_DONTWAIT);
+        uint64_t arrived_real_us = 0;
+        ssize_t n = wait ? read_waiting(link, buf, sizeof buf, &arrived_real_us)
+                         : recv(link->fd, buf, sizeof buf, MSG_DONTWAIT);
         uint64_t read_us = urrt_port_monotonic_us();
+        bool waited = wait;
+        wait = false;
+        if (waited && n > 0) {
+            before_us = arrival_or(arrived_real_us, before_us, read_us);
+        }
         if (n > 0) {
             link->last_rx_us = read_us;
             link->read_drained = (size_t)n < sizeof buf;
@@ -657,6 +721,9 @@ static void read_available(urrt_link *link)
         } else if (n == 0) {
             connection_lost(link, read_us, "closed by peer", false);
         } else if (errno == EINTR) {
+            /* Once more without waiting: what a signal (a stop and
+             * SIGCONT too) left in the queue is read before the silence
+             * is judged, and a stop request reaches the loop at once. */
             continue;
         } else if (errno == EAGAIN || errno == EWOULDBLOCK) {
             link->empty_us = before_us;
@@ -743,11 +810,14 @@ bool urrt_link_packet_newest(const urrt_link *link)
 
 /* What a connection does in one service call: the queue written, bytes
  * read, the source's requests acted on, silence judged. */
-static void service_connection(urrt_link *link, uint64_t now_us)
+static void service_connection(urrt_link *link, uint64_t now_us, bool wait)
 {
     if (!link->drop_pending) {
         flush_queue(link);
-        read_available(link);
+        read_available(link, wait);
+    }
+    if (wait) {
+        now_us = urrt_port_monotonic_us(); /* the silence is judged after the wait */
     }
     if (connected(link) && link->drop_pending) {
         handle_drop(link, now_us);
@@ -792,7 +862,69 @@ void urrt_link_service(urrt_link *link, uint64_t now_us, urrt_packet_fn fn, void
     }
     link->fn = fn;
     link->fn_ctx = ctx;
-    service_connection(link, now_us);
+    service_connection(link, now_us, false);
     link->fn = NULL;
     link->fn_ctx = NULL;
+}
+
+/* The kernel's tick, the unit SO_RCVTIMEO counts in (CLOCK_MONOTONIC_COARSE
+ * advances by one): 10 ms, the coarsest a Linux kernel has, if unknown. */
+static uint64_t kernel_tick_us(void)
+{
+    struct timespec res;
+    if (clock_getres(CLOCK_MONOTONIC_COARSE, &res) != 0 || res.tv_sec != 0 || res.tv_nsec <= 0) {
+        return 10000u;
+    }
+    return ((uint64_t)res.tv_nsec + 999u) / 1000u;
+}
+
+/* SO_RCVTIMEO for a wait that must end within room_us: half of what is
+ * left of it after a tick. The kernel rounds a timeout up to whole ticks
+ * and, past 64 ticks, lets its timer wheel fire up to an eighth late: a
+ * timeout t ends by t + t/8 + one tick. Setting it is a system call, so the
+ * one set is kept while it ends in time and is not under half of that:
+ * a deadline that moves on with every packet (the silence timeout, the
+ * data's freshness) never needs another, a fixed one (the outputs' ticks)
+ * is approached in a few steps of about half the room each, until the room
+ * is too short to wait in the read. */
+static bool wait_timeout_fits(urrt_link *link, uint64_t room_us)
+{
+    static uint64_t tick_us;
+    struct timeval tv;
+    uint64_t timeout_us = link->wait_timeout_us, half_us;
+    if (tick_us == 0) {
+        tick_us = kernel_tick_us();
+    }
+    if (room_us < tick_us + 2u * URRT_LINK_WAIT_MIN_US) {
+        return false;
+    }
+    half_us = (room_us - tick_us) / 2u;
+    if (timeout_us >= half_us / 2u && timeout_us + timeout_us / 8u + tick_us <= room_us) {
+        return true;
+    }
+    timeout_us = half_us;
+    tv.tv_sec = (time_t)(timeout_us / 1000000u);
+    tv.tv_usec = (suseconds_t)(timeout_us % 1000000u);
+    if (setsockopt(link->fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv) != 0) {
+        return false;
+    }
+    link->wait_timeout_us = timeout_us;
+    return true;
+}
+
+bool urrt_link_service_waiting(urrt_link *link, uint64_t until_us, urrt_packet_fn fn, void *ctx)
+{
+    uint64_t now_us = urrt_port_monotonic_us();
+    if (link == NULL || !connected(link) || !link->reads_can_wait || link->drop_pending || link->more_to_read ||
+        link->out_len > 0 || link->write_errno != 0 || until_us <= now_us ||
+        !wait_timeout_fits(link, until_us - now_us)) {
+        return false;
+    }
+    link->stats.read_waits++;
+    link->fn = fn;
+    link->fn_ctx = ctx;
+    service_connection(link, now_us, true);
+    link->fn = NULL;
+    link->fn_ctx = NULL;
+    return true;
 }

@@ -10,9 +10,12 @@
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
+#include <pthread.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/time.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -1021,6 +1024,157 @@ static void test_cli(void)
     CHECK_EQ_STR(host, "robot:30013");
 }
 
+/* ---- waiting in the read --------------------------------------------------------- */
+
+typedef struct late_send {
+    int fd;
+    int after_ms;
+    const uint8_t *bytes;
+    size_t len;
+    uint64_t sent_us; /* monotonic, just before the send */
+} late_send;
+
+/* The stimulus: a packet that comes while the link waits in its read. */
+static void *send_later(void *arg)
+{
+    late_send *ls = arg;
+    sleep_ms(ls->after_ms);
+    ls->sent_us = urrt_port_monotonic_us();
+    send_all(ls->fd, ls->bytes, ls->len);
+    return NULL;
+}
+
+static volatile sig_atomic_t alarms;
+static void on_alarm(int sig)
+{
+    (void)sig;
+    alarms++;
+}
+
+static uint64_t rcvtimeo_us(int fd)
+{
+    struct timeval tv = {0, 0};
+    socklen_t len = sizeof tv;
+    if (getsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, &len) != 0) {
+        return UINT64_MAX;
+    }
+    return (uint64_t)tv.tv_sec * 1000000u + (uint64_t)tv.tv_usec;
+}
+
+/* urrt_link_service_waiting: waits only where it can end in time, delivers
+ * what arrives with the stamps urrt_link_service gives (the empty queue from
+ * the kernel's receive time, not the start of the wait), and a signal ends
+ * the wait. */
+static void test_wait_in_read(void)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    rx r = {0};
+    uint8_t pkt[1116];
+    uint16_t port = 0;
+    int lfd = bind_any(AF_INET, &port, 16), s, fd;
+    const urrt_link_stats *st;
+    struct timespec res;
+    uint64_t tick_us, t0, until, waits;
+    late_send ls;
+    pthread_t th;
+    struct sigaction sa, old;
+    struct itimerval it = {{0, 0}, {0, 100000}};
+
+    CHECK(lfd >= 0, "listen");
+    CHECK(clock_getres(CLOCK_MONOTONIC_COARSE, &res) == 0, "the kernel's tick");
+    tick_us = (uint64_t)res.tv_nsec / 1000u;
+    urrt_link_config_defaults(&c);
+    c.name = "arm-wait";
+    c.host = "127.0.0.1";
+    c.port = port;
+    c.silence_timeout_ms = 60000; /* no deadline of its own while the test waits */
+    l = urrt_link_new(&c);
+    st = urrt_link_get_stats(l);
+    CHECK(!urrt_link_service_waiting(l, urrt_port_monotonic_us() + 1000000u, on_packet, &r),
+          "no wait before the link is connected");
+    s = accept_link(l, &r, lfd);
+    CHECK(s >= 0, "accept");
+    make_packet(pkt, sizeof pkt, 1);
+    send_all(s, pkt, sizeof pkt);
+    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "up at the first packet");
+    fd = urrt_link_poll_fd(l, NULL);
+
+    /* Too little room for a timeout that ends in time: nothing done. */
+    CHECK(!urrt_link_service_waiting(l, urrt_port_monotonic_us(), on_packet, &r), "no wait for a deadline now");
+    CHECK(!urrt_link_service_waiting(l, urrt_port_monotonic_us() + tick_us, on_packet, &r),
+          "no wait for a deadline a tick away");
+    CHECK_EQ_INT(st->read_waits, 0);
+
+    /* A packet that comes during the wait: delivered, and the queue's empty
+     * time is its arrival, not the start of the wait. */
+    ls = (late_send){.fd = s, .after_ms = 200, .bytes = pkt, .len = sizeof pkt};
+    make_packet(pkt, sizeof pkt, 2);
+    t0 = urrt_port_monotonic_us();
+    until = t0 + 20000000u;
+    CHECK(pthread_create(&th, NULL, send_later, &ls) == 0, "sender thread");
+    while (r.packets < 2 && urrt_port_monotonic_us() < until) {
+        CHECK(urrt_link_service_waiting(l, until, on_packet, &r), "waits for the packet");
+    }
+    pthread_join(th, NULL);
+    CHECK_EQ_INT(r.packets, 2);
+    CHECK_EQ_INT(r.first_byte_of_last, 2);
+    CHECK(st->read_waits >= 1, "counted (%llu)", (unsigned long long)st->read_waits);
+    CHECK(rcvtimeo_us(fd) <= (until - t0) / 2u + tick_us, "the read's timeout is at most half the room and a tick "
+          "(%llu us of %llu)", (unsigned long long)rcvtimeo_us(fd), (unsigned long long)(until - t0));
+    /* The next packet, already queued: its first byte came after the queue
+     * was seen empty, which the wait put at the last one's arrival (the
+     * start of the wait was 200 ms before it). */
+    make_packet(pkt, sizeof pkt, 3);
+    send_all(s, pkt, sizeof pkt);
+    waits = st->read_waits;
+    CHECK(urrt_link_service_waiting(l, urrt_port_monotonic_us() + 20000000u, on_packet, &r), "a queued packet");
+    CHECK_EQ_INT(r.packets, 3);
+    CHECK_EQ_INT(st->read_waits, waits + 1);
+    CHECK(urrt_link_packet_empty_us(l) >= t0 + 100000u && urrt_link_packet_empty_us(l) <= st->last_packet_us,
+          "empty queue at the kernel's arrival of the packet before (%lld us after the wait began, sent at %lld)",
+          (long long)(urrt_link_packet_empty_us(l) - t0), (long long)(ls.sent_us - t0));
+
+    /* A signal ends the wait (its timeout here is about 10 s). */
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_alarm;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = 0; /* no SA_RESTART, as urrt-gateway's handlers */
+    sigaction(SIGALRM, &sa, &old);
+    alarms = 0;
+    t0 = urrt_port_monotonic_us();
+    setitimer(ITIMER_REAL, &it, NULL);
+    CHECK(urrt_link_service_waiting(l, t0 + 20000000u, on_packet, &r), "waits until the signal");
+    CHECK(alarms == 1, "the signal came (%d)", (int)alarms);
+    CHECK(urrt_port_monotonic_us() - t0 < 5000000u, "the signal ended the wait (after %llu ms)",
+          (unsigned long long)((urrt_port_monotonic_us() - t0) / 1000u));
+    CHECK_EQ_INT(r.packets, 3);
+    CHECK_EQ_INT(urrt_link_get_state(l), URRT_LINK_UP);
+    sigaction(SIGALRM, &old, NULL);
+
+    /* Nothing comes: the timeout ends the wait before the deadline the
+     * caller gave, the link still up (its own silence is a minute). */
+    t0 = urrt_port_monotonic_us();
+    until = t0 + 300000u;
+    while (urrt_port_monotonic_us() < until && urrt_link_service_waiting(l, until, on_packet, &r)) {
+    }
+    CHECK_EQ_INT(r.packets, 3);
+    CHECK_EQ_INT(urrt_link_get_state(l), URRT_LINK_UP);
+    CHECK(rcvtimeo_us(fd) <= 150000u + tick_us, "each timeout at most half the room and a tick (%llu us)",
+          (unsigned long long)rcvtimeo_us(fd));
+
+    /* The peer closes: the wait reads the end of the stream. */
+    close(s);
+    while (urrt_link_get_state(l) == URRT_LINK_UP &&
+           urrt_link_service_waiting(l, urrt_port_monotonic_us() + 2000000u, on_packet, &r)) {
+    }
+    CHECK_EQ_INT(st->disconnects, 1);
+    CHECK(!urrt_link_service_waiting(l, urrt_port_monotonic_us() + 2000000u, on_packet, &r),
+          "no wait without a connection");
+    urrt_link_free(l);
+    close(lfd);
+}
+
 int main(void)
 {
     urrt_log_init("test_link", URRT_LOG_DEBUG);
@@ -1034,6 +1188,7 @@ int main(void)
     test_name();
     test_wrong_port();
     test_frozen_peer();
+    test_wait_in_read();
     test_source_handshake();
     test_source_refused();
     return check_report();
