@@ -809,15 +809,17 @@ bool urrt_link_packet_newest(const urrt_link *link)
 }
 
 /* What a connection does in one service call: the queue written, bytes
- * read, the source's requests acted on, silence judged. */
+ * read, the source's requests acted on, silence judged. The silence is
+ * judged at now_us, taken before the reads, also after a read that waited:
+ * a clock read after a read that found nothing may come after a stop (a
+ * SIGSTOP, a starved CPU) that left the queue full, and would call a link
+ * silent that only this process was not reading. A silence that a wait's
+ * timeout ends is judged at the next call, its deadline passed. */
 static void service_connection(urrt_link *link, uint64_t now_us, bool wait)
 {
     if (!link->drop_pending) {
         flush_queue(link);
         read_available(link, wait);
-    }
-    if (wait) {
-        now_us = urrt_port_monotonic_us(); /* the silence is judged after the wait */
     }
     if (connected(link) && link->drop_pending) {
         handle_drop(link, now_us);

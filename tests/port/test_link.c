@@ -1175,6 +1175,48 @@ static void test_wait_in_read(void)
     close(lfd);
 }
 
+/* A wait that its timeout ends, past the link's silence timeout: the
+ * silence is judged by the clock before the read, as urrt_link_service
+ * judges it, so the wait itself drops nothing (a clock read after a read
+ * that found nothing may come after a stop that left the queue full); the
+ * next call, its deadline passed, does. */
+static void test_wait_silence(void)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    rx r = {0};
+    uint8_t pkt[1116];
+    uint16_t port = 0;
+    int lfd = bind_any(AF_INET, &port, 16), s;
+    const urrt_link_stats *st;
+    uint64_t t0;
+
+    CHECK(lfd >= 0, "listen");
+    urrt_link_config_defaults(&c);
+    c.name = "arm-wait-silence";
+    c.host = "127.0.0.1";
+    c.port = port;
+    c.silence_timeout_ms = 50;
+    l = urrt_link_new(&c);
+    st = urrt_link_get_stats(l);
+    s = accept_link(l, &r, lfd);
+    CHECK(s >= 0, "accept");
+    make_packet(pkt, sizeof pkt, 1);
+    send_all(s, pkt, sizeof pkt);
+    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "up at the first packet");
+    t0 = urrt_port_monotonic_us();
+    CHECK(urrt_link_service_waiting(l, t0 + 400000u, on_packet, &r), "waits");
+    CHECK(urrt_port_monotonic_us() - st->last_packet_us >= 50000u, "the wait outlasted the silence timeout");
+    CHECK_EQ_INT(urrt_link_get_state(l), URRT_LINK_UP);
+    CHECK_EQ_INT(st->silences, 0);
+    urrt_link_service(l, urrt_port_monotonic_us(), on_packet, &r);
+    CHECK_EQ_INT(st->silences, 1);
+    CHECK(urrt_link_get_state(l) != URRT_LINK_UP, "the next call drops the silent link");
+    close(s);
+    urrt_link_free(l);
+    close(lfd);
+}
+
 int main(void)
 {
     urrt_log_init("test_link", URRT_LOG_DEBUG);
@@ -1189,6 +1231,7 @@ int main(void)
     test_wrong_port();
     test_frozen_peer();
     test_wait_in_read();
+    test_wait_silence();
     test_source_handshake();
     test_source_refused();
     return check_report();
