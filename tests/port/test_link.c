@@ -1061,18 +1061,46 @@ static uint64_t rcvtimeo_us(int fd)
     return (uint64_t)tv.tv_sec * 1000000u + (uint64_t)tv.tv_usec;
 }
 
+/* A link named `name` to a server of this test's on loopback, up at the
+ * server's first packet (tag 1): the listening socket in *lfd, the accepted
+ * one in *s. NULL (checks failed) if it did not come up. */
+static urrt_link *link_up(const char *name, uint32_t silence_timeout_ms, rx *r, int *lfd, int *s)
+{
+    urrt_link_config c;
+    urrt_link *l;
+    uint8_t pkt[1116];
+    uint16_t port = 0;
+
+    *lfd = bind_any(AF_INET, &port, 16);
+    CHECK(*lfd >= 0, "%s: listen", name);
+    urrt_link_config_defaults(&c);
+    c.name = name;
+    c.host = "127.0.0.1";
+    c.port = port;
+    c.silence_timeout_ms = silence_timeout_ms;
+    l = urrt_link_new(&c);
+    *s = accept_link(l, r, *lfd);
+    CHECK(*s >= 0, "%s: accept", name);
+    make_packet(pkt, sizeof pkt, 1);
+    send_all(*s, pkt, sizeof pkt);
+    if (!pump(l, r, 2000, is_up, NULL, NULL, 0)) {
+        CHECK(false, "%s: up at the first packet", name);
+        urrt_link_free(l);
+        return NULL;
+    }
+    return l;
+}
+
 /* urrt_link_service_waiting: waits only where it can end in time, delivers
  * what arrives with the stamps urrt_link_service gives (the empty queue from
  * the kernel's receive time, not the start of the wait), and a signal ends
  * the wait. */
 static void test_wait_in_read(void)
 {
-    urrt_link_config c;
     urrt_link *l;
     rx r = {0};
     uint8_t pkt[1116];
-    uint16_t port = 0;
-    int lfd = bind_any(AF_INET, &port, 16), s, fd;
+    int lfd, s, fd;
     const urrt_link_stats *st;
     struct timespec res;
     uint64_t tick_us, t0, until, waits;
@@ -1081,23 +1109,14 @@ static void test_wait_in_read(void)
     struct sigaction sa, old;
     struct itimerval it = {{0, 0}, {0, 100000}};
 
-    CHECK(lfd >= 0, "listen");
     CHECK(clock_getres(CLOCK_MONOTONIC_COARSE, &res) == 0, "the kernel's tick");
     tick_us = (uint64_t)res.tv_nsec / 1000u;
-    urrt_link_config_defaults(&c);
-    c.name = "arm-wait";
-    c.host = "127.0.0.1";
-    c.port = port;
-    c.silence_timeout_ms = 60000; /* no deadline of its own while the test waits */
-    l = urrt_link_new(&c);
+    /* A silence timeout of a minute: no deadline of the link's own while the test waits. */
+    l = link_up("arm-wait", 60000, &r, &lfd, &s);
+    if (l == NULL) {
+        return;
+    }
     st = urrt_link_get_stats(l);
-    CHECK(!urrt_link_service_waiting(l, urrt_port_monotonic_us() + 1000000u, on_packet, &r),
-          "no wait before the link is connected");
-    s = accept_link(l, &r, lfd);
-    CHECK(s >= 0, "accept");
-    make_packet(pkt, sizeof pkt, 1);
-    send_all(s, pkt, sizeof pkt);
-    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "up at the first packet");
     fd = urrt_link_poll_fd(l, NULL);
 
     /* Too little room for a timeout that ends in time: nothing done. */
@@ -1170,7 +1189,7 @@ static void test_wait_in_read(void)
     }
     CHECK_EQ_INT(st->disconnects, 1);
     CHECK(!urrt_link_service_waiting(l, urrt_port_monotonic_us() + 2000000u, on_packet, &r),
-          "no wait without a connection");
+          "no wait without a connection (closed by the peer)");
     urrt_link_free(l);
     close(lfd);
 }
@@ -1182,28 +1201,17 @@ static void test_wait_in_read(void)
  * next call, its deadline passed, does. */
 static void test_wait_silence(void)
 {
-    urrt_link_config c;
     urrt_link *l;
     rx r = {0};
-    uint8_t pkt[1116];
-    uint16_t port = 0;
-    int lfd = bind_any(AF_INET, &port, 16), s;
+    int lfd, s;
     const urrt_link_stats *st;
     uint64_t t0;
 
-    CHECK(lfd >= 0, "listen");
-    urrt_link_config_defaults(&c);
-    c.name = "arm-wait-silence";
-    c.host = "127.0.0.1";
-    c.port = port;
-    c.silence_timeout_ms = 50;
-    l = urrt_link_new(&c);
+    l = link_up("arm-wait-silence", 50, &r, &lfd, &s);
+    if (l == NULL) {
+        return;
+    }
     st = urrt_link_get_stats(l);
-    s = accept_link(l, &r, lfd);
-    CHECK(s >= 0, "accept");
-    make_packet(pkt, sizeof pkt, 1);
-    send_all(s, pkt, sizeof pkt);
-    CHECK(pump(l, &r, 2000, is_up, NULL, NULL, 0), "up at the first packet");
     t0 = urrt_port_monotonic_us();
     CHECK(urrt_link_service_waiting(l, t0 + 400000u, on_packet, &r), "waits");
     CHECK(urrt_port_monotonic_us() - st->last_packet_us >= 50000u, "the wait outlasted the silence timeout");
