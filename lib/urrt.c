@@ -655,25 +655,34 @@ unsigned urrt_x86_vector_bytes(void)
 #endif
 #endif
 
-/* 1.x and the ambiguous lengths: field by field from the table. */
+/* 1.x and the ambiguous lengths: field by field from the table, each
+ * field's doubles stored once, from the packet or as NaN (clearing the
+ * struct first and then copying stored the present fields twice). Where
+ * lib/vector/urrt_vector.c includes this file, it defines decode_by_table
+ * after it: the 1.x lengths of real controllers by vectors, the rest
+ * written out field by field (three times as fast as this loop, and a
+ * kilobyte more code than a firmware wants for them). */
+#ifdef URRT_VECTOR_PATHS
+static void decode_by_table(const uint8_t *body, unsigned doubles, urrt_generation gen, urrt_state *st);
+#else
 static void decode_by_table(const uint8_t *body, unsigned doubles, urrt_generation gen, urrt_state *st)
 {
+    uint64_t present = 0;
     unsigned id;
-    urrt_state_clear(st);
     for (id = 0; id < (unsigned)URRT_FIELD_COUNT; id++) {
         const field_layout *f = &layout_table[id];
-        unsigned column = urrt_field_column((urrt_field_id)id, gen);
+        unsigned column = layout_column(f, gen);
         double *slot = field_slot(st, id);
-        unsigned i;
-        if (!field_fits(id, column, doubles, gen)) {
-            continue;
+        if (field_fits(id, column, doubles, gen)) {
+            load_doubles(slot, body + 8u * (column - 1u), f->count);
+            present |= UINT64_C(1) << id;
+        } else {
+            fill_nan(slot, f->count);
         }
-        for (i = 0; i < f->count; i++) {
-            slot[i] = double_from_bits(load_be64(body + 8u * (column - 1u + i)));
-        }
-        st->present |= UINT64_C(1) << id;
     }
+    st->present = present;
 }
+#endif
 
 /* Everything but a 3.x/5.x packet: errors, 1.x, the ambiguous lengths. Not
  * inlined beside the vector paths, so that urrt_decode saves no registers
@@ -696,6 +705,7 @@ static int decode_other(const uint8_t *buf, int size, urrt_state *st)
     decode_by_table(buf + URRT_HEADER_SIZE, doubles, gen, st);
     st->length = (uint32_t)size;
     st->doubles = (uint16_t)doubles;
+    st->extra_columns = 0;
     st->generation = gen;
     return size;
 }
