@@ -152,6 +152,24 @@ URRT_STATIC_ASSERT(fill_holds_a_vector, URRT_FILL_END >= URRT_WIRE_COLUMNS + 8u)
         __builtin_memcpy(&dst[FILL_END - per], &nan, sizeof nan);                                  \
     }
 
+/* Every length of a 3.x/5.x packet up to the newest layout, in doubles: the
+ * decode is written out for each (URRT_DECODE_3X_CASE), the grid's shape
+ * and the loops' ends then constants (working them out at each decode,
+ * by a bit count and a CLZ, cost a tenth of it); longer packets, with
+ * columns past the newest layout, take the general one. */
+#define URRT_GRID_LENGTHS(X, A)                                                                    \
+    X(A, 130) X(A, 131) X(A, 132) X(A, 133) X(A, 134) X(A, 135) X(A, 136) X(A, 137) X(A, 138)       \
+    X(A, 139) X(A, 140) X(A, 141) X(A, 142) X(A, 143) X(A, 144) X(A, 145) X(A, 146) X(A, 147)       \
+    X(A, 148) X(A, 149) X(A, 150) X(A, 151) X(A, 152)
+#define URRT_X_LENGTH_COUNT(unused, d) +1
+#define URRT_X_LENGTH_SUM(unused, d) +(d)
+URRT_STATIC_ASSERT(grid_lengths_are_every_one,
+                   0 URRT_GRID_LENGTHS(URRT_X_LENGTH_COUNT, ~) == URRT_WIRE_COLUMNS - URRT_3X_MIN_DOUBLES + 1 &&
+                       0 URRT_GRID_LENGTHS(URRT_X_LENGTH_SUM, ~) ==
+                           (URRT_WIRE_COLUMNS + URRT_3X_MIN_DOUBLES) * (URRT_WIRE_COLUMNS - URRT_3X_MIN_DOUBLES + 1) / 2);
+#define URRT_DECODE_3X_CASE(NAME, d) \
+    case URRT_HEADER_SIZE + 8u * (d): return NAME##_any(buf, URRT_HEADER_SIZE + 8u * (d), st);
+
 /*
  * decode_3x at one width. The stores are aligned to the vector size except
  * the first and, where the caller's struct is not aligned, the last of the
@@ -165,7 +183,8 @@ URRT_STATIC_ASSERT(fill_holds_a_vector, URRT_FILL_END >= URRT_WIRE_COLUMNS + 8u)
  * a prologue). No stack, no call: a push is a store too.
  */
 #define URRT_DECODE_3X_FUNC(NAME, BYTES, ATTR, BOUNDARY)                                           \
-    static ATTR int NAME(const uint8_t *buf, unsigned size, urrt_state *st)                        \
+    static inline __attribute__((always_inline)) ATTR int NAME##_any(const uint8_t *buf, unsigned size, \
+                                                                      urrt_state *st)             \
     {                                                                                              \
         typedef unsigned char bytes_v __attribute__((vector_size(BYTES)));                         \
         typedef uint64_t u64_v __attribute__((vector_size(BYTES)));                                \
@@ -194,6 +213,13 @@ URRT_STATIC_ASSERT(fill_holds_a_vector, URRT_FILL_END >= URRT_WIRE_COLUMNS + 8u)
             st->generation = URRT_GEN_3X;                                                          \
         }                                                                                          \
         return (int)size;                                                                          \
+    }                                                                                              \
+    static __attribute__((noinline)) ATTR int NAME(const uint8_t *buf, unsigned size, urrt_state *st) \
+    {                                                                                              \
+        switch (size) {                                                                            \
+            URRT_GRID_LENGTHS(URRT_DECODE_3X_CASE, NAME)                                           \
+        default: return NAME##_any(buf, size, st);                                                 \
+        }                                                                                          \
     }
 
 /* BOUNDARY as two overlapping stores, and as one: lane j of the store at
@@ -340,9 +366,8 @@ URRT_STATIC_ASSERT(one_x_spans_hold_a_vector,
 #endif
 
 #ifdef URRT_VECTOR
-/* Not inlined either: inside urrt_decode it cost four pushes. */
-#define URRT_DECODE_3X_AT(BYTES) \
-    URRT_DECODE_3X_FUNC(decode_3x_vector, BYTES, __attribute__((noinline)), URRT_PASTE(URRT_BOUNDARY_, BYTES))
+/* Not inlined either (URRT_DECODE_3X_FUNC): inside urrt_decode it cost four pushes. */
+#define URRT_DECODE_3X_AT(BYTES) URRT_DECODE_3X_FUNC(decode_3x_vector, BYTES, , URRT_PASTE(URRT_BOUNDARY_, BYTES))
 URRT_DECODE_3X_AT(URRT_VECTOR_BYTES)
 #define URRT_DECODE_1X_AT(BYTES) URRT_DECODE_1X_FUNC(decode_1x_vector, BYTES, , URRT_PASTE(URRT_BOUNDARY_, BYTES))
 URRT_DECODE_1X_AT(URRT_VECTOR_BYTES)
