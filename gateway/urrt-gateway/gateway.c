@@ -375,12 +375,12 @@ static gw_robot *sole_reader(gateway *gw)
                : NULL;
 }
 
-/* The earliest deadline of the links, the outputs, the summary and the
- * ticks. The outputs' are kept for tick_outputs. */
+/* The earliest deadline of the links, the outputs and the summary (not
+ * the ticks of every output, tick_all_us). The outputs' are kept for
+ * tick_outputs. */
 static uint64_t next_deadline(gateway *gw)
 {
-    /* At most GW_TICK_MAX_US ahead: the wait's timeout fits an int. */
-    uint64_t deadline = gw->tick_all_us < gw->links_due_us ? gw->tick_all_us : gw->links_due_us;
+    uint64_t deadline = gw->links_due_us;
     for (unsigned o = 0; o < gw->output_count; o++) {
         const gw_output *out = &gw->outputs[o];
         gw->output_due[o] = out->deadline != NULL ? out->deadline(out->ctx) : UINT64_MAX;
@@ -393,17 +393,26 @@ static uint64_t next_deadline(gateway *gw)
 }
 
 /* Waits until a descriptor is ready or the deadline, and runs the ready
- * ones' owners; returns the time read after the wait. */
+ * ones' owners; returns the time read after the wait. The ticks of every
+ * output (tick_all_us) end a wait in epoll, not one in the sole robot's
+ * read: a fixed moment there would need the read's timeout set anew as it
+ * came near, a system call or two every GW_TICK_MAX_US, while the robot's
+ * next packet brings the ticks a packet's period late (and a silent
+ * robot's wait ends GW_TICK_MAX_US after it began at the latest). */
 static uint64_t wait_and_service(gateway *gw, uint64_t deadline, uint64_t now)
 {
     struct epoll_event events[GW_WAIT_EVENTS];
     gw_robot *sole = sole_reader(gw);
-    /* Round up: waking a little late is harmless, early wakes spin. */
-    int timeout_ms = deadline <= now ? 0 : (int)((deadline - now + 999u) / 1000u);
+    uint64_t read_until = deadline < now + GW_TICK_MAX_US ? deadline : now + GW_TICK_MAX_US;
+    int timeout_ms;
     int n;
-    if (sole != NULL && service_robot(sole, now, deadline)) {
+    if (sole != NULL && service_robot(sole, now, read_until)) {
         return urrt_port_monotonic_us();
     }
+    /* At most GW_TICK_MAX_US ahead, so the timeout fits an int; rounded
+     * up: waking a little late is harmless, early wakes spin. */
+    deadline = gw->tick_all_us < deadline ? gw->tick_all_us : deadline;
+    timeout_ms = deadline <= now ? 0 : (int)((deadline - now + 999u) / 1000u);
     n = epoll_wait(gw->epoll_fd, events, GW_WAIT_EVENTS, timeout_ms);
     if (n < 0 && errno != EINTR) {
         urrt_log(URRT_LOG_ERR, "epoll_wait: %s", strerror(errno));

@@ -29,8 +29,10 @@
 #include "urrt.h"
 
 #define GW_MAX_OUTPUTS 8
-/* An output's tick runs at least this often, whenever its deadline has
- * passed, and when a robot's link state or freshness changed. */
+/* An output's tick runs whenever its deadline has passed, when a robot's
+ * link state or freshness changed, and at least this often: a safety net,
+ * which may come late, by a packet's period while a robot sends and by
+ * GW_TICK_MAX_US at most (wait_and_service in gateway.c). */
 #define GW_TICK_MAX_US 100000u
 
 typedef struct gateway gateway;
@@ -113,8 +115,8 @@ typedef struct gw_output {
     void (*packet)(void *ctx, gw_robot *robot, const gw_packet *pkt);
     /* Periodic work (status reports, retries); now is monotonic. Runs when
      * its deadline has passed, after a wake-up in which a robot's link
-     * state or gw_robot_fresh changed, and at least every GW_TICK_MAX_US:
-     * not at every wake-up. An output with a descriptor of its own (the CAN
+     * state or gw_robot_fresh changed, and at least every GW_TICK_MAX_US
+     * (above): not at every wake-up. An output with a descriptor of its own (the CAN
      * socket) keeps it registered with a gw_watch. */
     void (*tick)(void *ctx, uint64_t now_us);
     /* Optional: monotonic time its tick is due at the latest. Asked at

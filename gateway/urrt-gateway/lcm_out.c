@@ -65,9 +65,10 @@ struct lcm_out {
     uint64_t error_log_us;
     lcm_robot *robots;
     /* The robots' earliest report or stale moment as of the last tick,
-     * lowered by each packet: never later than the true one, so that the
-     * deadline the loop asks at every wake-up costs nothing per robot (a
-     * tick that comes early finds nothing due and looks again). */
+     * lowered by each packet (one robot's: set by each): never later than
+     * the true one, so that the deadline the loop asks at every wake-up
+     * costs nothing per robot (a tick that comes early finds nothing due
+     * and looks again). */
     uint64_t robots_due_us;
     uint8_t *buf;
     /* Messages are filled in place, so that nothing is built per packet. */
@@ -460,6 +461,12 @@ static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
     lr->last_time_us = t_us;
     if (lr->reported_fresh) {
         uint64_t stale = stale_us(robot);
+        /* One robot's due moment is the earliest: set anew, it moves on
+         * with the data, so that a loop waiting in the robot's read needs
+         * no new timeout for an old one coming near. */
+        if (out->gw->robot_count == 1) {
+            out->robots_due_us = lr->report_due_us;
+        }
         out->robots_due_us = stale < out->robots_due_us ? stale : out->robots_due_us;
     }
 }
