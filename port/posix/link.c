@@ -287,7 +287,11 @@ static void schedule_retry(urrt_link *link, uint64_t now_us)
 static const char *errno_text(int err)
 {
     switch (err) {
-    case ECONNREFUSED: return "connection refused: nothing listens on that port; is the controller up, and the port 30003 or 30013?";
+    /* Both interfaces' ports: a wrong port is the usual cause, and the
+     * link does not know which interface its source speaks. */
+    case ECONNREFUSED:
+        return "connection refused: nothing listens on that port; is the controller up, and the port "
+               "right (RealTime 30003 or 30013, RTDE 30004)?";
     case ETIMEDOUT: return "timed out: no answer; check the address, the cable and the subnet";
     case ECONNRESET: return "reset by peer";
     case EHOSTUNREACH: return "host unreachable: check the address and the subnet";

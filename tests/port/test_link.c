@@ -348,7 +348,7 @@ static void test_refused_backoff(void)
     CHECK_EQ_INT(lines_with("still cannot connect"), 1);
     CHECK_EQ_INT(lines_with("after 10 attempts"), 1);
     CHECK_EQ_INT(lines_with("connection refused"), 2);
-    CHECK_EQ_INT(lines_with("is the controller up, and the port 30003 or 30013?"), 2);
+    CHECK_EQ_INT(lines_with("is the controller up, and the port right (RealTime 30003 or 30013, RTDE 30004)?"), 2);
     CHECK_EQ_INT(lines_with("connecting to"), 1);
     if (lines_with("cannot connect") != 2) {
         dump_log();
