@@ -36,6 +36,9 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "ref"))
 import urrt_ref as ref  # noqa: E402
+sys.path.insert(0, os.path.join(HERE, ".."))
+import suite  # noqa: E402  checks and their report
+from suite import check  # noqa: E402
 
 KINDS = ("STATE", "JOINTS", "TOOL", "STATUS", "RTDE", "GATEWAY")
 DATA_KINDS = ("STATE", "JOINTS", "TOOL", "STATUS")
@@ -48,19 +51,7 @@ WAIT = 60
 # check can close: a scheduling slice on a machine loaded several times
 # over; 16.6 ms was seen with the load average at 8 on 2 cores).
 AGE_MARGIN_US = 25000
-PASSED = 0
-FAILED = 0
 
-
-def check(cond, what):
-    global PASSED, FAILED
-    if cond:
-        PASSED += 1
-        print("ok: " + what)
-    else:
-        FAILED += 1
-        print("FAIL: " + what, file=sys.stderr)
-    return cond
 
 
 def free_udp_port():
@@ -1387,10 +1378,9 @@ def main():
         except Exception as e:  # a crashed test is a failure, the others still run
             check(False, "%s: raised %r" % (name, e))
         print("-- %s: %.1f s" % (name, time.monotonic() - t0))
-    line = "%d passed, %d failed" % (PASSED, FAILED)
-    print(line)
+    status = suite.report()
     subprocess.run(["rm", "-rf", args.tmp])
-    return 0 if FAILED == 0 else 1
+    return status
 
 
 if __name__ == "__main__":

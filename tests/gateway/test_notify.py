@@ -22,23 +22,15 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import suite  # noqa: E402  checks and their report
+from suite import check  # noqa: E402
+
 # Upper bound of any wait: reached only when something is broken.
 WAIT = 60
 # WATCHDOG_USEC the tests give: pings every 200 ms.
 WATCHDOG_US = 400000
-PASSED = 0
-FAILED = 0
 
-
-def check(cond, what):
-    global PASSED, FAILED
-    if cond:
-        PASSED += 1
-        print("ok: " + what)
-    else:
-        FAILED += 1
-        print("FAIL: " + what, file=sys.stderr)
-    return cond
 
 
 def free_udp_port():
@@ -273,9 +265,9 @@ def main():
         except Exception as e:  # a crashed test is a failure, the others still run
             check(False, "%s: raised %r" % (name, e))
         print("-- %s: %.1f s" % (name, time.monotonic() - t0))
-    print("%d passed, %d failed" % (PASSED, FAILED))
+    status = suite.report()
     subprocess.run(["rm", "-rf", args.tmp])
-    return 0 if FAILED == 0 else 1
+    return status
 
 
 if __name__ == "__main__":

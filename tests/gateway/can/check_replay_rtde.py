@@ -40,13 +40,15 @@ import subprocess
 import sys
 import tempfile
 import threading
-import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(ROOT, 'tests', 'gateway', 'tools'))
+sys.path.insert(0, os.path.join(ROOT, 'tests'))
 import rtde_peer  # noqa: E402
+import suite  # noqa: E402  checks, their report, waits
+from suite import check, wait_for  # noqa: E402
 with contextlib.redirect_stderr(io.StringIO()):  # canmatrix's "ldf is not supported"
     import test_dbc  # noqa: E402  (the configuration reader, the reference packing, canmatrix)
 
@@ -57,30 +59,6 @@ GW = os.path.join(BUILD, 'bin', 'urrt-gateway')
 TMP = tempfile.mkdtemp(prefix='urrt-replay-rtde.')
 MAGIC = b'URRT RTDE capture 1\n'
 RATE = 500  # controller 5.12: 500 Hz
-PASSED = FAILED = 0
-
-
-def check(ok, what, detail=''):
-    global PASSED, FAILED
-    if ok:
-        PASSED += 1
-        print('ok: ' + what)
-    else:
-        FAILED += 1
-        print('FAIL: %s%s' % (what, (': ' + str(detail)[:3000]) if detail != '' else ''), file=sys.stderr)
-    return ok
-
-
-def wait_for(what, cond, proc=None, timeout=10.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if cond():
-            return True
-        if proc is not None and proc.poll() is not None:
-            return cond()
-        time.sleep(0.02)
-    print('waited in vain for ' + what, file=sys.stderr)
-    return False
 
 
 def tmp(name):
@@ -512,8 +490,7 @@ def main():
         test_dump(sim)
     finally:
         sim.close()
-    print('%d passed, %d failed' % (PASSED, FAILED))
-    return 1 if FAILED else 0
+    return suite.report()
 
 
 if __name__ == '__main__':

@@ -25,59 +25,25 @@ import csv
 import io
 import json
 import os
-import signal
 import socket
 import struct
 import subprocess
 import sys
 import tempfile
 import threading
-import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'ref'))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
 import rtde_capture  # noqa: E402  the independent reader of the format
+import suite  # noqa: E402  checks, their report, waits
+from suite import check, end_group, wait_for  # noqa: E402
 from rtde_ref import MAPPED  # noqa: E402  the RTDE names RealTime has too, from the protocol
 
 BUILD = sys.argv[1] if len(sys.argv) > 1 else 'build'
 SIM = os.path.join(BUILD, 'bin', 'urrt-sim')
 DUMP = os.path.join(BUILD, 'bin', 'urrt-dump')
 TMP = tempfile.mkdtemp(prefix='urrt-dump-rtde.')
-PASSED = FAILED = 0
 START_TIME = 1000.0  # controller time of cycle 0 with --clock start (docs/tools.md)
-
-
-def check(ok, what, detail=''):
-    global PASSED, FAILED
-    if ok:
-        PASSED += 1
-        print('ok: ' + what)
-    else:
-        FAILED += 1
-        print('FAIL: %s%s' % (what, (': ' + str(detail)[:2000]) if detail else ''), file=sys.stderr)
-    return ok
-
-
-def wait_for(what, cond, proc=None, timeout=10.0):
-    """Until cond() holds (polled), or fails at once when proc has ended."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if cond():
-            return True
-        if proc is not None and proc.poll() is not None:
-            return cond()
-        time.sleep(0.02)
-    print('waited in vain for ' + what, file=sys.stderr)
-    return False
-
-
-def end_group(proc):
-    """Kills what is left of proc's process group (timeout leads one): a
-    simulator that outlived its timeout must not keep running, nor hold a
-    pipe of the suite's open (check-stress once hung on one that did)."""
-    try:
-        os.killpg(proc.pid, signal.SIGKILL)
-    except (ProcessLookupError, PermissionError):
-        pass
 
 
 class Sim:
@@ -672,8 +638,7 @@ def main():
     run(capture_sessions)
     run(capture_budget)
     run(capture_realtime)
-    print('%d passed, %d failed' % (PASSED, FAILED))
-    return 1 if FAILED else 0
+    return suite.report()
 
 
 if __name__ == '__main__':
