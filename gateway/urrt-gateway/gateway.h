@@ -116,8 +116,8 @@ typedef struct gw_output {
     /* Periodic work (status reports, retries); now is monotonic. Runs when
      * its deadline has passed, after a wake-up in which a robot's link
      * state or gw_robot_fresh changed, and at least every GW_TICK_MAX_US
-     * (above): not at every wake-up. An output with a descriptor of its own (the CAN
-     * socket) keeps it registered with a gw_watch. */
+     * (above): not at every wake-up. An output with a descriptor of its
+     * own (the CAN socket) keeps it registered with a gw_watch. */
     void (*tick)(void *ctx, uint64_t now_us);
     /* Optional: monotonic time its tick is due at the latest. Asked at
      * every wake-up: its cost must not grow with the robots. */
