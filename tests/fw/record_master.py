@@ -33,10 +33,12 @@ The window: the whole run is about 1.4 MB of 1220-byte packets that do not compr
 (the simulated currents carry noise), so the pair keeps the part of the run from
 WINDOW_BEFORE before the master's first NMT start (step 5: operational) to WINDOW_AFTER
 after its first NMT stop (step 7): TPDOs, the PDO configuration and event timer writes,
-SYNC counting with two transmission types, stop and an SDO request while stopped. The
+SYNC counting with two transmission types, the SYNC moved to another id (0x1005) and back,
+stop and an SDO request while stopped. The
 script refuses a pair over MAX_BYTES (a run on a loaded host is slower: record again on
 a quieter one).
 """
+import json
 import lzma
 import os
 import re
@@ -121,8 +123,12 @@ def main():
         sys.exit('usage: record_master.py RUN_DIR DEST_DIR')
     run, dest = sys.argv[1:]
     offset, err = clock_offset(os.path.join(run, 'clocks.txt'))
-    # The master's frames: NMT, SYNC, SDO requests, ids the node never sends.
-    frames = can_log(os.path.join(run, 'can.log'), offset, lambda i: i in (0, 0x080) or 0x600 <= i <= 0x67F)
+    # The master's frames: NMT, SYNC (on 0x080 and on every id it moved the SYNC to, which
+    # the master lists in expect.json), SDO requests; ids the node never sends.
+    with open(os.path.join(run, 'expect.json')) as f:
+        sync_ids = {0x080} | set(json.load(f)['sync_ids'])
+    frames = can_log(os.path.join(run, 'can.log'), offset,
+                     lambda i: i == 0 or i in sync_ids or 0x600 <= i <= 0x67F)
     answers = can_log(os.path.join(run, 'can.log'), offset, lambda i: i == 0x580 + NODE)
     pk = packets(os.path.join(run, 'sim1.bin')) + packets(os.path.join(run, 'sim2.bin'))
     t0 = nmt_time(frames, 0x01) - round(WINDOW_BEFORE * 1e9)
