@@ -11,7 +11,11 @@
  * system chose, reading LCM's datagrams itself (see subscribe_udp) so that
  * it costs less than what it measures. Latency is from the write of a
  * packet to the receipt of each of its messages; CPU is the subject's (all
- * threads, from /proc/PID/task/TID/schedstat) per packet read.
+ * threads, from /proc/PID/task/TID/schedstat) per packet read, beside how
+ * many times the scheduler ran it and the subscriber's reads per packet
+ * (counts, where the CPU is a time: they show what the bench did to it).
+ * The subject runs on a core of its own, this program on the other
+ * (choose_cores).
  *
  *   bench_gateway --gateway PATH --relay PATH [--focused-hz N] [--rounds R]
  *                 [--seconds S] [--max-rate]
@@ -22,6 +26,7 @@
  *       --focused-hz N: no state message, the focused ones at N Hz (the relay
  *       sends every 500/N-th packet).
  *       --max-rate: then the gateway's highest packet rate.
+ *   --no-pin (any mode): leave both cores to the scheduler (see choose_cores).
  *   bench_gateway --gateway PATH --robots N [--focused-hz N] [--seconds S]
  *       One gateway against N robots, every message at every packet, or
  *       the focused ones at N Hz and no state.
@@ -49,6 +54,7 @@
 #include <netinet/tcp.h>
 #include <poll.h>
 #include <pthread.h>
+#include <sched.h>
 #include <signal.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -85,6 +91,7 @@ typedef struct {
     size_t lat_n[KINDS];
     uint64_t received;     /* every message of a known kind, warm-up included */
     uint64_t late;         /* of an unknown packet or beyond the arrays */
+    uint64_t reads;        /* the subscriber's reads that brought datagrams: its wake-ups */
     volatile int stop;
 } session;
 
@@ -221,6 +228,7 @@ static void *subscriber(void *arg)
         if (poll(&p, 1, 20) != 1) continue;
         int n = recvmmsg(a->fd, msgs, BATCH, MSG_DONTWAIT, NULL);
         uint64_t now = mono_ns();
+        a->s->reads += n > 0;
         for (int i = 0; i < n; i++) {
             uint8_t *d = bufs[i];
             size_t len = msgs[i].msg_len;
@@ -234,29 +242,42 @@ static void *subscriber(void *arg)
     return NULL;
 }
 
-/* CPU time of every thread of pid, in ns. */
-static uint64_t cpu_ns(pid_t pid)
+/* CPU time of every thread of pid, in ns, and how many times the scheduler
+ * ran one of them (schedstat's third field: its wake-ups, near enough). */
+typedef struct {
+    uint64_t ns, runs;
+} task_time;
+
+static task_time task_times(pid_t pid)
 {
     char path[64];
-    uint64_t sum = 0;
+    task_time sum = {0, 0};
     snprintf(path, sizeof path, "/proc/%d/task", (int)pid);
     DIR *dir = opendir(path);
     if (dir == NULL) {
-        return 0;
+        return sum;
     }
     for (struct dirent *e; (e = readdir(dir)) != NULL;) {
         char p[320];
-        unsigned long long run = 0;
+        unsigned long long run = 0, wait = 0, runs = 0;
         if (e->d_name[0] == '.') continue;
         snprintf(p, sizeof p, "/proc/%d/task/%s/schedstat", (int)pid, e->d_name);
         FILE *f = fopen(p, "r");
         if (f != NULL) {
-            if (fscanf(f, "%llu", &run) == 1) sum += run;
+            if (fscanf(f, "%llu %llu %llu", &run, &wait, &runs) == 3) {
+                sum.ns += run;
+                sum.runs += runs;
+            }
             fclose(f);
         }
     }
     closedir(dir);
     return sum;
+}
+
+static uint64_t cpu_ns(pid_t pid)
+{
+    return task_times(pid).ns;
 }
 
 /* This process's CPU time (every thread), in ns. */
@@ -351,6 +372,8 @@ static double baseline_us(void)
 /* What a session measured. */
 typedef struct {
     double cpu_per_packet_us, cpu_percent;
+    double runs_per_packet; /* times the scheduler ran the subject: its wake-ups */
+    double sub_reads_per_packet; /* the subscriber's wake-ups (all packets, warm-up included) */
     double self_cpu_percent; /* this program: the robots and the subscriber */
     double median_us[KINDS], p99_us[KINDS], max_us[KINDS];
     size_t messages[KINDS];
@@ -366,6 +389,51 @@ typedef struct {
     double seconds;
     const char *focused_hz; /* NULL: every message at every packet */
 } subject;
+
+/* The cores: this program (robots, subscriber) on the first this process may
+ * use, the subject on the last, each alone. Left to the scheduler, they
+ * shared both cores as it chose, round by round: the subscriber, woken by
+ * each message, preempted the subject where they met on a core, and the
+ * subject ran 1.7-2.9 times a packet where once is its work, the same
+ * binary's CPU 0.9 to 2.2 times the relay's from one run to the next.
+ * Pinned, both run once a packet. -1: one core only, nothing pinned. */
+static int bench_core = -1, subject_core = -1;
+
+static void choose_cores(void)
+{
+    cpu_set_t allowed;
+    if (sched_getaffinity(0, sizeof allowed, &allowed) != 0 || CPU_COUNT(&allowed) < 2) {
+        return;
+    }
+    for (int c = 0; c < CPU_SETSIZE; c++) {
+        if (CPU_ISSET(c, &allowed)) {
+            if (bench_core < 0) bench_core = c;
+            subject_core = c;
+        }
+    }
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(bench_core, &one);
+    if (sched_setaffinity(0, sizeof one, &one) != 0) {
+        perror("bench_gateway: sched_setaffinity");
+        exit(1);
+    }
+}
+
+/* In a subject's child, before exec. */
+static void pin_subject(void)
+{
+    if (subject_core >= 0) {
+        cpu_set_t one;
+        CPU_ZERO(&one);
+        CPU_SET(subject_core, &one);
+        if (sched_setaffinity(0, sizeof one, &one) != 0) {
+            dprintf(2, "bench_gateway: cannot pin the subject to core %d: %s (--no-pin runs without)\n",
+                    subject_core, strerror(errno));
+            _exit(126);
+        }
+    }
+}
 
 static pid_t start_gateway(const subject *sj, const char *url, const char *prefix, const uint16_t *ports, char *ini)
 {
@@ -384,6 +452,7 @@ static pid_t start_gateway(const subject *sj, const char *url, const char *prefi
     close(ifd);
     pid_t pid = fork();
     if (pid == 0) {
+        pin_subject();
         execl(sj->path, sj->path, "--log-level", "warning", ini, (char *)NULL);
         _exit(127);
     }
@@ -398,6 +467,7 @@ static pid_t start_relay(const subject *sj, const char *url, const char *prefix,
     snprintf(chan, sizeof chan, "%s_0", prefix);
     pid_t pid = fork();
     if (pid == 0) {
+        pin_subject();
         if (sj->focused_hz == NULL) {
             execl(sj->path, sj->path, "127.0.0.1", ports, url, chan, every, "STATE", "JOINTS", "TOOL", "STATUS",
                   (char *)NULL);
@@ -437,7 +507,8 @@ typedef struct {
 
 /* Where the CPU and wall clocks stood when the measured packets began. */
 typedef struct {
-    uint64_t cpu, self, wall;
+    task_time cpu;
+    uint64_t self, wall;
 } clocks;
 
 /* The session's arrays and channel prefix, for sj against n robots. */
@@ -481,12 +552,12 @@ static bool subject_start(const subject *sj, const session *s, subject_run *sr)
 static clocks send_packets(session *s, const subject_run *sr, int n)
 {
     uint8_t pkt[LENGTH];
-    clocks at = {0, 0, 0};
+    clocks at = {{0, 0}, 0, 0};
     uint64_t start = mono_ns();
     size_t row = (size_t)(s->per_robot + 1);
     for (long index = 1; index <= s->per_robot; index++) {
         if (index == WARMUP + 1) {
-            at.cpu = cpu_ns(sr->pid);
+            at.cpu = task_times(sr->pid);
             at.self = self_cpu_ns();
             at.wall = mono_ns();
         }
@@ -553,14 +624,17 @@ static bool run(const subject *sj, result *res)
     clocks at = send_packets(&s, &sr, n);
     /* Every message is in once the subject's CPU stops moving and the
      * subscriber has them all, or after a second at most. */
-    uint64_t cpu1 = cpu_ns(sr.pid), self1 = self_cpu_ns(), wall1 = mono_ns();
+    task_time cpu1 = task_times(sr.pid);
+    uint64_t self1 = self_cpu_ns(), wall1 = mono_ns();
     res->packets = (long)(s.per_robot - WARMUP) * n;
     uint64_t all = sj->focused_hz == NULL ? (uint64_t)s.per_robot * (uint64_t)n * KINDS : 0;
     res->expected = sj->focused_hz == NULL ? (uint64_t)res->packets * KINDS : 0;
     await_messages(&s, all);
     subject_stop(sj, &s, &sr, th);
-    res->cpu_per_packet_us = (double)(cpu1 - at.cpu) / 1000.0 / (double)res->packets;
-    res->cpu_percent = 100.0 * (double)(cpu1 - at.cpu) / (double)(wall1 - at.wall);
+    res->cpu_per_packet_us = (double)(cpu1.ns - at.cpu.ns) / 1000.0 / (double)res->packets;
+    res->runs_per_packet = (double)(cpu1.runs - at.cpu.runs) / (double)res->packets;
+    res->sub_reads_per_packet = (double)s.reads / (double)(s.per_robot * n);
+    res->cpu_percent = 100.0 * (double)(cpu1.ns - at.cpu.ns) / (double)(wall1 - at.wall);
     res->self_cpu_percent = 100.0 * (double)(self1 - at.self) / (double)(wall1 - at.wall);
     summarize(&s, res);
     /* A connection's first packets may come as a burst, which the gateway
@@ -627,6 +701,8 @@ static void print_subject(const char *who, const result *r, int rounds)
     result m = r[0];
     m.cpu_per_packet_us = med_of(r, rounds, offsetof(result, cpu_per_packet_us));
     m.cpu_percent = med_of(r, rounds, offsetof(result, cpu_percent));
+    m.runs_per_packet = med_of(r, rounds, offsetof(result, runs_per_packet));
+    m.sub_reads_per_packet = med_of(r, rounds, offsetof(result, sub_reads_per_packet));
     for (int k = 0; k < KINDS; k++) {
         m.median_us[k] = med_of(r, rounds, offsetof(result, median_us) + (size_t)k * sizeof(double));
         m.p99_us[k] = med_of(r, rounds, offsetof(result, p99_us) + (size_t)k * sizeof(double));
@@ -635,6 +711,11 @@ static void print_subject(const char *who, const result *r, int rounds)
     printf("%scpu_per_packet_us: %.2f\n", who, m.cpu_per_packet_us);
     printf("%srobots_per_core: %.0f\n", who, robots_per_core(m.cpu_per_packet_us));
     printf("%scpu_percent_of_core_at_500hz: %.3f\n", who, m.cpu_percent);
+    printf("%sruns_per_packet: %.3f\n", who, m.runs_per_packet);
+    printf("%ssubscriber_reads_per_packet: %.3f\n", who, m.sub_reads_per_packet);
+    for (int i = 0; i < rounds; i++) {
+        printf("%sround_%d_cpu_per_packet_us: %.2f\n", who, i + 1, r[i].cpu_per_packet_us);
+    }
     print_latency(who, &m);
     uint64_t lost = 0;
     for (int i = 0; i < rounds; i++) {
@@ -655,6 +736,7 @@ static void compare(subject *gw, subject *relay, int rounds)
     print_subject("gateway_", g, rounds);
     printf("gateway_cpu_vs_relay: %.2f\n", med_ratio(g, rl, rounds, offsetof(result, cpu_per_packet_us)));
     printf("gateway_cpu_vs_relay_of_best: %.2f\n", best_ratio(g, rl, rounds, offsetof(result, cpu_per_packet_us)));
+    printf("gateway_runs_vs_relay: %.2f\n", med_ratio(g, rl, rounds, offsetof(result, runs_per_packet)));
     for (int k = 0; k < KINDS; k++) {
         char name[16];
         lower(name, kind_names[k]);
@@ -679,6 +761,7 @@ static void scaling(subject *gw)
     printf("%scpu_per_packet_us: %.2f\n", who, r.cpu_per_packet_us);
     printf("%srobots_per_core: %.0f\n", who, robots_per_core(r.cpu_per_packet_us));
     printf("%scpu_percent_of_core: %.1f\n", who, r.cpu_percent);
+    printf("%sruns_per_packet: %.3f\n", who, r.runs_per_packet);
     printf("%sbench_cpu_percent_of_core: %.1f\n", who, r.self_cpu_percent);
     print_latency(who, &r);
     /* All kinds together: the robots' worst message. */
@@ -709,6 +792,7 @@ static void versus(subject *gw, subject *vs, int rounds)
         other[i] = b.cpu_per_packet_us;
         ratio[i] = b.cpu_per_packet_us / a.cpu_per_packet_us;
         printf("%sround_%d_cpu_per_packet_us: %.2f vs %.2f (%.2fx)\n", who, i + 1, other[i], base[i], ratio[i]);
+        printf("%sround_%d_runs_per_packet: %.3f vs %.3f\n", who, i + 1, b.runs_per_packet, a.runs_per_packet);
     }
     printf("%scpu_per_packet_us_median: %.2f vs %.2f\n", who, median(other, rounds), median(base, rounds));
     double m = median(ratio, rounds);
@@ -783,7 +867,7 @@ int main(int argc, char **argv)
     prctl(PR_SET_TIMERSLACK, 1000UL);
     subject gw = {.robots = 0, .seconds = 4}, relay = {.relay = true, .robots = 1};
     int rounds = 3, versus_robots = 0;
-    bool max = false;
+    bool max = false, pin = true;
     for (int i = 1; i < argc; i++) {
         const char *v = i + 1 < argc ? argv[i + 1] : "";
         if (strcmp(argv[i], "--gateway") == 0) gw.path = argv[++i];
@@ -794,6 +878,7 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--robots") == 0) gw.robots = atoi(v), i++;
         else if (strcmp(argv[i], "--versus") == 0) versus_robots = atoi(v), i++;
         else if (strcmp(argv[i], "--max-rate") == 0) max = true;
+        else if (strcmp(argv[i], "--no-pin") == 0) pin = false;
     }
     bool scale = gw.robots > 0;
     if (gw.path == NULL || (!scale && relay.path == NULL) || gw.robots > MAX_ROBOTS || rounds < 1 ||
@@ -804,6 +889,8 @@ int main(int argc, char **argv)
         return 2;
     }
     signal(SIGPIPE, SIG_IGN);
+    if (pin) choose_cores();
+    printf("bench_core: %d\nsubject_core: %d\n", bench_core, subject_core);
     relay.seconds = gw.seconds;
     relay.focused_hz = gw.focused_hz;
     if (scale && versus_robots > 0) {

@@ -62,20 +62,25 @@ check-metrics: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim
 # rounds of each in turn, both ways. Each CPU per packet also says how many
 # robots one core serves.
 BENCH_GATEWAY_ROBOTS ?= 1 10 50
+# --no-pin: the bench and the subject wherever the scheduler puts them.
+BENCH_GATEWAY_FLAGS ?=
+BENCH_GW = $(GWT)/bench_gateway $(BENCH_GATEWAY_FLAGS)
 bench-gateway: $(BUILD)/bin/urrt-gateway $(GWT)/bench_gateway $(GWT)/bench_relay
 	@echo "bench-gateway: *robots_per_core = 1 / (cpu_per_packet_us * 1e-6 * 500): the 500 Hz robots one core"
 	@echo "bench-gateway: serves at the subject's CPU per packet (its threads, from schedstat) measured there"
+	@echo "bench-gateway: the subject on a core of its own, the bench on another (BENCH_GATEWAY_FLAGS=--no-pin:"
+	@echo "bench-gateway: as the scheduler places them); *runs_per_packet, *subscriber_reads_per_packet: counts"
 	@echo "bench-gateway: all messages at every packet, gateway beside relay"
-	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --relay $(GWT)/bench_relay --max-rate
+	@$(BENCH_GW) --gateway $(BUILD)/bin/urrt-gateway --relay $(GWT)/bench_relay --max-rate
 	@echo "bench-gateway: focused messages at 50 Hz, no state, gateway beside relay"
-	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --relay $(GWT)/bench_relay --focused-hz 50 \
+	@$(BENCH_GW) --gateway $(BUILD)/bin/urrt-gateway --relay $(GWT)/bench_relay --focused-hz 50 \
 	  | sed 's/^/decimated_/'
 	@echo "bench-gateway: one gateway, many robots at 500 Hz, every message at every packet"
 	@for n in $(BENCH_GATEWAY_ROBOTS); do \
-	  $(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --robots $$n || exit 1; done
+	  $(BENCH_GW) --gateway $(BUILD)/bin/urrt-gateway --robots $$n || exit 1; done
 	@echo "bench-gateway: one gateway, many robots at 500 Hz, focused messages at 50 Hz, no state"
 	@for n in $(BENCH_GATEWAY_ROBOTS); do \
-	  $(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --robots $$n --focused-hz 50 || exit 1; done
+	  $(BENCH_GW) --gateway $(BUILD)/bin/urrt-gateway --robots $$n --focused-hz 50 || exit 1; done
 	@echo "bench-gateway: CPU per packet at 50 robots against 10 (the loop's cost per wake-up must not grow with the robots)"
-	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --robots 10 --versus 50 --rounds 3
-	@$(GWT)/bench_gateway --gateway $(BUILD)/bin/urrt-gateway --robots 10 --versus 50 --rounds 3 --focused-hz 50
+	@$(BENCH_GW) --gateway $(BUILD)/bin/urrt-gateway --robots 10 --versus 50 --rounds 3
+	@$(BENCH_GW) --gateway $(BUILD)/bin/urrt-gateway --robots 10 --versus 50 --rounds 3 --focused-hz 50
