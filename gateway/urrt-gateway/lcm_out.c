@@ -12,6 +12,7 @@
 
 #include <lcm/lcm.h>
 
+#include "can_rtde.h"
 #include "urrt_gateway_t.h"
 #include "urrt_joints_t.h"
 #include "urrt_rtde_t.h"
@@ -340,40 +341,9 @@ static int encode_status(lcm_out *out, const gw_packet *pkt)
     return urrt_status_t_encode(out->buf, 0, LCM_OUT_BUFFER, msg);
 }
 
-/* One element of an RTDE-only value as a double (exact for every type but
- * a 64-bit integer past 2^53). */
-static double rtde_element(const urrt_rtde_values *v, int var, unsigned i)
-{
-    const void *p = urrt_rtde_value(v, var);
-    if (p == NULL || !urrt_rtde_has(v, var)) {
-        return NAN;
-    }
-    switch (urrt_rtde_var_type(var)) {
-    case URRT_RTDE_T_BOOL:
-    case URRT_RTDE_T_UINT8: return ((const uint8_t *)p)[i];
-    case URRT_RTDE_T_UINT32:
-    case URRT_RTDE_T_VECTOR6UINT32: return ((const uint32_t *)p)[i];
-    case URRT_RTDE_T_UINT64: return (double)((const uint64_t *)p)[i];
-    case URRT_RTDE_T_INT32:
-    case URRT_RTDE_T_VECTOR6INT32: return ((const int32_t *)p)[i];
-    default: return ((const double *)p)[i];
-    }
-}
-
-/* Elements of an RTDE-only value: NAME.RTDE has an entry for each. */
-static unsigned rtde_elements(int var)
-{
-    switch (urrt_rtde_var_type(var)) {
-    case URRT_RTDE_T_VECTOR3D: return 3;
-    case URRT_RTDE_T_VECTOR6D:
-    case URRT_RTDE_T_VECTOR6INT32:
-    case URRT_RTDE_T_VECTOR6UINT32: return 6;
-    case URRT_RTDE_T_NONE:
-    case URRT_RTDE_T_COUNT: return 0;
-    default: return 1;
-    }
-}
-
+/* NAME.RTDE: the package's RTDE-only values, each element a double read as
+ * the CAN output reads it (can_rtde: exact for every type but a 64-bit
+ * integer past 2^53; NaN where the package did not have it). */
 static int encode_rtde(lcm_out *out, gw_robot *robot, const gw_packet *pkt)
 {
     lcm_robot *lr = &out->robots[robot->index];
@@ -384,8 +354,8 @@ static int encode_rtde(lcm_out *out, gw_robot *robot, const gw_packet *pkt)
     msg->controller_time = pkt->state->time[0];
     msg->sequence = (int64_t)pkt->sequence;
     for (size_t i = 0; i < cfg->rtde_value_count; i++) {
-        for (unsigned e = 0; e < rtde_elements(cfg->rtde_values[i]); e++) {
-            lr->rtde_values[n++] = rtde_element(pkt->rtde, cfg->rtde_values[i], e);
+        for (unsigned e = 0; e < can_rtde_elements(cfg->rtde_values[i]); e++) {
+            lr->rtde_values[n++] = can_rtde_element(pkt->rtde, cfg->rtde_values[i], e);
         }
     }
     msg->count = lr->rtde_count;
@@ -399,7 +369,7 @@ static bool name_rtde_values(lcm_robot *lr, const gw_robot_config *cfg)
 {
     unsigned total = 0, n = 0;
     for (size_t i = 0; i < cfg->rtde_value_count; i++) {
-        total += rtde_elements(cfg->rtde_values[i]);
+        total += can_rtde_elements(cfg->rtde_values[i]);
     }
     lr->rtde_names = calloc(total + 1, sizeof *lr->rtde_names);
     lr->rtde_values = calloc(total + 1, sizeof *lr->rtde_values);
@@ -408,7 +378,7 @@ static bool name_rtde_values(lcm_robot *lr, const gw_robot_config *cfg)
     }
     for (size_t i = 0; i < cfg->rtde_value_count; i++) {
         char name[URRT_RTDE_NAME_MAX];
-        unsigned count = rtde_elements(cfg->rtde_values[i]);
+        unsigned count = can_rtde_elements(cfg->rtde_values[i]);
         urrt_rtde_var_name(cfg->rtde_values[i], name, sizeof name);
         for (unsigned e = 0; e < count; e++) {
             int r = count == 1 ? asprintf(&lr->rtde_names[n], "%s", name)
