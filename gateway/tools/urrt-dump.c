@@ -766,21 +766,31 @@ static void print_table_rtde(FILE *out, const urrt_rtde_values *vals, int var)
     }
 }
 
+/* A table line's second column: the unit of a RealTime field, the wire type
+ * of an RTDE-only value. */
+static const char *key_unit(unsigned key)
+{
+    return key < KEY_RTDE ? urrt_field((urrt_field_id)key)->unit
+                          : urrt_rtde_type_name(urrt_rtde_var_type((int)(key - KEY_RTDE)));
+}
+
 static void print_table(const dump *d, FILE *out, const sample *s)
 {
     char buf[URRT_RTDE_NAME_MAX];
     unsigned keys[KEY_COUNT];
     unsigned n = selected_keys(d, s, keys);
+    /* The columns as wide as their longest entry (RTDE names run to 38
+     * characters, types to 13), at least the widths RealTime's need. */
+    int name_width = 22, unit_width = 10;
+    for (unsigned k = 0; k < n; k++) {
+        int name = (int)strlen(key_name(keys[k], buf, sizeof buf)), unit = (int)strlen(key_unit(keys[k]));
+        name_width = name > name_width ? name : name_width;
+        unit_width = unit > unit_width ? unit : unit_width;
+    }
     print_table_head(d, out, s->st);
     for (unsigned k = 0; k < n; k++) {
         unsigned key = keys[k];
-        if (key < KEY_RTDE) {
-            fprintf(out, "  %-22s %-10s", key_name(key, buf, sizeof buf), urrt_field((urrt_field_id)key)->unit);
-        } else {
-            /* RTDE-only: the wire type where RealTime fields have a unit */
-            fprintf(out, "  %-22s %-10s", key_name(key, buf, sizeof buf),
-                    urrt_rtde_type_name(urrt_rtde_var_type((int)(key - KEY_RTDE))));
-        }
+        fprintf(out, "  %-*s %-*s", name_width, key_name(key, buf, sizeof buf), unit_width, key_unit(key));
         if (!key_present(s, key)) {
             fputs(s->vals != NULL ? " (not in this package)\n" : " (not in this packet)\n", out);
             continue;

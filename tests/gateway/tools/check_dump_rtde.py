@@ -319,11 +319,16 @@ def formats():
         check('summary: lengths: 1036 x 2 (RTDE data packages)' in err and
               'summary: rtde: controller 5.12.3.1234, protocol 2' in err and 'summary: rtde recipe: timestamp,' in err,
               'table: the summary says what the session was', err)
-        rc, out, err = dump('--rtde', sim.addr, '-n', '1', '-k', 'q_actual,output_int_register_2,tcp_offset')
+        rc, out, err = dump('--rtde', sim.addr, '-n', '1', '-k',
+                            'q_actual,output_int_register_2,tcp_offset,actual_configurable_digital_input_bits')
         lines = {ln.split()[0]: ln.split()[1:] for ln in out.splitlines()[1:]}
         check(rc == 0 and lines['output_int_register_2'][0] == 'INT32' and lines['output_int_register_2'][1].isdigit()
               and lines['tcp_offset'] == ['VECTOR6D'] + ['0'] * 6,
               'table: RTDE-only values with their type', out)
+        # Where each line's second column (unit or type) begins: one place for all, past the longest name.
+        starts = {ln.index(' ' + ln.split()[1], 2 + len(ln.split()[0])) + 1 for ln in out.splitlines()[1:]}
+        check(len(starts) == 1 and min(starts) > 2 + len('actual_configurable_digital_input_bits'),
+              'table: the columns line up past the longest name (38 characters)', out)
 
 
 def three_x():
