@@ -34,9 +34,8 @@ The window: the whole run is about 1.4 MB of 1220-byte packets that do not compr
 WINDOW_BEFORE before the master's first NMT start (step 5: operational) to WINDOW_AFTER
 after its first NMT stop (step 7): TPDOs, the PDO configuration and event timer writes,
 SYNC counting with two transmission types, the SYNC moved to another id (0x1005) and back,
-stop and an SDO request while stopped. The
-script refuses a pair over MAX_BYTES (a run on a loaded host is slower: record again on
-a quieter one).
+stop and an SDO request while stopped. The script refuses a pair over MAX_BYTES (a run on
+a loaded host is slower: record again on a quieter one).
 """
 import json
 import lzma
