@@ -193,16 +193,63 @@ const char *urrt_rtde_strerror(int result)
     case URRT_RTDE_E_PROTOCOL_REFUSED: return "controller refused protocol versions 2 and 1";
     case URRT_RTDE_E_START_REFUSED: return "controller refused to start the recipe";
     case URRT_RTDE_E_FREQUENCY: return "frequency past the controller's maximum";
+    case URRT_RTDE_E_IN_USE: return "input registers another client or a fieldbus owns";
+    case URRT_RTDE_E_INPUTS_PROTOCOL: return "inputs need protocol 2; the controller speaks 1 only";
     case URRT_RTDE_E_NAMES_TOO_LONG: return "name list past 2048 bytes";
+    case URRT_RTDE_E_NOT_WRITABLE: return "not a general purpose input register";
     case URRT_RTDE_E_DUPLICATE: return "variable asked for twice";
     case URRT_RTDE_E_UNKNOWN_NAME: return "no RTDE output of that name";
+    case URRT_RTDE_E_SCRIPT_PORT: return "port runs what it receives (URScript, dashboard) or is its read-only "
+                                         "twin: RTDE is port 30004";
+    case URRT_RTDE_E_VALUE: return "value its register cannot hold (refused, not clamped)";
+    case URRT_RTDE_E_NOT_STARTED: return "input package before its recipe is accepted and streaming";
+    case URRT_RTDE_E_INCOMPLETE: return "input package while a register has no value";
     default: return urrt_strerror(result);
     }
 }
 
 bool urrt_rtde_is_config_error(int result)
 {
-    return result <= URRT_RTDE_E_NOT_FOUND && result >= URRT_RTDE_E_FREQUENCY;
+    return result <= URRT_RTDE_E_NOT_FOUND && result >= URRT_RTDE_E_INPUTS_PROTOCOL;
+}
+
+/* ---- ports ------------------------------------------------------------------ */
+
+/* The controller's servers an RTDE client never writes to (the header says
+ * why each). Named arrays, not literals: literals share one section with
+ * the variable names, which a read-only firmware keeps, while these are
+ * dropped (--gc-sections) unless the table is used. */
+static const char role_dashboard[] = "the dashboard server, which runs the commands it receives";
+static const char role_primary[] = "the primary client interface, which runs the URScript it receives";
+static const char role_secondary[] = "the secondary client interface, which runs the URScript it receives";
+static const char role_realtime[] = "the RealTime interface, which runs the URScript it receives";
+static const char role_primary_ro[] = "the primary client interface's read-only twin";
+static const char role_secondary_ro[] = "the secondary client interface's read-only twin";
+static const char role_realtime_ro[] = "the RealTime interface's read-only twin";
+static const char role_interpreter[] = "the interpreter mode's socket, which runs the URScript it receives";
+static const struct {
+    uint16_t port;
+    const char *role;
+} script_ports[] = {
+    {29999u, role_dashboard},   {30001u, role_primary},      {30002u, role_secondary},
+    {30003u, role_realtime},    {30011u, role_primary_ro},   {30012u, role_secondary_ro},
+    {30013u, role_realtime_ro}, {30020u, role_interpreter},
+};
+
+const char *urrt_rtde_port_role(uint32_t port)
+{
+    size_t i;
+    for (i = 0; i < sizeof script_ports / sizeof script_ports[0]; i++) {
+        if (script_ports[i].port == port) {
+            return script_ports[i].role;
+        }
+    }
+    return 0;
+}
+
+int urrt_rtde_check_port(uint32_t port)
+{
+    return urrt_rtde_port_role(port) == 0 ? URRT_OK : URRT_RTDE_E_SCRIPT_PORT;
 }
 
 /* ---- types and variables -------------------------------------------------- */
@@ -696,6 +743,11 @@ static double max_frequency(const urrt_rtde *s)
     return s->controller[0] < 5 ? URRT_RTDE_HZ_CB3 : URRT_RTDE_HZ_E_SERIES;
 }
 
+double urrt_rtde_max_frequency(const urrt_rtde *s)
+{
+    return s != 0 ? max_frequency(s) : 0.0;
+}
+
 int urrt_rtde_output(urrt_rtde *s, uint8_t *out, size_t cap)
 {
     int n;
@@ -743,6 +795,38 @@ int urrt_rtde_start(urrt_rtde *s)
 bool urrt_rtde_up(const urrt_rtde *s)
 {
     return s != 0 && s->up != 0;
+}
+
+/* The writing side's view of the handshake (urrt_rtde_in.c): nothing in
+ * this file calls these three, so a read-only image links none of them. */
+int urrt_rtde_due(const urrt_rtde *s)
+{
+    if (s == 0) {
+        return 0;
+    }
+    switch (s->pending) {
+    case REQ_PROTOCOL: return URRT_RTDE_TYPE_PROTOCOL_VERSION;
+    case REQ_CONTROLLER: return URRT_RTDE_TYPE_CONTROLLER_VERSION;
+    case REQ_SETUP: return URRT_RTDE_TYPE_SETUP_OUTPUTS;
+    case REQ_START: return URRT_RTDE_TYPE_START;
+    case REQ_PAUSE: return URRT_RTDE_TYPE_PAUSE;
+    default: return 0;
+    }
+}
+
+bool urrt_rtde_streaming(const urrt_rtde *s)
+{
+    return s != 0 && s->phase == PH_STREAMING;
+}
+
+static int end_session(urrt_rtde *s, urrt_rtde_event *ev, int error);
+
+int urrt_rtde_end(urrt_rtde *s, urrt_rtde_event *ev, int error)
+{
+    if (s == 0 || ev == 0 || error >= 0) {
+        return URRT_E_ARG;
+    }
+    return end_session(s, ev, error);
 }
 
 int urrt_rtde_not_found(const urrt_rtde *s, size_t i)

@@ -113,10 +113,18 @@ enum urrt_rtde_result {
     URRT_RTDE_E_PROTOCOL_REFUSED = -50, /* neither protocol version 2 nor 1 accepted */
     URRT_RTDE_E_START_REFUSED = -51, /* the controller refused to start the recipe */
     URRT_RTDE_E_FREQUENCY = -52,     /* frequency past what this controller streams */
+    URRT_RTDE_E_IN_USE = -53,        /* inputs another client or a fieldbus owns (urrt_rtde_in.h) */
+    URRT_RTDE_E_INPUTS_PROTOCOL = -54, /* inputs asked of a controller that speaks protocol 1 only */
     /* arguments of urrt_rtde_begin and the request writers */
     URRT_RTDE_E_NAMES_TOO_LONG = -56, /* name list past URRT_RTDE_NAMES_MAX bytes */
+    URRT_RTDE_E_NOT_WRITABLE = -57,   /* an input that is not a general purpose register */
     URRT_RTDE_E_DUPLICATE = -58,      /* a variable asked for twice */
-    URRT_RTDE_E_UNKNOWN_NAME = -59    /* no RTDE output of that name */
+    URRT_RTDE_E_UNKNOWN_NAME = -59,   /* no RTDE output of that name */
+    URRT_RTDE_E_SCRIPT_PORT = -60,    /* a port that runs what it receives, or its twin */
+    /* the writing side's values and packages (urrt_rtde_in.h) */
+    URRT_RTDE_E_VALUE = -61,          /* a value its register cannot hold: refused, never clamped */
+    URRT_RTDE_E_NOT_STARTED = -62,    /* an input package before the recipe is accepted and streaming */
+    URRT_RTDE_E_INCOMPLETE = -63      /* an input package while a register has no value */
 };
 
 /* A short English text for a result (urrt_strerror's for urrt_result). */
@@ -124,6 +132,26 @@ const char *urrt_rtde_strerror(int result);
 
 /* True for the errors a reconnect does not cure. */
 bool urrt_rtde_is_config_error(int result);
+
+/* ---- ports ------------------------------------------------------------------ */
+
+/*
+ * The controller's other TCP servers, which an RTDE client must never write
+ * to: 29999 (the dashboard server runs the commands it receives), 30001,
+ * 30002 and 30003 (the primary, secondary and RealTime client interfaces run
+ * what they receive as URScript), 30020 (interpreter mode's socket, e-Series
+ * 5.10 on, runs URScript too) and 30011-30013 (the read-only twins of the
+ * first three: they stream without a handshake, so a handshake there is a
+ * mistake that another port would turn into a program). RTDE's port is
+ * URRT_RTDE_PORT; a forwarded or simulated port is any other number.
+ *
+ * urrt_rtde_check_port: URRT_OK, or URRT_RTDE_E_SCRIPT_PORT for those ports.
+ * A client calls it with the port it connects to before it writes a byte.
+ * urrt_rtde_port_role: what listens on such a port ("the RealTime interface,
+ * which runs the URScript it receives"), NULL for any other port.
+ */
+int urrt_rtde_check_port(uint32_t port);
+const char *urrt_rtde_port_role(uint32_t port);
 
 /* ---- wire types ------------------------------------------------------------- */
 
@@ -375,7 +403,8 @@ int urrt_rtde_var_available(int var, uint32_t major, uint32_t minor, uint32_t bu
 /* ---- requests, written into caller buffers -------------------------------- */
 
 /* Each returns the bytes written, URRT_E_NO_SPACE if cap is too small or
- * URRT_E_ARG. These five are every package the client can write. */
+ * URRT_E_ARG. These five are every package the client can write (the
+ * writing side, urrt_rtde_in.h, a file of its own, adds 'I' and 'U'). */
 int urrt_rtde_write_protocol_version(uint8_t *out, size_t cap, uint16_t version);
 int urrt_rtde_write_controller_version(uint8_t *out, size_t cap);
 /* Protocol 1 has no frequency field: frequency is then not written. */
@@ -397,7 +426,8 @@ typedef enum urrt_rtde_event_kind {
     URRT_RTDE_EV_TEXT,         /* text message: ev.level, ev.text, ev.source */
     URRT_RTDE_EV_DATA,         /* data package decoded into st and vals; ev.first once per session */
     URRT_RTDE_EV_DROP,         /* protocol error ev.error: close and reconnect */
-    URRT_RTDE_EV_CONFIG        /* configuration error ev.error: close, back off long */
+    URRT_RTDE_EV_CONFIG,       /* configuration error ev.error: close, back off long */
+    URRT_RTDE_EV_INPUTS        /* urrt_rtde_in_feed only: an input recipe accepted (urrt_rtde_in.h) */
 } urrt_rtde_event_kind;
 
 /* Text message levels. */
@@ -410,7 +440,7 @@ typedef struct urrt_rtde_event {
     urrt_rtde_event_kind kind;
     int error;             /* EV_DROP, EV_CONFIG: the reason */
     uint8_t protocol;      /* EV_PROTOCOL; EV_FALLBACK: the version asked for next */
-    uint8_t recipe_id;     /* EV_RECIPE */
+    uint8_t recipe_id;     /* EV_RECIPE; EV_INPUTS: the input recipe's */
     uint8_t level;         /* EV_TEXT: URRT_RTDE_LEVEL_*, as sent (may be past 3) */
     bool first;            /* EV_DATA: the session's first data package ("up") */
     uint32_t version[4];   /* EV_CONTROLLER: major, minor, bugfix, build */
@@ -418,8 +448,9 @@ typedef struct urrt_rtde_event {
     const char *source;    /* until the next feed (source_len 0 in protocol 1) */
     uint16_t text_len;
     uint16_t source_len;
-    uint16_t not_found;    /* EV_CONFIG with URRT_RTDE_E_NOT_FOUND: how many names */
-    int var;               /* EV_CONFIG, URRT_RTDE_E_TYPE_MISMATCH: the variable */
+    uint16_t not_found;    /* EV_CONFIG with URRT_RTDE_E_NOT_FOUND (or _IN_USE): how many names */
+    int var;               /* EV_CONFIG, URRT_RTDE_E_TYPE_MISMATCH (an input setup's refusal too):
+                            * the variable; EV_INPUTS: the input recipe's index */
 } urrt_rtde_event;
 
 typedef struct urrt_rtde_stats {
@@ -530,6 +561,24 @@ int urrt_rtde_start(urrt_rtde *s);
 
 /* True once the session has decoded its first data package ("up"). */
 bool urrt_rtde_up(const urrt_rtde *s);
+
+/* The most this session's controller streams, in Hz (URRT_RTDE_HZ_CB3 for
+ * major < 5, else URRT_RTDE_HZ_E_SERIES): what a frequency of 0 asks for,
+ * and what URRT_RTDE_E_FREQUENCY compares with once the version is known. */
+double urrt_rtde_max_frequency(const urrt_rtde *s);
+
+/* For the writing side (urrt_rtde_in.h), which runs the handshake around
+ * this one; a read-only firmware calls none of them and links none.
+ * urrt_rtde_due: the type letter of the request urrt_rtde_output writes
+ * next, 0 when none is due. urrt_rtde_streaming: start was accepted and the
+ * session is neither paused (nor asked to pause) nor ended. urrt_rtde_end:
+ * ends the session with error (< 0) as a reply that broke the protocol or
+ * the configuration would (ev gets EV_DROP or EV_CONFIG, as
+ * urrt_rtde_is_config_error says; later feeds return URRT_RTDE_E_ENDED);
+ * returns the event's kind, or URRT_E_ARG for null pointers or error >= 0. */
+int urrt_rtde_due(const urrt_rtde *s);
+bool urrt_rtde_streaming(const urrt_rtde *s);
+int urrt_rtde_end(urrt_rtde *s, urrt_rtde_event *ev, int error);
 
 /* The i-th variable (0-based) the controller answered NOT_FOUND for, or -1
  * past the last: after an EV_CONFIG with URRT_RTDE_E_NOT_FOUND. */

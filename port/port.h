@@ -269,8 +269,12 @@ typedef enum urrt_link_drop_kind {
     URRT_LINK_DROP_CONFIG        /* the peer refuses the configuration: report once, long backoff */
 } urrt_link_drop_kind;
 
-/* Copies *source; NULL goes back to the RealTime reader. */
-void urrt_link_set_source(urrt_link *link, const urrt_link_source *source);
+/* Copies *source; NULL goes back to the RealTime reader. URRT_OK, or
+ * URRT_RTDE_E_SCRIPT_PORT (logged, the link stays the RealTime reader) when
+ * the link's port runs what it receives or is such a port's read-only twin
+ * (urrt_rtde_check_port: 29999, 30001-30003, 30011-30013, 30020): no source
+ * writes there, and the link's one write asks again before every send. */
+int urrt_link_set_source(urrt_link *link, const urrt_link_source *source);
 /* Queues len bytes to write, all or none. URRT_OK; URRT_E_NO_SPACE when the
  * queue has no room for them; URRT_E_ARG without a source (the RealTime
  * reader never writes) or without a connection (the bytes belong to a

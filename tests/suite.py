@@ -13,6 +13,7 @@ The report line is what tests/summary.sh and the CI read.
 """
 import os
 import signal
+import subprocess
 import sys
 import time
 
@@ -26,7 +27,7 @@ def check(ok, what, detail=''):
     global passed, failed
     if ok:
         passed += 1
-        print('ok: ' + what)
+        print('ok: ' + what, flush=True)
     else:
         failed += 1
         print('FAIL: %s%s' % (what, (': ' + str(detail)[:3000]) if detail != '' else ''), file=sys.stderr)
@@ -61,3 +62,43 @@ def end_group(proc):
         os.killpg(proc.pid, signal.SIGKILL)
     except (ProcessLookupError, PermissionError):
         pass
+
+
+class Sim:
+    """urrt-sim serving RealTime and RTDE on ports the system picks, at -v,
+    its output kept in a log file under tmp; ended with its process group
+    (a context manager, or stop()). args: the simulator's own (-c 5.10,
+    --fault ...); timeout bounds its life. rt_port, port (RTDE's) and addr
+    (127.0.0.1:port) say where it listens."""
+    count = 0
+
+    def __init__(self, sim, tmp, *args, timeout=90):
+        Sim.count += 1
+        base = os.path.join(tmp, 'sim%d' % Sim.count)
+        self.log_path, rt_pf, rtde_pf = base + '.log', base + '.rt', base + '.rtde'
+        with open(self.log_path, 'w') as log:
+            self.proc = subprocess.Popen(['timeout', '-k', '3', str(timeout), sim, '-l', '127.0.0.1:0', '--port-file',
+                                          rt_pf, '--rtde', '127.0.0.1:0', '--rtde-port-file', rtde_pf, '-v'] + list(args),
+                                         stdout=log, stderr=log)
+        # Each port file is written whole and renamed: it exists only with its line.
+        if not wait_for('the simulator\'s port files', lambda: os.path.exists(rtde_pf) and os.path.exists(rt_pf),
+                        self.proc):
+            raise RuntimeError('the simulator did not start: ' + self.log())
+        self.rt_port = int(open(rt_pf).read())
+        self.port = int(open(rtde_pf).read())
+        self.addr = '127.0.0.1:%d' % self.port
+
+    def log(self):
+        with open(self.log_path) as f:
+            return f.read()
+
+    def stop(self):
+        self.proc.terminate()
+        self.proc.wait(timeout=10)
+        end_group(self.proc)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.stop()

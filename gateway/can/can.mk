@@ -8,7 +8,7 @@
 # loop that drives it, is gateway/urrt-gateway/can_out.c. tests/gateway/can/can.mk tests them.
 
 CAN_GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/can/,can_map.o can_run.o canopen_map.o co_run.o eds.o dbc.o \
-  can_ctables.o can_rtde.o)
+  can_ctables.o) $(RTDE_ONLY_OBJ)
 CAN_PORT_OBJS := $(addprefix $(BUILD)/gateway/can/,can_replay.o)
 GATEWAY_EXTRA_OBJS += $(CAN_GATEWAY_OBJS) $(CAN_PORT_OBJS)
 

@@ -6,6 +6,8 @@
 #include <inttypes.h>
 #include <string.h>
 
+#include "rtde_only.h"
+
 /* Doubles as C constants that read back to the same bits. */
 static void put_double(FILE *out, double v)
 {
@@ -167,7 +169,7 @@ static bool same_family(int a, int b)
     char na[URRT_RTDE_NAME_MAX];
     char nb[URRT_RTDE_NAME_MAX];
     size_t ia;
-    if (a < URRT_RTDE_MAPPED_COUNT || b < URRT_RTDE_MAPPED_COUNT || b >= URRT_RTDE_VAR_COUNT ||
+    if (!rtde_only(a) || !rtde_only(b) ||
         urrt_rtde_var_name(a, na, sizeof na) < 0 || urrt_rtde_var_name(b, nb, sizeof nb) < 0) {
         return false;
     }
@@ -269,6 +271,10 @@ static void put_rtde_recipes(FILE *out, const struct can_map *map, const struct 
         fputs(r ? ", " : "", out);
         put_double(out, is_rtde(robots, map, r) ? robots[r].frequency : 0.0);
     }
+    fprintf(out, "};\nconst uint16_t urrt_gateway_rtde_port[%zu] = {", robot_count);
+    for (size_t r = 0; r < robot_count; r++) {
+        fprintf(out, "%s%u", r ? ", " : "", (unsigned)robots[r].port);
+    }
     fprintf(out, "};\n\n"
                  "void urrt_gateway_rtde_values(size_t robot, const urrt_rtde_values *values)\n{\n"
                  "    if (robot < %zu) {\n        urrt_gateway_rtde[robot] = values;\n    }\n}\n",
@@ -305,9 +311,9 @@ static void put_rtde_reading(FILE *out, const struct can_map *map, const struct 
 }
 
 /* Frame f's fill function: each RTDE-only signal's value from its robot's
- * latest package, read as can_rtde.h reads it (the gateway's fill_rtde): a
+ * latest package, read as rtde_only.h reads it (the gateway's fill_rtde): a
  * quantity as a double, NaN when the package lacks it; a mask (can_map set
- * bitmask from can_rtde_is_mask) as its 64 bits, 0 when lacking. The C type
+ * bitmask from rtde_only_is_mask) as its 64 bits, 0 when lacking. The C type
  * of each is lib/'s (URRT_RTDE_CTYPE_ of the variable's wire type). */
 static void put_rtde_fill(FILE *out, const struct can_map_frame *f)
 {

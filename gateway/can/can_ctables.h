@@ -25,6 +25,7 @@
 struct can_ctables_robot {
     bool rtde;        /* source = rtde: lib/urrt_rtde.h's client; else the RealTime stream */
     double frequency; /* RTDE: Hz asked for, 0 for the controller's maximum */
+    uint16_t port;    /* the robot's TCP port, which a firmware checks before it writes */
 };
 
 /* Writes the C source of run, the tables of map, and with node (NULL:
@@ -33,7 +34,7 @@ struct can_ctables_robot {
  * comment). robots: how each of map's robots is read, in map's order
  * (NULL: all by RealTime); for an RTDE robot the source also holds the
  * recipe a firmware asks for (the timestamp and what its CAN signals need)
- * and the fill functions that read its RTDE-only values as can_rtde.h
+ * and the fill functions that read its RTDE-only values as rtde_only.h
  * does. 0, or -1 when the stream failed. */
 int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run, struct co_run *node,
                       const struct can_ctables_robot *robots, const char *source);

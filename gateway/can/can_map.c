@@ -12,7 +12,7 @@
 #include <string.h>
 #include <strings.h>
 
-#include "can_rtde.h"
+#include "rtde_only.h"
 #include "urrt_rtde.h"
 
 /* ---- reporting ------------------------------------------------------------------- */
@@ -478,14 +478,14 @@ static bool signal_value(struct signal_parse *s, const char *word, size_t name_l
         s->value = info->name;
         s->count = info->count;
         s->unit = info->unit;
-    } else if (can_rtde_only(var)) {
+    } else if (rtde_only(var)) {
         s->meta.role = CAN_MAP_ROLE_RTDE;
         s->meta.field = -1;
         s->meta.var = var;
         (void)urrt_rtde_var_name(var, s->rtde_name, sizeof s->rtde_name);
         s->value = s->rtde_name;
-        s->count = can_rtde_elements(var);
-        s->unit = can_rtde_unit(var);
+        s->count = rtde_only_elements(var);
+        s->unit = rtde_only_unit(var);
     } else {
         return conf_fail(why, n, "signal: no field '%.*s' (field names as in docs/protocol.md: q_actual, tcp_force, "
                    "robot_mode, ...; RTDE-only values by their RTDE names: output_int_register_24, ...)",

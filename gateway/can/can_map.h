@@ -53,7 +53,7 @@ enum can_map_role {
     CAN_MAP_ROLE_ALIVE,      /* the frame's alive counter */
     CAN_MAP_ROLE_VALID,      /* the frame's validity bit (1 = valid) */
     CAN_MAP_ROLE_RTDE        /* an element of an RTDE-only value (output_int_register_24, ...):
-                                its robot has source = rtde, its value the package's (can_rtde.h) */
+                                its robot has source = rtde, its value the package's (rtde_only.h) */
 };
 
 /* What a signal of the table carries; sigs[i] and meta[i] go together. */

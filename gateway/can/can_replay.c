@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "cli.h"
-#include "can_rtde.h"
+#include "rtde_only.h"
 #include "port.h"
 #include "rtde_capture.h"
 
@@ -302,7 +302,7 @@ static bool realtime_has_all(const struct can_map *map, const char *path)
     memset(&m, 0, sizeof m);
     for (size_t k = 0; k < n; k++) {
         char name[URRT_RTDE_NAME_MAX];
-        if (needs[k].var >= 0 && can_rtde_only(needs[k].var)) {
+        if (needs[k].var >= 0 && rtde_only(needs[k].var)) {
             (void)urrt_rtde_var_name(needs[k].var, name, sizeof name);
             add_missing(&m, name, &needs[k]);
         }

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "can_rtde.h"
+#include "rtde_only.h"
 
 struct can_run {
     urrt_cantx tx;
@@ -72,8 +72,8 @@ static void fill_rtde(urrt_cantx *tx, size_t frame, uint64_t now_us, bool sendin
     for (size_t k = 0; k < f->count; k++) {
         const struct can_map_signal *m = &f->meta[k];
         if (m->role == CAN_MAP_ROLE_RTDE) {
-            values[k] = m->bitmask ? urrt_cantx_mask_value(can_rtde_mask(v, m->var))
-                                   : can_rtde_element(v, m->var, m->elem);
+            values[k] = m->bitmask ? urrt_cantx_mask_value(rtde_only_mask(v, m->var))
+                                   : rtde_only_element(v, m->var, m->elem);
         }
     }
 }

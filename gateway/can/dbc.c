@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "can_rtde.h"
+#include "rtde_only.h"
 
 #define DBC_EXTENDED_FLAG 0x80000000u
 #define DBC_UNKNOWN_ROBOT_CYCLE_MS 8u /* 125 Hz: the slower rate, so a receiver's timeout is not too tight */
@@ -193,7 +193,7 @@ static void put_rtde_comment(FILE *out, unsigned long id, const struct can_map_s
     urrt_rtde_type type = urrt_rtde_var_type(m->var);
     (void)urrt_rtde_var_name(m->var, name, sizeof name);
     fprintf(out, "CM_ SG_ %lu %s \"%s", id, m->name, name);
-    if (can_rtde_elements(m->var) > 1) {
+    if (rtde_only_elements(m->var) > 1) {
         fprintf(out, "[%u]", m->elem);
     }
     fprintf(out, ": RTDE output %s, RTDE only (the robot's source = rtde), as of the package the frame's data is",

@@ -9,7 +9,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "can_rtde.h"
+#include "rtde_only.h"
 #include "dbc.h"
 
 #define ACCESS_RO "ro"
@@ -155,7 +155,7 @@ static void value_name(const struct can_map_signal *m, char *buf, size_t size)
     const urrt_field_info *info = m->role == CAN_MAP_ROLE_FIELD ? urrt_field((urrt_field_id)m->field) : NULL;
     char rtde[URRT_RTDE_NAME_MAX] = "?";
     const char *name = info != NULL ? info->name : rtde;
-    unsigned count = info != NULL ? info->count : can_rtde_elements(m->var);
+    unsigned count = info != NULL ? info->count : rtde_only_elements(m->var);
     if (m->role == CAN_MAP_ROLE_RTDE) {
         (void)urrt_rtde_var_name(m->var, rtde, sizeof rtde);
     }

@@ -3,6 +3,9 @@
 #define _GNU_SOURCE
 #include "conf.h"
 
+#include "urrt.h"
+#include "urrt_rtde.h"
+
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -252,6 +255,29 @@ const char *conf_bare_unit(const char *key)
     return NULL;
 }
 
+/* ---- rates ---------------------------------------------------------------------- */
+
+bool conf_rate_hz(const char *text, double min, double max, double *out, char *why, size_t n)
+{
+    double v;
+    const char *unit;
+    if (text == NULL || text[0] == '\0') {
+        return conf_fail(why, n, "no value");
+    }
+    if (text[0] == '-' || text[0] == '+' || !parse_decimal(text, &v, &unit)) {
+        return conf_fail(why, n, "not a rate: a number of Hz, e.g. \"50 Hz\" (or 50)");
+    }
+    unit += strspn(unit, " \t");
+    if (unit[0] != '\0' && strcmp(unit, "Hz") != 0) {
+        return conf_fail(why, n, "unknown unit \"%s\": a rate is in Hz, e.g. \"50 Hz\" (or 50)", unit);
+    }
+    if (v < min || v > max) {
+        return conf_fail(why, n, "out of range: from %g Hz to %g Hz", min, max);
+    }
+    *out = v;
+    return true;
+}
+
 /* ---- names and text ------------------------------------------------------------ */
 
 bool conf_name(const char *text, unsigned flags, size_t max, char *why, size_t n)
@@ -359,8 +385,9 @@ bool conf_key_set(const struct conf_key *key, void *obj, const char *value, stru
     return conf_fail(why, n, "%s = \"%s\": %s", key->name, value, reason);
 }
 
-/* Levenshtein distance, for names of up to 63 characters. */
-static size_t distance(const char *a, const char *b)
+/* Levenshtein distance, for names of up to 63 characters; fold: letters
+ * that differ only in case are the same. */
+static size_t distance(const char *a, const char *b, bool fold)
 {
     size_t la = strlen(a), lb = strlen(b);
     size_t row[64];
@@ -375,7 +402,8 @@ static size_t distance(const char *a, const char *b)
         row[0] = i;
         for (size_t j = 1; j <= lb; j++) {
             size_t up = row[j];
-            size_t best = diag + (a[i - 1] != b[j - 1]);
+            unsigned char ca = (unsigned char)a[i - 1], cb = (unsigned char)b[j - 1];
+            size_t best = diag + (fold ? tolower(ca) != tolower(cb) : ca != cb);
             best = up + 1 < best ? up + 1 : best;
             best = row[j - 1] + 1 < best ? row[j - 1] + 1 : best;
             diag = up;
@@ -385,19 +413,99 @@ static size_t distance(const char *a, const char *b)
     return row[lb];
 }
 
+/* The rule of every "did you mean": at most two edits away, fewer edits
+ * than the word has letters, and nearer than the best so far. */
+#define SUGGEST_EDITS 2
+static bool nearer(size_t d, size_t best_d, size_t word_len)
+{
+    return d <= SUGGEST_EDITS && d < word_len && d < best_d;
+}
+
 const char *conf_suggest(const char *word, const void *table, size_t count, size_t stride)
 {
     const char *best = NULL;
-    size_t best_d = 3;
+    size_t best_d = SIZE_MAX;
     for (size_t i = 0; i < count; i++) {
         const char *name = *(const char *const *)(const void *)((const char *)table + i * stride);
-        size_t d = distance(word, name);
-        if (d < best_d && d < strlen(word)) {
+        size_t d = distance(word, name, false);
+        if (nearer(d, best_d, strlen(word))) {
             best = name;
             best_d = d;
         }
     }
     return best;
+}
+
+/* The families of lib's RTDE table (its rows of several names): name
+ * followed by an index from first to first + names - 1. */
+static const struct {
+    const char *stem;
+    int first, names;
+} rtde_families[] = {
+#define CONF_X_FAMILY(ID, member, name, TYPE, first, names, split, since, since_hi) {name, first, names},
+    URRT_RTDE_ONLY(CONF_X_FAMILY)
+#undef CONF_X_FAMILY
+};
+
+const char *conf_suggest_value(const char *word, size_t len, char *buf, size_t size)
+{
+    char w[64], name[64];
+    size_t best_d = SIZE_MAX, stem_len = len;
+    long index = -1;
+    if (buf == NULL || size == 0) {
+        return NULL;
+    }
+    buf[0] = '\0';
+    if (word == NULL || len >= sizeof w) {
+        return NULL;
+    }
+    memcpy(w, word, len);
+    w[len] = '\0';
+    /* Every name of both tables: RealTime's fields, then RTDE's variables,
+     * each index of a family its own name (output_int_register_24). */
+    for (int i = 0; i < (int)URRT_FIELD_COUNT + (int)URRT_RTDE_VAR_COUNT; i++) {
+        const char *cand = name;
+        size_t d;
+        if (i < (int)URRT_FIELD_COUNT) {
+            cand = urrt_field((urrt_field_id)i)->name;
+        } else if (urrt_rtde_var_name(i - (int)URRT_FIELD_COUNT, name, sizeof name) < 0) {
+            continue;
+        }
+        d = distance(w, cand, true);
+        if (strcmp(w, cand) != 0 && nearer(d, best_d, len)) {
+            best_d = d;
+            snprintf(buf, size, "\"%s\"", cand);
+        }
+    }
+    /* A family's name and an index it has, the number written otherwise
+     * (output_int_register_05: output_int_register_5); without an index, or
+     * with one the family does not have (output_bit_register_3): the
+     * family's range. Either when nearer than any name above. */
+    while (stem_len > 0 && isdigit((unsigned char)w[stem_len - 1])) {
+        stem_len--;
+    }
+    if (stem_len < len && len - stem_len <= 9) {
+        index = strtol(w + stem_len, NULL, 10);
+    }
+    w[stem_len] = '\0';
+    for (size_t f = 0; f < sizeof rtde_families / sizeof rtde_families[0]; f++) {
+        int first = rtde_families[f].first, last = first + rtde_families[f].names - 1;
+        size_t d = distance(w, rtde_families[f].stem, true);
+        if (rtde_families[f].names == 1 || !nearer(d, best_d, len)) {
+            continue;
+        }
+        if (index >= first && index <= last) {
+            snprintf(name, sizeof name, "%s%ld", rtde_families[f].stem, index);
+            if (strncmp(word, name, len) == 0 && name[len] == '\0') {
+                continue;
+            }
+            snprintf(buf, size, "\"%s\"", name);
+        } else {
+            snprintf(buf, size, "one of %s%d to %s%d", rtde_families[f].stem, first, rtde_families[f].stem, last);
+        }
+        best_d = d;
+    }
+    return buf[0] != '\0' ? buf : NULL;
 }
 
 void conf_unknown_key(const struct conf_key *keys, size_t count, const char *key, const char *section, char *why,

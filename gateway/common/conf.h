@@ -13,6 +13,9 @@
  *   duration  a number and a unit: us, ms, s or min ("250 ms", "1.5s").
  *             A bare number only where the key's name carries the unit
  *             (stale_after_ms = 100), and it means that unit.
+ *   rate      a number of Hz, the unit optional ("50 Hz", "50Hz" and "50"
+ *             are the same rate): the one unit of a rate, so that a bare
+ *             number means Hz wherever a rate is given.
  *   name      1 to N letters, digits and '_' (and '-' or '.' where said);
  *             a C identifier where the name becomes a DBC name.
  *   text      any printable text, one pair of double quotes dropped.
@@ -56,6 +59,10 @@ bool conf_duration_ms(const char *text, const char *bare_unit, uint32_t min_ms, 
                       char *why, size_t n);
 /* The unit a key's name carries: "ms" for "period_ms" ("us", "s"), else NULL. */
 const char *conf_bare_unit(const char *key);
+
+/* A rate in Hz in [min, max]: a number, then "Hz" or nothing (a bare number
+ * is Hz). No sign: "-5 Hz" is no rate. */
+bool conf_rate_hz(const char *text, double min, double max, double *out, char *why, size_t n);
 
 enum conf_name_flags {
     CONF_NAME_DASH = 1, /* '-' allowed */
@@ -142,5 +149,15 @@ void conf_unknown_key(const struct conf_key *keys, size_t count, const char *key
  * each starting with its name (a const char *), the name nearest to word,
  * at most two edits away and fewer than word has letters; NULL if none. */
 const char *conf_suggest(const char *word, const void *table, size_t count, size_t stride);
+/* The same hint for the name of a value (word, len bytes, that neither table
+ * knows as written), over both of lib's tables: every RealTime field
+ * (lib/urrt.h) and every RTDE variable (lib/urrt_rtde.h, each index of a
+ * family a name: output_int_register_24), letters compared without case;
+ * or, nearer still, an RTDE family named without its index or with one it
+ * lacks (output_bit_register_3). Writes into buf (size bytes) what follows
+ * "did you mean ": "\"robot_status_bits\"" or "one of output_bit_register_64
+ * to output_bit_register_127", and returns buf; NULL (buf "") if nothing is
+ * near. */
+const char *conf_suggest_value(const char *word, size_t len, char *buf, size_t size);
 
 #endif

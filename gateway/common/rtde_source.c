@@ -22,6 +22,8 @@ struct rtde_source {
     rtde_source_tap_fn tap_fn;
     void *tap_ctx;
     bool dropped;                         /* this connection was dropped: ignore its bytes */
+    uint8_t first[4];                     /* the connection's first bytes: a RealTime length? */
+    size_t first_len;
 };
 
 /* Appends text to out[*len] as far as it fits, always NUL-terminated. */
@@ -120,6 +122,7 @@ static void on_connected(void *ctx, urrt_link *link, uint64_t now_us)
     (void)now_us;
     src->link = link;
     src->dropped = false;
+    src->first_len = 0;
     if (src->tap_fn != NULL) {
         src->tap_fn(src->tap_ctx, RTDE_SOURCE_TAP_CONNECTED, NULL, 0);
     }
@@ -182,6 +185,11 @@ static void config_reason(const rtde_source *src, const urrt_rtde_event *ev, cha
         }
         snprintf(why, size, "RTDE: controller version %s does not have %s (NOT_FOUND): remove them from the "
                  "configuration or update the controller", version, names);
+    } else if (ev->error == URRT_RTDE_E_FREQUENCY) {
+        double max = urrt_rtde_max_frequency(&src->session);
+        snprintf(why, size, "RTDE: rtde_frequency %g Hz is past this %" PRIu32 ".%" PRIu32 " controller's maximum "
+                 "of %g Hz: lower it or use auto", src->session.frequency, src->session.controller[0],
+                 src->session.controller[1], max);
     } else if (ev->error == URRT_RTDE_E_TYPE_MISMATCH) {
         append_name(names, sizeof names, &len, ev->var);
         snprintf(why, size, "RTDE: controller version %s sends %s in a type urrt does not know for it: "
@@ -189,6 +197,29 @@ static void config_reason(const rtde_source *src, const urrt_rtde_event *ev, cha
     } else {
         snprintf(why, size, "RTDE: controller version %s: %s; check the controller's RTDE settings and the "
                  "configuration", version, urrt_rtde_strerror(ev->error));
+    }
+}
+
+/* The reason of a protocol error. A peer that sends before it was answered,
+ * and whose first four bytes are the length of a RealTime packet, is a
+ * RealTime port (it streams without a handshake): say so, and how to read
+ * it, rather than what its bytes mean as RTDE. */
+static void drop_reason(const rtde_source *src, const urrt_rtde_event *ev, char *why, size_t size)
+{
+    uint32_t length = 0;
+    const char *versions = NULL;
+    if (!src->session.protocol_accepted && src->first_len == sizeof src->first) {
+        length = (uint32_t)src->first[0] << 24 | (uint32_t)src->first[1] << 16 | (uint32_t)src->first[2] << 8 |
+                 src->first[3];
+        versions = urrt_versions_of(length);
+    }
+    if (versions != NULL) {
+        snprintf(why, size, "the peer streams without a handshake, as a RealTime port (%u) does: its first bytes "
+                 "announce a %" PRIu32 "-byte RealTime packet (versions %s): read it as RealTime (urrt-dump "
+                 "without --rtde, source = realtime), or give RTDE's port (%u)",
+                 (unsigned)URRT_LINK_PORT_RW, length, versions, (unsigned)URRT_RTDE_PORT);
+    } else {
+        snprintf(why, size, "RTDE protocol error: %s", urrt_rtde_strerror(ev->error));
     }
 }
 
@@ -216,7 +247,7 @@ static bool on_event(rtde_source *src, const urrt_rtde_event *ev, uint64_t rx_us
         urrt_link_source_packet(src->link, src->session.buf, src->session.data_size, rx_us);
         break;
     case URRT_RTDE_EV_DROP:
-        snprintf(why, sizeof why, "RTDE protocol error: %s", urrt_rtde_strerror(ev->error));
+        drop_reason(src, ev, why, sizeof why);
         drop(src, URRT_LINK_DROP_PROTOCOL, why);
         break;
     case URRT_RTDE_EV_CONFIG:
@@ -238,6 +269,9 @@ static void on_received(void *ctx, urrt_link *link, const uint8_t *data, size_t 
 {
     rtde_source *src = ctx;
     src->link = link;
+    for (size_t i = 0; i < len && src->first_len < sizeof src->first; i++) {
+        src->first[src->first_len++] = data[i];
+    }
     while (len > 0 && !src->dropped) {
         size_t used = 0;
         urrt_rtde_event ev;
@@ -259,11 +293,11 @@ static void on_received(void *ctx, urrt_link *link, const uint8_t *data, size_t 
     }
 }
 
-void rtde_source_attach(rtde_source *src, urrt_link *link)
+bool rtde_source_attach(rtde_source *src, urrt_link *link)
 {
     urrt_link_source hooks = {.ctx = src, .connected = on_connected, .received = on_received};
     src->link = link;
-    urrt_link_set_source(link, &hooks);
+    return urrt_link_set_source(link, &hooks) == URRT_OK;
 }
 
 const urrt_state *rtde_source_state(const rtde_source *src)

@@ -66,8 +66,10 @@ rtde_source *rtde_source_new(const rtde_source_config *cfg, char *why, size_t wh
 void rtde_source_free(rtde_source *src);
 
 /* Makes src the link's source (urrt_link_set_source): call before the first
- * urrt_link_service. One source per link. */
-void rtde_source_attach(rtde_source *src, urrt_link *link);
+ * urrt_link_service. One source per link. False (logged by the link) when
+ * the link's port runs what it receives (urrt_rtde_check_port): nothing is
+ * ever written there. */
+bool rtde_source_attach(rtde_source *src, urrt_link *link);
 
 /* During the packet function of a package from this source (and until the
  * next byte is fed): the decoded values. The state is urrt_rtde_decode's:

@@ -29,6 +29,10 @@ EXAMPLES := $(sort $(wildcard docs/examples/*.ini))
 DIST_FILES := $(DIST)/README.md $(DIST)/urrt-spy $(DIST)/urrt-gateway.service $(DIST)/urrt-gateway@.service $(DIST)/urrt.pc \
               $(DIST)/gateway.ini $(DIST)/$(TYPES_JAR)
 
+# The library's headers: the header of each module of liburrt.a (lib/lib.mk's LIB_SRCS), so that
+# a module added to lib/ is installed whole (check-deb holds the package to the library's objects).
+LIB_INSTALL_HDRS = $(wildcard $(LIB_SRCS:.c=.h))
+
 INSTALL_ITEMS = $(foreach f,$(PROGRAMS) $(DIST)/urrt-spy,$(f):$(BINDIR):0755) \
   $(DIST)/$(TYPES_JAR):$(JAVADIR):0644 \
   $(DIST)/urrt-gateway.service:$(UNITDIR):0644 $(DIST)/urrt-gateway@.service:$(UNITDIR):0644 \
@@ -38,8 +42,7 @@ INSTALL_ITEMS = $(foreach f,$(PROGRAMS) $(DIST)/urrt-spy,$(f):$(BINDIR):0755) \
   $(foreach f,$(DIST)/README.md $(DOCS) LICENSE,$(f):$(DOCDIR):0644) \
   $(foreach f,$(DOC_IMAGES),$(f):$(DOCDIR)/img:0644) \
   $(foreach f,$(EXAMPLES),$(f):$(DOCDIR)/examples:0644) \
-  lib/urrt.h:$(INCLUDEDIR):0644 lib/urrt_can.h:$(INCLUDEDIR):0644 lib/urrt_cantx.h:$(INCLUDEDIR):0644 \
-  lib/urrt_co.h:$(INCLUDEDIR):0644 \
+  $(foreach f,$(LIB_INSTALL_HDRS),$(f):$(INCLUDEDIR):0644) \
   $(LIBURRT):$(LIBDIR):0644 \
   $(DIST)/urrt.pc:$(PKGCONFIGDIR):0644
 # Symbolic links: TARGET:LINK (TARGET relative to the link's directory).
@@ -103,7 +106,7 @@ $(DIST)/gateway.ini: gateway/install/urrt-gateway.example.ini
 $(DIST)/urrt.pc: lib/urrt.h
 	@mkdir -p $(@D)
 	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$(LIBDIR)' 'includedir=$(INCLUDEDIR)' '' 'Name: urrt' \
-	  'Description: Universal Robots RealTime interface decoder and CAN packing (freestanding C99)' \
+	  'Description: Universal Robots RealTime decoder and RTDE client, CAN packing and CANopen node (freestanding C99)' \
 	  'Version: $(URRT_VERSION)' 'Libs: -L$${libdir} -lurrt' 'Cflags: -I$${includedir}' > $@
 
 # The paths are baked into the generated files: make them again on every install.

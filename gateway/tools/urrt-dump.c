@@ -192,7 +192,11 @@ static void usage(FILE *out)
 "The summary (stderr, lines starting \"summary:\") gives the packets, lengths\n"
 "and controller versions seen, generations, resyncs and skipped bytes, partial\n"
 "packets dropped, the mean rate and the largest gap in controller time, and\n"
-"for a robot the link's connects, reconnects and silences.\n"
+"for a robot the link's connects, reconnects and silences. With --rtde (or an\n"
+"RTDE capture) the session's counts instead of generations, resyncs and\n"
+"partial packets: controller, protocol, recipe, packages, data packages, text\n"
+"messages, ignored packages, errors, bytes, and the bytes of a package cut\n"
+"short at close.\n"
 "\n"
 "Exit status: 0 done (--count reached, end of file, SIGINT/SIGTERM, end of\n"
 "connection with --once), 1 runtime error (cannot open or write a file, a\n"
@@ -240,19 +244,14 @@ static void parse_fields(const cli_option *row, const char *list, void *obj)
         size_t n = comma != NULL ? (size_t)(comma - p) : strlen(p);
         int id = key_of_name(p, n);
         if (id < 0) {
-            fprintf(stderr, PROGRAM ": --fields: no field named \"%.*s\". Fields (with --rtde also RTDE "
-                    "names, which --rtde --list HOST shows):\n", (int)n, p);
-            for (unsigned i = 0; i < URRT_FIELD_COUNT; i++) {
-                const urrt_field_info *f = urrt_field((urrt_field_id)i);
-                int var = urrt_rtde_var_of_field((urrt_field_id)i);
-                char rtde[URRT_RTDE_NAME_MAX] = "-";
-                if (var >= 0) {
-                    urrt_rtde_var_name(var, rtde, sizeof rtde);
-                }
-                fprintf(stderr, "  %-22s %-11s %-27s %s\n", f->name, f->unit[0] ? f->unit : "-", rtde,
-                        f->description);
+            char near[2 * URRT_RTDE_NAME_MAX + 16];
+            if (conf_suggest_value(p, n, near, sizeof near) != NULL) {
+                cli_usage_error(PROGRAM, "-k: no field or RTDE value named \"%.*s\": did you mean %s?", (int)n, p,
+                                near);
             }
-            exit(CLI_EXIT_USAGE);
+            cli_usage_error(PROGRAM, "-k: no field or RTDE value named \"%.*s\" (docs/protocol.md lists the "
+                            "fields, docs/rtde.md the RTDE names; --rtde --list HOST what a controller has)",
+                            (int)n, p);
         }
         if (!o->key_on[id]) {
             o->key_on[id] = true;
@@ -379,13 +378,17 @@ static void check_source(int argc, char **argv, int operand, options *o)
                                    sizeof o->host, &o->port)) != NULL) {
         cli_usage_error(PROGRAM, "%s: %s", argv[operand], err);
     }
-    /* RTDE speaks first: never to a port that would take its bytes for
-     * URScript (primary, secondary, RealTime, and their read-only twins). */
-    if (o->rtde && ((o->port >= 30001 && o->port <= 30003) || (o->port >= 30011 && o->port <= 30013))) {
-        cli_usage_error(PROGRAM, "--rtde %s: port %u is not RTDE (30001-30003 run what they receive as URScript, "
-                        "30011-30013 are their read-only twins): RTDE is port 30004, or drop --rtde to read "
-                        "RealTime",
-                        argv[operand], (unsigned)o->port);
+    /* RTDE speaks first: never to a port that runs what it receives (the
+     * link refuses it too). RealTime is never on RTDE's port, where a
+     * controller sends nothing until it hears a handshake. */
+    if (o->rtde && urrt_rtde_port_role(o->port) != NULL) {
+        cli_usage_error(PROGRAM, "--rtde %s: port %u is %s: RTDE is port %u, or drop --rtde to read RealTime",
+                        argv[operand], (unsigned)o->port, urrt_rtde_port_role(o->port), (unsigned)URRT_RTDE_PORT);
+    }
+    if (!o->rtde && o->port == URRT_RTDE_PORT) {
+        cli_usage_error(PROGRAM, "%s: port %u is RTDE's on every controller, which sends nothing until a client's "
+                        "handshake: add --rtde, or give RealTime's port (%u, or the read-only %u)",
+                        argv[operand], (unsigned)o->port, (unsigned)URRT_LINK_PORT_RW, (unsigned)URRT_LINK_PORT_RO);
     }
 }
 
@@ -1238,8 +1241,7 @@ static bool open_rtde(dump *d, urrt_link *link)
     if (d->capture != NULL) {
         rtde_source_set_tap(d->src, on_rtde_tap, d);
     }
-    rtde_source_attach(d->src, link);
-    return true;
+    return rtde_source_attach(d->src, link);
 }
 
 /* ---- sources ------------------------------------------------------------------ */
@@ -1633,8 +1635,9 @@ static int run_link(dump *d)
 
 /* ---- summary ------------------------------------------------------------------ */
 
-/* The RTDE session: controller, protocol, the recipe asked for, and the
- * packages that were no data. */
+/* The RTDE session: controller, protocol, the recipe asked for, and what
+ * lib's session counted (urrt_rtde_stats) in RTDE's words, not RealTime's
+ * resyncs: RTDE packages carry their size, a framer never hunts for one. */
 static void print_summary_rtde(const dump *d, FILE *out)
 {
     const urrt_rtde *ses = rtde_session_of(d);
@@ -1656,9 +1659,16 @@ static void print_summary_rtde(const dump *d, FILE *out)
             len += (size_t)snprintf(recipe + len, sizeof recipe - len, "%s%s", i > 0 ? "," : "", name);
         }
     }
-    fprintf(out, "summary: rtde: controller %s, protocol %u, text messages %" PRIu64 ", packages ignored %" PRIu64
-            "\n", version, (unsigned)ses->protocol_accepted, ses->stats.texts, ses->stats.ignored);
+    fprintf(out, "summary: rtde: controller %s, protocol %u\n", version, (unsigned)ses->protocol_accepted);
     fprintf(out, "summary: rtde recipe: %s\n", recipe);
+    fprintf(out, "summary: rtde packages: %" PRIu64 ", data packages: %" PRIu64 ", text messages: %" PRIu64
+            ", ignored: %" PRIu64 ", errors: %" PRIu64 ", bytes: %" PRIu64 "\n", ses->stats.packages,
+            ses->stats.data, ses->stats.texts, ses->stats.ignored, ses->stats.errors, ses->stats.bytes);
+    if (d->src != NULL) {
+        /* What urrt_rtde_finish would drop as the run closes the connection:
+         * the bytes of a package begun and not complete. */
+        fprintf(out, "summary: rtde partial package dropped at close: %u bytes\n", (unsigned)ses->have);
+    }
     if (d->replay != NULL) {
         fprintf(out, "summary: rtde capture: sessions %" PRIu64 ", last record cut short: %zu bytes\n", d->sessions,
                 d->cut_short);
@@ -1686,10 +1696,12 @@ static void print_summary(const dump *d, bool from_link)
                 d->gen_count[URRT_GEN_1X], d->gen_count[URRT_GEN_3X], d->gen_count[URRT_GEN_UNKNOWN]);
     }
     if (from_link) {
-        fprintf(out, "summary: resyncs: %" PRIu64 ", skipped bytes: %" PRIu64 "\n", d->lstats.resyncs,
-                d->lstats.skipped);
-        fprintf(out, "summary: partial packets dropped: %" PRIu64 " (%" PRIu64 " bytes)\n", d->lstats.partial_drops,
-                d->lstats.partial_bytes);
+        if (d->src == NULL) { /* RealTime's framer; RTDE's session said its own above */
+            fprintf(out, "summary: resyncs: %" PRIu64 ", skipped bytes: %" PRIu64 "\n", d->lstats.resyncs,
+                    d->lstats.skipped);
+            fprintf(out, "summary: partial packets dropped: %" PRIu64 " (%" PRIu64 " bytes)\n",
+                    d->lstats.partial_drops, d->lstats.partial_bytes);
+        }
         fprintf(out,
                 "summary: link: connects %" PRIu64 ", reconnects %" PRIu64 ", disconnects %" PRIu64
                 ", silences %" PRIu64 ", connect failures %" PRIu64 "\n",

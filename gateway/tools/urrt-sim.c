@@ -95,6 +95,7 @@ typedef struct options {
     char rtde_host[256];
     uint16_t rtde_port;
     const char *rtde_port_file;
+    bool rtde_fieldbus;       /* --fieldbus: an adapter owns input registers 0..23 */
     sim_rtde_controller rtde_controller;
     sim_clock clock;
     uint32_t length;
@@ -266,6 +267,19 @@ static void usage(FILE *out)
 "                           --replay of an RTDE capture, where to serve it\n"
 "                           (default " DEFAULT_RTDE_LISTEN ")\n"
 "      --rtde-port-file FILE  once listening, write the RTDE port to FILE\n"
+"      --fieldbus           as with an enabled fieldbus adapter (EtherNet/IP,\n"
+"                           PROFINET, Modbus): input registers 0..23 and bits\n"
+"                           0..63 (the two words) are IN_USE to every client\n"
+"  Inputs: a setup of inputs (I) gets the types of the input registers and\n"
+"  the other inputs a controller has, NOT_FOUND for a name this version\n"
+"  lacks, IN_USE for a variable another connected client set up (or the\n"
+"  fieldbus has); any of them makes recipe id 0. Valid recipes get ids 2, 3,\n"
+"  ... (1 is the output recipe's). A client's data package (U) takes effect\n"
+"  at the next control cycle and is read back by every client's output\n"
+"  recipe (input_int_register_24 as an output); one of an unknown recipe id,\n"
+"  of the wrong size or while not started is ignored, counted and told the\n"
+"  client in an error text. A client that leaves frees its variables; their\n"
+"  values stay.\n"
 "  An RTDE capture replayed is the controller it recorded: protocol versions\n"
 "  and version answered as recorded; the recorded variables, with their\n"
 "  recorded types, and no other (NOT_FOUND); a client's frequency f served as\n"
@@ -312,6 +326,10 @@ static void usage(FILE *out)
 "                                     field below the header\n"
 "      --fault rtde-backlog=B         disconnect a reader more than B bytes\n"
 "                                     behind (default 65536)\n"
+"      --fault rtde-hold-inputs[,for=MS]  a client's input variables stay\n"
+"                                     IN_USE for MS milliseconds (default\n"
+"                                     2000) after it left, as a controller\n"
+"                                     that still holds the old connection\n"
 "\n"
 "Other:\n"
 "  -v, --verbose            log every client (twice: debug)\n"
@@ -336,7 +354,8 @@ static void usage(FILE *out)
 "  " PROGRAM " --replay capture.bin --loop\n"
 "  " PROGRAM " --replay session.rtde --rtde 127.0.0.1:0 --rtde-port-file rtde.port\n"
 "  " PROGRAM " -c 5.12.3.1234 -l 127.0.0.1:0 --port-file rt.port \\\n"
-"           --rtde 127.0.0.1:0 --rtde-port-file rtde.port --fault rtde-text-every=500\n",
+"           --rtde 127.0.0.1:0 --rtde-port-file rtde.port --fault rtde-text-every=500\n"
+"  " PROGRAM " -c 5.12 --rtde 127.0.0.1:30004 --fieldbus --fault rtde-hold-inputs,for=3000\n",
             URRT_PACKET_MAX, DEFAULT_LENGTH);
 }
 
@@ -405,6 +424,9 @@ static bool parse_rtde_fault_kind(const char *kind, const char *value, fault_con
         f->rtde.bad_kind = SIM_RTDE_BAD_SIZE;
     } else if (strcmp(kind, "rtde-backlog") == 0) {
         f->rtde_backlog = (uint32_t)fault_value(kind, value, 1, 1u << 30);
+    } else if (strcmp(kind, "rtde-hold-inputs") == 0) {
+        no_value(kind, value);
+        f->rtde.hold_inputs_ms = SIM_RTDE_HOLD_DEFAULT_MS;
     } else {
         return false;
     }
@@ -440,8 +462,8 @@ static void parse_fault_kind(const char *kind, const char *value, fault_config *
     } else if (!parse_rtde_fault_kind(kind, value, f)) {
         cli_usage_error(PROGRAM, "unknown fault \"%s\": use close-after, reset-after, truncate-after, "
                         "garbage-every, tiny-writes, coalesce, stall-after, odd-length, freeze-after, freeze-every, "
-                        "or for RTDE rtde-refuse-v2, rtde-text-handshake, rtde-text-every, rtde-bad-package or "
-                        "rtde-backlog",
+                        "or for RTDE rtde-refuse-v2, rtde-text-handshake, rtde-text-every, rtde-bad-package, "
+                        "rtde-backlog or rtde-hold-inputs",
                         kind);
     }
 }
@@ -457,6 +479,8 @@ static void parse_fault_param(const char *spec, const char *kind, const char *ke
     } else if ((strcmp(kind, "freeze-after") == 0 || strcmp(kind, "freeze-every") == 0) &&
                strcmp(key, "for") == 0) {
         f->freeze_ms = fault_value(key, value, 1, 86400000);
+    } else if (strcmp(kind, "rtde-hold-inputs") == 0 && strcmp(key, "for") == 0) {
+        f->rtde.hold_inputs_ms = (uint32_t)fault_value(key, value, 1, 86400000);
     } else if (strcmp(kind, "rtde-text-every") == 0 && strcmp(key, "level") == 0) {
         f->rtde.text_level = (uint8_t)fault_value(key, value, 0, 3);
     } else if (strcmp(kind, "rtde-bad-package") == 0 && strcmp(key, "kind") == 0) {
@@ -552,7 +576,7 @@ static void parse_rate(const cli_option *row, const char *arg, void *obj)
 {
     command_line *cl = obj;
     char why[CONF_WHY_MAX];
-    if (!conf_number(arg, 0.1, 100000.0, &cl->opt.rate_hz, why, sizeof why)) {
+    if (!conf_rate_hz(arg, 0.1, 100000.0, &cl->opt.rate_hz, why, sizeof why)) {
         cli_bad_value(PROGRAM, row, arg, why);
     }
     cl->opt.rate_given = true;
@@ -570,6 +594,7 @@ static const cli_option option_table[] = {
     {"port-file", 0, required_argument, CLI_TEXT, AT(opt.port_file), 0, 0, NULL, NULL, NULL},
     {"rtde", 0, required_argument, CLI_TEXT, AT(rtde_arg), 0, 0, NULL, NULL, NULL},
     {"rtde-port-file", 0, required_argument, CLI_TEXT, AT(opt.rtde_port_file), 0, 0, NULL, NULL, NULL},
+    {"fieldbus", 0, no_argument, CLI_TRUE, AT(opt.rtde_fieldbus), 0, 0, NULL, NULL, NULL},
     {"clock", 0, required_argument, CLI_WORD, AT(opt.clock), 0, 0, NULL, clock_words, NULL},
     {"version", 'V', optional_argument, CLI_FN, 0, 0, 0, NULL, NULL, version_or_controller},
     {"controller", 'c', required_argument, CLI_TEXT, AT(version_arg), 0, 0, NULL, NULL, NULL},
@@ -665,6 +690,7 @@ static void resolve_rtde_replay(command_line *cl)
     if (o->fault.rtde_backlog == 0) {
         o->fault.rtde_backlog = SIM_RTDE_BACKLOG_DEFAULT;
     }
+    o->rtde_controller.fieldbus = o->rtde_fieldbus; /* kept when the capture is loaded */
     o->rtde = true;
 }
 
@@ -678,9 +704,11 @@ static void resolve_rtde(command_line *cl)
         return;
     }
     if (cl->rtde_arg == NULL) {
-        if (o->rtde_port_file != NULL || o->fault.rtde_given) {
+        if (o->rtde_port_file != NULL || o->fault.rtde_given || o->rtde_fieldbus) {
             cli_usage_error(PROGRAM, "%s goes with --rtde HOST:PORT or --replay of an RTDE capture",
-                            o->rtde_port_file != NULL ? "--rtde-port-file" : "an rtde-* fault");
+                            o->rtde_port_file != NULL ? "--rtde-port-file"
+                            : o->rtde_fieldbus        ? "--fieldbus"
+                                                      : "an rtde-* fault");
         }
         return;
     }
@@ -694,6 +722,7 @@ static void resolve_rtde(command_line *cl)
     if ((why = sim_rtde_controller_parse(version, &o->rtde_controller)) != NULL) {
         cli_usage_error(PROGRAM, "--rtde as controller %s: %s", version, why);
     }
+    o->rtde_controller.fieldbus = o->rtde_fieldbus;
     if (o->rate_hz != (double)o->rtde_controller.rate_hz) {
         cli_usage_error(PROGRAM, "--rtde: controller %s runs at %u Hz on both ports: drop --rate", version,
                         (unsigned)o->rtde_controller.rate_hz);
@@ -970,6 +999,9 @@ static void drop_client(sim *s, size_t i, urrt_log_level level, const char *why)
         s->record = NULL;
     }
     free(c->queue);
+    if (c->rtde != NULL) {
+        sim_rtde_session_end(c->rtde); /* its input variables free (or held), their values kept */
+    }
     free(c->rtde);
     s->clients[i] = s->clients[--s->nclients];
     if (i < s->nclients && s->clients[i].rtde != NULL) {

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "can_run.h"
+#include "rtde_only.h"
 
 #define CONFIG_MAX_KEYS 64
 
@@ -292,23 +293,20 @@ static bool set_lcm_url(void *obj, const struct conf_key *key, const char *url, 
     return true;
 }
 
-/* "every", "off" or "N Hz". */
+/* "every", "off" or a rate (conf_rate_hz: "50 Hz", or 50: a bare number is Hz). */
 static bool parse_rate(const char *key, const char *value, gw_rate *out, char *why, size_t n)
 {
-    char number[64];
-    size_t len = strcspn(value, " \tH");
-    const char *unit = value + len + strspn(value + len, " \t");
     if (strcmp(value, "every") == 0 || strcmp(value, "off") == 0) {
         *out = (gw_rate){value[0] == 'e' ? GW_RATE_EVERY : GW_RATE_OFF, 0};
         return true;
     }
-    snprintf(number, sizeof number, "%.*s", (int)(len < sizeof number ? len : sizeof number - 1), value);
-    if (!conf_number(number, -INFINITY, INFINITY, &out->hz, NULL, 0) || strcmp(unit, "Hz") != 0) {
-        return conf_fail(why, n, "%s must be \"every\", \"off\" or a rate such as \"50 Hz\", not \"%s\"", key, value);
+    if (!conf_rate_hz(value, 0.0, INFINITY, &out->hz, NULL, 0)) {
+        return conf_fail(why, n, "%s must be \"every\", \"off\" or a rate such as \"50 Hz\" (a bare 50 is Hz "
+                         "too), not \"%s\"", key, value);
     }
     if (out->hz < 0.01 || out->hz > GW_ROBOT_MAX_RATE_HZ) {
-        return conf_fail(why, n, "%s %s is out of range: from 0.01 Hz to %u Hz (the fastest robot)", key, value,
-                   GW_ROBOT_MAX_RATE_HZ);
+        return conf_fail(why, n, "%s %g Hz is out of range: from 0.01 Hz to %u Hz (the fastest robot)", key,
+                         out->hz, GW_ROBOT_MAX_RATE_HZ);
     }
     out->mode = GW_RATE_HZ;
     return true;
@@ -351,7 +349,7 @@ static bool set_lcm_rate(void *obj, const struct conf_key *key, const char *valu
         return conf_fail(why, n, "gateway_rate is a report rate: \"off\" or N Hz (default 1 Hz), not \"every\"");
     }
     if (k == GW_KIND_GATEWAY && rate.mode == GW_RATE_HZ && rate.hz > 100) {
-        return conf_fail(why, n, "gateway_rate %s is out of range: at most 100 Hz", value);
+        return conf_fail(why, n, "gateway_rate %g Hz is out of range: at most 100 Hz", rate.hz);
     }
     lcm->rate[k] = rate;
     lcm->rate_line[k] = at.line;
@@ -501,7 +499,6 @@ static bool set_port(void *obj, const struct conf_key *key, const char *value, s
     uint32_t port;
     char reason[CONF_WHY_MAX];
     (void)key;
-    (void)at;
     if (!conf_u32(value, 1, 65535, &port, reason, sizeof reason)) {
         if (CONF_IS_LEADING_ZERO(reason)) {
             return conf_fail(why, n, "port = \"%s\": %s", value, reason);
@@ -509,6 +506,7 @@ static bool set_port(void *obj, const struct conf_key *key, const char *value, s
         return conf_fail(why, n, "port must be a whole number from 1 to 65535, not \"%s\"", value);
     }
     robot->port = (uint16_t)port;
+    robot->port_line = at.line;
     return true;
 }
 
@@ -529,33 +527,33 @@ static bool set_source(void *obj, const struct conf_key *key, const char *value,
     return true;
 }
 
-/* "auto" or "N Hz": RTDE streams at most at the controller's own rate. */
+/* "auto" or a rate (conf_rate_hz: "125 Hz", or 125): RTDE streams at most at
+ * the controller's own rate. */
 static bool set_rtde_frequency(void *obj, const struct conf_key *key, const char *value, struct conf_at at,
                                char *why, size_t n)
 {
     gw_robot_config *robot = obj;
-    gw_rate rate;
+    double hz;
     (void)key;
     if (strcmp(value, "auto") == 0) {
         robot->rtde_frequency = 0.0;
         robot->rtde_frequency_line = at.line;
         return true;
     }
-    if (strcmp(value, "every") == 0 || strcmp(value, "off") == 0 ||
-        !parse_rate("rtde_frequency", value, &rate, why, n)) {
-        char number[64];
-        double hz;
-        size_t len = strcspn(value, " \tH");
-        snprintf(number, sizeof number, "%.*s", (int)(len < sizeof number ? len : sizeof number - 1), value);
-        if (conf_number(number, -INFINITY, INFINITY, &hz, NULL, 0) && hz > URRT_RTDE_HZ_E_SERIES) {
-            return conf_fail(why, n, "rtde_frequency %s is above %g Hz, the fastest any controller streams "
-                             "RTDE: give at most %g Hz, or auto", value, URRT_RTDE_HZ_E_SERIES,
-                             URRT_RTDE_HZ_E_SERIES);
-        }
-        return conf_fail(why, n, "rtde_frequency must be \"auto\" or a rate such as \"125 Hz\" (at most %g Hz), "
-                         "not \"%s\"", URRT_RTDE_HZ_E_SERIES, value);
+    if (!conf_rate_hz(value, 0.0, INFINITY, &hz, NULL, 0)) {
+        return conf_fail(why, n, "rtde_frequency must be \"auto\" or a rate such as \"125 Hz\" (a bare 125 is Hz "
+                         "too), at most %g Hz, not \"%s\"", URRT_RTDE_HZ_E_SERIES, value);
     }
-    robot->rtde_frequency = rate.hz;
+    if (hz > URRT_RTDE_HZ_E_SERIES) {
+        return conf_fail(why, n, "rtde_frequency %g Hz is above %g Hz, the fastest any controller streams RTDE: "
+                         "write rtde_frequency = %g Hz or less, or rtde_frequency = auto", hz,
+                         URRT_RTDE_HZ_E_SERIES, URRT_RTDE_HZ_E_SERIES);
+    }
+    if (hz < 0.01) {
+        return conf_fail(why, n, "rtde_frequency %g Hz is out of range: from 0.01 Hz to %g Hz, or auto", hz,
+                         URRT_RTDE_HZ_E_SERIES);
+    }
+    robot->rtde_frequency = hz;
     robot->rtde_frequency_line = at.line;
     return true;
 }
@@ -576,11 +574,20 @@ static bool set_rtde_values(void *obj, const struct conf_key *key, const char *v
     while (*(p += strspn(p, ", \t")) != '\0') {
         size_t len = strcspn(p, ", \t");
         int var = urrt_rtde_var_find(p, len);
+        char near[2 * URRT_RTDE_NAME_MAX + 16];
+        if (var < 0 && urrt_field_find(p, len) >= 0) {
+            return conf_fail(why, n, "rtde_values: \"%.*s\" is a RealTime field: it is published on NAME.STATE "
+                             "already; list only RTDE-only values here, by their RTDE names", (int)len, p);
+        }
+        if (var < 0 && conf_suggest_value(p, len, near, sizeof near) != NULL) {
+            return conf_fail(why, n, "rtde_values: \"%.*s\" is no RTDE output: did you mean %s?", (int)len, p,
+                             near);
+        }
         if (var < 0) {
             return conf_fail(why, n, "rtde_values: \"%.*s\" is no RTDE output (names are case-sensitive, e.g. "
                              "output_int_register_24, safety_status_bits; docs/rtde.md lists them)", (int)len, p);
         }
-        if (var < URRT_RTDE_MAPPED_COUNT) {
+        if (!rtde_only(var)) {
             return conf_fail(why, n, "rtde_values: \"%.*s\" is a value RealTime has too: it is published on "
                              "NAME.STATE already (as %s); list only RTDE-only values here", (int)len, p,
                              urrt_field((urrt_field_id)urrt_rtde_var_field(var))->name);
@@ -669,6 +676,29 @@ static bool robot_begin(config_ctx *ctx, gw_config *cfg, const char *name)
     return true;
 }
 
+/* The port against the source: RTDE never where a controller runs what it
+ * receives (lib's urrt_rtde_port_role: the link refuses it too), RealTime
+ * never on RTDE's port, where a controller waits for a handshake and sends
+ * nothing. A port given explicitly: the defaults are each source's own. */
+static void robot_port_check(config_ctx *ctx, const gw_robot_config *robot)
+{
+    const char *role = urrt_rtde_port_role(robot->port);
+    if (robot->port_line == 0) {
+        return;
+    }
+    if (robot->source == GW_SOURCE_RTDE && role != NULL) {
+        config_error(ctx, robot->port_line, "[robot %s]: port %u is %s, and this robot's source is rtde (line %d), "
+                     "which would send it RTDE's handshake: RTDE is port %u (write port = %u, or leave port out)",
+                     robot->name, (unsigned)robot->port, role, robot->source_line, (unsigned)URRT_RTDE_PORT,
+                     (unsigned)URRT_RTDE_PORT);
+    } else if (robot->source == GW_SOURCE_REALTIME && robot->port == URRT_RTDE_PORT) {
+        config_error(ctx, robot->port_line, "[robot %s]: port %u is RTDE's on every controller, where nothing is "
+                     "sent until a client's handshake, and this robot's source is realtime: add \"source = rtde\", "
+                     "or give RealTime's port (%u, or the read-only %u)", robot->name, (unsigned)robot->port,
+                     (unsigned)URRT_LINK_PORT_RW, (unsigned)URRT_LINK_PORT_RO);
+    }
+}
+
 /* What only an RTDE robot may say, and the rate it then sends at. */
 static void robot_source_check(config_ctx *ctx, gw_robot_config *robot)
 {
@@ -716,6 +746,7 @@ static void robot_finish(config_ctx *ctx, gw_config *cfg)
         if (robot->port == 0) {
             robot->port = robot->source == GW_SOURCE_RTDE ? URRT_RTDE_PORT : URRT_LINK_PORT_RW;
         }
+        robot_port_check(ctx, robot);
         robot_source_check(ctx, robot);
         robot->link.name = robot->name;
         robot->link.host = robot->host;
@@ -1292,8 +1323,8 @@ void gw_config_usage(FILE *out)
           "unless marked required; an unknown section or key is an error). Values:\n"
           "integers decimal or 0x hex (no leading zero); yes/no (true/false, on/off,\n"
           "1/0); DURATION a number and a unit: 250ms, 1.5 s, 2 min (us, ms, s, min),\n"
-          "a bare number only for keys named _ms (milliseconds). docs/can.md has the\n"
-          "signal grammar.\n",
+          "a bare number only for keys named _ms (milliseconds); N Hz a rate, a bare\n"
+          "number being Hz too (50 Hz or 50). docs/can.md has the signal grammar.\n",
           out);
     for (size_t i = 0; i < CONFIG_SECTION_COUNT; i++) {
         const config_section *sec = &config_sections[i];

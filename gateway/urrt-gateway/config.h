@@ -74,6 +74,7 @@ typedef struct gw_robot_config {
     char *host;
     int host_line;
     uint16_t port;         /* 0 until robot_finish: by source when not given */
+    int port_line;
     gw_source source;
     int source_line;
     double rtde_frequency; /* Hz; 0: auto, the controller's rate */

@@ -217,8 +217,7 @@ static bool rtde_attach(gw_robot *robot)
         urrt_log(URRT_LOG_ERR, "robot %s: %s", robot->cfg->name, why);
         return false;
     }
-    rtde_source_attach(robot->rtde, robot->link);
-    return true;
+    return rtde_source_attach(robot->rtde, robot->link);
 }
 
 /* A robot's link: serviced, its socket kept registered, its deadline

@@ -12,7 +12,7 @@
 
 #include <lcm/lcm.h>
 
-#include "can_rtde.h"
+#include "rtde_only.h"
 #include "urrt_gateway_t.h"
 #include "urrt_joints_t.h"
 #include "urrt_rtde_t.h"
@@ -342,7 +342,7 @@ static int encode_status(lcm_out *out, const gw_packet *pkt)
 }
 
 /* NAME.RTDE: the package's RTDE-only values, each element a double read as
- * the CAN output reads it (can_rtde: exact for every type but a 64-bit
+ * the CAN output reads it (rtde_only: exact for every type but a 64-bit
  * integer past 2^53; NaN where the package did not have it). */
 static int encode_rtde(lcm_out *out, gw_robot *robot, const gw_packet *pkt)
 {
@@ -354,8 +354,8 @@ static int encode_rtde(lcm_out *out, gw_robot *robot, const gw_packet *pkt)
     msg->controller_time = pkt->state->time[0];
     msg->sequence = (int64_t)pkt->sequence;
     for (size_t i = 0; i < cfg->rtde_value_count; i++) {
-        for (unsigned e = 0; e < can_rtde_elements(cfg->rtde_values[i]); e++) {
-            lr->rtde_values[n++] = can_rtde_element(pkt->rtde, cfg->rtde_values[i], e);
+        for (unsigned e = 0; e < rtde_only_elements(cfg->rtde_values[i]); e++) {
+            lr->rtde_values[n++] = rtde_only_element(pkt->rtde, cfg->rtde_values[i], e);
         }
     }
     msg->count = lr->rtde_count;
@@ -369,7 +369,7 @@ static bool name_rtde_values(lcm_robot *lr, const gw_robot_config *cfg)
 {
     unsigned total = 0, n = 0;
     for (size_t i = 0; i < cfg->rtde_value_count; i++) {
-        total += can_rtde_elements(cfg->rtde_values[i]);
+        total += rtde_only_elements(cfg->rtde_values[i]);
     }
     lr->rtde_names = calloc(total + 1, sizeof *lr->rtde_names);
     lr->rtde_values = calloc(total + 1, sizeof *lr->rtde_values);
@@ -378,7 +378,7 @@ static bool name_rtde_values(lcm_robot *lr, const gw_robot_config *cfg)
     }
     for (size_t i = 0; i < cfg->rtde_value_count; i++) {
         char name[URRT_RTDE_NAME_MAX];
-        unsigned count = can_rtde_elements(cfg->rtde_values[i]);
+        unsigned count = rtde_only_elements(cfg->rtde_values[i]);
         urrt_rtde_var_name(cfg->rtde_values[i], name, sizeof name);
         for (unsigned e = 0; e < count; e++) {
             int r = count == 1 ? asprintf(&lr->rtde_names[n], "%s", name)

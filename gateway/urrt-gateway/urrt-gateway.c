@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * urrt-gateway: reads the RealTime stream of one or more Universal Robots
- * controllers and publishes it on LCM (docs/gateway.md) and as CAN frames
- * (docs/can.md).
+ * urrt-gateway: reads one or more Universal Robots controllers, each over
+ * RealTime (port 30003) or RTDE (port 30004, source = rtde: docs/rtde.md),
+ * and publishes their state on LCM (docs/gateway.md) and as CAN frames or a
+ * CANopen node (docs/can.md, docs/canopen.md).
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -34,15 +35,17 @@ static void usage(FILE *out)
         "Usage: urrt-gateway [options] CONFIG\n"
         "       urrt-gateway --check-config CONFIG\n"
         "\n"
-        "Reads the RealTime interface (TCP 30003/30013) of the robots in CONFIG and\n"
-        "publishes each one's packets on LCM: NAME.STATE (urrt.state_t, every field),\n"
-        "NAME.JOINTS, NAME.TOOL, NAME.STATUS, and NAME.GATEWAY (urrt.gateway_t: link\n"
-        "state and counters, once per second even while the robot is unreachable).\n"
+        "Reads the robots in CONFIG, each over the RealTime interface (TCP 30003/30013)\n"
+        "or RTDE (TCP 30004, [robot] source = rtde), and publishes each one's packets on\n"
+        "LCM: NAME.STATE (urrt.state_t, every field), NAME.JOINTS, NAME.TOOL,\n"
+        "NAME.STATUS, NAME.RTDE (RTDE-only values) and NAME.GATEWAY (urrt.gateway_t:\n"
+        "link state and counters, once per second even while the robot is unreachable).\n"
         "With a [can] section it also sends the [frame NAME]s of CONFIG on a CAN bus,\n"
         "with a heartbeat frame, and --print-dbc describes them for the PLC side;\n"
         "with a [canopen] section it is a CANopen node, its frames TPDOs, and\n"
         "--print-eds writes its EDS.\n"
-        "Never writes to a robot. Stops on SIGINT or SIGTERM.\n"
+        "Never commands a robot: over RTDE it sends only the handshake that sets up\n"
+        "its recipe. Stops on SIGINT or SIGTERM.\n"
         "\n"
         "Options:\n"
         "  -c, --check-config     validate CONFIG, print what would run, exit\n"
@@ -180,6 +183,7 @@ static int c_tables_writer(FILE *out, gw_config *cfg, const char *path)
     for (unsigned i = 0; i < cfg->robot_count && i < GW_MAX_ROBOTS; i++) {
         robots[i].rtde = cfg->robots[i].source == GW_SOURCE_RTDE;
         robots[i].frequency = cfg->robots[i].rtde_frequency;
+        robots[i].port = cfg->robots[i].port;
     }
     return can_ctables_write(out, &cfg->can, cfg->can_run, cfg->co_run, robots, cfg->path);
 }

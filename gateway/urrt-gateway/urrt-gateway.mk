@@ -48,10 +48,13 @@ spy: deps-spy $(LCMTYPES_JAR)
 # publishing robot $(DEMO_ROBOT) on $(DEMO_LCM_URL), one summary line per second, until
 # Ctrl-C or DEMO_SECONDS. A simulator that cannot start stops the demo (exit 1).
 demo: deps-build all
-	@set -u; dir=$$(mktemp -d); sim=; gw=; timer=; \
+	@set -u; dir=$$(mktemp -d); sim=; gw=; timer=; tipped=; \
 	stop() { trap - EXIT INT TERM; \
 	  for p in $$timer $$gw $$sim; do kill $$p 2>/dev/null; done; wait 2>/dev/null; rm -rf "$$dir"; }; \
-	trap stop EXIT; trap 'stop; exit 0' INT TERM; \
+	tip() { [ -n "$$tipped" ] && return; tipped=1; \
+	  echo "demo: stopped. To watch the next one: make demo in one terminal, make spy in another" \
+	    "(both take DEMO_LCM_URL; channels $(DEMO_ROBOT).STATE, .JOINTS, .TOOL, .STATUS, .GATEWAY)"; }; \
+	trap stop EXIT; trap 'stop; tip; exit 0' INT TERM; \
 	$(BUILD)/bin/urrt-sim --listen 127.0.0.1:$(DEMO_PORT) --port-file "$$dir/port" --controller 5.10 --rate 500 & \
 	sim=$$!; \
 	while [ ! -s "$$dir/port" ]; do \
@@ -70,6 +73,4 @@ demo: deps-build all
 	  "(lcm-spy on $(DEMO_LCM_URL)), or $(BUILD)/bin/urrt-dump -n 1 127.0.0.1:$$port (the raw stream)"; \
 	echo "demo: runs until Ctrl-C$(if $(filter-out 0,$(DEMO_SECONDS)), (or $(DEMO_SECONDS) s), (make demo DEMO_SECONDS=10 stops after 10 s))"; \
 	wait $$gw; rc=$$?; gw=; \
-	echo "demo: stopped. To watch the next one: make demo in one terminal, make spy in another" \
-	  "(both take DEMO_LCM_URL; channels $(DEMO_ROBOT).STATE, .JOINTS, .TOOL, .STATUS, .GATEWAY)"; \
-	exit $$rc
+	tip; exit $$rc

@@ -21,7 +21,10 @@
  *
  * Without a source the link never sends: no write, no send, no shutdown;
  * closing the socket is the only thing it does to the peer. It writes only
- * bytes a source queued (urrt_link_send), and those only from its queue.
+ * bytes a source queued (urrt_link_send), and those only from its queue,
+ * and never to a port that runs what it receives (urrt_rtde_check_port):
+ * urrt_link_set_source refuses such a link, and the one send() below asks
+ * again, whatever a caller did.
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -40,6 +43,7 @@
 #include <unistd.h>
 
 #include "port.h"
+#include "urrt_rtde.h"
 
 /* One recv per chunk, and at most this many bytes per service call, so that
  * one busy link cannot starve the others in the same loop (about 58
@@ -49,7 +53,7 @@
 /* Connect failures are logged at the first one and then when their count
  * reaches 10, 100, 1000, ...: the log grows with the logarithm of an outage. */
 #define LINK_FAILURE_REPORT_BASE 10
-#define LINK_REASON_MAX 256
+#define LINK_REASON_MAX 384
 
 struct urrt_link {
     urrt_link_config cfg;
@@ -402,7 +406,11 @@ static void waiting_failed(urrt_link *link, uint64_t now_us, const char *reason)
 {
     char why[LINK_REASON_MAX + 160];
     uint64_t got = link->stats.bytes - link->conn_bytes_start;
-    if (got == 0) {
+    if (got == 0 && !link->has_source) {
+        snprintf(why, sizeof why, "it accepted, then %s before sending anything: an RTDE port (%u) sends "
+                 "nothing until a client's handshake; if this is one, read it as RTDE (urrt-dump --rtde, "
+                 "source = rtde)", reason, (unsigned)URRT_RTDE_PORT);
+    } else if (got == 0) {
         snprintf(why, sizeof why, "it accepted, then %s before sending anything", reason);
     } else if (link->has_source) {
         snprintf(why, sizeof why, "it accepted and sent %" PRIu64 " bytes but no data, then %s", got, reason);
@@ -743,6 +751,10 @@ static void read_available(urrt_link *link, bool wait)
  * function, where the connection must not end under it. */
 static void flush_queue(urrt_link *link)
 {
+    if (urrt_rtde_check_port(link->cfg.port) != URRT_OK) {
+        link->out_head = link->out_len = 0; /* never reached through set_source: the last guard */
+        return;
+    }
     while (link->out_len > 0 && link->write_errno == 0 && link->fd >= 0) {
         ssize_t n = send(link->fd, link->out + link->out_head, link->out_len, MSG_DONTWAIT | MSG_NOSIGNAL);
         if (n > 0) {
@@ -761,14 +773,24 @@ static void flush_queue(urrt_link *link)
     }
 }
 
-void urrt_link_set_source(urrt_link *link, const urrt_link_source *source)
+int urrt_link_set_source(urrt_link *link, const urrt_link_source *source)
 {
-    if (link != NULL) {
-        link->has_source = source != NULL;
-        if (source != NULL) {
-            link->source = *source;
-        }
+    const char *role;
+    if (link == NULL) {
+        return URRT_E_ARG;
     }
+    role = source != NULL ? urrt_rtde_port_role(link->cfg.port) : NULL;
+    if (role != NULL) {
+        urrt_log(URRT_LOG_ERR, "robot %s: will not write to %s: port %u is %s; RTDE is port %u",
+                 link->name, link->peer, (unsigned)link->cfg.port, role, (unsigned)URRT_RTDE_PORT);
+        link->has_source = false;
+        return URRT_RTDE_E_SCRIPT_PORT;
+    }
+    link->has_source = source != NULL;
+    if (source != NULL) {
+        link->source = *source;
+    }
+    return URRT_OK;
 }
 
 int urrt_link_send(urrt_link *link, const uint8_t *data, size_t len)

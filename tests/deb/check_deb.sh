@@ -3,7 +3,14 @@
 # check-deb: the Debian package as a user gets it.
 #  - make deb builds it; lintian finds no error and no warning (debian/ overrides justify any)
 #  - its contents: programs, unit and template unit (neither enabled), conffile, man pages, docs,
-#    examples, .lcm, jar, C header, library and pkg-config file
+#    examples, .lcm, jar, library and pkg-config file
+#  - the library whole: liburrt.a's members are lib/lib.mk's objects, and every header of lib/ they
+#    are compiled from (cc -MM) is installed as in the tree; a program using a function of each
+#    header compiles and links with the package's `pkg-config urrt` flags alone
+#  - what a robot is read over (the choices of [robot] source in the package's own --print-keys):
+#    urrt-gateway(8) and urrt-gateway.ini(5) as installed name every [robot] key and each
+#    `source = NAME`, the package's Description and urrt.pc name each source
+#    (tests/man/check_man.py --named, --sources: check-man's test of the pages in the tree)
 #  - every relative link in the installed README and documents resolves in the unpacked package
 #    (tests/deb/doc_links.py), and the README keeps all the links it has in the tree
 #  - dpkg installs it into a scratch root (a bootstrap of busybox and a dpkg database holding its
@@ -13,11 +20,12 @@
 set -u
 BUILD=${BUILD:-build}
 MAKE=${MAKE:-make}
+LIB_SRCS=${LIB_SRCS:-}   # liburrt.a's sources, from tests/deb/deb.mk (lib/lib.mk's LIB_HOST_SRCS)
 passed=0; failed=0
 check() {
   what=$1; shift
   if "$@" >/dev/null 2>&1; then passed=$((passed + 1)); echo "ok: $what"
-  else failed=$((failed + 1)); echo "FAIL: $what"; fi
+  else failed=$((failed + 1)); echo "FAIL: $what"; return 1; fi
 }
 finish() {
   echo "$passed passed, $failed failed"
@@ -45,8 +53,7 @@ for f in /usr/bin/urrt-gateway /usr/bin/urrt-dump /usr/bin/urrt-sim /usr/bin/urr
          /usr/share/doc/urrt/copyright /usr/share/doc/urrt/README.md /usr/share/doc/urrt/gateway.md \
          /usr/share/doc/urrt/examples/canopen.ini \
          /usr/share/urrt/urrt-gateway.example.ini /usr/share/urrt/lcmtypes/state_t.lcm \
-         /usr/share/java/urrt-lcmtypes.jar /usr/include/urrt.h /usr/include/urrt_can.h /usr/include/urrt_cantx.h \
-         /usr/include/urrt_co.h; do
+         /usr/share/java/urrt-lcmtypes.jar; do
   check "contents: $f" grep -qx "$f" "$T/contents"
 done
 check "contents: liburrt.a and urrt.pc under /usr/lib/<multiarch>" \
@@ -63,6 +70,49 @@ installed=$(sed -n 's|^usr/share/doc/urrt/README.md: \([0-9]*\) links.*|\1|p' "$
 check "the installed README keeps the tree's ${tree:-?} relative links (has ${installed:-?})" \
   sh -c "[ -n '$tree' ] && [ '$tree' = '$installed' ]"
 check "no document compressed (links name .md files)" sh -c "! grep -q '^/usr/share/doc/urrt/.*\.md\.gz$' '$T/contents'"
+
+# The library whole, its headers derived from it: liburrt.a's members are the objects of lib/lib.mk's
+# sources (LIB_SRCS, from tests/deb/deb.mk), and each header of lib/ those are compiled from is installed.
+lib=$(grep -m 1 '^/usr/lib/[^/]*/liburrt\.a$' "$T/contents")
+members=$(ar t "$T/pkg$lib" 2>/dev/null | sort | tr '\n' ' ')
+objects=$(for s in $LIB_SRCS; do echo "$(basename "$s" .c).o"; done | sort | tr '\n' ' ')
+check "liburrt.a's members are lib/lib.mk's objects (${members:-none})" sh -c "[ -n '$objects' ] && [ '$members' = '$objects' ]" ||
+  echo "  the package's library is not the one lib/lib.mk builds: see debian/rules and gateway/install/install.mk"
+headers=$(${CC:-cc} -MM $LIB_SRCS | tr ' \\' '\n\n' | grep '\.h$' | xargs -r realpath --relative-to=. | grep '^lib/' | sort -u)
+check "cc -MM names the headers liburrt.a's sources are compiled from: $(echo $headers)" [ -n "$headers" ]
+for h in $headers; do
+  check "contents: /usr/include/${h##*/}, as $h (liburrt.a is compiled from it)" cmp -s "$h" "$T/pkg/usr/include/${h##*/}" ||
+    echo "  install it with the library: gateway/install/install.mk installs each LIB_SRCS module's header (LIB_INSTALL_HDRS)"
+done
+# A program using a function of each header, built with the package's pkg-config file alone.
+nm -g --defined-only "$T/pkg$lib" 2>/dev/null | awk '$2 == "T" { print $3 }' | sort -u > "$T/defined"
+{ for h in $headers; do echo "#include <${h##*/}>"; done
+  echo 'typedef void (*fn)(void);'; echo 'static volatile fn used[] = {'
+  for h in $headers; do
+    f=$(grep -oE "\\<$(basename "$h" .h)_[a-z0-9_]+\\(" "$h" | tr -d '(' | sort -u | comm -12 - "$T/defined" | head -n 1)
+    echo "    (fn)&${f:-no_function_of_$(basename "$h" .h)_in_liburrt},"
+  done
+  echo '};'; echo 'int main(void) { return used[0] == 0; }'; } > "$T/use.c"
+pcdir=$T/pkg${lib%/*}/pkgconfig
+flags=$(PKG_CONFIG_SYSROOT_DIR="$T/pkg" PKG_CONFIG_LIBDIR="$pcdir" pkg-config --cflags --libs urrt 2>&1)
+${CC:-cc} -std=c99 -Wall -Wextra -Wpedantic -Werror -o "$T/use" "$T/use.c" $flags > "$T/use.log" 2>&1; rc=$?
+sed 's/^/cc: /' "$T/use.log"
+check "a program using a function of each header ($(echo $(grep -o '&[a-z0-9_]*' "$T/use.c" | tr -d '&'))) builds with \`pkg-config urrt\` alone ($(echo $flags | sed "s|$T/pkg|PKG|g"))" \
+  sh -c "[ $rc = 0 ] && '$T/use'"
+
+# What a robot is read over, as the package's own --print-keys says: named in the installed pages,
+# the package's Description and urrt.pc (check_man.py: the test check-man runs on the tree's pages).
+/usr/bin/python3 tests/man/check_man.py --named "$T/pkg/usr/bin/urrt-gateway" \
+  "$T/pkg/usr/share/man/man8/urrt-gateway.8.gz" "$T/pkg/usr/share/man/man5/urrt-gateway.ini.5.gz" > "$T/named" 2>&1; rc=$?
+sed "s|^|pages: |; s|$T/pkg||g" "$T/named"
+check "urrt-gateway(8) and urrt-gateway.ini(5) as installed name every [robot] key and each source (source = NAME)" \
+  [ "$rc" = 0 ]
+dpkg-deb -f "$deb" Description > "$T/Description"
+grep '^Description:' "$pcdir/urrt.pc" > "$T/urrt.pc-Description" 2>/dev/null
+/usr/bin/python3 tests/man/check_man.py --sources "$T/pkg/usr/bin/urrt-gateway" "$T/Description" "$T/urrt.pc-Description" \
+  > "$T/sources" 2>&1; rc=$?
+sed "s|^|sources: |; s|$T/||g" "$T/sources"
+check "the package's Description and urrt.pc name each source a robot is read over" [ "$rc" = 0 ]
 
 dpkg-deb --ctrl-tarfile "$deb" | tar -x -C "$T" ./conffiles ./postinst 2>/dev/null
 check "conffiles: /etc/urrt/gateway.ini alone" sh -c "[ \"\$(cat '$T/conffiles')\" = /etc/urrt/gateway.ini ]"

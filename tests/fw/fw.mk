@@ -84,6 +84,14 @@ $(FW)/rtde-types/gateway.ini: tests/fw/rtde-types.ini
 $(FW)/%/tables.c: $(FW)/%/gateway.ini $(BUILD)/bin/urrt-gateway
 	$(BUILD)/bin/urrt-gateway --print-c-tables -o $@ $<
 
+# rtde-port: rtde-types' tables with the robot's port made RealTime's (30003), which the
+# configuration check refuses and so only an edit makes: the image must refuse it, sending nothing.
+$(FW)/rtde-port/tables.c: $(FW)/rtde-types/tables.c
+	@mkdir -p $(@D)
+	sed 's/^\(const uint16_t urrt_gateway_rtde_port\[1\] = {\)30004};/\130003};/' $< > $@
+	@grep -q '^const uint16_t urrt_gateway_rtde_port\[1\] = {30003};' $@ || \
+	  { echo "$@: $< has no port table of one robot on 30004 to change"; exit 1; }
+
 $(FW)/lib/%.o: lib/%.c $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(TGT_CM) $(TGT_M4) -Os $(TGT_LIB_FLAGS) -c $< -o $@
@@ -101,11 +109,12 @@ $(FW)/%/fw_gateway.elf: tests/fw/fw_gateway.c tests/fw/fw_rx.h tests/target/cm.c
   tests/target/an386.ld $(FW)/%/tables.o $$(if $$(filter $$*,$$(FW_CANOPEN)),$(FW)/%/rx.o $(FW)/%/rx.log) \
   $$(FW_LIB_OBJS)
 	$(TGT_CM) $(TGT_M4) -Os $(TGT_FLAGS) -DURRT_TARGET_CORTEX_M $(if $(filter $*,$(FW_CANOPEN)),-DFW_CANOPEN) \
-	  $(if $(filter $*,$(FW_RTDE)),-DFW_RTDE) \
+	  $(if $(filter $*,$(FW_RTDE) rtde-port),-DFW_RTDE) \
 	  -Itests/fw tests/target/cm.c tests/fw/fw_gateway.c $(FW)/$*/tables.o \
 	  $(if $(filter $*,$(FW_CANOPEN)),$(FW)/$*/rx.o) $(FW_LIB_OBJS) -T tests/target/an386.ld $(TGT_LINK) -o $@
 
-check-fw-gateway: $(foreach c,$(FW_CONFIGS),$(FW)/$(c)/fw_gateway.elf $(FW)/$(c)/gateway.ini) $(FW)/capture.bin \
+check-fw-gateway: $(foreach c,$(FW_CONFIGS) rtde-port,$(FW)/$(c)/fw_gateway.elf) \
+  $(foreach c,$(FW_CONFIGS),$(FW)/$(c)/gateway.ini) $(FW)/capture.bin \
   $(FW)/canopen-vm/capture.bin $(FW)/canopen-vm/node.log $(foreach c,$(FW_RTDE),$(FW)/$(c)/controller.bin) \
   $(FW)/rtde-capture.bin tests/fw/run.sh tests/fw/compare.sh tests/fw/rtde_controller.py
 	$(call suite,check-fw-gateway,sh tests/fw/run.sh $(BUILD) $(FW) $(FW_CONFIGS))

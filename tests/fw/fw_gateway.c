@@ -57,6 +57,7 @@ int urrt_gateway_co_init(urrt_co *co, urrt_cantx *tx, size_t *bad_item);
 extern const uint16_t *const urrt_gateway_rtde_vars[];
 extern const size_t urrt_gateway_rtde_var_count[];
 extern const double urrt_gateway_rtde_frequency[];
+extern const uint16_t urrt_gateway_rtde_port[];
 void urrt_gateway_rtde_values(size_t robot, const urrt_rtde_values *values);
 #endif
 
@@ -305,6 +306,17 @@ int main(void)
     }
 #endif
 #ifdef FW_RTDE
+    /* Never a byte to a port that runs what it receives: checked before the
+     * connection, whatever the tables say (check-fw-gateway's rtde-port
+     * image is given 30003). */
+    if (urrt_rtde_check_port(urrt_gateway_rtde_port[0]) != URRT_OK) {
+        target_puts("fw_gateway: refusing RTDE on port ");
+        target_put_uint(urrt_gateway_rtde_port[0]);
+        target_puts(": ");
+        target_puts(urrt_rtde_port_role(urrt_gateway_rtde_port[0]));
+        target_puts("\n");
+        return 1;
+    }
     /* The TCP connection is up: the handshake with the generated recipe. */
     urrt_rtde_init(&session);
     if (urrt_rtde_begin(&session, urrt_gateway_rtde_vars[0], urrt_gateway_rtde_var_count[0],

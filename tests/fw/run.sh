@@ -108,6 +108,18 @@ for name in "$@"; do
     passed=$((passed + 1))
   fi
 done
+# The image given RealTime's port for its RTDE robot (fw.mk's rtde-port) refuses it and writes
+# no request: not one "rtde> " line.
+qemu-system-arm -nographic -monitor none -serial none \
+  -semihosting-config "enable=on,target=native,arg=$fw/rtde-types/controller.bin" \
+  -M mps2-an386 -kernel "$fw/rtde-port/fw_gateway.elf" > "$fw/rtde-port/firmware.out" 2>&1
+if grep -q '^fw_gateway: refusing RTDE on port 30003: the RealTime interface, which runs the URScript it receives$' \
+     "$fw/rtde-port/firmware.out" && ! grep -q 'rtde> ' "$fw/rtde-port/firmware.out"; then
+  echo "ok: rtde-port: the image refuses RTDE on port 30003 and sends no request"; passed=$((passed + 1))
+else
+  echo "FAIL: rtde-port: the image given port 30003 did not refuse it before any request:"
+  head -n 3 "$fw/rtde-port/firmware.out"; failed=$((failed + 1))
+fi
 echo "footprint of the canopen image on the Cortex-M4 at -Os (arm-none-eabi-size): the image; its tables; lib/"
 arm-none-eabi-size "$fw/canopen/fw_gateway.elf" "$fw/canopen/tables.o" "$fw"/lib/*.o
 echo "footprint of the rtde-plc image (RTDE, a CANopen node) on the Cortex-M4 at -Os: the image; its tables"

@@ -941,6 +941,43 @@ def t_rtde_refused(args):
           "not a tight loop" % (tries, span))
 
 
+def t_rtde_at_realtime(args):
+    """source = rtde at a port that streams RealTime (the simulator's, on a
+    port the configuration check cannot know): the failure says the peer
+    streams without a handshake, as RealTime does, and how to read it;
+    nothing is published."""
+    r = Run(args, "rdrt")
+    try:
+        r.sub()
+        _, port, _ = r.sim_rtde("--version", "5.10", "--clock", "realtime")
+        r.gateway(lcm_ini(r, gateway_rate="10 Hz") + robot_ini(r.prefix, port, "source = rtde\n"))
+        r.wait(lambda: "streams without a handshake" in r.log(), "rtde at realtime: the failure is logged")
+    finally:
+        r.stop()
+    lines = [l for l in r.log().splitlines() if "streams without a handshake" in l]
+    check(lines and "as a RealTime port (30003) does: its first bytes announce a 1220-byte RealTime packet" in
+          lines[0] and "source = realtime" in lines[0] and not r.channel("STATE"),
+          "rtde at realtime: the failure names RealTime and source = realtime, nothing published (%r)" % lines[:1])
+
+
+def t_rtde_frequency(args):
+    """rtde_frequency past what the controller streams, the version not in
+    the file: the controller's answer refuses it, and the one error line
+    names both rates and the controller's version, and says what to do."""
+    r = Run(args, "rdfreq")
+    try:
+        _, _, rport = r.sim_rtde("--version", "3.10", "--clock", "realtime")
+        r.gateway(lcm_ini(r) + robot_ini(r.prefix, rport, "source = rtde\nrtde_frequency = 250\n"
+                                         "backoff_initial = 100 ms\nbackoff_max = 500 ms\n"))
+        said = "rtde_frequency 250 Hz is past this 3.10 controller's maximum of 125 Hz: lower it or use auto"
+        wait_for(lambda: said in r.log(), WAIT)
+    finally:
+        r.stop()
+    lines = [l for l in r.log().splitlines() if "controller's maximum" in l]
+    check(len(lines) == 1 and said in lines[0] and "error" in lines[0],
+          "rtde frequency: one error line names both rates and the controller (%r)" % lines[:2])
+
+
 def t_rtde_fallback(args):
     """A controller that refuses protocol 2 gets protocol 1; its text
     messages go to the log at their level."""
@@ -1112,8 +1149,14 @@ BAD_CONFIGS = [
     ("url not multicast", "[lcm]\nurl = udpm://10.1.2.3:7667\n[robot a]\nhost = h\n", 2, r"not a multicast group"),
     ("url ttl", "[lcm]\nurl = udpm://239.255.76.67:7667?ttl=300\n[robot a]\nhost = h\n", 2, r"ttl must be 0 to 255"),
     ("url option", "[lcm]\nurl = udpm://239.255.76.67:7667?tll=0\n[robot a]\nhost = h\n", 2, r'unknown udpm option "tll"'),
-    ("rate syntax", "[lcm]\njoints_rate = 50\n[robot a]\nhost = h\n", 2, r'"every", "off" or a rate'),
+    ("rate syntax", "[lcm]\njoints_rate = 50 kHz\n[robot a]\nhost = h\n", 2,
+     r'joints_rate must be "every", "off" or a rate such as "50 Hz" \(a bare 50 is Hz too\), not "50 kHz"'),
     ("rate range", "[lcm]\njoints_rate = 501 Hz\n[robot a]\nhost = h\n", 2, r"out of range"),
+    # A bare number is Hz, in every key that takes a rate: the same message as with the unit.
+    ("rate range, bare", "[lcm]\njoints_rate = 501\n[robot a]\nhost = h\n", 2,
+     r"joints_rate 501 Hz is out of range: from 0.01 Hz to 500 Hz"),
+    ("gateway rate, bare", "[lcm]\ngateway_rate = 200\n[robot a]\nhost = h\n", 2,
+     r"gateway_rate 200 Hz is out of range: at most 100 Hz"),
     ("rate above robot", "[lcm]\ntool_rate = 200 Hz\n\n[robot a]\nhost = h\nversion = 3.10\n", 2,
      r'above the 125 Hz robot "a" sends \(version 3.10, line 6\)'),
     ("gateway every", "[lcm]\ngateway_rate = every\n[robot a]\nhost = h\n", 2, r"not \"every\""),
@@ -1132,6 +1175,25 @@ BAD_CONFIGS = [
     ("rtde shared value", "[robot a]\nhost = h\nsource = rtde\nrtde_values = actual_q\n", 4,
      r"on NAME.STATE already \(as q_actual\)"),
     ("rtde source", "[robot a]\nhost = h\nsource = RTDE\n", 3, r'source must be "realtime"'),
+    # RTDE never to a port that runs what it receives, or its twin: at the port's line, naming the source's.
+    ("rtde on realtime's port", "[robot a]\nhost = h\nsource = rtde\nport = 30003\n", 4,
+     r"port 30003 is the RealTime interface, which runs the URScript it receives, and this robot's source is rtde "
+     r"\(line 3\), which would send it RTDE's handshake: RTDE is port 30004 \(write port = 30004, or leave port out\)"),
+    ("rtde on the dashboard", "[robot a]\nhost = h\nport = 29999\nsource = rtde\n", 3,
+     r"port 29999 is the dashboard server, which runs the commands it receives, and this robot's source is rtde "
+     r"\(line 4\)"),
+    ("rtde on the primary", "[robot a]\nhost = h\nsource = rtde\nport = 30001\n", 4, r"port 30001 is the primary"),
+    ("rtde on the secondary", "[robot a]\nhost = h\nsource = rtde\nport = 30002\n", 4, r"port 30002 is the second"),
+    ("rtde on a twin", "[robot a]\nhost = h\nsource = rtde\nport = 30011\n", 4,
+     r"port 30011 is the primary client interface's read-only twin"),
+    ("rtde on a twin", "[robot a]\nhost = h\nsource = rtde\nport = 30012\n", 4, r"port 30012 is the secondary"),
+    ("rtde on realtime's twin", "[robot a]\nhost = h\nsource = rtde\nport = 30013\n", 4,
+     r"port 30013 is the RealTime interface's read-only twin"),
+    ("rtde on the interpreter", "[robot a]\nhost = h\nsource = rtde\nport = 30020\n", 4,
+     r"port 30020 is the interpreter mode's socket"),
+    ("realtime on rtde's port", "[robot a]\nhost = h\nport = 30004\n", 3,
+     r"port 30004 is RTDE's on every controller, where nothing is sent until a client's handshake, and this "
+     r"robot's source is realtime: add \"source = rtde\", or give RealTime's port \(30003, or the read-only 30013\)"),
     ("rtde-only value on CAN, realtime robot", "[robot a]\nhost = h\n[can]\ninterface = log:-\nheartbeat_id = 0x701\n"
      "[frame f]\nid = 0x181\nperiod_ms = 10\nsignal = safety_status_bits @0|32 intel unsigned\n", 9,
      r'signal safety_status_bits: an RTDE-only value, and robot "a" reads RealTime, which has none'),
@@ -1141,6 +1203,13 @@ BAD_CONFIGS = [
     ("rtde on 1.x", "[robot a]\nhost = h\nversion = 1.8\nsource = rtde\n", 3, r"version 1.8 has no RTDE"),
     ("rtde frequency", "[robot a]\nhost = h\nsource = rtde\nrtde_frequency = 501 Hz\n", 4,
      r"above 500 Hz, the fastest any controller streams RTDE"),
+    # Bare, as "give at most 500 Hz" was read: the advice is written as the file takes it.
+    ("rtde frequency, bare", "[robot a]\nhost = h\nsource = rtde\nrtde_frequency = 600\n", 4,
+     r"rtde_frequency 600 Hz is above 500 Hz, the fastest any controller streams RTDE: write rtde_frequency = "
+     r"500 Hz or less, or rtde_frequency = auto$"),
+    ("rtde frequency syntax", "[robot a]\nhost = h\nsource = rtde\nrtde_frequency = fast\n", 4,
+     r'rtde_frequency must be "auto" or a rate such as "125 Hz" \(a bare 125 is Hz too\), at most 500 Hz, '
+     r'not "fast"'),
     ("rtde frequency of the version", "[robot a]\nhost = h\nversion = 3.10\nsource = rtde\n"
      "rtde_frequency = 200 Hz\n", 5, r"above the 125 Hz version 3.10"),
     ("rtde frequency on realtime", "[robot a]\nhost = h\nrtde_frequency = 125 Hz\n", 3,
@@ -1185,6 +1254,18 @@ def t_configs(args):
     p = subprocess.run([args.gateway, "--check-config", good], capture_output=True, text=True, timeout=10)
     check(p.returncode == 0 and "robot a: [::1]:30003, version 1.8, connect 1500 ms" in p.stdout and
           "b.JOINTS: 125 Hz" in p.stdout, "config: comments, IPv6, versions, lengths and durations accepted")
+    # A bare number is Hz wherever a rate is given: rtde_frequency at the most the message above
+    # allows, and an [lcm] rate.
+    bare = os.path.join(d, "bare.ini")
+    with open(bare, "w") as f:
+        f.write("[lcm]\njoints_rate = 50\ngateway_rate = 2\n[robot a]\nhost = h\nsource = rtde\n"
+                "rtde_frequency = 500\n[robot b]\nhost = h\nsource = rtde\nrtde_frequency = 125Hz\n")
+    p = subprocess.run([args.gateway, "--check-config", bare], capture_output=True, text=True, timeout=10)
+    check(p.returncode == 0 and re.search(r"robot a: .*\n  rtde: \d+ values at 500 Hz", p.stdout) and
+          re.search(r"robot b: .*\n  rtde: \d+ values at 125 Hz", p.stdout) and "a.JOINTS: 50 Hz" in p.stdout and
+          "a.GATEWAY: 2 Hz" in p.stdout,
+          "config: a bare number is Hz (rtde_frequency = 500, joints_rate = 50, gateway_rate = 2), 125Hz too "
+          "(got %d: %s)" % (p.returncode, (p.stderr or p.stdout).strip().splitlines()[:2]))
     many = os.path.join(d, "many.ini")
     with open(many, "w") as f:
         f.write("[robot a]\nhost = h\nport = 0\nversion = x\n[nope]\n")
@@ -1361,6 +1442,8 @@ def main():
         ("publish_reopen", lambda: t_publish_reopen(args)),
         ("rtde_values", lambda: t_rtde_values(args)),
         ("rtde_refused", lambda: t_rtde_refused(args)),
+        ("rtde_at_realtime", lambda: t_rtde_at_realtime(args)),
+        ("rtde_frequency", lambda: t_rtde_frequency(args)),
         ("rtde_fallback", lambda: t_rtde_fallback(args)),
         ("rtde_restart", lambda: t_restart(args, rtde=True)),
         ("rtde_stall", lambda: t_stall(args, rtde=True)),

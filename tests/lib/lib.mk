@@ -10,7 +10,8 @@
 #                   needs is libgcc's and docs/footprint.md's symbol table; footprint vs that
 #                   page; mixing URRT_MAX_DOUBLES values fails to link
 # Executed on emulated Cortex-M and big-endian CPUs: tests/target/target.mk.
-#   check-docs      docs/protocol.md's generated tables are current (make docs rewrites them)
+#   check-docs      the generated tables of docs/protocol.md (fields, enums) and docs/rtde.md
+#                   (RTDE variables) are lib's, row for row (make docs rewrites them)
 #   bench-lib       ns/packet at every length of lib's controller table against the copy
 #                   floor (the packet's doubles byte-swapped by the CPU's widest vectors into
 #                   a urrt_state-sized buffer, the rest set), the store floor (memset of a
@@ -109,17 +110,19 @@ check-lib-san: $(LIBT)/test_lib_san $(LIB_VECTORS)
 check-cross: $(LIB_HOST_DEPS) $(wildcard tests/cross/*)
 	$(call suite,$@,sh tests/cross/check.sh $(BUILD)/cross docs/footprint.md "$(LIB_WARN)" $(LIB_SRCS))
 
-# ---- docs/protocol.md tables from the field table ----------------------------
+# ---- docs/protocol.md's and docs/rtde.md's tables from lib's tables ----------
+
+DOC_TABLE_DOCS := docs/protocol.md docs/rtde.md
 
 $(LIBT)/doc_table: tests/lib/doc_table.c $(LIBURRT) $(LIB_HDRS)
 	@mkdir -p $(@D)
 	$(CC) $(LIB_TEST_CFLAGS) $(OPT) $< $(LIBURRT) -o $@
 
 docs: $(LIBT)/doc_table
-	sh tests/lib/docs.sh $(LIBT)/doc_table docs/protocol.md
+	sh tests/lib/docs.sh $(LIBT)/doc_table $(DOC_TABLE_DOCS)
 
 check-docs: $(LIBT)/doc_table
-	$(call suite,$@,sh tests/lib/docs.sh $(LIBT)/doc_table docs/protocol.md --check)
+	$(call suite,$@,sh tests/lib/docs.sh $(LIBT)/doc_table $(DOC_TABLE_DOCS) --check)
 
 # ---- fuzzing -------------------------------------------------------------------
 

@@ -22,42 +22,7 @@
 #define IN_MAX 65536
 #define TRANSCRIPT_MAX 65536
 
-typedef struct named {
-    const char *name;
-    int value;
-} named;
-
-static const named errors[] = {
-    {"SIZE_SMALL", URRT_RTDE_E_SIZE_SMALL}, {"SIZE_LARGE", URRT_RTDE_E_SIZE_LARGE},
-    {"REPLY_LENGTH", URRT_RTDE_E_REPLY_LENGTH}, {"REPLY_VALUE", URRT_RTDE_E_REPLY_VALUE},
-    {"VERSION_ZERO", URRT_RTDE_E_VERSION_ZERO}, {"DATA_EARLY", URRT_RTDE_E_DATA_EARLY},
-    {"RECIPE_ID", URRT_RTDE_E_RECIPE_ID}, {"DATA_SIZE", URRT_RTDE_E_DATA_SIZE},
-    {"TYPE_TOKEN", URRT_RTDE_E_TYPE_TOKEN}, {"TYPE_COUNT", URRT_RTDE_E_TYPE_COUNT},
-    {"TEXT_LENGTH", URRT_RTDE_E_TEXT_LENGTH}, {"PAUSE_REFUSED", URRT_RTDE_E_PAUSE_REFUSED},
-    {"NOT_FOUND", URRT_RTDE_E_NOT_FOUND}, {"TYPE_MISMATCH", URRT_RTDE_E_TYPE_MISMATCH},
-    {"PROTOCOL_REFUSED", URRT_RTDE_E_PROTOCOL_REFUSED}, {"START_REFUSED", URRT_RTDE_E_START_REFUSED},
-    {"FREQUENCY", URRT_RTDE_E_FREQUENCY}, {"NAMES_TOO_LONG", URRT_RTDE_E_NAMES_TOO_LONG},
-    {"DUPLICATE", URRT_RTDE_E_DUPLICATE}, {"ARG", URRT_E_ARG},
-};
-
-static const named kinds[] = {
-    {"protocol", URRT_RTDE_EV_PROTOCOL}, {"fallback", URRT_RTDE_EV_FALLBACK}, {"controller", URRT_RTDE_EV_CONTROLLER},
-    {"recipe", URRT_RTDE_EV_RECIPE}, {"started", URRT_RTDE_EV_STARTED}, {"paused", URRT_RTDE_EV_PAUSED},
-    {"text", URRT_RTDE_EV_TEXT}, {"data", URRT_RTDE_EV_DATA}, {"drop", URRT_RTDE_EV_DROP},
-    {"config", URRT_RTDE_EV_CONFIG},
-};
-
-static int lookup(const named *t, size_t n, const char *name)
-{
-    for (size_t i = 0; i < n; i++) {
-        if (strcmp(t[i].name, name) == 0) {
-            return t[i].value;
-        }
-    }
-    CHECK(0, "unknown word %s in the vectors", name);
-    return 0;
-}
-#define LOOKUP(t, name) lookup(t, sizeof t / sizeof t[0], name)
+#include "rtde_names.h"
 
 static size_t unhex(const char *h, uint8_t *out, size_t cap)
 {
@@ -666,6 +631,27 @@ static void test_api_errors(void)
     CHECK_EQ_STR(urrt_rtde_strerror(URRT_E_NO_SPACE), urrt_strerror(URRT_E_NO_SPACE));
 }
 
+/* The ports an RTDE client never writes to, as UR documents the controller's
+ * servers (dashboard 29999; primary, secondary, RealTime 30001-30003 and
+ * their read-only twins 30011-30013; interpreter mode 30020), and their
+ * neighbours, which a forwarded or simulated RTDE port may be. */
+static void test_ports(void)
+{
+    static const uint32_t script[] = {29999, 30001, 30002, 30003, 30011, 30012, 30013, 30020};
+    static const uint32_t other[] = {0, 1, 502, 29998, 30000, 30004, 30010, 30014, 30019, 30021, 40000, 65535, 95535};
+    for (size_t i = 0; i < sizeof script / sizeof script[0]; i++) {
+        CHECK(urrt_rtde_check_port(script[i]) == URRT_RTDE_E_SCRIPT_PORT && urrt_rtde_port_role(script[i]) != NULL,
+              "port %u is refused", (unsigned)script[i]);
+    }
+    for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) {
+        CHECK(urrt_rtde_check_port(other[i]) == URRT_OK && urrt_rtde_port_role(other[i]) == NULL,
+              "port %u is allowed", (unsigned)other[i]);
+    }
+    CHECK_EQ_STR(urrt_rtde_port_role(30003), "the RealTime interface, which runs the URScript it receives");
+    CHECK_EQ_STR(urrt_rtde_port_role(30013), "the RealTime interface's read-only twin");
+    CHECK(strstr(urrt_rtde_strerror(URRT_RTDE_E_SCRIPT_PORT), "30004") != NULL, "the error names RTDE's port");
+}
+
 /* What the vectors cannot say: ids out of range, null pointers, and that a
  * refused change keeps the recipe's need for values (a recipe of urrt_state
  * fields only still takes vals NULL). The controller's two replies are
@@ -709,6 +695,7 @@ int main(int argc, char **argv)
     test_largest_recipe();
     test_api_errors();
     test_set_recipe_api();
+    test_ports();
     int sessions = run_vectors(argv[1], SIZE_MAX);
     CHECK(sessions >= 40, "only %d sessions in %s", sessions, argv[1]);
     run_vectors(argv[1], 1);

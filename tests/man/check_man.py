@@ -6,24 +6,17 @@ The options come from the option table in the program's source (cli.h's
 cli_option rows, or getopt_long's table and option string), and again from its --help; the page's are the `### ` headings of its
 OPTIONS section (gateway/man/*.md). Both directions: every option documented,
 nothing documented that does not exist. Each rendered page is also read by
-man(1) with warnings on, and must produce none."""
+man(1) with warnings on, and must produce none. urrt-gateway(8) and urrt-gateway.ini(5) name every
+key of [robot] and each source (`source = rtde`); check-deb runs the same test on the installed
+pages and the package's descriptions (--named, --sources)."""
 import os
 import re
 import subprocess
 import sys
 
-PASSED = FAILED = 0
-
-
-def check(ok, what):
-    global PASSED, FAILED
-    if ok:
-        PASSED += 1
-        print("ok: " + what)
-    else:
-        FAILED += 1
-        print("FAIL: " + what)
-    return ok
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import suite  # noqa: E402  the check and report every Python suite shares
+from suite import check  # noqa: E402
 
 
 def table_options(source):
@@ -204,6 +197,64 @@ def check_example(keys, path, sections):
         check_all_listed(keys, path, s, listed[s])
 
 
+# ---- what a robot is read over, named where a reader looks first -------------------------
+# check-man holds the pages in the tree to it, check-deb the pages and texts of the package
+# (`check_man.py --named PROGRAM PAGE...`, `--sources PROGRAM FILE...`): the same table, the same test.
+
+
+def choices(form):
+    """A form of lowercase words (`realtime|rtde`) is the list of its choices; others
+    (`auto|N Hz`, `DURATION`) have none."""
+    return form.split("|") if re.fullmatch(r"[a-z]+(\|[a-z]+)+", form) else []
+
+
+def readable(path):
+    """A man page (roff, gzipped or not) as man(1) shows it, without hyphenation or justification;
+    any other file as it is. Whitespace runs are one blank, so that no line break splits a phrase."""
+    if re.search(r"\.\d(\.gz)?$", path):
+        r = subprocess.run(["man", "--nh", "--nj", "-E", "UTF-8", "-l", path], capture_output=True, text=True,
+                           timeout=30, env=dict(os.environ, MANWIDTH="80"))
+        text = r.stdout
+    else:
+        text = open(path).read()
+    return " ".join(text.split())
+
+
+def unnamed_keys(keys, section, text):
+    """What of SECTION's keys TEXT leaves out: each key as a word, and each choice of a key whose form
+    lists its choices as `key = choice`, alone or in the list (`source = rtde`, `source = realtime|rtde`)."""
+    missing = [k for k in keys[section] if not re.search(r"(?<![\w-])%s(?![\w-])" % re.escape(k), text)]
+    for k, key in keys[section].items():
+        missing += ["%s = %s" % (k, c) for c in choices(key["form"])
+                    if not re.search(r"(?<![\w-])%s = (?:[a-z]+\|)*%s(?![\w-])" % (re.escape(k), c), text)]
+    return missing
+
+
+def unnamed_sources(keys, text):
+    """The sources a robot is read over (the choices of [robot] source) TEXT does not name, in any case
+    (`RealTime`, `RTDE`)."""
+    return [c for c in choices(keys["robot"]["source"]["form"]) if not re.search(r"\b%s\b" % c, text, re.I)]
+
+
+def check_named(keys, pages):
+    """Each page (rendered, in the tree or installed) names every [robot] key and each source as
+    `source = NAME`; a failure names the page's source to edit."""
+    for page in pages:
+        missing = unnamed_keys(keys, "robot", readable(page))
+        fix = "; add them to gateway/man/%s.md" % re.sub(r"\.gz$", "", os.path.basename(page))
+        check(not missing, "%s names every [robot] key of --print-keys and each source as `source = NAME`"
+              " (missing: %s)%s" % (page, ", ".join(missing) or "none", fix if missing else ""))
+
+
+def check_sources(keys, files):
+    """Each text names every source, the choices of `[robot] source` (a package's description)."""
+    for path in files:
+        missing = unnamed_sources(keys, readable(path))
+        check(not missing, "%s names every source of [robot] source = %s (missing: %s%s)" %
+              (path, keys["robot"]["source"]["form"], ", ".join(missing) or "none",
+               ": name them in debian/control's Description and gateway/install/install.mk's urrt.pc" if missing else ""))
+
+
 def check_keys(build):
     keys = table_keys(os.path.join(build, "bin", "urrt-gateway"))
     check(len(keys) == 6 and len(keys.get("robot", {})) >= 7, "--print-keys lists the sections' keys (%s)" %
@@ -213,9 +264,22 @@ def check_keys(build):
     check_doc_tables(keys, "docs/can.md", r"## `\[(\w+)[ \w]*\]`", ["can", "frame"])
     check_doc_tables(keys, "docs/canopen.md", r"## `\[(\w+)[ \w]*\]`", ["canopen"])
     check_example(keys, "gateway/install/urrt-gateway.example.ini", ["gateway", "lcm", "robot"])
+    check_named(keys, [os.path.join(build, "man", p) for p in ("urrt-gateway.8", "urrt-gateway.ini.5")])
+
+
+def named_main(mode, program, files):
+    """check-deb's entry: the installed pages (--named) or texts (--sources) against PROGRAM's keys."""
+    keys = table_keys(program)
+    if mode == "--named":
+        check_named(keys, files)
+    else:
+        check_sources(keys, files)
+    return suite.report() if suite.passed > 0 else 1
 
 
 def main():
+    if sys.argv[1] in ("--named", "--sources"):
+        return named_main(sys.argv[1], sys.argv[2], sys.argv[3:])
     build = sys.argv[1]
     check_keys(build)
     # program: (man section, the source with its option table)
@@ -257,9 +321,7 @@ def main():
     page = open("gateway/man/urrt-gateway.8.md").read()
     check("urrt-gateway@NAME" in page and "/etc/urrt/NAME.ini" in page,
           "urrt-gateway(8) names the template unit urrt-gateway@NAME and the file it reads")
-    line = "%d passed, %d failed" % (PASSED, FAILED)
-    print(line)
-    return 0 if FAILED == 0 else 1
+    return suite.report()
 
 
 if __name__ == "__main__":

@@ -22,6 +22,7 @@
 #include "check.h"
 #include "cli.h"
 #include "port.h"
+#include "urrt_rtde.h"
 
 
 /* ---- log capture ---------------------------------------------------------- */
@@ -913,6 +914,73 @@ static void test_source_handshake(void)
     close(lfd);
 }
 
+/* A source on a port that runs what it receives: refused, logged with the
+ * port's role, and the link stays the RealTime reader that writes nothing.
+ * The ports are the controller's servers as UR documents them (dashboard
+ * 29999; primary, secondary, RealTime 30001-30003 and their read-only twins
+ * 30011-30013; interpreter mode 30020), not lib's table. Where 30003 is
+ * free on loopback a listener there sees the link connect and receives not
+ * one byte. */
+static void test_source_script_port(void)
+{
+    static const uint16_t ports[] = {29999, 30001, 30002, 30003, 30011, 30012, 30013, 30020};
+    test_source src = {0};
+    urrt_link_source source = {.ctx = &src, .connected = source_connected, .received = source_received};
+    urrt_link_config c;
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons(30003)};
+    int lfd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0), one = 1;
+
+    urrt_link_config_defaults(&c);
+    c.name = "script";
+    c.host = "127.0.0.1";
+    c.backoff_initial_ms = 10;
+    for (size_t i = 0; i < sizeof ports / sizeof ports[0]; i++) {
+        urrt_link *l;
+        char want[64];
+        c.port = ports[i];
+        l = urrt_link_new(&c);
+        log_count = 0;
+        CHECK_EQ_INT(urrt_link_set_source(l, &source), URRT_RTDE_E_SCRIPT_PORT);
+        snprintf(want, sizeof want, "will not write to 127.0.0.1:%u: port %u is the", (unsigned)ports[i],
+                 (unsigned)ports[i]);
+        CHECK(lines_with(want) == 1 && lines_with("RTDE is port 30004") == 1, "port %u: the refusal is logged",
+              (unsigned)ports[i]);
+        urrt_link_free(l);
+    }
+    c.port = 30004;
+    {
+        urrt_link *l = urrt_link_new(&c);
+        CHECK_EQ_INT(urrt_link_set_source(l, &source), URRT_OK);
+        urrt_link_free(l);
+    }
+
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    (void)setsockopt(lfd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    if (lfd >= 0 && bind(lfd, (struct sockaddr *)&a, sizeof a) == 0 && listen(lfd, 4) == 0) {
+        rx r = {0};
+        urrt_link *l;
+        int s;
+        c.port = 30003;
+        l = urrt_link_new(&c);
+        (void)urrt_link_set_source(l, &source);
+        CHECK(pump(l, &r, 3000, is_waiting, NULL, NULL, 0), "the link connects to 30003 as the RealTime reader");
+        s = accept_within(lfd, 2000);
+        CHECK(s >= 0, "the listener on 30003 accepts");
+        CHECK_EQ_INT(src.connections, 0);
+        CHECK_EQ_INT(urrt_link_send(l, (const uint8_t *)"V", 1), URRT_E_ARG);
+        CHECK_EQ_INT(bytes_from_client(s), 0);
+        if (s >= 0) {
+            close(s);
+        }
+        urrt_link_free(l);
+    } else {
+        printf("note: 127.0.0.1:30003 is taken here: the refusals above are checked without a listener\n");
+    }
+    if (lfd >= 0) {
+        close(lfd);
+    }
+}
+
 /* A controller that refuses the configuration: reported once, however
  * often it refuses, and retried with the long backoff, never in a loop. */
 static void test_source_refused(void)
@@ -1242,5 +1310,6 @@ int main(void)
     test_wait_silence();
     test_source_handshake();
     test_source_refused();
+    test_source_script_port();
     return check_report();
 }

@@ -33,6 +33,10 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import suite  # noqa: E402  the check and report every Python suite shares
+from suite import check  # noqa: E402
+
 BOUND_MS = 100          # the robot's silence_timeout, and [can] stale_after_ms
 FAST_BOUND_MS = 50      # stale_after_ms of frame 0x182
 # What a measured age may exceed its bound by: the loopback transport and the
@@ -92,21 +96,6 @@ EMCY_LINK, EMCY_STALE = 0xFF01, 0xFF02
 EXPECTED_EMCY = {"close": (EMCY_LINK,), "reset": (EMCY_LINK,), "truncate": (EMCY_LINK,), "restart": (EMCY_LINK,),
                  "stall": (EMCY_STALE, EMCY_LINK), "freeze-after": (EMCY_STALE, EMCY_LINK),
                  "freeze-every": (EMCY_STALE,)}
-
-PASSED = 0
-FAILED = 0
-
-
-def check(cond, what):
-    global PASSED, FAILED
-    if cond:
-        PASSED += 1
-        print("ok: " + what)
-    else:
-        FAILED += 1
-        print("FAIL: " + what)
-    sys.stdout.flush()
-    return cond
 
 
 def now_us():
@@ -751,7 +740,7 @@ def report(s, can, co, samples, warm_phases, exits):
     report_canopen(co)
     for key in ("can", "canopen"):
         check_growth(key, samples[key], warm_phases)
-    return FAILED == 0
+    return suite.failed == 0
 
 
 def report_canopen(co):
@@ -857,12 +846,11 @@ def main():
         check(False, "soak: %r" % e)
     except KeyboardInterrupt as e:
         check(False, "soak interrupted (%s)" % e)
-    line = "%d passed, %d failed" % (PASSED, FAILED)
-    print(line)
+    status = suite.report()
     if args.result:
         with open(args.result, "w") as f:
-            f.write(line + "\n")
-    return 0 if FAILED == 0 else 1
+            f.write("%d passed, %d failed\n" % (suite.passed, suite.failed))
+    return status
 
 
 if __name__ == "__main__":

@@ -28,49 +28,8 @@ static urrt_state st;
 static urrt_rtde_values vals;
 static uint8_t out[URRT_RTDE_REQUEST_MAX];
 
-/* ---- stack marks ---------------------------------------------------------- */
-
-static struct {
-    const char *name;
-    unsigned bytes;
-} marks[32];
-static unsigned mark_count;
-static bool measuring;
-
-static void note(const char *fn, uintptr_t sp, uintptr_t lowest)
-{
-    unsigned i;
-    CHECK(lowest > target_stack_limit(), "%s reached the stack's limit", fn);
-    for (i = 0; i < mark_count && !CHECK_SAME_TEXT(marks[i].name, fn); i++) {
-    }
-    if (i == mark_count) {
-        CHECK(i < sizeof marks / sizeof marks[0], "more than %u functions", i);
-        if (i == sizeof marks / sizeof marks[0]) {
-            return;
-        }
-        marks[mark_count].name = fn;
-        marks[mark_count++].bytes = 0;
-    }
-    if (sp - lowest > marks[i].bytes) {
-        marks[i].bytes = (unsigned)(sp - lowest);
-    }
-}
-
-/* The call, its stack painted and measured while measuring: result = fn
- * args, or for functions without a result MEASURED_VOID(fn, args). */
-#define MEASURED_CALL(call, fn)                                     \
-    do {                                                            \
-        uintptr_t sp_ = target_sp();                                \
-        if (measuring) {                                            \
-            target_stack_paint(sp_);                                \
-        }                                                           \
-        call;                                                       \
-        if (measuring) {                                            \
-            note(#fn, sp_, target_stack_lowest_used(sp_));          \
-        }                                                           \
-    } while (0)
-#define MEASURED(result, fn, args) MEASURED_CALL(result = fn args, fn)
-#define MEASURED_VOID(fn, args) MEASURED_CALL(fn args, fn)
+#define STACK_MARKS_MAX 32
+#include "stack_marks.h"
 
 static size_t text_len(const char *t)
 {
@@ -86,39 +45,7 @@ static int var_of(const char *name)
     return urrt_rtde_var_find(name, text_len(name));
 }
 
-typedef struct named {
-    const char *name;
-    int value;
-} named;
-
-static const named kinds[] = {
-    {"protocol", URRT_RTDE_EV_PROTOCOL}, {"fallback", URRT_RTDE_EV_FALLBACK},
-    {"controller", URRT_RTDE_EV_CONTROLLER}, {"recipe", URRT_RTDE_EV_RECIPE},
-    {"started", URRT_RTDE_EV_STARTED}, {"paused", URRT_RTDE_EV_PAUSED}, {"text", URRT_RTDE_EV_TEXT},
-    {"data", URRT_RTDE_EV_DATA}, {"drop", URRT_RTDE_EV_DROP}, {"config", URRT_RTDE_EV_CONFIG},
-};
-
-static const named errors[] = {
-    {"SIZE_SMALL", URRT_RTDE_E_SIZE_SMALL}, {"SIZE_LARGE", URRT_RTDE_E_SIZE_LARGE},
-    {"REPLY_LENGTH", URRT_RTDE_E_REPLY_LENGTH}, {"REPLY_VALUE", URRT_RTDE_E_REPLY_VALUE},
-    {"VERSION_ZERO", URRT_RTDE_E_VERSION_ZERO}, {"DATA_EARLY", URRT_RTDE_E_DATA_EARLY},
-    {"RECIPE_ID", URRT_RTDE_E_RECIPE_ID}, {"DATA_SIZE", URRT_RTDE_E_DATA_SIZE},
-    {"TYPE_TOKEN", URRT_RTDE_E_TYPE_TOKEN}, {"TYPE_COUNT", URRT_RTDE_E_TYPE_COUNT},
-    {"TEXT_LENGTH", URRT_RTDE_E_TEXT_LENGTH}, {"NOT_FOUND", URRT_RTDE_E_NOT_FOUND},
-    {"TYPE_MISMATCH", URRT_RTDE_E_TYPE_MISMATCH}, {"PROTOCOL_REFUSED", URRT_RTDE_E_PROTOCOL_REFUSED},
-    {"START_REFUSED", URRT_RTDE_E_START_REFUSED}, {"FREQUENCY", URRT_RTDE_E_FREQUENCY},
-};
-
-static int lookup(const named *t, size_t n, const char *name)
-{
-    for (size_t i = 0; i < n; i++) {
-        if (CHECK_SAME_TEXT(t[i].name, name)) {
-            return t[i].value;
-        }
-    }
-    CHECK(0, "unknown name %s", name);
-    return 0;
-}
+#include "../lib/rtde_names.h"
 
 static uint64_t raw_of(const rtv_value *v)
 {
@@ -141,10 +68,10 @@ static uint64_t raw_of(const rtv_value *v)
 static void check_event(const rtv_session *t, unsigned e, int k, const urrt_rtde_event *ev)
 {
     const rtv_event *want = &t->events[e];
-    CHECK(k == lookup(kinds, sizeof kinds / sizeof kinds[0], want->kind), "%s: event %u is %d, not %s", t->name,
+    CHECK(k == LOOKUP(kinds, want->kind), "%s: event %u is %d, not %s", t->name,
           e, k, want->kind);
     if (want->error != NULL) {
-        CHECK(ev->error == lookup(errors, sizeof errors / sizeof errors[0], want->error), "%s: error %d, not %s",
+        CHECK(ev->error == LOOKUP(errors, want->error), "%s: error %d, not %s",
               t->name, ev->error, want->error);
     } else if (k == URRT_RTDE_EV_TEXT) {
         CHECK(ev->level == want->arg && ev->text_len == want->text_len && ev->source_len == want->source_len &&
@@ -235,6 +162,7 @@ static void measure_rest(void)
     unsigned u;
     int r;
     bool b;
+    double d;
     MEASURED(r, urrt_rtde_pause, (&s));
     MEASURED(r, urrt_rtde_start, (&s));
     MEASURED(b, urrt_rtde_up, (&s));
@@ -257,7 +185,11 @@ static void measure_rest(void)
     MEASURED(r, urrt_rtde_write_setup_outputs, (out, sizeof out, 2, 500.0, family, 2));
     MEASURED(r, urrt_rtde_write_start, (out, sizeof out));
     MEASURED(r, urrt_rtde_write_pause, (out, sizeof out));
+    MEASURED(r, urrt_rtde_check_port, (30003u));
+    MEASURED(d, urrt_rtde_max_frequency, (&s));
+    MEASURED(text, urrt_rtde_port_role, (30013u));
     (void)p;
+    (void)d;
     (void)u;
     (void)text;
     (void)b;
@@ -303,8 +235,6 @@ int main(void)
     measuring = true;
     measure_rest();
     measure_set_recipe();
-    for (unsigned i = 0; i < mark_count; i++) {
-        check_printf("stack: %s %u\n", marks[i].name, marks[i].bytes);
-    }
+    stack_marks_print();
     return check_report();
 }

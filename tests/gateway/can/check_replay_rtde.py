@@ -65,26 +65,7 @@ def tmp(name):
     return os.path.join(TMP, name)
 
 
-# ---- the simulator, the recorders ---------------------------------------------------
-
-class Sim:
-    def __init__(self):
-        self.log = open(tmp('sim.log'), 'w')
-        rt_pf, rtde_pf = tmp('sim.rt'), tmp('sim.rtde')
-        self.proc = subprocess.Popen(['timeout', '-k', '3', '120', SIM, '-c', '5.12', '-l', '127.0.0.1:0',
-                                      '--port-file', rt_pf, '--rtde', '127.0.0.1:0', '--rtde-port-file', rtde_pf],
-                                     stderr=self.log)
-        if not wait_for('the simulator\'s port files', lambda: os.path.exists(rtde_pf) and
-                        os.path.exists(rt_pf), self.proc):
-            raise RuntimeError('the simulator did not start: ' + open(tmp('sim.log')).read())
-        self.rt_port = int(open(rt_pf).read())
-        self.port = int(open(rtde_pf).read())
-
-    def close(self):
-        self.proc.terminate()
-        self.proc.wait(timeout=10)
-        self.log.close()
-
+# ---- the recorders ---------------------------------------------------
 
 def package(kind, payload):
     return struct.pack('>HB', 3 + len(payload), kind) + payload
@@ -471,7 +452,7 @@ def main():
         if not os.access(path, os.X_OK):
             print('FAIL: %s is not built' % path, file=sys.stderr)
             return 1
-    sim = Sim()
+    sim = suite.Sim(SIM, TMP, '-c', '5.12', timeout=120)
     try:
         reader = RealTimeReader(sim.rt_port)
         records = []
@@ -489,7 +470,7 @@ def main():
         check(read_capture(main_cap) == packages, 'the recorder\'s capture reads back as recorded')
         test_dump(sim)
     finally:
-        sim.close()
+        sim.stop()
     return suite.report()
 
 

@@ -315,6 +315,69 @@ static void test_durations(void)
     CHECK(conf_bare_unit("ms") == NULL, "a name that is only a unit");
 }
 
+/* One grammar for every rate: a number of Hz, the unit optional, so a bare
+ * number means Hz in [lcm] and [robot] alike; the refusal of a frequency too
+ * high says the largest one in a form the file takes. */
+static void test_rates(void)
+{
+    static const struct { const char *text; double hz; } good[] = {
+        {"50 Hz", 50}, {"50Hz", 50}, {"50", 50}, {"0.5 Hz", 0.5}, {"1e2", 100}, {"125\tHz", 125},
+    };
+    static const struct { const char *text; const char *why; } bad[] = {
+        {"50 hz", "unknown unit \"hz\": a rate is in Hz, e.g. \"50 Hz\" (or 50)"},
+        {"50 kHz", "unknown unit \"kHz\": a rate is in Hz, e.g. \"50 Hz\" (or 50)"},
+        {"fast", "not a rate: a number of Hz, e.g. \"50 Hz\" (or 50)"},
+        {"-5", "not a rate: a number of Hz, e.g. \"50 Hz\" (or 50)"},
+        {"nan Hz", "not a rate: a number of Hz, e.g. \"50 Hz\" (or 50)"},
+        {"600", "out of range: from 0.01 Hz to 500 Hz"},
+        {"", "no value"},
+    };
+    static const struct { const char *value; const char *want; } refused[] = {
+        {"600", "t.ini:4: rtde_frequency 600 Hz is above 500 Hz, the fastest any controller streams RTDE: write "
+                "rtde_frequency = 500 Hz or less, or rtde_frequency = auto\n"},
+        {"600 Hz", "t.ini:4: rtde_frequency 600 Hz is above 500 Hz, the fastest any controller streams RTDE: write "
+                   "rtde_frequency = 500 Hz or less, or rtde_frequency = auto\n"},
+        {"0", "t.ini:4: rtde_frequency 0 Hz is out of range: from 0.01 Hz to 500 Hz, or auto\n"},
+        {"fast", "t.ini:4: rtde_frequency must be \"auto\" or a rate such as \"125 Hz\" (a bare 125 is Hz too), at "
+                 "most 500 Hz, not \"fast\"\n"},
+    };
+    char why[CONF_WHY_MAX] = "";
+    double hz = 0;
+    for (size_t k = 0; k < sizeof good / sizeof good[0]; k++) {
+        hz = 0;
+        CHECK(conf_rate_hz(good[k].text, 0.01, 500, &hz, why, sizeof why) && hz == good[k].hz, "%s: %g, %s",
+              good[k].text, hz, why);
+    }
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        CHECK(!conf_rate_hz(bad[k].text, 0.01, 500, &hz, why, sizeof why), "%s accepted", bad[k].text);
+        CHECK_EQ_STR(why, bad[k].why);
+    }
+    /* The same values with and without the unit, in each key that takes a rate. */
+    for (int unit = 0; unit < 2; unit++) {
+        char text[256];
+        char *messages = NULL;
+        gw_config cfg;
+        const char *hz_ = unit ? " Hz" : "";
+        snprintf(text, sizeof text, "[lcm]\njoints_rate = 50%s\ngateway_rate = 2%s\n[robot a]\nhost = h\n"
+                 "source = rtde\nrtde_frequency = 500%s\n", hz_, hz_, hz_);
+        CHECK_ERRORS(load(text, strlen(text), &messages, &cfg), 0);
+        CHECK(cfg.robot_count == 1 && cfg.robots[0].rtde_frequency == 500 &&
+                  cfg.lcm.rate[GW_KIND_JOINTS].mode == GW_RATE_HZ && cfg.lcm.rate[GW_KIND_JOINTS].hz == 50 &&
+                  cfg.lcm.rate[GW_KIND_GATEWAY].hz == 2, "rates%s: %s", hz_, messages);
+        gw_config_free(&cfg);
+        free(messages);
+    }
+    for (size_t k = 0; k < sizeof refused / sizeof refused[0]; k++) {
+        char text[256];
+        char *messages = NULL;
+        snprintf(text, sizeof text, "[robot a]\nhost = h\nsource = rtde\nrtde_frequency = %s\n", refused[k].value);
+        CHECK_ERRORS(load_str(text, &messages), 1);
+        CHECK(strcmp(messages, refused[k].want) == 0, "rtde_frequency = %s:\n  got:  %s  want: %s",
+              refused[k].value, messages, refused[k].want);
+        free(messages);
+    }
+}
+
 static void test_names_and_text(void)
 {
     char why[CONF_WHY_MAX] = "";
@@ -607,6 +670,63 @@ static void test_causes_first(void)
     }
 }
 
+/* A misspelled value name gets the nearest name of both of lib's tables (the
+ * RealTime fields and the RTDE variables, each index of a family a name),
+ * or a family's range: one short line, never a list of names. The same
+ * conf_suggest_value serves urrt-dump's -k (check-tools, check-dump-rtde). */
+static void test_value_names(void)
+{
+#define RTDE_ROBOT "[robot a]\nhost = h\nsource = rtde\nrtde_values = "
+    static const struct { const char *value; const char *want; } cases[] = {
+        {"robot_status_bit", "t.ini:4: rtde_values: \"robot_status_bit\" is no RTDE output: did you mean "
+                             "\"robot_status_bits\"?\n"},
+        {"safety_status_bits, outptu_int_register_24", "t.ini:4: rtde_values: \"outptu_int_register_24\" is no "
+                                                       "RTDE output: did you mean \"output_int_register_24\"?\n"},
+        {"Robot_Status_Bits", "t.ini:4: rtde_values: \"Robot_Status_Bits\" is no RTDE output: did you mean "
+                              "\"robot_status_bits\"?\n"},
+        {"output_bit_register_3", "t.ini:4: rtde_values: \"output_bit_register_3\" is no RTDE output: did you mean "
+                                  "one of output_bit_register_64 to output_bit_register_127?\n"},
+        {"input_int_register_48", "t.ini:4: rtde_values: \"input_int_register_48\" is no RTDE output: did you mean "
+                                  "one of input_int_register_0 to input_int_register_47?\n"},
+        {"output_int_register_05", "t.ini:4: rtde_values: \"output_int_register_05\" is no RTDE output: did you "
+                                   "mean \"output_int_register_5\"?\n"},
+        {"q_actual", "t.ini:4: rtde_values: \"q_actual\" is a RealTime field: it is published on NAME.STATE "
+                     "already; list only RTDE-only values here, by their RTDE names\n"},
+        {"colour", "t.ini:4: rtde_values: \"colour\" is no RTDE output (names are case-sensitive, e.g. "
+                   "output_int_register_24, safety_status_bits; docs/rtde.md lists them)\n"},
+    };
+    static const struct { const char *word; const char *want; } near[] = {
+        {"q_actul", "\"q_actual\""},                   /* RealTime's table */
+        {"actual_TCP_pos", "\"actual_TCP_pose\""},     /* RTDE's, a mapped name */
+        {"tool_analog_input", "one of tool_analog_input0 to tool_analog_input1"},
+        {"output_int_register", "one of output_int_register_0 to output_int_register_47"},
+        {"output_bit_registers0_to_3", "\"output_bit_registers0_to_31\""},
+        {"xyz", NULL},
+        {"o", NULL},
+    };
+    char buf[128];
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        char text[256];
+        char *messages = NULL;
+        snprintf(text, sizeof text, RTDE_ROBOT "%s\n", cases[k].value);
+        CHECK_ERRORS(load_str(text, &messages), 1);
+        CHECK(strcmp(messages, cases[k].want) == 0, "rtde_values = %s:\n  got:  %s  want: %s", cases[k].value,
+              messages, cases[k].want);
+        CHECK(strchr(messages, '\n') == messages + strlen(messages) - 1 && strlen(messages) < 200,
+              "rtde_values = %s: one short line, no list of names: %s", cases[k].value, messages);
+        free(messages);
+    }
+    for (size_t k = 0; k < sizeof near / sizeof near[0]; k++) {
+        const char *got = conf_suggest_value(near[k].word, strlen(near[k].word), buf, sizeof buf);
+        CHECK(near[k].want != NULL ? got == buf && strcmp(buf, near[k].want) == 0 : got == NULL && buf[0] == '\0',
+              "conf_suggest_value(%s): got %s, want %s", near[k].word, buf, near[k].want ? near[k].want : "none");
+    }
+    /* Not NUL-terminated: len bytes only ("robot_status_bit" of a longer text). */
+    CHECK(conf_suggest_value("robot_status_bit,x", 16, buf, sizeof buf) == buf &&
+              strcmp(buf, "\"robot_status_bits\"") == 0, "a word inside a list: %s", buf);
+#undef RTDE_ROBOT
+}
+
 int main(void)
 {
     test_stream_and_file();
@@ -620,6 +740,7 @@ int main(void)
     test_integers();
     test_numbers_and_booleans();
     test_durations();
+    test_rates();
     test_names_and_text();
     test_same_everywhere();
     test_refusals();
@@ -628,5 +749,6 @@ int main(void)
     test_tables_built();
     test_reader();
     test_causes_first();
+    test_value_names();
     return check_report();
 }

@@ -25,6 +25,7 @@ import csv
 import io
 import json
 import os
+import re
 import socket
 import struct
 import subprocess
@@ -46,30 +47,9 @@ TMP = tempfile.mkdtemp(prefix='urrt-dump-rtde.')
 START_TIME = 1000.0  # controller time of cycle 0 with --clock start (docs/tools.md)
 
 
-class Sim:
-    count = 0
-
-    def __init__(self, *args):
-        Sim.count += 1
-        base = os.path.join(TMP, 'sim%d' % Sim.count)
-        self.log_path, rt_pf, rtde_pf = base + '.log', base + '.rt', base + '.rtde'
-        with open(self.log_path, 'w') as log:
-            self.proc = subprocess.Popen(['timeout', '-k', '3', '90', SIM, '-l', '127.0.0.1:0', '--port-file', rt_pf,
-                                          '--rtde', '127.0.0.1:0', '--rtde-port-file', rtde_pf, '-v'] + list(args),
-                                         stdout=log, stderr=log)
-        if not wait_for('the simulator\'s port files', lambda: os.path.exists(rtde_pf), self.proc):
-            raise RuntimeError('simulator did not start: ' + open(self.log_path).read())
-        self.rt_port = int(open(rt_pf).read())
-        self.port = int(open(rtde_pf).read())
-        self.addr = '127.0.0.1:%d' % self.port
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.proc.terminate()
-        self.proc.wait(timeout=10)
-        end_group(self.proc)
+def Sim(*args):
+    """The simulator of these checks (tests/suite.py's), with its arguments."""
+    return suite.Sim(SIM, TMP, *args)
 
 
 def dump(*args, timeout=30):
@@ -107,14 +87,43 @@ def usage_errors():
         (['--rtde', '--file', '/dev/null'], 'is no RTDE capture (it is empty'),
         (['--rtde', '--file', '/dev/null', '-k', 'test_value'], 'RTDE has no such value (RealTime only)'),
         (['--rtde', '-k', 'nosuch', '127.0.0.1'], '"nosuch"'),
-        (['--rtde', '127.0.0.1:30003'], 'port 30003 is not RTDE'),
-        (['--rtde', '--list', '[::1]:30013'], 'port 30013 is not RTDE'),
+        # Every port that runs what it receives, or is such a port's twin (the
+        # controller's servers as UR documents them, not lib's table).
+        (['--rtde', '127.0.0.1:29999'], 'port 29999 is the dashboard server, which runs the commands it receives: '
+         'RTDE is port 30004'),
+        (['--rtde', '127.0.0.1:30001'], 'port 30001 is the primary client interface, which runs the URScript'),
+        (['--rtde', '127.0.0.1:30002'], 'port 30002 is the secondary client interface, which runs the URScript'),
+        (['--rtde', '127.0.0.1:30003'], 'port 30003 is the RealTime interface, which runs the URScript it receives'),
+        (['--rtde', '127.0.0.1:30011'], "port 30011 is the primary client interface's read-only twin"),
+        (['--rtde', '127.0.0.1:30012'], "port 30012 is the secondary client interface's read-only twin"),
+        (['--rtde', '--list', '[::1]:30013'], "port 30013 is the RealTime interface's read-only twin"),
+        (['--rtde', '127.0.0.1:30020'], "port 30020 is the interpreter mode's socket, which runs the URScript"),
+        (['127.0.0.1:30004'], "port 30004 is RTDE's on every controller, which sends nothing until a client's "
+         "handshake: add --rtde"),
     ]
     for args, text in cases:
         rc, _, err = dump(*args, timeout=10)
         check(rc == 2 and text in err, 'usage error: %s' % ' '.join(args), err.strip())
+    # A misspelled -k name: the nearest name of both of lib's tables (the RealTime
+    # fields, the RTDE variables with each index of a family), or a family's
+    # range, in one line and the usage hint: never a list of names.
+    misspelled = [
+        ('robot_status_bit', 'did you mean "robot_status_bits"?'),
+        ('safety_status_bit', 'did you mean "safety_status_bits"?'),
+        ('outptu_int_register_24', 'did you mean "output_int_register_24"?'),
+        ('output_bit_register_3', 'did you mean one of output_bit_register_64 to output_bit_register_127?'),
+        ('standard_analog_input2', 'did you mean one of standard_analog_input0 to standard_analog_input1?'),
+        ('actual_TCP_Pose', 'did you mean "actual_TCP_pose"?'),
+        ('q_actul', 'did you mean "q_actual"?'),
+    ]
+    for name, hint in misspelled:
+        rc, out, err = dump('--rtde', '-k', 'time,' + name, '127.0.0.1', timeout=10)
+        want = 'urrt-dump: -k: no field or RTDE value named "%s": %s\nTry \'urrt-dump --help\'.\n' % (name, hint)
+        check(rc == 2 and out == '' and err == want, '-k %s: %s, and nothing else' % (name, hint), err)
     rc, _, err = dump('--rtde', '-k', 'nosuch', '127.0.0.1', timeout=10)
-    check('q_actual' in err and 'actual_q' in err, 'an unknown -k name lists urrt names with their RTDE names', err)
+    check(rc == 2 and err == 'urrt-dump: -k: no field or RTDE value named "nosuch" (docs/protocol.md lists the '
+          'fields, docs/rtde.md the RTDE names; --rtde --list HOST what a controller has)\n'
+          "Try 'urrt-dump --help'.\n", 'an unknown -k name nothing is near: where the names are, not a list', err)
     rc, out, _ = dump('--help', timeout=10)
     check('--rtde' in out and '--list' in out and '30004' in out, '--help shows --rtde and --list', out)
 
@@ -319,6 +328,18 @@ def formats():
         check('summary: lengths: 1036 x 2 (RTDE data packages)' in err and
               'summary: rtde: controller 5.12.3.1234, protocol 2' in err and 'summary: rtde recipe: timestamp,' in err,
               'table: the summary says what the session was', err)
+        # What the RTDE session counted, in its words: the four replies of the
+        # handshake and at least the two data packages of -n 2, 1036 bytes
+        # each; RealTime's framer words (resyncs, partial packets) are not
+        # RTDE's.
+        counts = re.search(r'^summary: rtde packages: (\d+), data packages: (\d+), text messages: (\d+), '
+                           r'ignored: (\d+), errors: (\d+), bytes: (\d+)$', err, re.M)
+        n = [int(x) for x in counts.groups()] if counts else []
+        check(counts and n[1] >= 2 and n[0] >= n[1] + 4 and n[2] == n[3] == n[4] == 0 and n[5] >= 2 * 1036,
+              'summary: the RTDE session\'s packages, data packages, text messages, ignored, errors, bytes', err)
+        check(re.search(r'^summary: rtde partial package dropped at close: \d+ bytes$', err, re.M) and
+              'resyncs' not in err and 'partial packets' not in err and 'generations' not in err,
+              'summary: the bytes of a package cut short at close, no RealTime words (resyncs, partial packets)', err)
         rc, out, err = dump('--rtde', sim.addr, '-n', '1', '-k',
                             'q_actual,output_int_register_2,tcp_offset,actual_configurable_digital_input_bits')
         lines = {ln.split()[0]: ln.split()[1:] for ln in out.splitlines()[1:]}
@@ -402,6 +423,21 @@ def no_rtde():
           'a refused RTDE port: exit 1, saying to check the port and that RTDE is enabled', err)
     rc, out, err = dump('--rtde', '--list', '127.0.0.1:%d' % port, timeout=20)
     check(rc == 1 and out == '', '--list of a refused port: exit 1, nothing listed', err)
+
+
+def port_mixups():
+    """Each interface read at the other's port: the failure names the other interface."""
+    with Sim('-c', '5.12.3.1234') as sim:
+        rt = '127.0.0.1:%d' % sim.rt_port
+        rc, out, err = dump('--rtde', rt, '--once', '--no-summary', timeout=20)
+        check(rc == 1 and 'the peer streams without a handshake, as a RealTime port (30003) does: its first bytes '
+              'announce a 1220-byte RealTime packet' in err and 'read it as RealTime (urrt-dump without --rtde' in err
+              and 'package size below' not in err,
+              '--rtde at a RealTime port: it streams without a handshake, drop --rtde', err)
+        rc, out, err = dump(sim.addr, '--once', '--no-summary', '--silence-timeout', '200', timeout=20)
+        check(rc == 1 and 'before sending anything: an RTDE port (30004) sends nothing until a client\'s handshake; '
+              'if this is one, read it as RTDE (urrt-dump --rtde' in err,
+              'RealTime at an RTDE port: it waits for a handshake, add --rtde', err)
 
 
 # ---- captures: --rtde -w, --file ------------------------------------------------------
@@ -503,6 +539,12 @@ def capture_read_back():
           'summary: rtde recipe: timestamp,' in err and 'output_int_register_24' in err and
           'summary: rtde capture: sessions 1, last record cut short: 0 bytes' in err,
           '--file\'s summary: packages, controller, protocol, recipe, sessions', err)
+    # The replay's session counted exactly what the capture received, by the independent reader.
+    got = [r for r in cap.records if r.kind == '<']
+    want = 'summary: rtde packages: %d, data packages: %d, text messages: %d, ignored: 0, errors: 0, bytes: %d' % (
+        len(got), sum(r.type == 'U' for r in got), sum(r.type == 'M' for r in got), sum(3 + len(r.payload) for r in got))
+    check(want in err and 'partial package dropped at close' not in err and 'resyncs' not in err,
+          '--file\'s summary: the session\'s counts are the capture\'s received packages (%s)' % want, err)
     rc, _, err = dump('--file', path, '-k', 'time,output_int_register_5')
     check(rc == 1 and '-k output_int_register_5: the capture' in err and
           'record it with urrt-dump --rtde -w FILE -k output_int_register_5' in err,
@@ -637,6 +679,7 @@ def main():
     run(lists)
     run(texts)
     run(no_rtde)
+    run(port_mixups)
     run(capture_read_back)
     run(capture_formats)
     run(capture_3x)

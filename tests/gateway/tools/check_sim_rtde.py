@@ -34,35 +34,9 @@ TMP = tempfile.mkdtemp(prefix='urrt-sim-rtde.')
 START_TIME = 1000.0  # controller time of cycle 0 (docs/tools.md)
 
 
-class Sim:
-    count = 0
-
-    def __init__(self, *args):
-        Sim.count += 1
-        base = os.path.join(TMP, 'sim%d' % Sim.count)
-        self.log_path, self.rt_pf, self.rtde_pf = base + '.log', base + '.rt', base + '.rtde'
-        with open(self.log_path, 'w') as log:
-            self.proc = subprocess.Popen(['timeout', '-k', '3', '60', SIM, '-l', '127.0.0.1:0', '--port-file', self.rt_pf,
-                                          '--rtde', '127.0.0.1:0', '--rtde-port-file', self.rtde_pf, '-v'] + list(args),
-                                         stdout=log, stderr=log)
-        if not wait_for('the simulator\'s port files', lambda: os.path.exists(self.rtde_pf), self.proc):
-            raise RuntimeError('simulator did not start: ' + self.log())
-        self.rt_port = int(open(self.rt_pf).read())
-        self.port = int(open(self.rtde_pf).read())
-
-    def log(self):
-        return open(self.log_path).read()
-
-    def stop(self):
-        self.proc.terminate()
-        self.proc.wait(timeout=10)
-        end_group(self.proc)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.stop()
+def Sim(*args):
+    """The simulator of these checks (tests/suite.py's), with its arguments."""
+    return suite.Sim(SIM, TMP, *args, timeout=60)
 
 
 def cycle(ts, rate):
@@ -92,6 +66,10 @@ def usage_errors():
         (['--rtde', '127.0.0.1:0', '-c', '5.10', '--rate', '125'], 'runs at 500 Hz on both ports: drop --rate'),
         (['--fault', 'rtde-refuse-v2'], 'an rtde-* fault goes with --rtde'),
         (['--rtde-port-file', 'x'], '--rtde-port-file goes with --rtde'),
+        (['--fieldbus'], '--fieldbus goes with --rtde'),
+        (['--rtde', '127.0.0.1:0', '--fault', 'rtde-hold-inputs=5'], 'takes no value'),
+        (['--rtde', '127.0.0.1:0', '--fault', 'rtde-hold-inputs,for=0'], 'from 1 to 86400000'),
+        (['--fault', 'rtde-hold-inputs'], 'an rtde-* fault goes with --rtde'),
         (['--rtde', '127.0.0.1:0', '--fault', 'rtde-bad-package=3,kind=odd'], 'kind is size, type, recipe or header'),
         (['--rtde', '127.0.0.1:0', '--fault', 'rtde-text-every=3,level=4'], 'from 0 to 3'),
         (['--rtde', '127.0.0.1:0', '--fault', 'rtde-refuse-v2=1'], 'takes no value'),
@@ -184,7 +162,8 @@ def inputs_and_misc():
         p = Peer(sim.port)
         p.protocol_version(2)
         rid, types = p.setup_inputs(['input_int_register_24', 'input_double_register_0', 'speed_slider_fraction'])
-        check(rid == 1 and types == ['INT32', 'DOUBLE', 'DOUBLE'], 'inputs: recipe id and types', (rid, types))
+        check(rid == 2 and types == ['INT32', 'DOUBLE', 'DOUBLE'], 'inputs: recipe id 2 (1 is the output recipe\'s) '
+              'and types', (rid, types))
         rid, types = p.setup_inputs(['input_int_register_48'])
         check(rid == 0 and types == ['NOT_FOUND'], 'inputs: register 48 NOT_FOUND, id 0', (rid, types))
         p.send(b'Z')
@@ -250,6 +229,305 @@ def frequencies():
                   '%s: %g Hz refused (recipe id 0, an error text)' % (version, asked), (rid, types, p.texts))
             check(p.start() == 0, '%s: %g Hz: start refused' % (version, asked))
             p.close()
+
+
+# ---- inputs: setup inputs (I) and the client's data packages (U) ----------------------------
+# The types a controller gives each input (UR's input list), and the other
+# inputs than the registers, which urrt never asks for.
+INPUT_TYPES = {'input_int_register_0': 'INT32', 'input_int_register_23': 'INT32', 'input_int_register_24': 'INT32',
+               'input_int_register_47': 'INT32', 'input_double_register_0': 'DOUBLE',
+               'input_double_register_24': 'DOUBLE', 'input_double_register_47': 'DOUBLE',
+               'input_bit_register_64': 'BOOL', 'input_bit_register_127': 'BOOL',
+               'input_bit_registers0_to_31': 'UINT32', 'input_bit_registers32_to_63': 'UINT32',
+               'speed_slider_mask': 'UINT32', 'speed_slider_fraction': 'DOUBLE',
+               'standard_digital_output_mask': 'UINT8', 'standard_digital_output': 'UINT8',
+               'configurable_digital_output_mask': 'UINT8', 'configurable_digital_output': 'UINT8',
+               'tool_digital_output_mask': 'UINT8', 'tool_digital_output': 'UINT8',
+               'standard_analog_output_mask': 'UINT8', 'standard_analog_output_type': 'UINT8',
+               'standard_analog_output_0': 'DOUBLE', 'standard_analog_output_1': 'DOUBLE',
+               'external_force_torque': 'VECTOR6D'}
+# Registers 24..47 and bits 64..127 came with 3.9 / 5.3 (as outputs in UR's
+# table, and lib/urrt_rtde.h's); 0..23 and the bit words with 3.4.
+UPPER = ['input_int_register_24', 'input_int_register_47', 'input_double_register_24', 'input_double_register_47',
+         'input_bit_register_64', 'input_bit_register_127']
+LOWER = ['input_int_register_0', 'input_int_register_23', 'input_double_register_0', 'input_bit_registers0_to_31',
+         'input_bit_registers32_to_63']
+FIELDBUS = ['input_int_register_0', 'input_int_register_23', 'input_double_register_0', 'input_double_register_23',
+            'input_bit_registers0_to_31', 'input_bit_registers32_to_63']
+
+
+def log_lines(sim, text):
+    return [l for l in sim.log().splitlines() if text in l]
+
+
+def inputs_types():
+    with Sim('-c', '5.12') as sim:
+        p = Peer(sim.port)
+        p.protocol_version(2)
+        names = sorted(INPUT_TYPES)
+        rid, types = p.setup_inputs(names)
+        check(rid == 2 and types == [INPUT_TYPES[n] for n in names],
+              'inputs 5.12: every input a controller has, its type, in order (recipe id 2)', list(zip(names, types)))
+        orid, _ = p.setup_outputs(['timestamp'], 500.0)
+        rid3, types3 = p.setup_inputs(['input_int_register_30', 'input_double_register_31'])
+        rid4, _ = p.setup_inputs(['input_bit_register_100'])
+        check(orid == 1 and (rid3, rid4) == (3, 4) and types3 == ['INT32', 'DOUBLE'],
+              'inputs: several recipes per connection, each its own id (3, 4), none the output recipe\'s 1',
+              (orid, rid3, rid4))
+        bad = ['input_int_register_48', 'input_bit_register_63', 'input_bit_register_0', 'no_such_input',
+               'output_int_register_24', 'timestamp', 'input_double_register_-1']
+        rid, types = p.setup_inputs(['input_int_register_25'] + bad)
+        check(rid == 0 and types == ['INT32'] + ['NOT_FOUND'] * len(bad),
+              'inputs: NOT_FOUND for unknown names (register 48, single bits 0-63, outputs), the whole recipe id 0',
+              (rid, types))
+        rid, _ = p.setup_inputs(['input_int_register_25'])
+        check(rid == 5, 'inputs: a refused recipe takes no id (the next valid one is 5)', rid)
+        p.close()
+
+
+def inputs_versions():
+    for version, proto, upper, lower in (('3.3', 1, False, False), ('3.4', 2, False, True), ('3.8', 2, False, True),
+                                         ('3.9', 2, True, True), ('5.2', 2, False, True), ('5.3', 2, True, True)):
+        with Sim('-c', version) as sim:
+            p = Peer(sim.port)
+            if proto == 2:
+                p.protocol_version(2)
+            names = UPPER + LOWER
+            rid, types = p.setup_inputs(names)
+            want = [INPUT_TYPES[n] if (upper if n in UPPER else lower) else 'NOT_FOUND' for n in names]
+            check(types == want and (rid == 0) == ('NOT_FOUND' in want),
+                  '%s: registers 24-47 and bits 64-127 %s, 0-23 and the bit words %s (recipe id %d)' %
+                  (version, 'there' if upper else 'NOT_FOUND', 'there' if lower else 'NOT_FOUND', rid),
+                  list(zip(names, types)))
+            p.close()
+
+
+def inputs_in_use():
+    with Sim('-c', '5.12', '--fieldbus') as sim:
+        p = Peer(sim.port)
+        p.protocol_version(2)
+        for name in FIELDBUS:
+            rid, types = p.setup_inputs([name])
+            check(rid == 0 and types == ['IN_USE'], '--fieldbus: %s IN_USE, id 0' % name, (rid, types))
+        rid, types = p.setup_inputs(['input_int_register_24', 'input_int_register_0', 'input_bit_register_64'])
+        check(rid == 0 and types == ['INT32', 'IN_USE', 'BOOL'], '--fieldbus: one IN_USE makes the recipe invalid',
+              (rid, types))
+        rid, types = p.setup_inputs(['input_int_register_24', 'input_double_register_47', 'input_bit_register_64',
+                                     'speed_slider_fraction'])
+        check(rid == 2 and 'IN_USE' not in types, '--fieldbus: registers 24-47, bits 64-127 and the rest are free',
+              (rid, types))
+        p.close()
+    with Sim('-c', '5.12') as sim:
+        a = Peer(sim.port)
+        a.protocol_version(2)
+        rid, _ = a.setup_inputs(['input_int_register_0', 'input_bit_registers0_to_31'])
+        check(rid == 2, 'without --fieldbus registers 0-23 and the bit words are free', rid)
+        a.setup_inputs(['input_int_register_24', 'input_double_register_24'])
+        rid, _ = a.setup_inputs(['input_int_register_24'])
+        check(rid == 4, 'a client may name its own input variable again in another recipe', rid)
+        a.setup_outputs(['timestamp'], 500.0)
+        a.start()
+        a.send_inputs(3, [4242, 0.25])
+        b = Peer(sim.port)
+        b.protocol_version(2)
+        rid, types = b.setup_inputs(['input_int_register_25', 'input_int_register_24'])
+        check(rid == 0 and types == ['INT32', 'IN_USE'], 'a second client: a variable the first holds is IN_USE',
+              (rid, types))
+        rid, types = b.setup_inputs(['input_bit_registers0_to_31'])
+        check(rid == 0 and types == ['IN_USE'], 'a second client: the first\'s bit word IN_USE too', (rid, types))
+        rid, _ = b.setup_inputs(['input_int_register_25'])
+        check(rid == 2, 'a second client: a free register is its own (id 2 on its connection)', rid)
+        check(wait_for('the first client\'s input data applied', lambda: log_lines(sim, 'applied at cycle')),
+              'the first client\'s input data applied')
+        a.close()
+        check(wait_for('the first client\'s release',
+                       lambda: log_lines(sim, 'left: its 4 input variables are free again')),
+              'the first client leaves: its 4 input variables free again, said at -v', sim.log()[-500:])
+        rid, types = b.setup_inputs(['input_int_register_24', 'input_bit_registers0_to_31'])
+        check(rid == 3 and types == ['INT32', 'UINT32'], 'then the second client gets them', (rid, types))
+        b.setup_outputs(['timestamp', 'input_int_register_24', 'input_double_register_24'], 500.0)
+        b.start()
+        x = b.data(1)[0]
+        check(x[1:] == [4242, 0.25], 'their values stay when their client leaves (no source says they reset)', x)
+        b.close()
+
+
+NAN = struct.unpack('>d', bytes.fromhex('7ff8000000000123'))[0]
+ROUNDS = [  # input_int_register_24, input_double_register_24, input_bit_register_64, input_bit_registers32_to_63
+    (-2 ** 31, -0.0, 1, 0xffffffff),
+    (2 ** 31 - 1, 5e-324, 0, 0x80000001),
+    (-1, float('inf'), 1, 0),
+    (0, NAN, 0, 1),
+    (123456, 1.7976931348623157e308, 1, 0x12345678),
+]
+BACK = ['timestamp', 'input_int_register_24', 'input_double_register_24', 'input_bit_register_64',
+        'input_bit_registers32_to_63']
+
+
+def exact(a, b):
+    if isinstance(a, float) or isinstance(b, float):
+        return struct.pack('>d', a) == struct.pack('>d', b)
+    return a == b
+
+
+def inputs_next_cycle():
+    """A client writes registers after the package of cycle c; the
+    simulator says at which cycle k it applied them; the values are in the
+    packages of cycle k on, of both clients, and in none before."""
+    with Sim('-c', '5.12') as sim:
+        w = Peer(sim.port)
+        w.protocol_version(2)
+        rid, types = w.setup_inputs(BACK[1:])
+        w.setup_outputs(BACK, 500.0)
+        w.start()
+        r = Peer(sim.port)  # another client, reading back only
+        r.protocol_version(2)
+        r.setup_outputs(BACK, 500.0)
+        r.start()
+        check(rid == 2 and types == ['INT32', 'DOUBLE', 'BOOL', 'UINT32'], 'inputs: the writer\'s recipe', types)
+        old = (0, 0.0, 0, 0)
+        prev = {}
+        for n, vals in enumerate(ROUNDS):
+            prev['reader'] = r.data(1)[0]
+            prev['writer'] = w.data(1)[0]
+            c = cycle(prev['writer'][0], 500)
+            w.send_inputs(rid, list(vals))
+            ok = wait_for('the log line of input data %d' % (n + 1),
+                          lambda: len(log_lines(sim, 'input data of recipe 2 (4 variables) applied at cycle')) > n)
+            if not check(ok, 'round %d: the simulator applies the input data at a cycle (log at -v)' % (n + 1)):
+                return
+            k = int(log_lines(sim, 'applied at cycle')[n].rsplit(' ', 1)[1])
+            for who, p in (('writer', w), ('reader', r)):
+                seen = [prev[who]]
+                while cycle(seen[-1][0], 500) < k:
+                    seen += p.data(1)
+                first = seen[-1]
+                before = seen[:-1]
+                check(k > c and cycle(first[0], 500) == k and all(exact(a, b) for a, b in zip(first[1:], vals)),
+                      'round %d, %s: the package of cycle %d (the next after the write, at %d) holds the values, '
+                      'bit for bit' % (n + 1, who, k, c), (c, k, first, vals))
+                check(before and cycle(before[-1][0], 500) == k - 1 and
+                      all(all(exact(a, b) for a, b in zip(x[1:], old)) for x in before),
+                      'round %d, %s: the packages before it (cycle %d the last) still hold the old ones' %
+                      (n + 1, who, k - 1), (before[-1:], old))
+            old = vals
+        w.close()
+        r.close()
+
+
+def inputs_several_and_v1():
+    with Sim('-c', '5.12') as sim:
+        p = Peer(sim.port)
+        p.protocol_version(2)
+        a, _ = p.setup_inputs(['input_int_register_30', 'input_int_register_31'])
+        b, _ = p.setup_inputs(['input_double_register_30', 'input_bit_register_70'])
+        c, _ = p.setup_inputs(['speed_slider_fraction', 'speed_slider_mask', 'external_force_torque',
+                               'standard_digital_output'])
+        p.setup_outputs(['timestamp', 'input_int_register_30', 'input_int_register_31', 'input_double_register_30',
+                         'input_bit_register_70'], 500.0)
+        p.start()
+        p.send_inputs(b, [2.5, 1])
+        p.send_inputs(c, [0.5, 1, (1.0, 2.0, 3.0, 4.0, 5.0, 6.0), 255])
+        check(wait_for('2 input data applied', lambda: len(log_lines(sim, 'applied at cycle')) == 2),
+              'several recipes: data of recipes %d and %d applied' % (b, c))
+        k = int(log_lines(sim, 'applied at cycle')[-1].rsplit(' ', 1)[1])
+        x = p.data(1)[0]
+        while cycle(x[0], 500) < k:
+            x = p.data(1)[0]
+        check(x[1:] == [0, 0, 2.5, 1], 'several recipes: a package of recipe %d sets its variables, no other' % b, x)
+        p.send_inputs(a, [7, -7])
+        check(wait_for('the third applied', lambda: len(log_lines(sim, 'applied at cycle')) == 3), 'recipe %d too' % a)
+        k = int(log_lines(sim, 'applied at cycle')[-1].rsplit(' ', 1)[1])
+        while cycle(x[0], 500) < k:
+            x = p.data(1)[0]
+        check(x[1:] == [7, -7, 2.5, 1], 'several recipes: then recipe %d\'s, the others\' values kept' % a, x)
+        p.close()
+    with Sim('-c', '3.10') as sim:
+        p = Peer(sim.port)
+        check(p.protocol_version(1) == 1, 'protocol 1')
+        rid, types = p.setup_inputs(['input_int_register_24'])
+        rid2, types2 = p.setup_inputs(['input_int_register_25', 'input_double_register_2'])
+        check((rid, rid2) == (2, 3) and types == ['INT32'] and types2 == ['INT32', 'DOUBLE'],
+              'I in protocol 1: the reply carries the recipe id too (no v1 layout without it is described)',
+              (rid, rid2, types2))
+        p.setup_outputs(['timestamp', 'input_int_register_24', 'input_int_register_25', 'input_double_register_2'])
+        p.start()
+        p.send_inputs(rid2, [-99, 0.125])  # protocol 1: no recipe id, the connection's last input recipe
+        check(wait_for('the v1 input data applied', lambda: log_lines(sim, 'input data of recipe 3 (2 variables)')),
+              'U in protocol 1 (values only): applied to the connection\'s last input recipe (3)', sim.log()[-300:])
+        k = int(log_lines(sim, 'applied at cycle')[-1].rsplit(' ', 1)[1])
+        x = p.data(1)[0]
+        while cycle(x[0], 125) < k:
+            x = p.data(1)[0]
+        check(x[1:] == [0, -99, 0.125], 'protocol 1: the values read back', x)
+        p.close()
+
+
+def inputs_ignored():
+    """Input data the controller cannot take: of a recipe id the connection
+    does not have, of the wrong size, before start. Each is ignored, told
+    the client in an error text, logged and counted."""
+    with Sim('-c', '5.12') as sim:
+        p = Peer(sim.port)
+        p.protocol_version(2)
+        rid, _ = p.setup_inputs(['input_int_register_24'])
+        p.setup_outputs(['timestamp', 'input_int_register_24'], 500.0)
+
+        def refused(payload, text, what):
+            p.texts = []
+            p.send(U, payload)
+            while not p.texts:
+                p.package()
+            level, msg, _ = p.texts[-1]
+            check(level == 1 and text in msg and msg.endswith(': ignored'), '%s: an error text, "%s"' % (what, msg),
+                  p.texts)
+        refused(p.input_package(rid, [5]), 'while not started', 'U before start')
+        p.start()
+        refused(p.input_package(9, [6], ['INT32']), 'of recipe id 9, no input recipe of this connection',
+                'U of an unknown recipe id')
+        refused(p.input_package(1, [6], ['INT32']), 'of recipe id 1', 'U of the output recipe\'s id')
+        refused(p.input_package(rid, [7, 0], ['INT32', 'UINT8']), 'of 5 bytes of values for input recipe 2, which '
+                'has 4', 'U one byte too long')
+        refused(p.input_package(rid, [0], ['UINT8']), 'of 1 byte of', 'U too short')
+        refused(b'', 'without a recipe id', 'U without a recipe id')
+        x = p.data(3)
+        check(all(v[1] == 0 for v in x), 'none of them applied', x)
+        p.send_inputs(rid, [8])
+        check(wait_for('the good one applied', lambda: log_lines(sim, 'applied at cycle')), 'a good one then is')
+        p.close()
+        check(wait_for('the count at the end', lambda: log_lines(sim, '1 input data package taken, 6 ignored')),
+              'counted: "1 input data package taken, 6 ignored" when the client leaves', sim.log()[-600:])
+        check(len(log_lines(sim, ': ignored (')) == 6, 'each logged at -v with its count')
+
+
+def inputs_hold():
+    """--fault rtde-hold-inputs: a client's variables stay IN_USE for 2 s
+    (the default) after it left, as a controller that still holds the
+    old connection; a client retrying gets them after that."""
+    with Sim('-c', '5.12', '--fault', 'rtde-hold-inputs') as sim:
+        a = Peer(sim.port)
+        a.protocol_version(2)
+        a.setup_inputs(['input_int_register_24', 'input_bit_register_64'])
+        a.close()
+        left = time.monotonic()
+        b = Peer(sim.port)
+        b.protocol_version(2)
+        check(wait_for('the hold', lambda: log_lines(sim, 'stay IN_USE for 2000 ms (fault rtde-hold-inputs)')),
+              'rtde-hold-inputs: the client leaves, its 2 variables held 2000 ms (log)', sim.log()[-400:])
+        rid, types = b.setup_inputs(['input_int_register_24'])
+        early = time.monotonic() - left
+        check(rid == 0 and types == ['IN_USE'] and early < 2.0,
+              'rtde-hold-inputs: the same register asked for again %.3f s later: IN_USE' % early, (rid, types))
+        rid, types = b.setup_inputs(['input_int_register_25'])
+        check(rid == 2, 'rtde-hold-inputs: other registers are free', (rid, types))
+        b.setup_outputs(['timestamp'], 10.0)
+        b.start()  # cycles run: the hold ends on time
+        ok = wait_for('the end of the hold', lambda: log_lines(sim, 'held after it left are free again'), timeout=10)
+        rid, types = b.setup_inputs(['input_int_register_24', 'input_bit_register_64'])
+        late = time.monotonic() - left
+        check(ok and rid == 3 and types == ['INT32', 'BOOL'] and late >= 2.0,
+              'rtde-hold-inputs: free again after the hold (asked %.3f s after the client left)' % late, (rid, types))
+        b.close()
 
 
 # ---- the same arm on both ports ------------------------------------------------------------
@@ -877,6 +1155,13 @@ def main():
     run(handshake_v1, '5.10', 500)
     run(old_protocol)
     run(inputs_and_misc)
+    run(inputs_types)
+    run(inputs_versions)
+    run(inputs_in_use)
+    run(inputs_next_cycle)
+    run(inputs_several_and_v1)
+    run(inputs_ignored)
+    run(inputs_hold)
     run(frequencies)
     run(same_arm, '5.10', 500, 'start')
     run(same_arm, '3.15', 125, 'monotonic')

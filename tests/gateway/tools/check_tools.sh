@@ -76,8 +76,14 @@ check "dump without source: usage error 2" [ $rc = 2 ]
 check "dump without source: says what to give" has "$T/e1" "give HOST[:PORT] or --file PATH"
 "$DUMP" --fields time,nosuch --file /dev/null > /dev/null 2> "$T/e2"; rc=$?
 check "unknown field: usage error 2" [ $rc = 2 ]
-check "unknown field: lists the valid names" has "$T/e2" "q_actual"
-check "unknown field: names the wrong one" has "$T/e2" '"nosuch"'
+check "unknown field: names the wrong one, says where the names are" has "$T/e2" \
+  'urrt-dump: -k: no field or RTDE value named "nosuch" (docs/protocol.md lists the fields, docs/rtde.md the RTDE names; --rtde --list HOST what a controller has)'
+check "unknown field: two lines, no list of names" [ "$(wc -l < "$T/e2")" = 2 ]
+# A misspelled name: the nearest of both of lib's tables (gateway/common/conf.c), not a list.
+"$DUMP" -k time,q_actul --file /dev/null > /dev/null 2> "$T/e2b"; rc=$?
+check "misspelled field: usage error 2" [ $rc = 2 ]
+check "misspelled field: two lines, no list of names" [ "$(wc -l < "$T/e2b")" = 2 ]
+check "misspelled field: the suggestion" has "$T/e2b" 'urrt-dump: -k: no field or RTDE value named "q_actul": did you mean "q_actual"?'
 "$DUMP" -F gnuplot -k time --file /dev/null > /dev/null 2>&1; rc=$?
 check "gnuplot with --fields: usage error" [ $rc = 2 ]
 "$DUMP" --file "$T/nonexistent" > /dev/null 2> "$T/e3"; rc=$?

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* can_rtde.c: see can_rtde.h. */
-#include "can_rtde.h"
+/* rtde_only.c: see rtde_only.h. */
+#include "rtde_only.h"
 
 #include <math.h>
 #include <string.h>
@@ -67,14 +67,14 @@ static const struct {
 };
 #undef ROW
 
-bool can_rtde_only(int var)
+bool rtde_only(int var)
 {
     return var >= URRT_RTDE_MAPPED_COUNT && var < URRT_RTDE_VAR_COUNT;
 }
 
-unsigned can_rtde_elements(int var)
+unsigned rtde_only_elements(int var)
 {
-    if (!can_rtde_only(var)) {
+    if (!rtde_only(var)) {
         return 0;
     }
     switch (urrt_rtde_var_type(var)) {
@@ -86,7 +86,7 @@ unsigned can_rtde_elements(int var)
     }
 }
 
-const char *can_rtde_unit(int var)
+const char *rtde_only_unit(int var)
 {
     for (size_t i = 0; i < sizeof units / sizeof units[0]; i++) {
         if (var >= units[i].first && var <= units[i].last) {
@@ -96,15 +96,15 @@ const char *can_rtde_unit(int var)
     return "";
 }
 
-bool can_rtde_is_mask(int var)
+bool rtde_only_is_mask(int var)
 {
-    return strcmp(can_rtde_unit(var), "bits") == 0;
+    return strcmp(rtde_only_unit(var), "bits") == 0;
 }
 
-double can_rtde_element(const urrt_rtde_values *v, int var, unsigned elem)
+double rtde_only_element(const urrt_rtde_values *v, int var, unsigned elem)
 {
     const void *p = urrt_rtde_value(v, var);
-    if (p == NULL || !urrt_rtde_has(v, var) || elem >= can_rtde_elements(var)) {
+    if (p == NULL || !urrt_rtde_has(v, var) || elem >= rtde_only_elements(var)) {
         return NAN;
     }
     switch (urrt_rtde_var_type(var)) {
@@ -119,7 +119,7 @@ double can_rtde_element(const urrt_rtde_values *v, int var, unsigned elem)
     }
 }
 
-uint64_t can_rtde_mask(const urrt_rtde_values *v, int var)
+uint64_t rtde_only_mask(const urrt_rtde_values *v, int var)
 {
     const void *p = urrt_rtde_value(v, var);
     if (p == NULL || !urrt_rtde_has(v, var)) {
