@@ -177,23 +177,42 @@ static const variable outputs[] = {
     {"target_base_wrench", W_VECTOR6D, NEVER, VER(5, 26, 0), AT(zero)},
 };
 
-/* Inputs (RTDE_CONTROL_PACKAGE_SETUP_INPUTS) other than the registers. */
+/* The controller's inputs, one double per element: sim_rtde_inputs.value
+ * and .next by these indices (slots). A variable is owned at its first slot. */
+typedef struct input_values {
+    double in_int[48], in_double[48], in_bit[64], in_bits[2];
+    double speed_slider_mask, speed_slider_fraction;
+    double standard_digital_output_mask, standard_digital_output;
+    double configurable_digital_output_mask, configurable_digital_output;
+    double tool_digital_output_mask, tool_digital_output;
+    double standard_analog_output_mask, standard_analog_output_type, standard_analog_output[2];
+    double external_force_torque[6];
+} input_values;
+
+_Static_assert(sizeof(input_values) == SIM_RTDE_INPUT_SLOTS * sizeof(double), "a slot per input element");
+#define IN_AT(member) ((uint16_t)(offsetof(input_values, member) / sizeof(double)))
+_Static_assert(offsetof(input_values, in_int) == 0, "the int registers are slots 0..47");
+/* The fieldbus adapters' range: registers 0..23 and bits 0..63. */
+#define FIELDBUS_REGISTERS 24u
+
+/* Inputs (RTDE_CONTROL_PACKAGE_SETUP_INPUTS) other than the numbered
+ * registers: a controller takes them all (urrt writes registers only). */
 static const variable inputs[] = {
-    {"speed_slider_mask", W_UINT32, BASE3, BASE5, 0},
-    {"speed_slider_fraction", W_DOUBLE, BASE3, BASE5, 0},
-    {"standard_digital_output_mask", W_UINT8, BASE3, BASE5, 0},
-    {"standard_digital_output", W_UINT8, BASE3, BASE5, 0},
-    {"configurable_digital_output_mask", W_UINT8, BASE3, BASE5, 0},
-    {"configurable_digital_output", W_UINT8, BASE3, BASE5, 0},
-    {"tool_digital_output_mask", W_UINT8, BASE3, BASE5, 0},
-    {"tool_digital_output", W_UINT8, BASE3, BASE5, 0},
-    {"standard_analog_output_mask", W_UINT8, BASE3, BASE5, 0},
-    {"standard_analog_output_type", W_UINT8, BASE3, BASE5, 0},
-    {"standard_analog_output_0", W_DOUBLE, BASE3, BASE5, 0},
-    {"standard_analog_output_1", W_DOUBLE, BASE3, BASE5, 0},
-    {"input_bit_registers0_to_31", W_UINT32, REG3, BASE5, 0},
-    {"input_bit_registers32_to_63", W_UINT32, REG3, BASE5, 0},
-    {"external_force_torque", W_VECTOR6D, BASE3, BASE5, 0},
+    {"speed_slider_mask", W_UINT32, BASE3, BASE5, IN_AT(speed_slider_mask)},
+    {"speed_slider_fraction", W_DOUBLE, BASE3, BASE5, IN_AT(speed_slider_fraction)},
+    {"standard_digital_output_mask", W_UINT8, BASE3, BASE5, IN_AT(standard_digital_output_mask)},
+    {"standard_digital_output", W_UINT8, BASE3, BASE5, IN_AT(standard_digital_output)},
+    {"configurable_digital_output_mask", W_UINT8, BASE3, BASE5, IN_AT(configurable_digital_output_mask)},
+    {"configurable_digital_output", W_UINT8, BASE3, BASE5, IN_AT(configurable_digital_output)},
+    {"tool_digital_output_mask", W_UINT8, BASE3, BASE5, IN_AT(tool_digital_output_mask)},
+    {"tool_digital_output", W_UINT8, BASE3, BASE5, IN_AT(tool_digital_output)},
+    {"standard_analog_output_mask", W_UINT8, BASE3, BASE5, IN_AT(standard_analog_output_mask)},
+    {"standard_analog_output_type", W_UINT8, BASE3, BASE5, IN_AT(standard_analog_output_type)},
+    {"standard_analog_output_0", W_DOUBLE, BASE3, BASE5, IN_AT(standard_analog_output[0])},
+    {"standard_analog_output_1", W_DOUBLE, BASE3, BASE5, IN_AT(standard_analog_output[1])},
+    {"input_bit_registers0_to_31", W_UINT32, REG3, BASE5, IN_AT(in_bits[0])},
+    {"input_bit_registers32_to_63", W_UINT32, REG3, BASE5, IN_AT(in_bits[1])},
+    {"external_force_torque", W_VECTOR6D, BASE3, BASE5, IN_AT(external_force_torque)},
 };
 
 /* The numbered registers: PREFIX + index, a version per range. */
@@ -214,9 +233,9 @@ static const register_bank output_banks[] = {
     {"input_bit_register_", W_BOOL, 64, 127, 64, AT(in_bit), 0},
 };
 static const register_bank input_banks[] = {
-    {"input_int_register_", W_INT32, 0, 47, 24, 0, 0},
-    {"input_double_register_", W_DOUBLE, 0, 47, 24, 0, 0},
-    {"input_bit_register_", W_BOOL, 64, 127, 64, 0, 0},
+    {"input_int_register_", W_INT32, 0, 47, 24, 0, IN_AT(in_int)},
+    {"input_double_register_", W_DOUBLE, 0, 47, 24, 0, IN_AT(in_double)},
+    {"input_bit_register_", W_BOOL, 64, 127, 64, 0, IN_AT(in_bit)},
 };
 
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
@@ -473,14 +492,33 @@ static bool find_variable(const sim_rtde_controller *c, const char *name, size_t
                  : find_register(c, output_banks, COUNT(output_banks), name, len, false, f);
 }
 
+/* Whether an input variable (by its first slot) belongs to another: to an
+ * enabled fieldbus adapter (registers 0..23, the words of bits 0..63), or
+ * to another connection's input recipe (one that left too, while
+ * rtde-hold-inputs holds its variables). */
+static bool input_in_use(const sim_rtde_session *s, uint16_t slot)
+{
+    uint32_t owner = s->ctl->inputs.owner[slot];
+    if (s->ctl->fieldbus &&
+        (slot < IN_AT(in_int) + FIELDBUS_REGISTERS || /* in_int is slot 0 on */
+         (slot >= IN_AT(in_double) && slot < IN_AT(in_double) + FIELDBUS_REGISTERS) || slot == IN_AT(in_bits[0]) ||
+         slot == IN_AT(in_bits[1]))) {
+        return true;
+    }
+    return owner != 0 && owner != s->id;
+}
+
 /* The names of a setup, one by one: the type list of the reply, the
  * fields in out (up to max, NULL to drop them). Returns the number of
- * names, *found the number known; the types go to types (NUL-terminated). */
+ * names, *found the number with a type, *in_use (inputs) the number known
+ * but another's; the types go to types (NUL-terminated). */
 static size_t resolve_names(const sim_rtde_session *s, const uint8_t *names, size_t len, bool input,
-                            sim_rtde_field *out, size_t max, size_t *found, char *types, size_t types_cap)
+                            sim_rtde_field *out, size_t max, size_t *found, size_t *in_use, char *types,
+                            size_t types_cap)
 {
     size_t count = 0, tlen = 0, start = 0;
     *found = 0;
+    *in_use = 0;
     types[0] = '\0';
     for (size_t i = 0; i <= len; i++) {
         sim_rtde_field f;
@@ -488,14 +526,17 @@ static size_t resolve_names(const sim_rtde_session *s, const uint8_t *names, siz
         if (i < len && names[i] != ',') {
             continue;
         }
-        if (find_variable(s->ctl, (const char *)names + start, i - start, input, &f)) {
+        if (!find_variable(s->ctl, (const char *)names + start, i - start, input, &f)) {
+            token = "NOT_FOUND";
+        } else if (input && input_in_use(s, f.value)) {
+            token = "IN_USE";
+            (*in_use)++;
+        } else {
             token = wire[f.type].token;
             if (out != NULL && *found < max) {
                 out[*found] = f;
             }
             (*found)++;
-        } else {
-            token = "NOT_FOUND";
         }
         tlen += (size_t)snprintf(types + tlen, types_cap - tlen, "%s%s", count ? "," : "", token);
         tlen = tlen < types_cap ? tlen : types_cap - 1;
@@ -535,7 +576,7 @@ static bool on_setup_outputs(sim_rtde_session *s, const uint8_t *p, size_t len)
     uint8_t out[sizeof types + 1];
     double freq = (double)s->ctl->rate_hz;
     const char *problem = NULL;
-    size_t names, found, off = 0, tlen;
+    size_t names, found, in_use, off = 0, tlen;
 
     if (s->protocol >= 2) {
         if (len < 8) {
@@ -550,7 +591,7 @@ static bool on_setup_outputs(sim_rtde_session *s, const uint8_t *p, size_t len)
     if (len > SIM_RTDE_NAMES_MAX) {
         problem = "the variable names are longer than 2048 bytes";
     }
-    names = resolve_names(s, p, len, false, s->fields, SIM_RTDE_RECIPE_MAX, &found, types, sizeof types);
+    names = resolve_names(s, p, len, false, s->fields, SIM_RTDE_RECIPE_MAX, &found, &in_use, types, sizeof types);
     if (problem == NULL && found > SIM_RTDE_RECIPE_MAX) {
         problem = "more variables than the simulator holds in a recipe (512)";
     }
@@ -585,26 +626,80 @@ static bool on_setup_outputs(sim_rtde_session *s, const uint8_t *p, size_t len)
     return reply(s, RTDE_SETUP_OUTPUTS, out, off + tlen);
 }
 
+/* Holds of rtde-hold-inputs that are over: their variables free again. */
+static void release_held(sim_rtde_inputs *in)
+{
+    uint64_t now;
+    size_t i = 0;
+    if (in->nheld == 0) {
+        return;
+    }
+    now = urrt_port_monotonic_us();
+    while (i < in->nheld) {
+        const sim_rtde_held *h = &in->held[i];
+        size_t n = 0;
+        if (now < h->until_us) {
+            i++;
+            continue;
+        }
+        for (size_t j = 0; j < SIM_RTDE_INPUT_SLOTS; j++) {
+            if (in->owner[j] == h->owner) {
+                in->owner[j] = 0;
+                n++;
+            }
+        }
+        urrt_log(URRT_LOG_INFO, "RTDE client %s: its %zu input variable%s held after it left %s free again "
+                 "(fault rtde-hold-inputs)", h->peer, n, n == 1 ? "" : "s", n == 1 ? "is" : "are");
+        in->held[i] = in->held[--in->nheld];
+    }
+}
+
+/* An input recipe: each name's type, IN_USE for another's variable,
+ * NOT_FOUND for one this version lacks; any of those, id 0. A valid one
+ * gets the next id (SIM_RTDE_INPUT_ID on, the output recipe's is 1) and
+ * takes its variables for this connection. Protocol 1 too, with the id. */
 static bool on_setup_inputs(sim_rtde_session *s, const uint8_t *p, size_t len)
 {
     static char types[SIM_RTDE_NAMES_MAX * 13 + 2];
     static sim_rtde_field fields[SIM_RTDE_RECIPE_MAX];
     uint8_t out[sizeof types + 1];
-    size_t names, found, size = 0, tlen;
-    bool valid;
+    const char *problem = NULL;
+    size_t names, found, in_use, size = 0, tlen;
+    uint8_t id = 0;
 
-    names = resolve_names(s, p, len, true, fields, SIM_RTDE_RECIPE_MAX, &found, types, sizeof types);
-    valid = found == names && found <= SIM_RTDE_RECIPE_MAX && len <= SIM_RTDE_NAMES_MAX &&
-            s->ninputs < SIM_RTDE_INPUT_RECIPES;
-    if (valid) {
-        for (size_t i = 0; i < found; i++) {
-            size += (size_t)wire[fields[i].type].count * wire[fields[i].type].size;
-        }
-        s->input_size[++s->ninputs] = size;
+    release_held(&s->ctl->inputs);
+    names = resolve_names(s, p, len, true, fields, SIM_RTDE_RECIPE_MAX, &found, &in_use, types, sizeof types);
+    if (len > SIM_RTDE_NAMES_MAX) {
+        problem = "the variable names are longer than 2048 bytes";
+    } else if (found > SIM_RTDE_RECIPE_MAX) {
+        problem = "more variables than the simulator holds in a recipe (512)";
+    } else if (found == names && s->ninputs == SIM_RTDE_INPUT_RECIPES) {
+        problem = "more input recipes than the simulator holds on a connection (16)";
+    } else if (found == names && s->in_nfields + found > SIM_RTDE_INPUT_FIELDS) {
+        problem = "more input variables than the simulator holds on a connection (1024)";
     }
-    urrt_log(URRT_LOG_INFO, "RTDE client %s: input recipe of %zu variable%s, %s (the simulator applies no input)",
-             s->peer, names, names == 1 ? "" : "s", valid ? "valid" : "invalid");
-    out[0] = valid ? (uint8_t)s->ninputs : 0;
+    if (problem == NULL && found == names) {
+        sim_rtde_input_recipe *r = &s->inputs[s->ninputs];
+        r->first = (uint16_t)s->in_nfields;
+        r->count = (uint16_t)found;
+        for (size_t i = 0; i < found; i++) {
+            s->in_fields[s->in_nfields++] = fields[i];
+            size += (size_t)wire[fields[i].type].count * wire[fields[i].type].size;
+            s->ctl->inputs.owner[fields[i].value] = s->id;
+        }
+        r->size = size;
+        id = (uint8_t)(SIM_RTDE_INPUT_ID + s->ninputs++);
+        urrt_log(URRT_LOG_INFO, "RTDE client %s: input recipe %u of %zu variable%s (%zu bytes of values)", s->peer,
+                 (unsigned)id, names, names == 1 ? "" : "s", size);
+    } else {
+        urrt_log(URRT_LOG_INFO, "RTDE client %s: input recipe of %zu variable%s refused (id 0): %zu NOT_FOUND, %zu "
+                 "IN_USE%s%s", s->peer, names, names == 1 ? "" : "s", names - found - in_use, in_use,
+                 problem ? ", " : "", problem ? problem : "");
+    }
+    if (problem != NULL && !complain(s, problem)) {
+        return false;
+    }
+    out[0] = id;
     tlen = strlen(types);
     memcpy(out + 1, types, tlen);
     return reply(s, RTDE_SETUP_INPUTS, out, 1 + tlen);
@@ -618,17 +713,98 @@ static bool on_start(sim_rtde_session *s)
     return reply_byte(s, RTDE_START, s->started ? 1 : 0);
 }
 
-/* Input data from the client: checked against its input recipe, not applied. */
+/* An input data package the controller does not take: counted, logged (at
+ * -v) and told the client in an error text message, as the simulator tells
+ * every request UR's documentation is silent about; nothing is applied. */
+static bool ignore_input(sim_rtde_session *s, const char *why)
+{
+    char msg[160];
+    s->inputs_ignored++;
+    snprintf(msg, sizeof msg, "%s: ignored", why);
+    urrt_log(URRT_LOG_INFO, "RTDE client %s: %s (%" PRIu64 " so far)", s->peer, msg, s->inputs_ignored);
+    return send_text(s, LEVEL_ERROR, msg);
+}
+
+static uint32_t get_u32(const uint8_t *p)
+{
+    return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3];
+}
+
+/* A field's values from the wire into the controller's next values (the
+ * elements of its slots); returns its bytes. Doubles keep their bits. */
+static size_t take_field(const uint8_t *p, const sim_rtde_field *f, sim_rtde_inputs *in)
+{
+    size_t n = 0;
+    for (unsigned e = 0; e < wire[f->type].count; e++) {
+        double x;
+        switch (f->type) {
+        case W_BOOL: x = p[n] != 0 ? 1.0 : 0.0; n += 1; break;
+        case W_UINT8: x = p[n]; n += 1; break;
+        case W_UINT32:
+        case W_VECTOR6UINT32: x = (double)get_u32(p + n); n += 4; break;
+        case W_INT32:
+        case W_VECTOR6INT32: x = (double)(int32_t)get_u32(p + n); n += 4; break;
+        case W_UINT64: x = (double)((uint64_t)get_u32(p + n) << 32 | get_u32(p + n + 4)); n += 8; break;
+        default: x = get_double(p + n); n += 8; break;
+        }
+        in->next[f->value + e] = x;
+        in->written[f->value + e] = true;
+    }
+    return n;
+}
+
+/* Input data from the client: protocol 2 names its input recipe by id, a
+ * protocol 1 package (no id) is the connection's last input recipe's. Its
+ * values take effect at the next control cycle (sim_rtde_due), for every
+ * client's output recipe. */
 static bool on_input_data(sim_rtde_session *s, const uint8_t *p, size_t len)
 {
-    size_t id = s->ninputs;
+    sim_rtde_inputs *in = &s->ctl->inputs;
+    const sim_rtde_input_recipe *r;
+    unsigned id;
+    char why[128];
+
     if (s->protocol >= 2) {
-        id = len > 0 ? p[0] : 0;
-        len = len > 0 ? len - 1 : 0;
+        if (len == 0) {
+            return ignore_input(s, "an input data package without a recipe id");
+        }
+        id = p[0];
+        p++;
+        len--;
+    } else {
+        id = s->ninputs > 0 ? SIM_RTDE_INPUT_ID + s->ninputs - 1 : 0;
     }
-    if (id == 0 || id > s->ninputs || s->input_size[id] != len) {
-        return complain(s, "RTDE_DATA_PACKAGE from the client matches no input recipe");
+    if (id < SIM_RTDE_INPUT_ID || id - SIM_RTDE_INPUT_ID >= s->ninputs) {
+        if (s->protocol >= 2) {
+            snprintf(why, sizeof why, "an input data package of recipe id %u, no input recipe of this connection",
+                     id);
+        } else {
+            snprintf(why, sizeof why, "an input data package before any input recipe");
+        }
+        return ignore_input(s, why);
     }
+    r = &s->inputs[id - SIM_RTDE_INPUT_ID];
+    if (len != r->size) {
+        snprintf(why, sizeof why, "an input data package of %zu byte%s of values for input recipe %u, which has %zu",
+                 len, len == 1 ? "" : "s", id, r->size);
+        return ignore_input(s, why);
+    }
+    if (!s->started) {
+        snprintf(why, sizeof why, "an input data package for input recipe %u while not started", id);
+        return ignore_input(s, why);
+    }
+    for (size_t i = 0; i < r->count; i++) {
+        p += take_field(p, &s->in_fields[r->first + i], in);
+    }
+    if (in->npending < SIM_RTDE_PENDING_MAX) {
+        sim_rtde_pending *q = &in->pending[in->npending++];
+        snprintf(q->peer, sizeof q->peer, "%s", s->peer);
+        q->recipe_id = (uint8_t)id;
+        q->count = r->count;
+    } else {
+        in->pending_over++;
+    }
+    s->inputs_applied++;
     return true;
 }
 
@@ -664,17 +840,60 @@ static bool on_package(sim_rtde_session *s, uint8_t type, const uint8_t *p, size
     }
 }
 
-void sim_rtde_session_init(sim_rtde_session *s, const sim_rtde_controller *ctl, const sim_rtde_faults *faults,
+void sim_rtde_session_init(sim_rtde_session *s, sim_rtde_controller *ctl, const sim_rtde_faults *faults,
                            sim_rtde_emit emit, void *emit_ctx, const char *peer)
 {
     memset(s, 0, sizeof *s);
     s->ctl = ctl;
+    if (++ctl->inputs.sessions == 0) {
+        ctl->inputs.sessions = 1; /* 0 is no owner */
+    }
+    s->id = ctl->inputs.sessions;
     s->faults = faults;
     s->emit = emit;
     s->emit_ctx = emit_ctx;
     s->protocol = 1;
     s->divisor = 1;
     snprintf(s->peer, sizeof s->peer, "%s", peer);
+}
+
+void sim_rtde_session_end(sim_rtde_session *s)
+{
+    sim_rtde_inputs *in = &s->ctl->inputs;
+    uint32_t hold = s->faults->hold_inputs_ms;
+    size_t n = 0;
+    for (size_t i = 0; i < SIM_RTDE_INPUT_SLOTS; i++) {
+        if (in->owner[i] == s->id) {
+            n++;
+            if (hold == 0) {
+                in->owner[i] = 0;
+            }
+        }
+    }
+    if (n > 0 && hold != 0) {
+        sim_rtde_held *h;
+        if (in->nheld == SIM_RTDE_HELD_MAX) {
+            size_t first = 0; /* the hold that ends first ends now */
+            for (size_t i = 1; i < in->nheld; i++) {
+                first = in->held[i].until_us < in->held[first].until_us ? i : first;
+            }
+            in->held[first].until_us = 0;
+            release_held(in);
+        }
+        h = &in->held[in->nheld++];
+        h->owner = s->id;
+        h->until_us = urrt_port_monotonic_us() + (uint64_t)hold * 1000u;
+        snprintf(h->peer, sizeof h->peer, "%s", s->peer);
+        urrt_log(URRT_LOG_INFO, "RTDE client %s left: its %zu input variable%s stay%s IN_USE for %" PRIu32 " ms "
+                 "(fault rtde-hold-inputs)", s->peer, n, n == 1 ? "" : "s", n == 1 ? "s" : "", hold);
+    } else if (n > 0) {
+        urrt_log(URRT_LOG_INFO, "RTDE client %s left: its %zu input variable%s %s free again, %s kept", s->peer, n,
+                 n == 1 ? "" : "s", n == 1 ? "is" : "are", n == 1 ? "its value" : "their values");
+    }
+    if (s->inputs_applied != 0 || s->inputs_ignored != 0) {
+        urrt_log(URRT_LOG_INFO, "RTDE client %s: %" PRIu64 " input data package%s taken, %" PRIu64 " ignored", s->peer,
+                 s->inputs_applied, s->inputs_applied == 1 ? "" : "s", s->inputs_ignored);
+    }
 }
 
 bool sim_rtde_feed(sim_rtde_session *s, const uint8_t *data, size_t len)
@@ -709,8 +928,38 @@ bool sim_rtde_feed(sim_rtde_session *s, const uint8_t *data, size_t len)
 
 /* ---- data ---------------------------------------------------------------------- */
 
-bool sim_rtde_due(const sim_rtde_session *s, uint64_t k)
+/* A new control cycle k: the input packages received since the last one
+ * take effect (each logged at -v), and holds that are over end. */
+static void inputs_cycle(sim_rtde_inputs *in, uint64_t k)
 {
+    for (size_t i = 0; i < SIM_RTDE_INPUT_SLOTS; i++) {
+        if (in->written[i]) {
+            in->value[i] = in->next[i];
+            in->written[i] = false;
+        }
+    }
+    for (size_t i = 0; i < in->npending; i++) {
+        const sim_rtde_pending *q = &in->pending[i];
+        urrt_log(URRT_LOG_INFO, "RTDE client %s: input data of recipe %u (%u variable%s) applied at cycle %" PRIu64,
+                 q->peer, (unsigned)q->recipe_id, (unsigned)q->count, q->count == 1 ? "" : "s", k);
+    }
+    if (in->pending_over != 0) {
+        urrt_log(URRT_LOG_INFO, "RTDE: %" PRIu64 " more input data packages applied at cycle %" PRIu64,
+                 in->pending_over, k);
+    }
+    in->npending = 0;
+    in->pending_over = 0;
+    in->cycle = k;
+    in->cycle_known = true;
+    release_held(in);
+}
+
+bool sim_rtde_due(sim_rtde_session *s, uint64_t k)
+{
+    sim_rtde_inputs *in = &s->ctl->inputs;
+    if (!in->cycle_known || in->cycle != k) {
+        inputs_cycle(in, k);
+    }
     return s->started && k % s->divisor == 0;
 }
 
@@ -721,7 +970,7 @@ static void copy_doubles(double *to, const double *from, size_t n)
 
 /* Cycle k's values: the RealTime ones from the state, the RTDE-only ones
  * by the rules of docs/tools.md. */
-static void cycle_values(uint64_t k, const urrt_state *st, values *v)
+static void cycle_values(uint64_t k, const urrt_state *st, const sim_rtde_inputs *in, values *v)
 {
     memset(v, 0, sizeof *v);
     v->timestamp = st->time[0];
@@ -784,6 +1033,11 @@ static void cycle_values(uint64_t k, const urrt_state *st, values *v)
     for (unsigned n = 64; n < 128; n++) {
         v->out_bit[n - 64] = (double)((k >> (n % 32)) & 1u);
     }
+    /* The input registers, read back: what the controller holds. */
+    copy_doubles(v->in_int, in->value + IN_AT(in_int), 48);
+    copy_doubles(v->in_double, in->value + IN_AT(in_double), 48);
+    copy_doubles(v->in_bit, in->value + IN_AT(in_bit), 64);
+    copy_doubles(v->in_bits, in->value + IN_AT(in_bits), 2);
 }
 
 /* A field's wire bytes. */
@@ -866,7 +1120,7 @@ bool sim_rtde_send_data(sim_rtde_session *s, uint64_t k, const urrt_state *st)
     size_t off = put_recipe_id(s, payload);
 
     _Static_assert(sizeof(values) == VALUES_COUNT * sizeof(double), "values is an array of doubles");
-    cycle_values(k, st, &v);
+    cycle_values(k, st, &s->ctl->inputs, &v);
     for (size_t i = 0; i < s->nfields; i++) {
         off += put_field(payload + off, &s->fields[i], (const double *)&v);
     }
@@ -1248,10 +1502,12 @@ bool sim_rtde_recording_load(const char *path, sim_rtde_recording *r, sim_rtde_c
     FILE *f = NULL;
     void *map;
     bool ok;
+    bool fieldbus = ctl->fieldbus; /* the controller's configuration, not the capture's */
     int fd = open(path, O_RDONLY | O_CLOEXEC);
 
     memset(r, 0, sizeof *r);
     memset(ctl, 0, sizeof *ctl);
+    ctl->fieldbus = fieldbus;
     memset(r->protocol_answer, 0xff, sizeof r->protocol_answer);
     if (fd < 0 || fstat(fd, &st) != 0 || st.st_size == 0) {
         snprintf(why, why_size, "cannot read the capture %s: %s", path, fd < 0 ? strerror(errno) : "empty");

@@ -15,6 +15,15 @@
  * one is NOT_FOUND), the rate (125 Hz before 5.0, 500 Hz from 5.0), and the
  * protocol (1 only before 3.4).
  *
+ * Inputs are the controller's, shared by every connection
+ * (sim_rtde_controller.inputs): an input recipe ('I') takes its variables
+ * for its connection (IN_USE for any other, and for registers 0..23 and
+ * bits 0..63 while a fieldbus adapter is enabled); input data packages
+ * ('U' from the client) are applied at the next control cycle, so that
+ * every client's output recipe reads the values back from that cycle on;
+ * sim_rtde_session_end() gives the variables up (or holds them for a while,
+ * fault rtde-hold-inputs) and keeps their values.
+ *
  * Or the controller is an RTDE capture (urrt-sim --replay): a
  * sim_rtde_recording answers the handshake as the recorded controller did
  * and has only the recorded variables; each data package copies, for the
@@ -34,12 +43,57 @@
 #define SIM_RTDE_NAMES_MAX 2048
 /* Fields in one recipe: 2048 bytes of names hold fewer valid ones. */
 #define SIM_RTDE_RECIPE_MAX 512
-/* Input recipes a connection may set up (the simulator applies none). */
+/* Input recipes a connection may set up, their ids from SIM_RTDE_INPUT_ID
+ * on (the output recipe's is 1), and their variables on one connection. */
 #define SIM_RTDE_INPUT_RECIPES 16
+#define SIM_RTDE_INPUT_ID 2
+#define SIM_RTDE_INPUT_FIELDS 1024
+/* Every input's value, one double per element: the registers (48 int, 48
+ * double, bits 64..127, the two words of bits 0..63) and the other inputs. */
+#define SIM_RTDE_INPUT_SLOTS 180
+/* Input packages received since the last control cycle, for its log lines. */
+#define SIM_RTDE_PENDING_MAX 256
+/* Connections whose inputs are held after they left (rtde-hold-inputs). */
+#define SIM_RTDE_HELD_MAX 64
+/* How long rtde-hold-inputs holds them by default. */
+#define SIM_RTDE_HOLD_DEFAULT_MS 2000u
 /* Backlog past the socket's buffer after which a reader is disconnected. */
 #define SIM_RTDE_BACKLOG_DEFAULT (64u * 1024u)
 
 typedef struct sim_rtde_recording sim_rtde_recording;
+
+/* An input package received, applied at the next cycle (for its log line). */
+typedef struct sim_rtde_pending {
+    char peer[80];
+    uint8_t recipe_id;
+    uint16_t count;           /* variables */
+} sim_rtde_pending;
+
+/* A connection gone whose input variables stay IN_USE until a time. */
+typedef struct sim_rtde_held {
+    uint32_t owner;           /* its session id */
+    uint64_t until_us;        /* monotonic */
+    char peer[80];
+} sim_rtde_held;
+
+/* The controller's inputs, shared by its connections. A variable is owned
+ * by the session that set it up in an input recipe (owner, at the slot of
+ * its first element; 0: free); values are what the controller holds, read
+ * back by output recipes, and stay when their owner leaves. */
+typedef struct sim_rtde_inputs {
+    double value[SIM_RTDE_INPUT_SLOTS];       /* in effect this cycle (doubles as bits) */
+    double next[SIM_RTDE_INPUT_SLOTS];        /* written since: in effect from the next cycle */
+    bool written[SIM_RTDE_INPUT_SLOTS];
+    uint32_t owner[SIM_RTDE_INPUT_SLOTS];
+    uint32_t sessions;        /* session ids given so far */
+    bool cycle_known;
+    uint64_t cycle;           /* the control cycle in effect (the last one sim_rtde_due saw) */
+    sim_rtde_pending pending[SIM_RTDE_PENDING_MAX];
+    size_t npending;
+    uint64_t pending_over;    /* input packages past the log's records this cycle */
+    sim_rtde_held held[SIM_RTDE_HELD_MAX];
+    size_t nheld;
+} sim_rtde_inputs;
 
 /* The controller behind the port. */
 typedef struct sim_rtde_controller {
@@ -47,6 +101,9 @@ typedef struct sim_rtde_controller {
     uint32_t rate_hz;     /* 125 before 5.0, 500 from 5.0: the highest frequency a client may ask */
     double cycle_hz;      /* the cycles k counted by sim_rtde_due: rate_hz, or a capture's own rate */
     const sim_rtde_recording *recording;   /* a capture's controller; NULL: the model's */
+    bool fieldbus;        /* an enabled fieldbus adapter (EtherNet/IP, PROFINET, Modbus) owns input
+                             registers 0..23 and bits 0..63 (urrt-sim --fieldbus) */
+    sim_rtde_inputs inputs;
 } sim_rtde_controller;
 
 /* What a bad data package looks like (--fault rtde-bad-package). */
@@ -67,6 +124,7 @@ typedef struct sim_rtde_faults {
     uint8_t text_level;       /* 0 exception, 1 error, 2 warning, 3 info */
     uint64_t bad_every;       /* every Nth data package is bad ... */
     sim_rtde_bad bad_kind;    /* ... this way */
+    uint32_t hold_inputs_ms;  /* a connection's input variables stay IN_USE this long after it left (0: no) */
 } sim_rtde_faults;
 
 /* Sends bytes to the client; false when they cannot be queued. */
@@ -128,8 +186,14 @@ bool sim_rtde_recording_load(const char *path, sim_rtde_recording *r, sim_rtde_c
 double sim_rtde_recording_time(const sim_rtde_recording *r, size_t i);
 void sim_rtde_recording_free(sim_rtde_recording *r);
 
+/* An input recipe of a connection: its variables in the session's in_fields. */
+typedef struct sim_rtde_input_recipe {
+    uint16_t first, count;
+    size_t size;              /* bytes of values in its data package */
+} sim_rtde_input_recipe;
+
 typedef struct sim_rtde_session {
-    const sim_rtde_controller *ctl;
+    sim_rtde_controller *ctl;
     const sim_rtde_faults *faults;
     sim_rtde_emit emit;
     void *emit_ctx;
@@ -141,8 +205,13 @@ typedef struct sim_rtde_session {
     size_t nfields;
     sim_rtde_field fields[SIM_RTDE_RECIPE_MAX];
     size_t data_size;         /* the recipe's bytes in a data package */
-    size_t input_size[SIM_RTDE_INPUT_RECIPES + 1];   /* by input recipe id; 0: none */
+    uint32_t id;              /* as the owner of input variables */
+    sim_rtde_input_recipe inputs[SIM_RTDE_INPUT_RECIPES];   /* id SIM_RTDE_INPUT_ID + index */
     unsigned ninputs;
+    sim_rtde_field in_fields[SIM_RTDE_INPUT_FIELDS];
+    size_t in_nfields;
+    uint64_t inputs_applied;  /* input packages taken (applied at the next cycle) */
+    uint64_t inputs_ignored;  /* input packages of no recipe, of the wrong size, before start */
     uint64_t data_sent;       /* data packages, for the faults that count them */
     uint64_t texts_sent;
     bool broken;              /* the client sent an unframable package: close */
@@ -154,15 +223,23 @@ typedef struct sim_rtde_session {
  * why the version serves no RTDE. */
 const char *sim_rtde_controller_parse(const char *text, sim_rtde_controller *c);
 
-void sim_rtde_session_init(sim_rtde_session *s, const sim_rtde_controller *ctl, const sim_rtde_faults *faults,
+void sim_rtde_session_init(sim_rtde_session *s, sim_rtde_controller *ctl, const sim_rtde_faults *faults,
                            sim_rtde_emit emit, void *emit_ctx, const char *peer);
+
+/* The client left (before the session is freed): its input variables are
+ * free again, or IN_USE a while longer with rtde-hold-inputs; their values
+ * stay. */
+void sim_rtde_session_end(sim_rtde_session *s);
 
 /* Bytes the client sent, in any chunking; replies go out through emit.
  * False when the client must be disconnected (an unframable package). */
 bool sim_rtde_feed(sim_rtde_session *s, const uint8_t *data, size_t len);
 
-/* Whether control cycle k (of the controller's rate) carries a data package. */
-bool sim_rtde_due(const sim_rtde_session *s, uint64_t k);
+/* Whether control cycle k (of the controller's rate) carries a data package.
+ * Called for every session at every cycle: the first call of a cycle applies
+ * the input packages received since the one before, and ends the holds
+ * that are over. */
+bool sim_rtde_due(sim_rtde_session *s, uint64_t k);
 
 /* Cycle k's data package from its state (preceded by a text message, or
  * replaced by a bad package, when a fault says so). False when it cannot be

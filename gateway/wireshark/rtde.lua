@@ -6,14 +6,16 @@
 --
 -- A TCP conversation is one session. What earlier packages of it set up says
 -- how later ones read: the protocol version (1 until a V reply accepts the
--- version its request asked for) and the recipe (the names of the last O
--- request with the types of its reply). Wireshark dissects frames again in
+-- version its request asked for), the recipe (the names of the last O
+-- request with the types of its reply) and the input recipes (the names of
+-- each I request with the id and types of its reply), by which a client's
+-- data packages read. Wireshark dissects frames again in
 -- any order, so the session as it stood before each frame is kept, and a
 -- frame dissected again starts from that copy.
 
 local rtde = Proto("urrt_rtde", "Universal Robots RTDE")
 
--- Setup inputs: lib/ has no constant for it because urrt never sends it.
+-- Setup inputs: lib/urrt_rtde.h, the reading side, has no constant for it.
 local LETTER_I = string.byte("I")
 local PACKAGES = {
     [RTDE_LETTER.V] = "protocol version", [RTDE_LETTER.v] = "controller version",
@@ -71,7 +73,7 @@ for _, v in ipairs(RTDE_VARS) do
     local text = desc and ("%s (RealTime's %s)%s"):format(desc, field, is_unit(unit) and " [" .. unit .. "]" or "")
         or "RTDE variable " .. name
     var_field[name] = element_field("urrt_rtde." .. name, name, RTDE_TYPES[type][1], text, v[6])
-    rf[name] = var_field[name]
+    rf["var_" .. name] = var_field[name] -- prefixed: the variable "payload" is not rf.payload
 end
 for _, element in ipairs({ "double", "int32", "uint32", "uint64", "uint8", "bool" }) do
     other_field[element] = element_field("urrt_rtde.other." .. element, "other " .. element, element,
@@ -83,29 +85,30 @@ rtde.fields = rf
 local function warn(abbr, text) return ProtoExpert.new(abbr, text, expert.group.PROTOCOL, expert.severity.WARN) end
 local rx = {
     not_found = warn("urrt_rtde.not_found", "Variable not found on this controller: the recipe is invalid"),
-    bad_word = warn("urrt_rtde.bad_type", "A setup reply word that is no output type: the recipe is invalid"),
+    in_use = warn("urrt_rtde.in_use",
+        "Input in use by another client or an enabled fieldbus adapter: the input recipe is invalid"),
+    bad_word = warn("urrt_rtde.bad_type", "A setup reply word that is no type: the recipe is invalid"),
     count = warn("urrt_rtde.type_count", "Setup reply: not one type per name asked for"),
     layout = warn("urrt_rtde.layout", "Package longer or shorter than its layout"),
     early = warn("urrt_rtde.data_early", "Data package before a recipe was set up"),
     recipe_id = warn("urrt_rtde.recipe_id", "Data package of another recipe id"),
     data_size = warn("urrt_rtde.data_size", "Data package size is not the recipe's"),
+    input_recipe = warn("urrt_rtde.input_recipe", "Input data package of no input recipe of this connection"),
     unknown = warn("urrt_rtde.unknown_type", "Unknown package type"),
     size = ProtoExpert.new("urrt_rtde.size_small", "Size below the 3-byte header: the stream cannot be framed",
         expert.group.MALFORMED, expert.severity.ERROR),
-    inputs = ProtoExpert.new("urrt_rtde.setup_inputs", "Setup inputs: urrt never sends this",
-        expert.group.SEQUENCE, expert.severity.NOTE),
 }
-rtde.experts = { rx.not_found, rx.bad_word, rx.count, rx.layout, rx.early, rx.recipe_id, rx.data_size, rx.unknown,
-    rx.size, rx.inputs }
+rtde.experts = { rx.not_found, rx.in_use, rx.bad_word, rx.count, rx.layout, rx.early, rx.recipe_id, rx.data_size,
+    rx.input_recipe, rx.unknown, rx.size }
 
 -- ---- the session per conversation ----------------------------------------------
 
 local sessions, before_frame = {}, {}
 local session_in_frame -- the session the frame being dissected reads and changes
 
-local function new_session() return { protocol = 1 } end
+local function new_session() return { protocol = 1, inputs = {} } end
 
--- Shallow: the tables a session holds (names, recipe) are replaced, never changed.
+-- Shallow: the tables a session holds (names, recipe, inputs) are replaced, never changed.
 local function copy(s)
     local c = {}
     for k, v in pairs(s) do c[k] = v end
@@ -176,7 +179,7 @@ local function setup_request(t, tvb, s, inputs)
     end
     local names = names_of(add_words(t, tvb, offset, rf.names, rf.name))
     if inputs then
-        t:add_proto_expert_info(rx.inputs)
+        s.input_names = names
         return ("%d names"):format(#names)
     end
     s.names, s.recipe = names, nil
@@ -185,16 +188,21 @@ local function setup_request(t, tvb, s, inputs)
 end
 
 -- The recipe of a setup reply: names of the request, types of the reply; nil
--- (and expert infos) when any word is NOT_FOUND or no type, or counts differ.
-local function recipe_of(t, words, names)
+-- (and expert infos) when any word is NOT_FOUND, IN_USE (inputs) or no type,
+-- or counts differ.
+local function recipe_of(t, words, names, inputs)
     local recipe, ok = { bytes = 0 }, true
     for i, w in ipairs(words) do
         local coding = RTDE_TYPES[w.word]
         if w.word == "NOT_FOUND" then
             w.item:add_proto_expert_info(rx.not_found, ("%s: not found on this controller"):format(names[i] or "?"))
             ok = false
+        elseif w.word == "IN_USE" and inputs then
+            w.item:add_proto_expert_info(rx.in_use, ("%s: in use by another client or a fieldbus adapter"):format(
+                names[i] or "?"))
+            ok = false
         elseif coding == nil then
-            w.item:add_proto_expert_info(rx.bad_word, ("%q is no output type"):format(w.word))
+            w.item:add_proto_expert_info(rx.bad_word, ("%q is no type"):format(w.word))
             ok = false
         else
             recipe[i] = { name = names[i], type = w.word }
@@ -209,6 +217,21 @@ local function recipe_of(t, words, names)
     return ok and recipe or nil
 end
 
+-- An input recipe's reply carries its id in both protocols (no layout
+-- without it is described); a valid one (id not 0) is kept by its id, and
+-- is the one a protocol 1 data package from the client (no id) is of.
+local function input_setup_reply(t, tvb, s, id, words)
+    local recipe = recipe_of(t, words, s.input_names or {}, true)
+    if recipe and id ~= 0 then
+        local inputs = {}
+        for k, v in pairs(s.inputs) do inputs[k] = v end
+        inputs[id] = recipe
+        s.inputs, s.last_input = inputs, id
+    end
+    local what = recipe and id ~= 0 and "input recipe" or "input recipe INVALID"
+    return ("%s %d, %d types"):format(what, id, #words)
+end
+
 local function setup_reply(t, tvb, s, inputs)
     local offset, id = RTDE_HEADER, nil
     if s.protocol >= 2 or inputs then
@@ -217,8 +240,8 @@ local function setup_reply(t, tvb, s, inputs)
         id, offset = tvb(offset, 1):uint(), offset + 1
     end
     local words = add_words(t, tvb, offset, rf.types, rf.var_type)
-    if inputs then return ("%d types"):format(#words) end
-    s.recipe = recipe_of(t, words, s.names or {})
+    if inputs then return input_setup_reply(t, tvb, s, id, words) end
+    s.recipe = recipe_of(t, words, s.names or {}, false)
     s.recipe_id = id
     local what = s.recipe and "recipe" or "recipe INVALID"
     return id and ("%s %d, %d types"):format(what, id, #words) or ("%s, %d types"):format(what, #words)
@@ -291,6 +314,32 @@ local function add_variable(t, tvb, offset, entry)
     return offset + esize * count
 end
 
+-- A client's data package: the values of one of its input recipes, by the
+-- id in protocol 2, the last one set up in protocol 1.
+local function input_package(t, tvb, s)
+    local offset, id = RTDE_HEADER, s.last_input
+    if s.protocol >= 2 then
+        if tvb:len() == offset then return layout_ok(t, tvb, 1, true) and "" or "malformed" end
+        id = tvb(offset, 1):uint()
+        local item = t:add(rf.recipe_id, tvb(offset, 1))
+        if s.inputs[id] == nil then item:add_proto_expert_info(rx.input_recipe, ("input recipe %d"):format(id)) end
+        offset = offset + 1
+    end
+    local recipe = id and s.inputs[id]
+    if recipe == nil then
+        local item = tvb:len() > offset and t:add(rf.payload, tvb(offset)) or t
+        if s.protocol < 2 then item:add_proto_expert_info(rx.input_recipe, "no input recipe set up") end
+        return ("no input recipe %s"):format(id and tostring(id) or "")
+    end
+    if tvb:len() ~= offset + recipe.bytes then
+        t:add(rf.payload, tvb(RTDE_HEADER)):add_proto_expert_info(rx.data_size,
+            ("%d bytes, input recipe %d's package has %d"):format(tvb:len(), id, offset + recipe.bytes))
+        return ("input recipe %d: size not the recipe's"):format(id)
+    end
+    for _, entry in ipairs(recipe) do offset = add_variable(t, tvb, offset, entry) end
+    return ("input recipe %d, %d values"):format(id, #recipe)
+end
+
 local function data_package(t, tvb, s)
     if s.recipe == nil then
         t:add(rf.payload, tvb(RTDE_HEADER)):add_proto_expert_info(rx.early)
@@ -351,7 +400,10 @@ local BODY = {
         return layout_ok(t, tvb, 0) and "" or "malformed"
     end,
     [RTDE_LETTER.M] = text_message,
-    [RTDE_LETTER.U] = function(t, tvb, s) return data_package(t, tvb, s) end,
+    [RTDE_LETTER.U] = function(t, tvb, s, from_server)
+        if from_server then return data_package(t, tvb, s) end
+        return input_package(t, tvb, s)
+    end,
     [RTDE_LETTER.O] = function(t, tvb, s, from_server)
         if from_server then return setup_reply(t, tvb, s, false) end
         return setup_request(t, tvb, s, false)
@@ -372,7 +424,6 @@ local function dissect_package(tvb, tree, s, from_server)
     local letter = tvb(2, 1):uint()
     local t = tree:add(rtde, tvb())
     local name = PACKAGES[letter] or "unknown type"
-    if letter == LETTER_I then name = name .. " (urrt never sends this)" end
     local dir = from_server and "reply" or "request"
     if letter == RTDE_LETTER.U or letter == RTDE_LETTER.M then dir = from_server and "from controller" or "from client" end
     t:append_text((", %s %s, %d bytes"):format(name, dir, tvb:len()))

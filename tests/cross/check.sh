@@ -190,6 +190,39 @@ if [ -f "$out/image-co.elf" ] && [ -f "$out/image-co-eds.elf" ]; then
   check "the image with urrt_co_comm_name holds the object names (\"$co_name\")" grep -q "$co_name" "$out/image-co-eds.elf"
 fi
 
+# The RTDE client as a read-only firmware links it (a session: begin, the
+# recipe, requests, feed, close), and with its writing side (every
+# urrt_rtde_in_ function) as well. "This firmware cannot write" is a property
+# of the link map: the read-only image holds no urrt_rtde_in_ symbol, nor the
+# three functions urrt_rtde.c has for the writing side alone, and
+# lib/urrt_rtde.o itself references no urrt_rtde_in_ symbol.
+rtde_roots=""
+for f in urrt_rtde_init urrt_rtde_begin urrt_rtde_set_recipe urrt_rtde_output urrt_rtde_feed urrt_rtde_finish \
+         urrt_rtde_var_find urrt_rtde_up; do
+  rtde_roots="$rtde_roots -Wl,-u,$f"
+done
+in_roots=$(${CROSS}nm -g --defined-only "$out/urrt_rtde_in.o" | awk 'NF == 3 && $2 ~ /[TDR]/ { printf " -Wl,-u,%s", $3 }')
+check "image (the RTDE client, read-only) links with -nostdlib -lgcc" \
+  ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $rtde_roots -lgcc -o "$out/image-rtde.elf"
+check "image (the RTDE client and its writing side) links with -nostdlib -lgcc" \
+  ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $rtde_roots $in_roots -lgcc -o "$out/image-rtde-in.elf"
+if [ -f "$out/image-rtde.elf" ] && [ -f "$out/image-rtde-in.elf" ]; then
+  writer=$(${CROSS}nm "$out/image-rtde.elf" | awk '$3 ~ /^urrt_rtde_in_|^urrt_rtde_(due|streaming|end)$/ { print $3 }')
+  if [ -n "$writer" ]; then
+    fail "the read-only RTDE image links the writing side: $(echo $writer)"
+  else
+    ok "the read-only RTDE image links no urrt_rtde_in_ function, nor urrt_rtde_due, _streaming, _end"
+  fi
+  check "the RTDE image with its writing side links urrt_rtde_in_package and urrt_rtde_in_feed" \
+    sh -c "${CROSS}nm '$out/image-rtde-in.elf' | grep -q ' urrt_rtde_in_package\$' &&
+      ${CROSS}nm '$out/image-rtde-in.elf' | grep -q ' urrt_rtde_in_feed\$'"
+fi
+if ${CROSS}nm "$out/urrt_rtde.o" | grep -q 'urrt_rtde_in_'; then
+  fail "lib/urrt_rtde.o references the writing side: $(${CROSS}nm "$out/urrt_rtde.o" | grep 'urrt_rtde_in_' | head -n 3)"
+else
+  ok "lib/urrt_rtde.o references no urrt_rtde_in_ symbol"
+fi
+
 # Footprint.
 row() { # name text data bss
   printf '| %s | %s | %s | %s |\n' "$1" "$2" "$3" "$4"
@@ -215,13 +248,15 @@ while IFS='|' read -r core cc flags; do
 done <<EOF_CORES
 $CORES
 EOF_CORES
-for img in min co co-eds all; do
+for img in min co co-eds rtde rtde-in all; do
   [ -f "$out/image-$img.elf" ] || continue
   set -- $(${CROSS}size "$out/image-$img.elf" | awk 'NR == 2 { print $1, $2, $3 }')
   case $img in
     min) name="image: framer + decode + random access (tests/cross)" ;;
     co) name="image: the CANopen node, no EDS writer (tests/cross)" ;;
     co-eds) name="image: the CANopen node and urrt_co_comm_name (tests/cross)" ;;
+    rtde) name="image: the RTDE client, read-only (tests/cross)" ;;
+    rtde-in) name="image: the RTDE client and its writing side (tests/cross)" ;;
     all) name="image: every lib/ function (tests/cross)" ;;
   esac
   row "$name" "$1" "$2" "$3" >> "$measured"
@@ -236,6 +271,8 @@ printf '| sizeof(urrt_state) | %s |\n| sizeof(urrt_framer) | %s |\n' "$state" "$
 # The RTDE client's session and its RTDE-only values (lib/urrt_rtde.h).
 printf '| sizeof(urrt_rtde) | %s |\n| sizeof(urrt_rtde_values) | %s |\n' \
   "$(symbol_size urrt_probe_rtde)" "$(symbol_size urrt_probe_rtde_values)" >> "$measured"
+# One input recipe of the writing side (lib/urrt_rtde_in.h).
+printf '| sizeof(urrt_rtde_in) | %s |\n' "$(symbol_size urrt_probe_rtde_in)" >> "$measured"
 rm -f "$out"/*.O2.su
 echo "cross: largest stack frames of lib/ functions (-fstack-usage, bytes; lib/ has no recursion):"
 for obj in $objs; do cat "${obj%.o}.su"; done | sort -t "$(printf '\t')" -k2 -n -r | head -n 5 | sed 's/^/cross:   /'

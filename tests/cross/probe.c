@@ -3,8 +3,10 @@
  * read back from the symbol table (arm-none-eabi-nm -S). */
 #include "urrt.h"
 #include "urrt_rtde.h"
+#include "urrt_rtde_in.h"
 
 char urrt_probe_state[sizeof(urrt_state)];
 char urrt_probe_framer[sizeof(urrt_framer)];
 char urrt_probe_rtde[sizeof(urrt_rtde)];
 char urrt_probe_rtde_values[sizeof(urrt_rtde_values)];
+char urrt_probe_rtde_in[sizeof(urrt_rtde_in)];

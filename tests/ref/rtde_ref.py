@@ -39,7 +39,29 @@ Output format (one directive per line):
 A seed corpus for the fuzz harness (tests/lib/fuzz_rtde.c) is written with
 --corpus: each controller stream of the sessions whose recipe is FUZZ_VARS.
 
-Usage: rtde_ref.py --out vectors.txt [--corpus DIR] [--seed N]
+With --inputs it writes instead the sessions of a client that also writes
+input registers (lib/urrt_rtde_in, tests/lib/test_rtde_in.c): the order
+V v O I.. S, each setup-inputs request byte for byte, every reply token, and
+the input data packages the client must write for given values, byte for
+byte. The directives above, and:
+    inputs G NAME,...           input recipe G (0, 1, ... in order): init must take it
+    inputs_error ERR NAME,...   init must refuse this recipe with ERR (it is no recipe G)
+    event inputs G ID           recipe G accepted, its id ID
+    event config ERR NAME COUNT an input setup refused (IN_USE, NOT_FOUND): the first
+                                register refused and how many; TYPE_MISMATCH: NAME only
+    set G I int N RESULT        the caller gives register I of recipe G the integer N
+    set G I double HEX RESULT   ... the double of these 64 bits; RESULT OK or VALUE (refused)
+    forget G                    recipe G's registers lose their values
+    package G HEX               the client's input data package for recipe G, byte for byte
+    package G ERR               ... refused with ERR (NOT_STARTED, INCOMPLETE)
+    refused G N                 values refused for recipe G so far
+    ignored N                   packages the session ignored so far (replies nobody awaited)
+    reconnect                   the connection closes on a package boundary and a new one
+                                begins (the recipes and their values are kept)
+Their corpus (--corpus with --inputs) seeds tests/lib/fuzz_rtde_in.c: each controller
+stream of the sessions whose recipes are FUZZ_OUT_VARS and FUZZ_IN_VARS.
+
+Usage: rtde_ref.py [--inputs] --out vectors.txt [--corpus DIR] [--seed N]
 Standard library only.
 """
 import argparse
@@ -637,6 +659,398 @@ def error_sessions(rng):
             recipe_changes(rng))
 
 
+# ---- writing input registers (docs/rtde.md "Writing registers") ------------------
+
+# The input registers a client may write, with their wire types (the facts'
+# input list, typed again here: these are inputs, ONLY holds them as outputs).
+INPUTS = {"input_bit_registers0_to_31": "UINT32", "input_bit_registers32_to_63": "UINT32"}
+for i in range(64, 128):
+    INPUTS["input_bit_register_%d" % i] = "BOOL"
+for i in range(48):
+    INPUTS["input_int_register_%d" % i] = "INT32"
+    INPUTS["input_double_register_%d" % i] = "DOUBLE"
+
+IN_FMT = {"BOOL": ">B", "UINT32": ">I", "INT32": ">i", "DOUBLE": ">d"}
+
+
+def req_setup_inputs(names):
+    """Setup inputs: the names, comma-separated; no frequency (either protocol)."""
+    return package(I, ",".join(names).encode("ascii"))
+
+
+def rep_setup_inputs(recipe_id, words):
+    return package(I, bytes([recipe_id]) + ",".join(words).encode("ascii"))
+
+
+def dbl(bits_hex):
+    return struct.unpack(">d", bytes.fromhex(bits_hex))[0]
+
+
+def accepts(typ, kind, x):
+    """Whether a register of wire type typ takes x given as an integer
+    (kind "int") or a double ("double"), and the value it then holds: the
+    register holds exactly what it was given, or refuses it."""
+    if kind == "double":
+        if math.isnan(x) or math.isinf(x):
+            return False, None
+        if typ == "DOUBLE":
+            return True, x
+        if x != math.floor(x):
+            return False, None
+        x = int(x)  # -0.0 is the integer 0
+    if typ == "DOUBLE":  # an integer: only if a double holds it exactly
+        return (True, float(x)) if int(float(x)) == x else (False, None)
+    lo, hi = {"BOOL": (0, 1), "INT32": (-2**31, 2**31 - 1), "UINT32": (0, 2**32 - 1)}[typ]
+    return (True, x) if lo <= x <= hi else (False, None)
+
+
+class InRecipe:
+    def __init__(self, names):
+        self.names = names
+        self.values = {}  # name -> value held; a name absent holds none
+        self.refused = 0
+
+    def payload(self):
+        return b"".join(struct.pack(IN_FMT[INPUTS[n]], self.values[n]) for n in self.names)
+
+
+class InSession(Session):
+    """A session with input recipes: the controller, and the client's model
+    of what it may write (accepted ids, whether it streams)."""
+
+    def __init__(self, name, names, recipes, freq=0.0):
+        Session.__init__(self, name, names, freq)
+        self.recipes = [InRecipe(r) for r in recipes]
+        self.ids = [0] * len(recipes)
+        self.streaming = False
+        self.ignored = 0
+        for g, r in enumerate(recipes):
+            self.add("inputs %d %s" % (g, ",".join(r)))
+
+    def up_to_recipe(self, protocol=2, controller=(5, 12, 3, 1234), recipe_id=1):
+        self.send(req_protocol(2))
+        if protocol == 1:
+            self.recv(rep_flag(V, 0))
+            self.event("fallback", 1)
+            self.send(req_protocol(1))
+        self.recv(rep_flag(V, 1))
+        self.event("protocol", protocol)
+        self.send(req_controller())
+        self.recv(rep_controller(*controller))
+        self.event("controller", *controller)
+        self.send(req_setup(protocol, 125.0 if controller[0] < 5 else 500.0, self.names))
+        self.recv(rep_setup(protocol, recipe_id, [type_of(n) for n in self.names]))
+
+    def setup_inputs(self, ids):
+        """Each recipe's request in turn, each answered with its types and id."""
+        for g, r in enumerate(self.recipes):
+            self.send(req_setup_inputs(r.names))
+            self.package_check(g)  # not accepted yet
+            self.recv(rep_setup_inputs(ids[g], [INPUTS[n] for n in r.names]))
+            self.event("inputs", g, ids[g])
+            self.ids[g] = ids[g]
+        self.send(req_start())
+
+    def start_streaming(self):
+        self.recv(rep_flag(S, 1))
+        self.event("started")
+        self.streaming = True
+
+    def set(self, g, i, kind, x):
+        r = self.recipes[g]
+        name = r.names[i]
+        ok, held = accepts(INPUTS[name], kind, x)
+        arg = str(x) if kind == "int" else struct.pack(">d", x).hex()
+        self.add("set %d %d %s %s %s" % (g, i, kind, arg, "OK" if ok else "VALUE"))
+        if ok:
+            r.values[name] = held
+        else:
+            r.values.pop(name, None)
+            r.refused += 1
+
+    def forget(self, g):
+        self.add("forget %d" % g)
+        self.recipes[g].values = {}
+
+    def package_check(self, g):
+        """What the client must write for recipe g now: nothing before the
+        recipe is accepted and the session streams, nothing while a register
+        has no value, else the package byte for byte."""
+        r = self.recipes[g]
+        if not (self.streaming and self.ids[g] != 0):
+            self.add("package %d NOT_STARTED" % g)
+        elif any(n not in r.values for n in r.names):
+            self.add("package %d INCOMPLETE" % g)
+        else:
+            self.add("package %d %s" % (g, package(U, bytes([self.ids[g]]) + r.payload()).hex()))
+
+    def foreign(self, b):
+        """A package the client must ignore (and count)."""
+        self.recv(b)
+        self.ignored += 1
+
+    def counts(self):
+        self.add("ignored %d" % self.ignored)
+        for g, r in enumerate(self.recipes):
+            self.add("refused %d %d" % (g, r.refused))
+
+
+REG3 = ["input_int_register_24", "input_double_register_24", "input_bit_register_64"]
+# Every writable type, the fuzz harness's recipes (outputs read some back).
+FUZZ_OUT_VARS = ["timestamp", "input_int_register_24", "input_double_register_30", "robot_status_bits"]
+FUZZ_IN_VARS = ["input_int_register_24", "input_double_register_30", "input_bit_register_64",
+                "input_bit_registers32_to_63", "input_int_register_47"]
+
+
+def in_registers(rng):
+    """The main case: one recipe of every writable type, read back through the
+    output recipe; values given, refused, forgotten; pause and start."""
+    s = InSession("in_registers_v2", FUZZ_OUT_VARS, [FUZZ_IN_VARS])
+    s.up_to_recipe(recipe_id=1)
+    s.event("recipe", 1)
+    s.setup_inputs([4])
+    s.package_check(0)  # accepted, start not yet
+    s.set(0, 0, "int", 24)
+    s.start_streaming()
+    s.package_check(0)  # four registers have no value
+    s.set(0, 1, "double", -2.5)
+    s.set(0, 2, "int", 1)
+    s.set(0, 3, "int", 0x80000001)
+    s.set(0, 4, "int", -7)
+    s.package_check(0)
+    back = random_values(rng, s.names, 0)
+    back["input_int_register_24"] = [24]
+    back["input_double_register_30"] = [-2.5]
+    s.data(2, 1, back, True)  # the registers read back as the controller holds them
+    s.set(0, 4, "int", 2**31)  # refused: the register has no value now
+    s.package_check(0)
+    s.set(0, 4, "double", 2147483647.0)
+    s.package_check(0)
+    s.forget(0)
+    s.package_check(0)
+    for i, (kind, x) in enumerate([("int", -1), ("double", 1e-3), ("double", 0.0), ("double", 4294967295.0),
+                                   ("int", -2**31)]):
+        s.set(0, i, kind, x)
+    s.package_check(0)
+    s.add("pause")
+    s.send(req_pause())
+    s.streaming = False
+    s.package_check(0)  # a pause is asked: nothing more
+    s.recv(rep_flag(P, 1))
+    s.event("paused")
+    s.package_check(0)
+    s.add("start")
+    s.send(req_start())
+    s.start_streaming()
+    s.package_check(0)
+    s.data(2, 1, random_values(rng, s.names, 1), False)
+    s.add("idle")
+    s.counts()
+    return s.end()
+
+
+def in_edge_values():
+    """Edge values packed byte for byte, refused ones never packed."""
+    regs = (["input_int_register_24", "input_int_register_25"] +
+            ["input_double_register_%d" % i for i in range(24, 32)] +
+            ["input_bit_register_64", "input_bit_register_127", "input_bit_registers0_to_31",
+             "input_bit_registers32_to_63"])
+    s = InSession("in_edge_values_v2", ["timestamp"], [regs])
+    s.up_to_recipe(recipe_id=2)
+    s.event("recipe", 2)
+    s.setup_inputs([255])
+    s.start_streaming()
+    doubles = ["8000000000000000",  # -0.0
+               "0000000000000001",  # the least denormal
+               "8000000000000001",
+               "7fefffffffffffff",  # the largest double
+               "ffefffffffffffff",
+               "0010000000000000",  # the least normal
+               "000fffffffffffff",  # the largest denormal
+               "3ff0000000000000"]
+    first = [("int", -2**31), ("int", 2**31 - 1)] + [("double", dbl(h)) for h in doubles] +             [("int", 0), ("int", 1), ("int", 0xFFFFFFFF), ("int", 0)]
+    for i, (kind, x) in enumerate(first):
+        s.set(0, i, kind, x)
+    s.package_check(0)
+    refused = [(0, "int", 2**31), (1, "int", -2**31 - 1), (0, "double", 1.5), (0, "double", dbl("7ff8000000000000")),
+               (0, "double", math.inf), (0, "double", 2147483648.0), (0, "double", dbl("0000000000000001")),
+               (1, "double", -2147483649.0),
+               (2, "double", dbl("7ff8000000000000")), (3, "double", dbl("7ff0000000000001")),
+               (4, "double", dbl("fff8000000000000")), (5, "double", math.inf), (6, "double", -math.inf),
+               (2, "int", 2**53 + 1), (3, "int", 2**63 - 1), (4, "int", -2**53 - 1),
+               (10, "int", 2), (10, "int", -1), (11, "double", 0.5), (11, "double", dbl("0000000000000001")),
+               (12, "int", -1), (12, "int", 2**32), (13, "double", 4294967296.0), (13, "double", -1.0)]
+    for i, kind, x in refused:
+        s.set(0, i, kind, x)
+        s.package_check(0)
+    accepted = [(0, "double", -2147483648.0), (1, "double", dbl("8000000000000000")),  # -0.0: the integer 0
+                (2, "int", 2**53), (3, "int", -2**63), (4, "int", -(2**53)), (5, "double", 1e-300),
+                (6, "double", -1.7976931348623157e308), (7, "int", 0),
+                (10, "double", 1.0), (11, "double", dbl("8000000000000000")),
+                (12, "double", 4294967295.0), (13, "int", 0x80000000)]
+    for i, kind, x in accepted:
+        s.set(0, i, kind, x)
+    s.package_check(0)
+    s.add("idle")
+    s.counts()
+    return s.end()
+
+
+def in_three_recipes():
+    """Several input recipes: one request at a time, start after the last reply."""
+    recipes = [["input_int_register_30"], ["input_double_register_40", "input_bit_register_100"],
+               ["input_bit_registers0_to_31", "input_int_register_31", "input_double_register_47"]]
+    s = InSession("in_three_recipes_v2", ["timestamp", "actual_q"], recipes)
+    s.up_to_recipe(recipe_id=1)
+    s.event("recipe", 1)
+    s.setup_inputs([2, 3, 9])
+    s.start_streaming()
+    s.set(0, 0, "int", 30)
+    s.set(1, 0, "double", 40.5)
+    s.set(1, 1, "int", 1)
+    s.set(2, 0, "int", 0x00FF00FF)
+    s.set(2, 1, "int", -31)
+    s.set(2, 2, "double", -47.25)
+    for g in range(3):
+        s.package_check(g)
+    s.forget(1)
+    for g in range(3):
+        s.package_check(g)
+    s.add("idle")
+    s.counts()
+    return s.end()
+
+
+def in_foreign():
+    """Packages before the reply: a text message (an event), replies nobody
+    waits for and unknown letters (ignored), an 'I' before the request and
+    after every reply (ignored)."""
+    s = InSession("in_foreign_v2", ["timestamp"], [REG3])
+    s.send(req_protocol(2))
+    s.recv(rep_flag(V, 1))
+    s.event("protocol", 2)
+    s.send(req_controller())
+    s.recv(rep_controller(5, 12, 3, 1234))
+    s.event("controller", 5, 12, 3, 1234)
+    s.send(req_setup(2, 500.0, s.names))
+    s.foreign(rep_setup_inputs(3, ["INT32", "DOUBLE", "BOOL"]))  # before its request: nobody waits for it
+    s.recv(rep_setup(2, 1, ["DOUBLE"]))
+    s.event("recipe", 1)
+    s.send(req_setup_inputs(REG3))
+    s.recv(text_v2(2, b"input registers 0-23 are the fieldbus's", b"RTDE"))
+    s.event("text", 2, b"input registers 0-23 are the fieldbus's".hex(), b"RTDE".hex())
+    s.foreign(rep_flag(V, 1))
+    s.foreign(rep_setup(2, 1, ["DOUBLE"]))
+    s.foreign(package(b"X", b"\x01\x02"))
+    s.foreign(rep_flag(P, 1))
+    s.foreign(package(b"Q"))
+    s.recv(text_v2(3, b"", b""))
+    s.event("text", 3, "-", "-")
+    s.recv(rep_setup_inputs(3, ["INT32", "DOUBLE", "BOOL"]))
+    s.event("inputs", 0, 3)
+    s.ids[0] = 3
+    s.foreign(rep_setup_inputs(4, ["INT32", "DOUBLE", "BOOL"]))  # every reply is in: ignored
+    s.send(req_start())
+    s.start_streaming()
+    s.foreign(rep_setup_inputs(5, ["INT32", "DOUBLE", "BOOL"]))
+    for i, x in enumerate([-24, 24.0, 1]):
+        s.set(0, i, "int" if i != 1 else "double", x)
+    s.package_check(0)
+    s.add("idle")
+    s.counts()
+    return s.end()
+
+
+def in_reconnect():
+    """A reconnect sets the inputs up again: nothing is written until the new
+    session accepts them (under its new id); the values are kept."""
+    s = InSession("in_reconnect_v2", ["timestamp"], [REG3])
+    s.up_to_recipe(recipe_id=1)
+    s.event("recipe", 1)
+    s.setup_inputs([7])
+    s.start_streaming()
+    for i, x in enumerate([1, 2.0, 0]):
+        s.set(0, i, "int" if i != 1 else "double", x)
+    s.package_check(0)
+    s.add("reconnect")
+    s.streaming = False
+    s.ids = [0]
+    s.package_check(0)
+    s.up_to_recipe(recipe_id=1)
+    s.event("recipe", 1)
+    s.setup_inputs([8])
+    s.package_check(0)
+    s.start_streaming()
+    s.package_check(0)
+    s.add("idle")
+    s.counts()
+    return s.end()
+
+
+def in_reply_errors():
+    """Every reply token and shape: refusals (configuration), broken replies
+    (protocol); the session ends and nothing is ever written."""
+    out = []
+
+    def refused(name, reply, *expect):
+        s = InSession(name, ["timestamp"], [REG3])
+        s.up_to_recipe(recipe_id=1)
+        s.event("recipe", 1)
+        s.send(req_setup_inputs(REG3))
+        s.recv(reply)
+        s.event(*expect)
+        s.package_check(0)
+        s.add("ended")
+        s.package_check(0)
+        out.append(s.end())
+    words = lambda *w: rep_setup_inputs(0, list(w))
+    refused("in_reply_in_use", words("IN_USE", "DOUBLE", "BOOL"), "config", "IN_USE", REG3[0], 1)
+    refused("in_reply_in_use_two", words("INT32", "IN_USE", "IN_USE"), "config", "IN_USE", REG3[1], 2)
+    refused("in_reply_in_use_id", rep_setup_inputs(7, ["IN_USE", "IN_USE", "IN_USE"]), "config", "IN_USE", REG3[0], 3)
+    refused("in_reply_not_found", words("INT32", "DOUBLE", "NOT_FOUND"), "config", "NOT_FOUND", REG3[2], 1)
+    refused("in_reply_mixed", words("IN_USE", "NOT_FOUND", "NOT_FOUND"), "config", "NOT_FOUND", REG3[1], 2)
+    refused("in_reply_mixed_order", words("NOT_FOUND", "IN_USE", "BOOL"), "config", "NOT_FOUND", REG3[0], 1)
+    refused("in_reply_mismatch", rep_setup_inputs(5, ["INT32", "INT32", "BOOL"]), "config", "TYPE_MISMATCH", REG3[1])
+    refused("in_reply_more", rep_setup_inputs(5, ["INT32", "DOUBLE", "BOOL", "BOOL"]), "drop", "TYPE_COUNT")
+    refused("in_reply_fewer", rep_setup_inputs(5, ["INT32", "DOUBLE"]), "drop", "TYPE_COUNT")
+    refused("in_reply_trailing_comma", package(I, b"\x05INT32,DOUBLE,BOOL,"), "drop", "TYPE_COUNT")
+    refused("in_reply_no_types", package(I, b"\x05"), "drop", "TYPE_COUNT")
+    refused("in_reply_no_id", package(I), "drop", "REPLY_LENGTH")
+    refused("in_reply_unknown_word", rep_setup_inputs(5, ["INT32", "FLOAT", "BOOL"]), "drop", "TYPE_TOKEN")
+    refused("in_reply_lower_case", rep_setup_inputs(5, ["int32", "DOUBLE", "BOOL"]), "drop", "TYPE_TOKEN")
+    refused("in_reply_empty_word", package(I, b"\x05INT32,,BOOL"), "drop", "TYPE_TOKEN")
+    refused("in_reply_space", package(I, b"\x00NOT_FOUND ,DOUBLE,BOOL"), "drop", "TYPE_TOKEN")
+    refused("in_reply_refusal_then_word", words("NOT_FOUND", "VECTOR7D", "BOOL"), "drop", "TYPE_TOKEN")
+    refused("in_reply_id_zero", words("INT32", "DOUBLE", "BOOL"), "drop", "RECIPE_ID")
+    return out
+
+
+def in_protocol_1():
+    """Inputs need protocol 2: a controller that speaks 1 only is a
+    configuration error once the output recipe is accepted."""
+    s = InSession("in_protocol_1", ["timestamp"], [REG3])
+    s.up_to_recipe(protocol=1, controller=(3, 9, 1, 1), recipe_id=0)
+    s.event("config", "INPUTS_PROTOCOL")
+    s.package_check(0)
+    s.add("ended")
+    return s.end()
+
+
+def in_init_errors():
+    """Recipes init refuses: no session runs."""
+    s = Session("in_init_errors", ["timestamp"])
+    s.add("inputs_error NOT_WRITABLE output_int_register_24")
+    s.add("inputs_error NOT_WRITABLE input_int_register_24,timestamp")
+    s.add("inputs_error NOT_WRITABLE robot_status_bits")
+    s.add("inputs_error DUPLICATE input_bit_register_64,input_int_register_1,input_bit_register_64")
+    return s.end()  # (more than 64 registers: tests/lib/test_rtde_in.c's API test, a line too long here)
+
+
+def input_sessions(rng):
+    return ([in_registers(rng), in_edge_values(), in_three_recipes(), in_foreign(), in_reconnect(),
+             in_protocol_1(), in_init_errors()] + in_reply_errors())
+
+
 def check_sizes():
     """Own arithmetic of docs/rtde.md: the state recipe's data package."""
     size = 3 + 1 + sum(struct.calcsize(">" + TYPES[type_of(n)][0] * TYPES[type_of(n)][1])
@@ -652,9 +1066,13 @@ def main():
     ap.add_argument("--out", required=True)
     ap.add_argument("--corpus")
     ap.add_argument("--seed", type=int, default=0x27DE)
+    ap.add_argument("--inputs", action="store_true", help="the sessions of a client writing input registers")
     args = ap.parse_args()
     check_sizes()
     rng = random.Random(args.seed)
+    if args.inputs:
+        write_inputs(args, rng)
+        return
     sessions = good_sessions(rng) + error_sessions(rng)
     with open(args.out, "w") as f:
         for s in sessions:
@@ -674,6 +1092,25 @@ def main():
                 n += 1
                 with open(os.path.join(args.corpus, "seed%02d" % n), "wb") as f:
                     f.write(b"\x00" + s.stream)
+
+
+def write_inputs(args, rng):
+    sessions = input_sessions(rng)
+    with open(args.out, "w") as f:
+        for s in sessions:
+            f.write("\n".join(s.lines) + "\n")
+    if args.corpus:
+        os.makedirs(args.corpus, exist_ok=True)
+        n = 0
+        for s in sessions:
+            if not s.stream:
+                continue
+            fuzz = s.names == FUZZ_OUT_VARS and getattr(s, "recipes", None) and \
+                s.recipes[0].names == FUZZ_IN_VARS
+            for mode in range(4) if fuzz else range(1):  # the harness's first byte: chunking
+                n += 1
+                with open(os.path.join(args.corpus, "seed%02d" % n), "wb") as f:
+                    f.write(bytes([mode * 37]) + s.stream)
 
 
 if __name__ == "__main__":

@@ -11,10 +11,13 @@
 #                  the CAN core's and the CANopen node's tests (tests/lib/test_cantx.c, test_co.c)
 #                  on the M4 (soft and hard float) and the M0; the RTDE client on the reference's
 #                  sessions (tests/target/rtde_target.c) on the same three, which also paints the
-#                  stack of the urrt_rtde functions (its log joins stack_target.h's for stack.py)
+#                  stack of the urrt_rtde functions (its log joins stack_target.h's for stack.py);
+#                  the RTDE client's writing side (tests/lib/test_rtde_in.c, which reads
+#                  tests/ref/rtde_ref.py --inputs's sessions through semihosting) on the same three,
+#                  with the stack of the urrt_rtde_in functions
 #   check-lib-be   tests/lib/test_lib.c on big-endian s390x, powerpc and mips (with the lib/urrt_can,
-#                  urrt_cantx, urrt_co and urrt_rtde tests of tests/lib/test_can.c, test_cantx.c,
-#                  test_co.c, test_rtde.c),
+#                  urrt_cantx, urrt_co, urrt_rtde and urrt_rtde_in tests of tests/lib/test_can.c,
+#                  test_cantx.c, test_co.c, test_rtde.c, test_rtde_in.c),
 #                  lib/*.c alone, and on little-endian NEON
 #                  (aarch64, armhf; lib/vector/urrt_vector.c, and aarch64 also lib/*.c alone)
 #                  under qemu-user; on big-endian NEON (aarch64_be, armeb; freestanding)
@@ -96,7 +99,7 @@ $(TGT)/rtde_vectors.c: $(RTDE_VECTORS) tests/target/rtde_vectors_c.py
 	@mkdir -p $(@D)
 	$(PYTHON) tests/target/rtde_vectors_c.py $(RTDE_VECTORS) $@
 define tgt_rtde_image
-$(TGT)/$(1)/rtde.elf: tests/target/rtde_target.c tests/target/rtde_vectors.h $(TGT_UNIT_DEPS) tests/target/$(4) \
+$(TGT)/$(1)/rtde.elf: tests/target/rtde_target.c tests/target/rtde_vectors.h tests/target/stack_marks.h tests/lib/rtde_names.h $(TGT_UNIT_DEPS) tests/target/$(4) \
   $(TGT)/rtde_vectors.c $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
 	$(TGT_CM) $(2) $(3) $(TGT_FLAGS) -Itests -DURRT_TARGET_CORTEX_M tests/target/cm.c $$< $(TGT)/rtde_vectors.c \
 	  $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -T tests/target/$(4) $(TGT_LINK) -o $$@
@@ -106,17 +109,35 @@ $(eval $(call tgt_rtde_image,m4f-o2,$(TGT_M4F),-O2,an386.ld))
 $(eval $(call tgt_rtde_image,m0-os,$(TGT_M0),-Os,microbit.ld))
 TGT_RTDE_BOARDS := m4-os:mps2-an386 m4f-o2:mps2-an386 m0-os:microbit
 
+# The writing side (tests/lib/test_rtde_in.c) as NAME/rtde_in.elf on the same lib/ objects; it
+# reads the vectors through semihosting, the file qemu's arg= names: $(call tgt_rtde_in_image,...).
+TGT_QEMU_M_VECTORS := qemu-system-arm -nographic -monitor none -serial none \
+                      -semihosting-config enable=on,target=native,arg=$(RTDE_IN_VECTORS)
+define tgt_rtde_in_image
+$(TGT)/$(1)/rtde_in.elf: tests/lib/test_rtde_in.c tests/target/stack_marks.h tests/lib/rtde_names.h $(TGT_UNIT_DEPS) tests/target/$(4) \
+  $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
+	$(TGT_CM) $(2) $(3) $(TGT_FLAGS) -Itests -DURRT_TARGET_CORTEX_M tests/target/cm.c $$< \
+	  $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -T tests/target/$(4) $(TGT_LINK) -o $$@
+endef
+$(eval $(call tgt_rtde_in_image,m4-os,$(TGT_M4),-Os,an386.ld))
+$(eval $(call tgt_rtde_in_image,m4f-o2,$(TGT_M4F),-O2,an386.ld))
+$(eval $(call tgt_rtde_in_image,m0-os,$(TGT_M0),-Os,microbit.ld))
+
 check-lib-m4: $(foreach b,$(TGT_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/test.elf) tests/target/stack.py \
   $(foreach u,$(TGT_UNITS),$(foreach b,$(TGT_UNIT_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/$(u).elf)) \
-  $(foreach b,$(TGT_RTDE_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/rtde.elf)
+  $(foreach b,$(TGT_RTDE_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/rtde.elf) \
+  $(foreach b,$(TGT_RTDE_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/rtde_in.elf) $(RTDE_IN_VECTORS)
 	$(call suite,check-lib-m4,sh tests/target/run.sh $(TGT)/logs \
 	  $(foreach b,$(TGT_RTDE_BOARDS),rtde-$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M) \
 	    -M $(lastword $(subst :, ,$(b))) -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/rtde.elf") \
+	  $(foreach b,$(TGT_RTDE_BOARDS),rtde-in-$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M_VECTORS) \
+	    -M $(lastword $(subst :, ,$(b))) -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/rtde_in.elf") \
 	  $(foreach b,$(TGT_BOARDS),$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M) -M $(lastword $(subst :, ,$(b))) \
 	    -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/test.elf") \
 	  $(foreach u,$(TGT_UNITS),$(foreach b,$(TGT_UNIT_BOARDS),$(u)-$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M) \
 	    -M $(lastword $(subst :, ,$(b))) -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/$(u).elf")) \
-	  stack-m4-os="cat $(TGT)/logs/m4-os.log $(TGT)/logs/rtde-m4-os.log > $(TGT)/logs/stack-m4-os.marks && \
+	  stack-m4-os="cat $(TGT)/logs/m4-os.log $(TGT)/logs/rtde-m4-os.log $(TGT)/logs/rtde-in-m4-os.log \
+	    > $(TGT)/logs/stack-m4-os.marks && \
 	    $(PYTHON) tests/target/stack.py $(TGT)/logs/stack-m4-os.marks docs/footprint.md $(TGT)/m4-os/lib/*.ci")
 
 # ---- big-endian and NEON under qemu-user ---------------------------------------------
@@ -186,16 +207,19 @@ TGT_BE_BINS += $(foreach a,armeb aarch64_be,$(TGT)/$(a)/neon_be $(TGT)/$(a)/neon
 # The RTDE client's tests (tests/lib/test_rtde.c, tests/lib/rtde.mk) on the big-endian CPUs,
 # on the reference's sessions: $(call tgt_rtde,NAME,CC,QEMU), on the lib/ objects of tgt_linux.
 define tgt_rtde
-$(TGT)/$(1)/test_rtde: tests/lib/test_rtde.c tests/check.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
+$(TGT)/$(1)/test_rtde: tests/lib/test_rtde.c tests/check.h tests/lib/rtde_names.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
 	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
-TGT_BE_BINS += $(TGT)/$(1)/test_rtde
-TGT_BE_RUNS += $(1)-rtde="$(3) $(TGT)/$(1)/test_rtde $(RTDE_VECTORS)"
+$(TGT)/$(1)/test_rtde_in: tests/lib/test_rtde_in.c tests/check.h tests/target/stack_marks.h tests/lib/rtde_names.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
+	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
+TGT_BE_BINS += $(TGT)/$(1)/test_rtde $(TGT)/$(1)/test_rtde_in
+TGT_BE_RUNS += $(1)-rtde="$(3) $(TGT)/$(1)/test_rtde $(RTDE_VECTORS)" \
+               $(1)-rtde-in="$(3) $(TGT)/$(1)/test_rtde_in $(RTDE_IN_VECTORS)"
 endef
 $(eval $(call tgt_rtde,s390x,s390x-linux-gnu-gcc,qemu-s390x))
 $(eval $(call tgt_rtde,powerpc,powerpc-linux-gnu-gcc,qemu-ppc))
 $(eval $(call tgt_rtde,mips,mips-linux-gnu-gcc,qemu-mips))
 
-check-lib-be: $(TGT_BE_BINS) $(LIB_VECTORS) $(RTDE_VECTORS) $(TGT_OLD_NEON)
+check-lib-be: $(TGT_BE_BINS) $(LIB_VECTORS) $(RTDE_VECTORS) $(RTDE_IN_VECTORS) $(TGT_OLD_NEON)
 	$(call suite,check-lib-be,sh tests/target/run.sh $(TGT)/logs-be $(TGT_BE_RUNS) \
 	  aarch64-vector-path="$(call tgt_vector,aarch64-linux-gnu-gcc)" \
 	  armhf-vector-path="$(call tgt_vector,arm-linux-gnueabihf-gcc $(TGT_NEON))" \

@@ -5,9 +5,13 @@
 # (port from the system) to urrt-dump --rtde in protocol 2 and, with the
 # fault rtde-refuse-v2, in protocol 1, each with segments cut small
 # (tiny-writes) and with packages coalesced, with text messages during the
-# handshake and between data packages; a last session is run by
+# handshake and between data packages; a session is run by
 # tests/gateway/tools/rtde_peer.py, which asks for a name the controller
-# lacks (NOT_FOUND), sends setup inputs, pauses and sends a text message.
+# lacks (NOT_FOUND), sends setup inputs, pauses and sends a text message;
+# two more (protocol 2 and 1, the simulator with --fieldbus) set up input
+# recipes refused (IN_USE, NOT_FOUND) and accepted and write registers with
+# data packages of their own (some of no recipe or the wrong size), which
+# the output recipe reads back.
 # tshark captures them all at once on loopback while the clients record
 # what they decoded: urrt-dump records its session (--rtde -w) and
 # afterwards prints it from that capture (--file, JSON, which must equal
@@ -72,13 +76,16 @@ actual_tool_accelerometer,safety_status_bits,speed_scaling
 # recording recipe, keys: that and -k KEYS, peer: rtde_peer.py), expert infos, sim
 # options. edges: tests/wireshark/rtde_controller.py serves the extremes of
 # every type instead of urrt-sim and records what it sent; rtde_peer.py asks.
+# inputs: rtde_peer.py writes inputs and records what it sent (NAME.sent).
 cat > "$T/cases" <<'EOF'
 v2-coalesce 2 3 keys - -c 5.12 -n 24 --fault coalesce=4 --fault rtde-text-every=6
 v2-tiny 2 4 all - -c 3.10 -n 24 --fault tiny-writes=50 --fault rtde-text-handshake
 v1-tiny 1 3 keys - -c 5.12 -n 24 --fault rtde-refuse-v2 --fault tiny-writes=30 --fault rtde-text-every=6,level=1
 v1-coalesce 1 5 all - -c 3.10 -n 24 --fault rtde-refuse-v2 --fault coalesce=5 --fault rtde-text-handshake
-peer 2 0 peer not_found+setup_inputs -c 5.12 -n 100000
+peer 2 0 peer not_found -c 5.12 -n 100000
 edges 2 0 edges - rtde_controller.py
+inputs 2 2 inputs not_found+in_use+input_recipe+data_size -c 5.12 -n 100000 --fieldbus
+inputs-v1 1 1 inputs not_found+in_use+data_size -c 3.10 -n 100000 --fieldbus
 EOF
 # The peer: protocol 2, a recipe with a name no controller has (NOT_FOUND),
 # setup inputs, then a good recipe, N data packages, pause (the packages that
@@ -105,6 +112,57 @@ p.close()
 with open(out, "w") as f:
     for vals in got:
         f.write(json.dumps({k: list(v) if isinstance(v, tuple) else v for k, v in zip(names, vals)}) + "\n")'
+
+# The inputs sessions (protocol $5): a setup of inputs refused (IN_USE: the
+# fieldbus's register 0; NOT_FOUND: register 48), recipes B (other inputs
+# than registers) and A (registers past the fieldbus's, the last: a
+# protocol 1 package is its), an output recipe that reads A back, start;
+# then N data packages, after every one an input package with the extremes
+# of A's types (B's too in protocol 2), one of a recipe id the connection lacks (protocol 2) and
+# one a byte too long, which the controller ignores; pause, close. The
+# output packages go to OUT, every input package sent to SENT (JSON lines:
+# id, names, types, values, whether the controller takes it).
+INPUTS='import json, sys
+sys.path.insert(0, "tests/gateway/tools")
+import rtde_peer
+port, out, sent, n, proto = int(sys.argv[1]), sys.argv[2], sys.argv[3], int(sys.argv[4]), int(sys.argv[5])
+p = rtde_peer.Peer(port, timeout=20)
+if proto == 2:
+    assert p.protocol_version(2) == 1
+p.controller_version()
+assert p.setup_inputs(["input_int_register_0", "input_int_register_48", "input_int_register_25"]) == \
+    (0, ["IN_USE", "NOT_FOUND", "INT32"])
+b_names = ["speed_slider_fraction", "speed_slider_mask", "external_force_torque", "standard_digital_output"]
+a_names = ["input_int_register_24", "input_double_register_24", "input_bit_register_64", "input_bit_register_127"]
+b, b_types = p.setup_inputs(b_names)
+a, a_types = p.setup_inputs(a_names)
+assert (b, a) == (2, 3), (b, a)
+names = ["timestamp"] + a_names
+p.setup_outputs(names, 125.0) if proto == 2 else p.setup_outputs(names)
+assert p.start() == 1
+ints, bits, words = [-2 ** 31, 2 ** 31 - 1, -1, 0], [1, 0, 2, 255], [2 ** 32 - 1, 2 ** 31 + 1, 0, 1]
+doubles = [-0.0, 5e-324, float("inf"), float("-inf"), 1.7976931348623157e308, 0.1]
+log = open(sent, "w")
+def send(rid, names, types, values, taken, payload=None):
+    p.send(rtde_peer.U, payload if payload is not None else p.input_package(rid, values, types))
+    log.write(json.dumps({"id": rid, "names": names, "types": types, "values": values, "taken": taken}) + "\n")
+got = []
+for i in range(n):
+    got += p.data(1)
+    send(a, a_names, a_types, [ints[i % 4], doubles[i % 6], bits[i % 4], bits[(i + 1) % 4]], True)
+    if proto == 2 and i % 3 == 0:
+        send(b, b_names, b_types, [doubles[-i % 6], words[i % 4], doubles[i % 6:] + doubles[:i % 6], 255 - i], True)
+    if i == 5 and proto == 2:
+        send(9, ["input_int_register_24"], ["INT32"], [7], False)
+    if i == 7:
+        send(a, a_names + ["x"], a_types + ["UINT8"], [1, 1.0, 1, 1, 1], False)
+p.foreign = []
+assert p.pause() == 1
+got += [p.decode(x) for kind, x in p.foreign if kind == rtde_peer.U]
+p.close()
+with open(out, "w") as f:
+    for vals in got:
+        f.write(json.dumps(dict(zip(names, vals))) + "\n")'
 
 EDGES='import sys
 sys.path.insert(0, "tests/gateway/tools")
@@ -157,6 +215,8 @@ while read -r name proto texts client experts opts; do
   case $client in
     peer) timeout -k 3 60 $PYTHON -c "$PEER" "$port" "$T/$name.json" $N 2> "$T/$name.client" & ;;
     edges) timeout -k 3 60 $PYTHON -c "$EDGES" "$port" $N 2> "$T/$name.client" & ;;
+    inputs) timeout -k 3 60 $PYTHON -c "$INPUTS" "$port" "$T/$name.json" "$T/$name.sent" $N "$proto" \
+              2> "$T/$name.client" & ;;
     keys) timeout -k 3 60 "$DUMP" --rtde "127.0.0.1:$port" -w "$T/$name.rtde" --once -t 10 -F json --no-summary \
             -k "$KEYS" > "$T/$name.live" 2> "$T/$name.client" & ;;
     *) timeout -k 3 60 "$DUMP" --rtde "127.0.0.1:$port" -w "$T/$name.rtde" --once -t 10 -F json --no-summary \
@@ -192,7 +252,7 @@ while read -r name proto texts client experts opts; do
   lines=$(wc -l < "$T/$name.json")
   if [ "$client" = edges ]; then
     check "$name: rtde_controller.py sent $N data packages" [ "$lines" = $N ]
-  elif [ "$client" = peer ]; then
+  elif [ "$client" = peer ] || [ "$client" = inputs ]; then
     check "$name: rtde_peer.py decoded $N data packages or more" [ "$lines" -ge $N ]
   else
     check "$name: urrt-dump decoded $N data packages in protocol $proto" \
@@ -200,7 +260,8 @@ while read -r name proto texts client experts opts; do
   fi
   [ "$lines" -gt 0 ] || sed 's/^/    client: /' "$T/$name.client" >&2
   [ "$experts" != - ] || experts=
-  specs="$specs $name:$port:$T/$name.json:$proto:$texts:$experts"
+  [ "$client" = inputs ] && sent=":$T/$name.sent" || sent=
+  specs="$specs $name:$port:$T/$name.json:$proto:$texts:$experts$sent"
 done < "$T/cases"
 
 # ---- dissect and compare --------------------------------------------------------
@@ -215,6 +276,10 @@ compare() {
   fi
   if grep -q 'Lua Error\|Lua: Error' "$T/$label.pdml" "$T/$label.err"; then
     grep -m 3 'Lua Error\|Lua: Error' "$T/$label.pdml" "$T/$label.err" >&2; fail "$label: Lua errors"
+  fi
+  # A field read past its bytes is an exception, shown as a malformed packet.
+  if grep -q '_ws.malformed' "$T/$label.pdml"; then
+    grep -m 3 -B 3 '_ws.malformed' "$T/$label.pdml" >&2; fail "$label: malformed packets (an exception in the dissector)"
   fi
   # shellcheck disable=SC2086 # specs is a word list
   $PYTHON tests/wireshark/compare_rtde.py docs/protocol.md "$T/$label.pdml" "$label" $specs > "$T/$label.out"
@@ -271,4 +336,11 @@ for name in v2-coalesce v1-coalesce; do
   check "$name: segments holding several data packages" has "$(cat "$T/$name.port")" "U from controller.*U from controller"
 done
 check "Info: protocol 2 refused and 1 accepted" has "$(cat "$T/v1-tiny.port")" "V reply: 2 refused" "V reply: 1 accepted"
+check "Info: the inputs session's setups of inputs and its data packages" \
+  has "$(cat "$T/inputs.port")" "I request: 3 names" "I reply: input recipe INVALID 0, 3 types" \
+  "I reply: input recipe 2, 4 types" "I reply: input recipe 3, 4 types" "U from client: input recipe 3, 4 values" \
+  "U from client: input recipe 2, 4 values" "U from client: no input recipe 9" \
+  "U from client: input recipe 3: size not the recipe's"
+check "Info: protocol 1: a client's data package is of the last input recipe" \
+  has "$(cat "$T/inputs-v1.port")" "I reply: input recipe 3, 4 types" "U from client: input recipe 3, 4 values"
 finish

@@ -4,7 +4,7 @@
 sessions against the values a client decoded from the same sessions.
 
     compare_rtde.py DOC PDML LABEL CASE...
-        CASE is NAME:PORT:JSON:PROTOCOL:TEXTS:EXTRA
+        CASE is NAME:PORT:JSON:PROTOCOL:TEXTS:EXTRA[:SENT]
 
 For the session the simulator served on PORT, every data package tshark shows
 is matched by its controller timestamp with one line of JSON (urrt-dump
@@ -18,9 +18,15 @@ value and the number in the item's label, and the items of a package must be
 exactly the recipe's, in order, element by element. PROTOCOL is the protocol
 the session must run (every package's "protocol in use" once the V reply
 accepted it), TEXTS the least number of text messages it must show, EXTRA a
-"+"-separated list of expert infos the session must carry (not_found,
-setup_inputs); no other expert info may appear. Prints ok:/FAIL: lines and a
-last line with the totals.
+"+"-separated list of expert infos the session must carry (not_found, in_use,
+input_recipe, data_size); no other expert info may appear. SENT, for a client
+that writes inputs, is its record of every data package it sent (JSON lines:
+id, names, types, values, whether the controller takes it): the client's
+packages tshark shows must be those, in order, and each one the controller
+takes must read, item by item, as its input recipe (names of the setup
+request and types of its reply, read from their bytes, by the recipe id, or
+in protocol 1 the last one) says, every value equal to the one sent.
+Prints ok:/FAIL: lines and a last line with the totals.
 """
 import json
 import math
@@ -35,7 +41,16 @@ TYPES = {
     "DOUBLE": ("d", 1), "VECTOR3D": ("d", 3), "VECTOR6D": ("d", 6), "VECTOR6INT32": ("i", 6),
     "VECTOR6UINT32": ("I", 6),
 }
-DATA, SETUP = 0x55, 0x4F
+DATA, SETUP, SETUP_INPUTS = 0x55, 0x4F, 0x49
+# Inputs that are no output (UR's input list): lib's table, and so the
+# dissector, has no field of their own; they show as urrt_rtde.other.KIND.
+INPUT_ONLY = {"speed_slider_mask", "speed_slider_fraction", "standard_digital_output_mask", "standard_digital_output",
+              "configurable_digital_output_mask", "configurable_digital_output", "tool_digital_output_mask",
+              "tool_digital_output", "standard_analog_output_mask", "standard_analog_output_type",
+              "standard_analog_output_0", "standard_analog_output_1", "external_force_torque"}
+OTHER_KIND = {"BOOL": "bool", "UINT8": "uint8", "UINT32": "uint32", "VECTOR6UINT32": "uint32", "INT32": "int32",
+              "VECTOR6INT32": "int32", "UINT64": "uint64", "DOUBLE": "double", "VECTOR3D": "double",
+              "VECTOR6D": "double"}
 
 
 def doc_rtde_names(path):
@@ -64,19 +79,28 @@ def items(node):
         yield from items(f)
 
 
+class Package(list):
+    """A package's items, (name, element) each; from_server: its direction."""
+    from_server = True
+
+
 def sessions(pdml, ports):
     """Server port (one of ports) -> its packages in frame order, both
-    directions, each a list of (name, element)."""
+    directions, each a Package."""
     per_port = {}
     for packet in ET.parse(pdml).getroot().iter("packet"):
-        server = None
+        server = src = None
         for proto in packet.findall("proto"):
             if proto.get("name") == "tcp":
                 for f in proto.iter("field"):
+                    if f.get("name") == "tcp.srcport":
+                        src = f.get("show")
                     if f.get("name") in ("tcp.srcport", "tcp.dstport") and f.get("show") in ports:
                         server = f.get("show")
             elif proto.get("name") == "urrt_rtde":
-                per_port.setdefault(server, []).append(list(items(proto)))
+                pkg = Package(items(proto))
+                pkg.from_server = src == server
+                per_port.setdefault(server, []).append(pkg)
     return per_port
 
 
@@ -104,8 +128,10 @@ def check_package(pkg, recipe, rec, rtde_to_field):
     elems = [(n[len("urrt_rtde."):], f) for n, f in pkg
              if n not in ("expert", "urrt_rtde.size", "urrt_rtde.type", "urrt_rtde.protocol", "urrt_rtde.recipe_id")]
     want = [(name, typ, i) for name, typ in recipe for i in range(TYPES[typ][1])]
-    if [n for n, _ in elems] != [name for name, _, _ in want]:
-        return ["items %s, recipe %s" % ([n for n, _ in elems][:8], [w[0] for w in want][:8])], 0
+    shown_as = [("other." + OTHER_KIND[typ]) if name in INPUT_ONLY else name for name, typ, _ in want]
+    if [n for n, _ in elems] != shown_as:
+        return ["items %s, recipe %s" % ([n for n, _ in elems][:8], shown_as[:8])], 0
+    elems = [(name, f) for (name, _, _), (_, f) in zip(want, elems)]
     for (name, f), (_, typ, i) in zip(elems, want):
         fmt, count = TYPES[typ]
         b = raw(f)
@@ -165,7 +191,7 @@ def check_session(packages, recs, protocol, texts, extra, rtde_to_field):
         if t in by_time:
             errs.append("the client has two records at t=%r" % t)
         by_time[t] = rec
-    data = [p for p in packages if int(first(p, "urrt_rtde.type").get("show"), 0) == DATA]
+    data = [p for p in packages if int(first(p, "urrt_rtde.type").get("show"), 0) == DATA and p.from_server]
     n_texts = sum(1 for p in packages if first(p, "urrt_rtde.level") is not None)
     if n_texts < texts:
         errs.append("%d text messages shown, at least %d sent" % (n_texts, texts))
@@ -191,17 +217,72 @@ def check_session(packages, recs, protocol, texts, extra, rtde_to_field):
     return errs, len(matched), values
 
 
+def input_recipes(packages):
+    """The input recipes of a session from the bytes of its setups of
+    inputs: id -> [(name, type)] for each accepted one (id not 0, a type
+    per name), and the id of the last."""
+    recipes, last, names = {}, None, None
+    for pkg in packages:
+        if int(first(pkg, "urrt_rtde.type").get("show"), 0) != SETUP_INPUTS:
+            continue
+        if not pkg.from_server:
+            f = first(pkg, "urrt_rtde.names")
+            names = raw(f).decode().split(",") if f is not None else []
+            continue
+        rid, types = first(pkg, "urrt_rtde.recipe_id"), first(pkg, "urrt_rtde.types")
+        rid = raw(rid)[0] if rid is not None else 0
+        types = raw(types).decode().split(",") if types is not None else []
+        if rid != 0 and names is not None and len(types) == len(names) and all(t in TYPES for t in types):
+            recipes[rid], last = list(zip(names, types)), rid
+    return recipes, last
+
+
+def check_inputs(packages, sent, protocol, rtde_to_field):
+    """The client's data packages against what it sent."""
+    errs, values = [], 0
+    recipes, last = input_recipes(packages)
+    mine = [p for p in packages if int(first(p, "urrt_rtde.type").get("show"), 0) == DATA and not p.from_server]
+    if len(mine) != len(sent):
+        return ["tshark shows %d data packages from the client, it sent %d" % (len(mine), len(sent))], 0
+    for n, (pkg, rec) in enumerate(zip(mine, sent)):
+        pid = first(pkg, "urrt_rtde.recipe_id")
+        rid = raw(pid)[0] if pid is not None else last
+        if (pid is not None) != (protocol >= 2) or (protocol >= 2 and int(pid.get("show")) != rec["id"]):
+            errs.append("client package %d: recipe id %s, sent %s" % (n, pid.get("show") if pid is not None else None,
+                                                                       rec["id"]))
+            continue
+        if not rec["taken"]:
+            continue  # its expert info is the session's to show
+        recipe = recipes.get(rid)
+        if recipe is None or [nm for nm, _ in recipe] != rec["names"] or [t for _, t in recipe] != rec["types"]:
+            errs.append("client package %d: input recipe %s is %s, sent as %s" % (n, rid, recipe, rec["names"]))
+            continue
+        vals = {nm: (tuple(v) if isinstance(v, list) else v) for nm, v in zip(rec["names"], rec["values"])}
+        e, v = check_package(pkg, recipe, vals, rtde_to_field)
+        errs += ["client package %d: %s" % (n, x) for x in e]
+        values += v
+    return errs, values
+
+
 def main():
     doc, pdml, label = sys.argv[1:4]
     rtde_to_field = doc_rtde_names(doc)
     cases = [c.split(":") for c in sys.argv[4:]]
     per_port = sessions(pdml, {c[1] for c in cases})
     failed = packages = values = 0
-    for name, port, jpath, protocol, texts, extra in cases:
+    for name, port, jpath, protocol, texts, extra, *more in cases:
         with open(jpath) as f:
             recs = [json.loads(line) for line in f if line.strip()]
         errs, n, v = check_session(per_port.get(port, []), recs, int(protocol), int(texts),
                                    [e for e in extra.split("+") if e], rtde_to_field)
+        if more:
+            with open(more[0]) as f:
+                sent = [json.loads(line) for line in f if line.strip()]
+            e, w = check_inputs(per_port.get(port, []), sent, int(protocol), rtde_to_field)
+            errs += e
+            v += w
+            if not e:
+                print("ok: %s %s: the client's %d data packages as it sent them" % (label, name, len(sent)))
         packages += n
         values += v
         if errs:

@@ -6,6 +6,9 @@ no code with lib/ and imports nothing from the C side.
 
 Wire format: every package is a big-endian uint16 size (the 3-byte header
 included), a type letter, then the payload; every number is big-endian.
+It writes inputs too: setup_inputs() ('I': names; the reply an input recipe
+id and a type per name) and send_inputs() (a data package 'U' from the
+client: the recipe id in protocol 2, then the values packed by its types).
 """
 import select
 import socket
@@ -75,6 +78,8 @@ class Peer:
         self.foreign = []     # (type, payload) of packages skipped while waiting for a reply
         self.types = None
         self.recipe_id = None
+        self.inputs = {}      # input recipe id -> its types (valid recipes only)
+        self.last_input = None  # the id of the last valid input recipe (protocol 1 packages go to it)
         self.timeout = timeout
 
     def close(self):
@@ -174,8 +179,33 @@ class Peer:
         return self.recipe_id, self.types
 
     def setup_inputs(self, names):
+        """Returns (input recipe id, [type tokens]); the reply carries the id
+        in both protocol versions. Id 0 (a NOT_FOUND or IN_USE): invalid."""
         p = self.request(I, ','.join(names).encode())
-        return p[0], p[1:].decode().split(',')
+        rid, types = p[0], p[1:].decode().split(',')
+        if rid != 0:
+            self.inputs[rid] = types
+            self.last_input = rid
+        return rid, types
+
+    @staticmethod
+    def pack(types, values):
+        """Values (a tuple per vector) packed by their types, big-endian."""
+        out = b''
+        for t, v in zip(types, values):
+            fmt, n = TYPES[t]
+            out += struct.pack('>%d%s' % (n, fmt), *(v if n > 1 else (v,)))
+        return out
+
+    def input_package(self, rid, values, types=None):
+        """The payload of an input data package: in protocol 2 the recipe id
+        first, then the values by the recipe's (or the given) types."""
+        body = self.pack(types or self.inputs[rid], values)
+        return (bytes([rid]) if self.protocol >= 2 else b'') + body
+
+    def send_inputs(self, rid, values, types=None):
+        """Sends an input data package; the controller answers none."""
+        self.send(U, self.input_package(rid, values, types))
 
     def start(self):
         return self.request(S)[0]
