@@ -49,6 +49,15 @@ check "demo: summary lines with demo.STATE at 500/s" grep -q 'demo.STATE 5[0-9][
 check "demo: says it runs until Ctrl-C, or for DEMO_SECONDS" grep -qx 'demo: runs until Ctrl-C (or 3 s)' "$T/demo.out"
 check "demo: the closing lines say how to watch it" sh -c "tail -n 1 '$T/demo.out' | grep -q 'make spy'"
 check "demo: no process left behind" sh -c "! pgrep -s $(cat "$T/demo.sid")"
+# Ctrl-C as a terminal sends it: SIGINT to the demo's process group, once it publishes.
+setsid -w sh -c 'echo $$ > "$1"; shift; exec "$@"' sh "$T/int.sid" \
+  $MAKE --no-print-directory -s BUILD="$BUILD" demo > "$T/int.out" 2> "$T/int.err" &
+INT=$!; PIDS="$PIDS $INT"
+i=0; while ! grep -q 'demo.STATE' "$T/int.out" 2>/dev/null && kill -0 $INT 2>/dev/null && [ $i -lt 1500 ]; do
+  sleep 0.02; i=$((i + 1)); done
+env kill -s INT -- -"$(cat "$T/int.sid")"; wait $INT  # procps kill: dash's takes no --
+check "demo after Ctrl-C: the closing tip, once, and no process left behind" \
+  sh -c "[ \$(grep -c 'To watch the next one' '$T/int.out') = 1 ] && ! pgrep -s $(cat "$T/int.sid")"
 # A port that is taken: the simulator cannot listen, the demo stops and names the variable.
 $PYTHON -c '
 import socket, sys, os
