@@ -426,7 +426,8 @@ static void put_node(FILE *out, struct co_run *node)
     put_string(out, d->hardware_version);
     fputs(", ", out);
     put_string(out, d->software_version);
-    fprintf(out, ",\n    urrt_gateway_tpdos, %zu, urrt_gateway_objects, %zu};\n", d->tpdo_count, d->object_count);
+    fprintf(out, ",\n    urrt_gateway_tpdos, %zu, urrt_gateway_objects, %zu, NULL, 0, NULL, 0};\n", d->tpdo_count,
+            d->object_count); /* no RPDOs, no 0x1016 (the configuration has none yet) */
     fprintf(out, "const uint32_t urrt_gateway_rx_ids[%zu] = {", rx_count);
     for (size_t i = 0; i < rx_count; i++) {
         fprintf(out, "%s0x%03" PRIX32, i ? ", " : "", rx[i]);

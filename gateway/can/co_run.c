@@ -18,7 +18,7 @@ struct co_run {
     urrt_co_object *objects;
     urrt_co_tpdo_state *states;
     uint32_t var;                   /* no variables: urrt_co_init wants storage all the same */
-    uint32_t rx_ids[CO_RUN_RX_IDS];
+    uint32_t rx_ids[URRT_CO_RX_IDS_MAX]; /* urrt_co_rx_ids' first CO_RUN_RX_IDS */
 };
 
 void co_run_free(struct co_run *run)

@@ -32,7 +32,7 @@
 #include "canopen_map.h"
 #include "urrt_co.h"
 
-#define CO_RUN_RX_IDS URRT_CO_RX_IDS_MAX /* NMT 0x000, SYNC 0x080, SDO request 0x600 + node id */
+#define CO_RUN_RX_IDS 3u /* NMT 0x000, SYNC 0x080, SDO request 0x600 + node id (no RPDOs, no 0x1016 yet) */
 
 struct co_run;
 

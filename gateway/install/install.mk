@@ -29,9 +29,10 @@ EXAMPLES := $(sort $(wildcard docs/examples/*.ini))
 DIST_FILES := $(DIST)/README.md $(DIST)/urrt-spy $(DIST)/urrt-gateway.service $(DIST)/urrt-gateway@.service $(DIST)/urrt.pc \
               $(DIST)/gateway.ini $(DIST)/$(TYPES_JAR)
 
-# The library's headers: the header of each module of liburrt.a (lib/lib.mk's LIB_SRCS), so that
-# a module added to lib/ is installed whole (check-deb holds the package to the library's objects).
-LIB_INSTALL_HDRS = $(wildcard $(LIB_SRCS:.c=.h))
+# The library's headers: every header of lib/ (lib/lib.mk's LIB_HDRS: each module's, and the
+# seams its sources include, such as urrt_co_internal.h), so that a module added to lib/ is
+# installed whole (check-deb holds the package to the headers the library's objects are built from).
+LIB_INSTALL_HDRS = $(LIB_HDRS)
 
 INSTALL_ITEMS = $(foreach f,$(PROGRAMS) $(DIST)/urrt-spy,$(f):$(BINDIR):0755) \
   $(DIST)/$(TYPES_JAR):$(JAVADIR):0644 \

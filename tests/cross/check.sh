@@ -180,6 +180,35 @@ check "image (the CANopen node, no EDS writer) links with -nostdlib -lgcc" \
   ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $co_roots -lgcc -o "$out/image-co.elf"
 check "image (the CANopen node and urrt_co_comm_name) links with -nostdlib -lgcc" \
   ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $co_roots -Wl,-u,urrt_co_comm_name -lgcc -o "$out/image-co-eds.elf"
+# With the receiving side (RPDOs, 0x1016): every urrt_co_ function of both
+# files. urrt_co.c reaches lib/urrt_co_rx.c only through the table
+# urrt_co_init_rx installs, so the node without it (image-co, a TPDO-only
+# node) holds no symbol of urrt_co_rx.o: not one of its functions, nor the
+# table (symbols urrt_co.o defines too, static inline copies, aside).
+rx_roots=$(${CROSS}nm -g --defined-only "$out/urrt_co_rx.o" | awk 'NF == 3 && $2 ~ /[TDR]/ { printf " -Wl,-u,%s", $3 }')
+check "image (the CANopen node with RPDOs and 0x1016, no EDS writer) links with -nostdlib -lgcc" \
+  ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $co_roots $rx_roots -lgcc -o "$out/image-co-rx.elf"
+if [ -f "$out/image-co.elf" ] && [ -f "$out/image-co-rx.elf" ]; then
+  ${CROSS}nm --defined-only "$out/urrt_co.o" | awk 'NF == 3 { print $3 }' | sort -u > "$out/co-syms"
+  ${CROSS}nm --defined-only "$out/urrt_co_rx.o" | awk 'NF == 3 && $2 ~ /[TtDdRrBb]/ { print $3 }' | sort -u |
+    comm -23 - "$out/co-syms" > "$out/co-rx-syms"
+  leaked=$(${CROSS}nm "$out/image-co.elf" | awk 'NF == 3 { print $3 }' | sort -u | comm -12 - "$out/co-rx-syms")
+  if [ ! -s "$out/co-rx-syms" ]; then
+    fail "lib/urrt_co_rx.o defines no symbol of its own: the check below would prove nothing"
+  elif [ -n "$leaked" ]; then
+    fail "the CANopen node without urrt_co_init_rx links the receiving side: $(echo $leaked)"
+  else
+    ok "the CANopen node without urrt_co_init_rx links none of lib/urrt_co_rx.c's $(wc -l < "$out/co-rx-syms") symbols"
+  fi
+  check "the image with the receiving side links urrt_co_init_rx and urrt_co_rpdo_status" \
+    sh -c "${CROSS}nm '$out/image-co-rx.elf' | grep -q ' urrt_co_init_rx\$' &&
+      ${CROSS}nm '$out/image-co-rx.elf' | grep -q ' urrt_co_rpdo_status\$'"
+fi
+if ${CROSS}nm "$out/urrt_co.o" | grep -q ' U urrt_co_\(init_rx\|rpdo_\)'; then
+  fail "lib/urrt_co.o references the receiving side: $(${CROSS}nm "$out/urrt_co.o" | grep ' U urrt_co_' | head -n 3)"
+else
+  ok "lib/urrt_co.o references no function of lib/urrt_co_rx.c"
+fi
 co_name="Producer heartbeat time" # 0x1017's name
 if [ -f "$out/image-co.elf" ] && [ -f "$out/image-co-eds.elf" ]; then
   if grep -q "$co_name" "$out/image-co.elf"; then
@@ -248,12 +277,13 @@ while IFS='|' read -r core cc flags; do
 done <<EOF_CORES
 $CORES
 EOF_CORES
-for img in min co co-eds rtde rtde-in all; do
+for img in min co co-rx co-eds rtde rtde-in all; do
   [ -f "$out/image-$img.elf" ] || continue
   set -- $(${CROSS}size "$out/image-$img.elf" | awk 'NR == 2 { print $1, $2, $3 }')
   case $img in
     min) name="image: framer + decode + random access (tests/cross)" ;;
     co) name="image: the CANopen node, no EDS writer (tests/cross)" ;;
+    co-rx) name="image: the CANopen node with RPDOs and 0x1016, no EDS writer (tests/cross)" ;;
     co-eds) name="image: the CANopen node and urrt_co_comm_name (tests/cross)" ;;
     rtde) name="image: the RTDE client, read-only (tests/cross)" ;;
     rtde-in) name="image: the RTDE client and its writing side (tests/cross)" ;;
@@ -273,6 +303,11 @@ printf '| sizeof(urrt_rtde) | %s |\n| sizeof(urrt_rtde_values) | %s |\n' \
   "$(symbol_size urrt_probe_rtde)" "$(symbol_size urrt_probe_rtde_values)" >> "$measured"
 # One input recipe of the writing side (lib/urrt_rtde_in.h).
 printf '| sizeof(urrt_rtde_in) | %s |\n' "$(symbol_size urrt_probe_rtde_in)" >> "$measured"
+# The CANopen node, and what it needs per TPDO, RPDO and 0x1016 entry (lib/urrt_co.h).
+printf '| sizeof(urrt_co) | %s |\n| sizeof(urrt_co_tpdo_state) | %s |\n' \
+  "$(symbol_size urrt_probe_co)" "$(symbol_size urrt_probe_co_tpdo)" >> "$measured"
+printf '| sizeof(urrt_co_rpdo_state) | %s |\n| sizeof(urrt_co_consumer) | %s |\n' \
+  "$(symbol_size urrt_probe_co_rpdo)" "$(symbol_size urrt_probe_co_consumer)" >> "$measured"
 rm -f "$out"/*.O2.su
 echo "cross: largest stack frames of lib/ functions (-fstack-usage, bytes; lib/ has no recursion):"
 for obj in $objs; do cat "${obj%.o}.su"; done | sort -t "$(printf '\t')" -k2 -n -r | head -n 5 | sed 's/^/cross:   /'

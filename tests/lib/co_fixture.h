@@ -11,6 +11,19 @@
  *   0x2100: UNSIGNED16 variable, rw, default 100, range 10..1000.
  *   0x2101: UNSIGNED8 variable, write-only.
  * Robot data is stale after 50 ms; heartbeat 100 ms; the CAN core's startup 1 s.
+ *
+ * co_fixture_rx_node: the same node with two RPDOs and a consumer heartbeat
+ * (urrt_co_init_rx, vars[CO_FIXTURE_RX_VARS]):
+ *   0x2200 sub 1: INTEGER16 vars[2], rw, -1000..1000, default 0
+ *   0x2200 sub 2: UNSIGNED8 vars[3], rw, a BOOLEAN: 0..1, default 0
+ *   0x2200 sub 3: UNSIGNED32 vars[4], rw, whole range, default 7
+ *   0x2200 sub 4: INTEGER8 vars[5], write-only, -100..100, default 0
+ *   0x2201:       UNSIGNED16 vars[6], read-only, default 5
+ *   RPDO1 (0x20A): type 255, event timer 100 ms, 7 bytes: 0x2200 sub 1 (bytes 0-1),
+ *                  sub 2 (byte 2), sub 3 (bytes 3-6)
+ *   RPDO2 (0x30A): type 0 (at the next SYNC), no event timer, 4 bytes: 0x2200 sub 4
+ *                  (byte 0), an UNSIGNED8 dummy (byte 1), 0x2200 sub 1 (bytes 2-3)
+ *   0x1016: 2 entries, sub 1 = node 1 every 150 ms (0x00010096), sub 2 = 0 (off)
  */
 #ifndef URRT_TEST_CO_FIXTURE_H
 #define URRT_TEST_CO_FIXTURE_H
@@ -55,12 +68,40 @@ static const urrt_co_object objects[4] = {
 };
 static const urrt_co_desc co_fixture_node = {
     NODE, URRT_CO_START_PRE_OPERATIONAL, 100, 0, 50000, 0x12345678, 0x01020304, 0x0000ABCD, 0x00010002,
-    0x00000042, "urrt CANopen gateway", "1.0", "0.9.0", tpdos, 2, objects, 4,
+    0x00000042, "urrt CANopen gateway", "1.0", "0.9.0", tpdos, 2, objects, 4, NULL, 0, NULL, 0,
+};
+
+#define CO_FIXTURE_RX_VARS 7u
+static const urrt_co_object rx_objects[9] = {
+    {0x2000, 1, URRT_CO_INTEGER16, URRT_CO_RO, URRT_CO_SIGNAL, 0, 0, 0, 0, 0},
+    {0x2000, 2, URRT_CO_INTEGER8, URRT_CO_RO, URRT_CO_SIGNAL, 0, 1, 0, 0, 0},
+    {0x2100, 0, URRT_CO_UNSIGNED16, URRT_CO_RW, URRT_CO_VAR, 0, 0, 100, 10, 1000},
+    {0x2101, 0, URRT_CO_UNSIGNED8, URRT_CO_WO, URRT_CO_VAR, 0, 1, 0, 0, 1},
+    {0x2200, 1, URRT_CO_INTEGER16, URRT_CO_RW, URRT_CO_VAR, 0, 2, 0, 0xFC18, 1000},
+    {0x2200, 2, URRT_CO_UNSIGNED8, URRT_CO_RW, URRT_CO_VAR, 0, 3, 0, 0, 1},
+    {0x2200, 3, URRT_CO_UNSIGNED32, URRT_CO_RW, URRT_CO_VAR, 0, 4, 7, 0, 0xFFFFFFFF},
+    {0x2200, 4, URRT_CO_INTEGER8, URRT_CO_WO, URRT_CO_VAR, 0, 5, 0, 0x9C, 100},
+    {0x2201, 0, URRT_CO_UNSIGNED16, URRT_CO_RO, URRT_CO_VAR, 0, 6, 5, 0, 0xFFFF},
+};
+static const uint32_t rmap_1[3] = {0x22000110, 0x22000208, 0x22000320};
+static const uint32_t rmap_2[3] = {0x22000408, 0x00050008, 0x22000110};
+static const urrt_co_rpdo rpdos[2] = {
+    {rmap_1, URRT_CO_COB_DEFAULT, 100, 255, 3},
+    {rmap_2, URRT_CO_COB_DEFAULT, 0, 0, 3},
+};
+static const uint32_t consumers[2] = {0x00010096, 0};
+static const urrt_co_desc co_fixture_rx_node = {
+    NODE, URRT_CO_START_PRE_OPERATIONAL, 100, 0, 50000, 0x12345678, 0x01020304, 0x0000ABCD, 0x00010002,
+    0x00000042, "urrt CANopen gateway", "1.0", "0.9.0", tpdos, 2, rx_objects, 9, rpdos, 2, consumers, 2,
 };
 /* The description, its defaults restored (tests change fields of it). */
 static inline void co_fixture_desc(urrt_co_desc *d)
 {
     *d = co_fixture_node;
+}
+static inline void co_fixture_rx_desc(urrt_co_desc *d)
+{
+    *d = co_fixture_rx_node;
 }
 
 #endif

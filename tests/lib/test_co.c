@@ -1020,6 +1020,568 @@ static void test_emcy(void)
     read_errors(1080000, 0x11, 0);
 }
 
+/* ---- the receiving side: RPDOs and the consumer heartbeat -------------------------------- */
+
+/* co_fixture_rx_node's storage (urrt_co_init_rx). */
+static urrt_co_rpdo_state rpdo_states[2];
+static urrt_co_consumer consumer_states[2];
+static uint32_t rx_vars[CO_FIXTURE_RX_VARS];
+static uint64_t written[CO_FIXTURE_RX_VARS];
+
+static int init_rx(size_t *bad)
+{
+    const urrt_co_rx_storage storage = {rpdo_states, consumer_states, written};
+    memset(frame_states, 0, sizeof frame_states);
+    EQ(urrt_cantx_init(&tx, &tables, frame_states, robots, values, 8, NULL, NULL), 0);
+    return urrt_co_init_rx(&co, &desc, &tx, tpdo_states, rx_vars, CO_FIXTURE_RX_VARS, &storage, bad);
+}
+
+/* desc (co_fixture_rx_node's, as a test changed it) started at time 0. */
+static void setup_rx(void)
+{
+    size_t bad = 0;
+    EQ(init_rx(&bad), 0);
+    out_count = 0;
+    EQ(urrt_co_start(&co, 0, capture, NULL), 1);
+}
+
+/* The node of the RPDO tests: no heartbeat of its own, both TPDOs switched off
+ * (their COB-IDs invalid), so that only EMCYs come out of a run. No robot
+ * packet comes: the tests end before the CAN core's startup second. */
+static void rx_node(void)
+{
+    co_fixture_rx_desc(&desc);
+    desc.heartbeat_ms = 0;
+    setup_rx();
+    SDO(0, 0x23, 0x00, 0x18, 0x01, 0x8A, 0x01, 0x00, 0xC0);
+    ANSWER(0x60, 0x00, 0x18, 0x01, 0, 0, 0, 0);
+    SDO(0, 0x23, 0x01, 0x18, 0x01, 0x8A, 0x02, 0x00, 0xC0);
+    ANSWER(0x60, 0x01, 0x18, 0x01, 0, 0, 0, 0);
+}
+
+/* A frame the node answers nothing to (an RPDO, a heartbeat). */
+#define RX0(t, id, ...)                                                   \
+    do {                                                                  \
+        static const uint8_t d_[] = {__VA_ARGS__};                        \
+        EQ(rx((id), d_, sizeof d_, (t)), 0);                              \
+    } while (0)
+
+/* The node as a loop runs it, woken at each of its deadlines from t on, until
+ * a frame on id goes out (that run's time; out[] its frames) or limit. */
+static uint64_t wake_until(uint32_t id, uint64_t t, uint64_t limit)
+{
+    unsigned wakes;
+    for (wakes = 0; wakes < 100000u; wakes++) {
+        uint64_t due = urrt_co_deadline(&co);
+        t = due > t ? due : t;
+        if (t >= limit) {
+            return limit;
+        }
+        run(t);
+        if (count_id(id) > 0u) {
+            return t;
+        }
+    }
+    CHECK(0, "the node woke without end at %llu", (unsigned long long)t);
+    return limit;
+}
+
+static void expect_rx_init(int want, size_t want_item, const char *what)
+{
+    size_t bad = 0;
+    int rc = init_rx(&bad);
+    CHECK(rc == want && bad == want_item, "%s: got %d at %zu, want %d at %zu", what, rc, bad, want, want_item);
+    CHECK(urrt_co_strerror(rc)[0] != '\0', "a text for %d", rc);
+}
+
+/* Descriptions urrt_co_init_rx refuses, each naming the RPDO or 0x1016 entry. */
+static void test_rx_init(void)
+{
+    static urrt_co_rpdo bad_rpdos[5];
+    static uint32_t bad_map[3];
+    static uint32_t bad_consumers[5];
+    size_t bad = 0;
+    co_fixture_rx_desc(&desc);
+    expect_rx_init(0, SIZE_MAX, "the test's description with RPDOs");
+    memset(frame_states, 0, sizeof frame_states);
+    EQ(urrt_cantx_init(&tx, &tables, frame_states, robots, values, 8, NULL, NULL), 0);
+    EQ(urrt_co_init(&co, &desc, &tx, tpdo_states, rx_vars, CO_FIXTURE_RX_VARS, &bad), URRT_CO_E_STORAGE);
+    memcpy(bad_rpdos, rpdos, sizeof rpdos);
+    bad_rpdos[2] = bad_rpdos[3] = bad_rpdos[4] = bad_rpdos[1];
+    desc.rpdos = bad_rpdos;
+    desc.rpdo_count = 5;
+    expect_rx_init(URRT_CO_E_RPDO, SIZE_MAX, "five RPDOs");
+    desc.rpdo_count = 2;
+    memcpy(bad_map, rmap_1, sizeof rmap_1);
+    bad_rpdos[0].mapping = bad_map;
+    bad_map[0] = 0x22010010;
+    expect_rx_init(URRT_CO_E_RPDO, 0, "a read-only variable mapped");
+    bad_map[0] = 0x20000110;
+    expect_rx_init(URRT_CO_E_RPDO, 0, "a robot value mapped");
+    bad_map[0] = 0x22000108;
+    expect_rx_init(URRT_CO_E_RPDO, 0, "8 bits of an INTEGER16");
+    bad_map[0] = 0x22050008;
+    expect_rx_init(URRT_CO_E_RPDO, 0, "an object that does not exist");
+    bad_map[0] = 0x00050010;
+    expect_rx_init(URRT_CO_E_RPDO, 0, "an UNSIGNED8 dummy of 16 bits");
+    bad_map[0] = 0x00060010; /* an UNSIGNED16 dummy is fine ... */
+    bad_map[1] = 0x22000320;
+    bad_map[2] = 0x22000320; /* ... but 16 + 32 + 32 bits is over 8 bytes */
+    expect_rx_init(URRT_CO_E_RPDO, 0, "a mapping of 80 bits");
+    bad_rpdos[0].mapping = rmap_1;
+    bad_rpdos[1].transmission_type = 241;
+    expect_rx_init(URRT_CO_E_RPDO, 1, "transmission type 241");
+    bad_rpdos[1].transmission_type = 240;
+    bad_rpdos[1].cob_id = 0x601;
+    expect_rx_init(URRT_CO_E_RPDO, 1, "a restricted COB-ID (SDO)");
+    bad_rpdos[1].cob_id = 0x20A;
+    expect_rx_init(URRT_CO_E_RPDO, 1, "RPDO1's id");
+    bad_rpdos[1].cob_id = 0x8000020A;
+    expect_rx_init(0, SIZE_MAX, "RPDO1's id, invalid");
+    co_fixture_rx_desc(&desc);
+    desc.consumer_count = 0;
+    expect_rx_init(URRT_CO_E_CONSUMER, SIZE_MAX, "RPDOs without 0x1016");
+    desc.consumer_count = 5;
+    expect_rx_init(URRT_CO_E_CONSUMER, SIZE_MAX, "five 0x1016 entries");
+    desc.consumer_count = 2;
+    desc.consumers = bad_consumers;
+    bad_consumers[0] = 0x00800064;
+    expect_rx_init(URRT_CO_E_CONSUMER, 0, "node id 128");
+    bad_consumers[0] = 0x01010064;
+    expect_rx_init(URRT_CO_E_CONSUMER, 0, "bit 24");
+    bad_consumers[0] = 0x00010064;
+    bad_consumers[1] = 0x000100C8;
+    expect_rx_init(URRT_CO_E_CONSUMER, 1, "node 1 twice");
+    bad_consumers[1] = 0x00010000;
+    expect_rx_init(0, SIZE_MAX, "node 1 twice, once off (time 0)");
+    desc.consumers = NULL;
+    expect_rx_init(0, SIZE_MAX, "0x1016 all 0");
+    /* Heartbeat consumers without RPDOs. */
+    desc.rpdos = NULL;
+    desc.rpdo_count = 0;
+    expect_rx_init(0, SIZE_MAX, "0x1016 alone");
+    EQ(urrt_co_init(&co, &desc, &tx, tpdo_states, rx_vars, CO_FIXTURE_RX_VARS, &bad), URRT_CO_E_STORAGE);
+}
+
+/* 0x1400, 0x1600, 0x1016 as CiA 301 lays them out; none on a node without. */
+static void test_rx_sdo_reads(void)
+{
+    co_fixture_rx_desc(&desc);
+    setup_rx();
+    SDO(0, 0x40, 0x00, 0x14, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x00, 0x14, 0x00, 0x05, 0x00, 0x00, 0x00);
+    SDO(0, 0x40, 0x00, 0x14, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x00, 0x14, 0x01, 0x0A, 0x02, 0x00, 0x00); /* 0x200 + 10 */
+    SDO(0, 0x40, 0x01, 0x14, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x01, 0x14, 0x01, 0x0A, 0x03, 0x00, 0x00); /* 0x300 + 10 */
+    SDO(0, 0x40, 0x00, 0x14, 0x02, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x00, 0x14, 0x02, 0xFF, 0x00, 0x00, 0x00);
+    SDO(0, 0x40, 0x01, 0x14, 0x02, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x01, 0x14, 0x02, 0x00, 0x00, 0x00, 0x00);
+    SDO(0, 0x40, 0x00, 0x14, 0x05, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x00, 0x14, 0x05, 0x64, 0x00, 0x00, 0x00);
+    SDO(0, 0x40, 0x01, 0x14, 0x05, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x01, 0x14, 0x05, 0x00, 0x00, 0x00, 0x00);
+    ABORT(0, 0x06090011, 0x40, 0x00, 0x14, 0x03, 0, 0, 0, 0); /* no inhibit time on an RPDO */
+    ABORT(0, 0x06090011, 0x40, 0x00, 0x14, 0x04, 0, 0, 0, 0);
+    ABORT(0, 0x06090011, 0x40, 0x00, 0x14, 0x06, 0, 0, 0, 0);
+    ABORT(0, 0x06020000, 0x40, 0x02, 0x14, 0x00, 0, 0, 0, 0); /* no RPDO3 */
+    SDO(0, 0x40, 0x00, 0x16, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x00, 0x16, 0x00, 0x03, 0x00, 0x00, 0x00);
+    SDO(0, 0x40, 0x00, 0x16, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x00, 0x16, 0x01, 0x10, 0x01, 0x00, 0x22);
+    SDO(0, 0x40, 0x00, 0x16, 0x03, 0, 0, 0, 0);
+    ANSWER(0x43, 0x00, 0x16, 0x03, 0x20, 0x03, 0x00, 0x22);
+    SDO(0, 0x40, 0x01, 0x16, 0x02, 0, 0, 0, 0);
+    ANSWER(0x43, 0x01, 0x16, 0x02, 0x08, 0x00, 0x05, 0x00); /* the UNSIGNED8 dummy */
+    ABORT(0, 0x06090011, 0x40, 0x00, 0x16, 0x04, 0, 0, 0, 0);
+    ABORT(0, 0x06020000, 0x40, 0x02, 0x16, 0x00, 0, 0, 0, 0);
+    SDO(0, 0x40, 0x16, 0x10, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x16, 0x10, 0x00, 0x02, 0x00, 0x00, 0x00);
+    SDO(0, 0x40, 0x16, 0x10, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x16, 0x10, 0x01, 0x96, 0x00, 0x01, 0x00); /* node 1, 150 ms */
+    SDO(0, 0x40, 0x16, 0x10, 0x02, 0, 0, 0, 0);
+    ANSWER(0x43, 0x16, 0x10, 0x02, 0x00, 0x00, 0x00, 0x00);
+    ABORT(0, 0x06090011, 0x40, 0x16, 0x10, 0x03, 0, 0, 0, 0);
+    SDO(0, 0x40, 0x00, 0x22, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x00, 0x22, 0x00, 0x04, 0x00, 0x00, 0x00);
+    SDO(0, 0x40, 0x00, 0x22, 0x03, 0, 0, 0, 0);
+    ANSWER(0x43, 0x00, 0x22, 0x03, 0x07, 0x00, 0x00, 0x00);
+    SDO(0, 0x40, 0x01, 0x22, 0x00, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x01, 0x22, 0x00, 0x05, 0x00, 0x00, 0x00);
+    ABORT(0, 0x06010001, 0x40, 0x00, 0x22, 0x04, 0, 0, 0, 0); /* write-only */
+    /* The node without RPDOs has none of these objects. */
+    desc_defaults();
+    setup();
+    ABORT(0, 0x06020000, 0x40, 0x00, 0x14, 0x00, 0, 0, 0, 0);
+    ABORT(0, 0x06020000, 0x40, 0x00, 0x16, 0x00, 0, 0, 0, 0);
+    ABORT(0, 0x06020000, 0x40, 0x16, 0x10, 0x00, 0, 0, 0, 0);
+    ABORT(0, 0x06020000, 0x23, 0x16, 0x10, 0x01, 0x64, 0x00, 0x01, 0x00);
+}
+
+/* urrt_co_rx_ids on the node with RPDOs: NMT, SYNC, SDO, RPDO1, RPDO2, node 1's heartbeat. */
+static void expect_rx_ids6(int line, const uint32_t *want, size_t want_count, uint32_t changes)
+{
+    uint32_t ids[URRT_CO_RX_IDS_MAX];
+    size_t n = urrt_co_rx_ids(&co, ids);
+    size_t i;
+    bool same = n == want_count && co.rx_changes == changes;
+    for (i = 0; same && i < n; i++) {
+        same = ids[i] == want[i];
+    }
+    CHECK(same, "line %d: %zu ids (0x%03X ...) after %u changes, want %zu after %u", line, n, (unsigned)ids[3],
+          (unsigned)co.rx_changes, want_count, (unsigned)changes);
+}
+#define RX_IDS_ARE(changes, ...)                                                            \
+    do {                                                                                    \
+        static const uint32_t w_[] = {__VA_ARGS__};                                         \
+        expect_rx_ids6(__LINE__, w_, sizeof w_ / sizeof w_[0], (changes));                  \
+    } while (0)
+
+/* Writes of 0x1400, 0x1600, 0x1016 and the variables: what CiA 301 allows,
+ * the abort of each refusal, and the ids received following them. */
+static void test_rx_sdo_writes(void)
+{
+    co_fixture_rx_desc(&desc);
+    desc.heartbeat_ms = 0;
+    setup_rx();
+    RX_IDS_ARE(0, 0x000, 0x080, 0x60A, 0x20A, 0x30A, 0x701);
+    /* The mapping is the description's: read-only, even the remap sequence's sub 0 = 0. */
+    ABORT(0, 0x06010002, 0x2F, 0x00, 0x16, 0x00, 0x00, 0, 0, 0);
+    ABORT(0, 0x06010002, 0x23, 0x00, 0x16, 0x01, 0x08, 0x00, 0x01, 0x21);
+    ABORT(0, 0x06090011, 0x23, 0x00, 0x16, 0x04, 0x08, 0x00, 0x01, 0x21); /* past the entries: exists first */
+    ABORT(0, 0x06010002, 0x2F, 0x00, 0x14, 0x00, 0x02, 0, 0, 0);
+    ABORT(0, 0x06010002, 0x2B, 0x01, 0x22, 0x00, 0x06, 0x00, 0, 0); /* a read-only register */
+    ABORT(0, 0x06010002, 0x2F, 0x16, 0x10, 0x00, 0x01, 0, 0, 0);
+    /* COB-ID: a new id only while or into invalid (CiA 301), as for TPDOs. */
+    ABORT(0, 0x06090030, 0x23, 0x00, 0x14, 0x01, 0x0B, 0x02, 0x00, 0x00);
+    ABORT(0, 0x06090030, 0x23, 0x00, 0x14, 0x01, 0x0A, 0x02, 0x00, 0x20); /* bit 29 */
+    ABORT(0, 0x06070013, 0x2B, 0x00, 0x14, 0x01, 0x0A, 0x02, 0x00, 0x00); /* 2 bytes into UNSIGNED32 */
+    RX_IDS_ARE(0, 0x000, 0x080, 0x60A, 0x20A, 0x30A, 0x701);
+    SDO(0, 0x23, 0x00, 0x14, 0x01, 0x0A, 0x02, 0x00, 0x80); /* RPDO1 off */
+    ANSWER(0x60, 0x00, 0x14, 0x01, 0, 0, 0, 0);
+    RX_IDS_ARE(1, 0x000, 0x080, 0x60A, 0x30A, 0x701);
+    EQ(rx_changes_at_emit, 1); /* before the answer */
+    SDO(0, 0x23, 0x00, 0x14, 0x01, 0x1A, 0x02, 0x00, 0x80); /* a new id while off */
+    ANSWER(0x60, 0x00, 0x14, 0x01, 0, 0, 0, 0);
+    RX_IDS_ARE(1, 0x000, 0x080, 0x60A, 0x30A, 0x701);
+    ABORT(0, 0x06090030, 0x23, 0x00, 0x14, 0x01, 0x01, 0x06, 0x00, 0x00); /* valid on 0x601: restricted */
+    ABORT(0, 0x06090030, 0x23, 0x00, 0x14, 0x01, 0x0A, 0x03, 0x00, 0x00); /* valid on RPDO2's 0x30A */
+    SDO(0, 0x23, 0x00, 0x14, 0x01, 0x1A, 0x02, 0x00, 0x00); /* valid on 0x21A */
+    ANSWER(0x60, 0x00, 0x14, 0x01, 0, 0, 0, 0);
+    RX_IDS_ARE(2, 0x000, 0x080, 0x60A, 0x21A, 0x30A, 0x701);
+    SDO(0, 0x40, 0x00, 0x14, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x00, 0x14, 0x01, 0x1A, 0x02, 0x00, 0x00);
+    SDO(0, 0x23, 0x00, 0x14, 0x01, 0x1A, 0x02, 0x00, 0x40); /* bit 30 kept as written, the id the same */
+    ANSWER(0x60, 0x00, 0x14, 0x01, 0, 0, 0, 0);
+    RX_IDS_ARE(2, 0x000, 0x080, 0x60A, 0x21A, 0x30A, 0x701);
+    /* Transmission type: 0..240, 254, 255; 241..253 refused. */
+    ABORT(0, 0x06090031, 0x2F, 0x00, 0x14, 0x02, 0xF1, 0, 0, 0);
+    ABORT(0, 0x06090031, 0x2F, 0x00, 0x14, 0x02, 0xFD, 0, 0, 0);
+    ABORT(0, 0x06070012, 0x23, 0x00, 0x14, 0x02, 0x00, 0, 0, 0); /* 4 bytes into UNSIGNED8 */
+    SDO(0, 0x2F, 0x00, 0x14, 0x02, 0x00, 0, 0, 0);
+    ANSWER(0x60, 0x00, 0x14, 0x02, 0, 0, 0, 0);
+    SDO(0, 0x2F, 0x00, 0x14, 0x02, 0xF0, 0, 0, 0);
+    ANSWER(0x60, 0x00, 0x14, 0x02, 0, 0, 0, 0);
+    SDO(0, 0x2F, 0x00, 0x14, 0x02, 0xFE, 0, 0, 0);
+    ANSWER(0x60, 0x00, 0x14, 0x02, 0, 0, 0, 0);
+    SDO(0, 0x40, 0x00, 0x14, 0x02, 0, 0, 0, 0);
+    ANSWER(0x4F, 0x00, 0x14, 0x02, 0xFE, 0x00, 0x00, 0x00);
+    /* Event timer: any value, 2 bytes. */
+    ABORT(0, 0x06070013, 0x2F, 0x00, 0x14, 0x05, 0x32, 0, 0, 0);
+    SDO(0, 0x2B, 0x00, 0x14, 0x05, 0xF4, 0x01, 0, 0);
+    ANSWER(0x60, 0x00, 0x14, 0x05, 0, 0, 0, 0);
+    SDO(0, 0x40, 0x00, 0x14, 0x05, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x00, 0x14, 0x05, 0xF4, 0x01, 0x00, 0x00);
+    /* A request frame shorter than 8 bytes: 0x06070010 with its index. */
+    {
+        static const uint8_t seven[7] = {0x23, 0x00, 0x14, 0x05, 0x32, 0x00, 0x00};
+        EQ(rx(0x60A, seven, 7, 0), 1);
+        EXPECT(0, 0x58A, 0x80, 0x00, 0x14, 0x05, 0x10, 0x00, 0x07, 0x06);
+    }
+    /* 0x1016: node id << 16 | ms; one node once; bits 24..31 0; node ids to 127. */
+    ABORT(0, 0x06070013, 0x2B, 0x16, 0x10, 0x01, 0x64, 0x00, 0, 0);
+    SDO(0, 0x23, 0x16, 0x10, 0x02, 0x64, 0x00, 0x02, 0x00); /* node 2, 100 ms */
+    ANSWER(0x60, 0x16, 0x10, 0x02, 0, 0, 0, 0);
+    RX_IDS_ARE(3, 0x000, 0x080, 0x60A, 0x21A, 0x30A, 0x701, 0x702);
+    ABORT(0, 0x06040043, 0x23, 0x16, 0x10, 0x01, 0xC8, 0x00, 0x02, 0x00); /* node 2 twice */
+    ABORT(0, 0x06090030, 0x23, 0x16, 0x10, 0x01, 0x64, 0x00, 0x80, 0x00); /* node 128 */
+    ABORT(0, 0x06090030, 0x23, 0x16, 0x10, 0x01, 0x64, 0x00, 0x03, 0x01); /* bit 24 */
+    SDO(0, 0x23, 0x16, 0x10, 0x01, 0x00, 0x00, 0x02, 0x00); /* node 2, time 0: off, so not twice */
+    ANSWER(0x60, 0x16, 0x10, 0x01, 0, 0, 0, 0);
+    RX_IDS_ARE(4, 0x000, 0x080, 0x60A, 0x21A, 0x30A, 0x702);
+    SDO(0, 0x40, 0x16, 0x10, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x16, 0x10, 0x01, 0x00, 0x00, 0x02, 0x00);
+    /* The variables: in range stored and recorded, out of range refused. */
+    ABORT(0, 0x06090032, 0x2B, 0x00, 0x22, 0x01, 0x17, 0xFC, 0, 0); /* -1001 */
+    ABORT(0, 0x06090031, 0x2B, 0x00, 0x22, 0x01, 0xE9, 0x03, 0, 0); /* 1001 */
+    ABORT(0, 0x06090031, 0x2F, 0x00, 0x22, 0x02, 0x02, 0, 0, 0);    /* a BOOLEAN: 2 */
+    ABORT(0, 0x06070012, 0x23, 0x00, 0x22, 0x02, 0x01, 0, 0, 0);    /* 4 bytes into UNSIGNED8 */
+    EQ(co.var_writes, 0);
+    EQ(written[2], URRT_CANTX_NEVER);
+    SDO(5000, 0x2B, 0x00, 0x22, 0x01, 0x18, 0xFC, 0, 0); /* -1000 */
+    ANSWER(0x60, 0x00, 0x22, 0x01, 0, 0, 0, 0);
+    EQ(rx_vars[2], 0xFC18);
+    EQ(written[2], 5000);
+    EQ(co.var_writes, 1);
+    /* Reset communication: the parameters back, the ids with them. */
+    nmt(0x82, NODE, 6000);
+    RX_IDS_ARE(5, 0x000, 0x080, 0x60A, 0x20A, 0x30A, 0x701);
+    EQ(rx_changes_at_emit, 5); /* before the boot-up */
+    SDO(6000, 0x40, 0x00, 0x14, 0x05, 0, 0, 0, 0);
+    ANSWER(0x4B, 0x00, 0x14, 0x05, 0x64, 0x00, 0x00, 0x00);
+    EQ(rx_vars[2], 0xFC18); /* the application's values stay */
+    EQ(written[2], 5000);
+    nmt(0x81, NODE, 7000); /* reset node: they go back too */
+    EQ(rx_vars[2], 0);
+    EQ(rx_vars[4], 7);
+    EQ(written[2], URRT_CANTX_NEVER);
+    RX_IDS_ARE(5, 0x000, 0x080, 0x60A, 0x20A, 0x30A, 0x701);
+}
+
+/* RPDO1 (type 255) at once, RPDO2 (type 0) at the next SYNC, only in
+ * OPERATIONAL; too short: EMCY 0x8210 once, not processed; too long:
+ * processed; values outside their range refused and counted. */
+static void test_rpdo_processing(void)
+{
+    rx_node();
+    RX0(1000, 0x20A, 0xF4, 0x01, 0x01, 0x78, 0x56, 0x34, 0x12);
+    EQ(rx_vars[2], 0); /* pre-operational: not processed */
+    EQ(co.var_writes, 0);
+    nmt(0x02, NODE, 1000);
+    RX0(1000, 0x20A, 0xF4, 0x01, 0x01, 0x78, 0x56, 0x34, 0x12);
+    EQ(rx_vars[2], 0); /* stopped */
+    nmt(0x01, NODE, 2000);
+    RX0(10000, 0x20A, 0xF4, 0x01, 0x01, 0x78, 0x56, 0x34, 0x12);
+    EQ(rx_vars[2], 500);
+    EQ(rx_vars[3], 1);
+    EQ(rx_vars[4], 0x12345678);
+    EQ(written[2], 10000);
+    EQ(written[3], 10000);
+    EQ(written[4], 10000);
+    EQ(written[5], URRT_CANTX_NEVER);
+    EQ(co.var_writes, 1);
+    EQ(run(10000), 0);
+    /* Longer: the extra byte ignored. */
+    RX0(20000, 0x20A, 0x18, 0xFC, 0x00, 0x01, 0x00, 0x00, 0x00, 0xEE);
+    EQ(rx_vars[2], 0xFC18); /* -1000, as the INTEGER16's bits */
+    EQ(rx_vars[3], 0);
+    EQ(rx_vars[4], 1);
+    EQ(co.var_writes, 2);
+    /* Shorter: not processed, EMCY 0x8210 once, reset by one of the right length. */
+    RX0(30000, 0x20A, 0x01, 0x00, 0x01, 0x02, 0x00, 0x00);
+    EQ(rx_vars[2], 0xFC18);
+    EQ(co.var_writes, 2);
+    EQ(urrt_co_deadline(&co) <= 30000, 1); /* the EMCY is due at once */
+    EQ(run(30000), 1);
+    EXPECT(0, 0x08A, 0x10, 0x82, 0x11, 0x00, 0x00, 0x01, 0x00, 0x00);
+    read_errors(30000, 0x11, 1);
+    RX0(31000, 0x20A, 0x01);
+    EQ(run(31000), 0); /* told once */
+    RX0(40000, 0x20A, 0x02, 0x00, 0x00, 0x03, 0x00, 0x00, 0x00);
+    EQ(rx_vars[2], 2);
+    EQ(run(40000), 1);
+    EXPECT(0, 0x08A, 0x00, 0x00, 0x00, 0x10, 0x82, 0x01, 0x00, 0x00);
+    read_errors(40000, 0x00, 1);
+    /* Out of range: 1001 and a BOOLEAN 2 refused, the UNSIGNED32 stored. */
+    RX0(50000, 0x20A, 0xE9, 0x03, 0x02, 0x05, 0x00, 0x00, 0x00);
+    EQ(rx_vars[2], 2);
+    EQ(rx_vars[3], 0);
+    EQ(rx_vars[4], 5);
+    EQ(written[2], 40000);
+    EQ(written[4], 50000);
+    EQ(co.values_refused, 2);
+    EQ(co.var_writes, 4);
+    /* RPDO2, type 0: kept; the latest before the SYNC acted on at it. */
+    RX0(60000, 0x30A, 0x9C, 0xAA, 0x10, 0x00); /* -100, dummy, 16 */
+    RX0(61000, 0x30A, 0x05, 0xAA, 0x20, 0x00); /* 5, dummy, 32 */
+    EQ(rx_vars[5], 0);
+    EQ(rx_vars[2], 2);
+    EQ(rx(0x080, NULL, 0, 62000), 0);
+    EQ(rx_vars[5], 5);
+    EQ(rx_vars[2], 0x20);
+    EQ(written[5], 62000);
+    EQ(written[2], 62000);
+    EQ(co.var_writes, 5);
+    EQ(rx(0x080, NULL, 0, 63000), 0);
+    EQ(co.var_writes, 5); /* nothing new at the next SYNC */
+    RX0(64000, 0x30A, 0x9B, 0xAA, 0x20, 0x00); /* -101: below -100 */
+    EQ(rx(0x080, NULL, 0, 65000), 0);
+    EQ(rx_vars[5], 5);
+    EQ(co.values_refused, 3);
+    EQ(written[2], 65000); /* its other value was stored */
+    /* A kept RPDO does not outlive OPERATIONAL. */
+    RX0(66000, 0x30A, 0x01, 0xAA, 0x30, 0x00);
+    nmt(0x80, NODE, 67000);
+    nmt(0x01, NODE, 68000);
+    EQ(rx(0x080, NULL, 0, 69000), 0);
+    EQ(rx_vars[5], 5);
+    /* RPDO2 made event-driven (255): at once. */
+    SDO(70000, 0x2F, 0x01, 0x14, 0x02, 0xFF, 0, 0, 0);
+    ANSWER(0x60, 0x01, 0x14, 0x02, 0, 0, 0, 0);
+    RX0(71000, 0x30A, 0x9C, 0xAA, 0x30, 0x00);
+    EQ(rx_vars[5], 0x9C);
+    EQ(rx_vars[2], 0x30);
+    /* An RPDO whose COB-ID is invalid is not received. */
+    SDO(72000, 0x23, 0x01, 0x14, 0x01, 0x0A, 0x03, 0x00, 0x80);
+    ANSWER(0x60, 0x01, 0x14, 0x01, 0, 0, 0, 0);
+    RX0(73000, 0x30A, 0x01, 0xAA, 0x40, 0x00);
+    EQ(rx_vars[2], 0x30);
+    EQ(run(80000), 0);
+}
+
+/* The event timer is RPDO1's deadline: watched from its first RPDO in
+ * OPERATIONAL; late: EMCY 0x8250 once (at the deadline a loop wakes for),
+ * reset when it comes again. */
+static void test_rpdo_deadline(void)
+{
+    rx_node();
+    nmt(0x01, NODE, 0);
+    EQ(wake_until(0x08A, 0, 500000), 500000); /* none before the first */
+    RX0(500000, 0x20A, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00);
+    EQ(wake_until(0x08A, 500000, 900000), 600001); /* 100 ms after it, plus 1 us */
+    EXPECT(0, 0x08A, 0x50, 0x82, 0x11, 0x00, 0x00, 0x01, 0x00, 0x00);
+    EQ(wake_until(0x08A, 600001, 650000), 650000); /* once */
+    RX0(650000, 0x20A, 0x02, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00);
+    EQ(run(650000), 1);
+    EXPECT(0, 0x08A, 0x00, 0x00, 0x00, 0x50, 0x82, 0x01, 0x00, 0x00);
+    /* On time: no EMCY. */
+    RX0(740000, 0x20A, 0x02, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00);
+    RX0(840000, 0x20A, 0x02, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00);
+    EQ(wake_until(0x08A, 840000, 940000), 940000);
+    /* Not watched outside OPERATIONAL. */
+    nmt(0x80, NODE, 940000);
+    EQ(wake_until(0x08A, 940000, 999000), 999000);
+}
+
+/* The same deadline written by SDO: watched again from the next RPDO; 0 is off. */
+static void test_rpdo_deadline_write(void)
+{
+    rx_node();
+    nmt(0x01, NODE, 0);
+    RX0(10000, 0x20A, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00);
+    SDO(20000, 0x2B, 0x00, 0x14, 0x05, 0x00, 0x00, 0, 0); /* off */
+    ANSWER(0x60, 0x00, 0x14, 0x05, 0, 0, 0, 0);
+    EQ(wake_until(0x08A, 20000, 500000), 500000);
+    SDO(500000, 0x2B, 0x00, 0x14, 0x05, 0x0A, 0x00, 0, 0); /* 10 ms */
+    ANSWER(0x60, 0x00, 0x14, 0x05, 0, 0, 0, 0);
+    EQ(wake_until(0x08A, 500000, 600000), 600000); /* from the next RPDO */
+    RX0(600000, 0x20A, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00);
+    EQ(wake_until(0x08A, 600000, 700000), 610001);
+    EXPECT(0, 0x08A, 0x50, 0x82, 0x11, 0x00, 0x00, 0x01, 0x00, 0x00);
+    /* RPDO2 has no event timer: never late. */
+    RX0(620000, 0x30A, 0x01, 0x00, 0x00, 0x00);
+    /* RPDO1 switched off: its condition ends. */
+    SDO(630000, 0x23, 0x00, 0x14, 0x01, 0x0A, 0x02, 0x00, 0x80);
+    ANSWER(0x60, 0x00, 0x14, 0x01, 0, 0, 0, 0);
+    EQ(run(630000), 1);
+    EXPECT(0, 0x08A, 0x00, 0x00, 0x00, 0x50, 0x82, 0x01, 0x00, 0x00);
+    EQ(wake_until(0x08A, 630000, 990000), 990000);
+}
+
+/* 0x1016 sub 1: node 1, 150 ms. Watched from its first heartbeat; a lost
+ * one raises EMCY 0x8130 once, reset when heartbeats come back. */
+static void test_consumer_heartbeat(void)
+{
+    rx_node();
+    EQ(wake_until(0x08A, 0, 300000), 300000); /* none before the first */
+    RX0(300000, 0x701, 0x05);
+    RX0(400000, 0x701, 0x05);
+    EQ(wake_until(0x08A, 400000, 900000), 550001); /* 150 ms after the last, plus 1 us */
+    EXPECT(0, 0x08A, 0x30, 0x81, 0x11, 0x00, 0x00, 0x01, 0x00, 0x00);
+    read_errors(550001, 0x11, 1);
+    SDO(550001, 0x40, 0x03, 0x10, 0x01, 0, 0, 0, 0);
+    ANSWER(0x43, 0x03, 0x10, 0x01, 0x30, 0x81, 0x00, 0x00);
+    EQ(wake_until(0x08A, 550001, 700000), 700000); /* once */
+    {
+        const uint8_t two[2] = {0x05, 0x00};
+        EQ(rx(0x701, two, 2, 700000), 0); /* a heartbeat is one byte */
+        EQ(run(700000), 0);
+        EQ(rx(0x702, two, 1, 700000), 0); /* another node's */
+        EQ(run(700000), 0);
+    }
+    RX0(710000, 0x701, 0x7F);
+    EQ(run(710000), 1);
+    EXPECT(0, 0x08A, 0x00, 0x00, 0x00, 0x30, 0x81, 0x01, 0x00, 0x00);
+    EQ(consumer_states[0].producer_state, 0x7F);
+    /* A boot-up starts it over: nothing until the next heartbeat. */
+    RX0(720000, 0x701, 0x00);
+    EQ(wake_until(0x08A, 720000, 900000), 900000);
+    /* STOPPED stops it; back in PRE-OPERATIONAL it starts with the next heartbeat. */
+    RX0(900000, 0x701, 0x05);
+    nmt(0x02, NODE, 910000);
+    EQ(wake_until(0x08A, 910000, 960000), 960000);
+    nmt(0x80, NODE, 960000);
+    EQ(wake_until(0x08A, 960000, 999000), 999000);
+}
+
+/* The same in OPERATIONAL, with a moved producer: 0x1016 sub 1 = node 2, 20 ms. */
+static void test_consumer_write(void)
+{
+    rx_node();
+    nmt(0x01, NODE, 0);
+    RX0(10000, 0x701, 0x05);
+    SDO(20000, 0x23, 0x16, 0x10, 0x01, 0x14, 0x00, 0x02, 0x00);
+    ANSWER(0x60, 0x16, 0x10, 0x01, 0, 0, 0, 0);
+    RX0(30000, 0x701, 0x05); /* node 1 no longer watched */
+    EQ(wake_until(0x08A, 30000, 200000), 200000);
+    RX0(200000, 0x702, 0x05);
+    EQ(wake_until(0x08A, 200000, 300000), 220001);
+    EXPECT(0, 0x08A, 0x30, 0x81, 0x11, 0x00, 0x00, 0x01, 0x00, 0x00);
+    SDO(230000, 0x23, 0x16, 0x10, 0x01, 0x00, 0x00, 0x00, 0x00); /* off: the condition ends */
+    ANSWER(0x60, 0x16, 0x10, 0x01, 0, 0, 0, 0);
+    EQ(run(230000), 1);
+    EXPECT(0, 0x08A, 0x00, 0x00, 0x00, 0x30, 0x81, 0x01, 0x00, 0x00);
+}
+
+/* urrt_co_rpdo_status: what a gateway's silence policy reads, through
+ * every reason. */
+static void test_rpdo_status(void)
+{
+    size_t bad = 0;
+    co_fixture_rx_desc(&desc);
+    desc.heartbeat_ms = 0;
+    EQ(init_rx(&bad), 0);
+    EQ(urrt_co_rpdo_status(&co, 0, 0), URRT_CO_RPDO_NOT_OPERATIONAL); /* not started */
+    rx_node();
+    EQ(urrt_co_rpdo_status(&co, 2, 0), URRT_CO_RPDO_NONE);
+    EQ(urrt_co_rpdo_status(NULL, 0, 0), URRT_CO_RPDO_NONE);
+    EQ(urrt_co_rpdo_status(&co, 0, 0), URRT_CO_RPDO_NOT_OPERATIONAL);
+    nmt(0x01, NODE, 0);
+    EQ(urrt_co_rpdo_status(&co, 0, 0), URRT_CO_RPDO_NO_DATA);
+    RX0(10000, 0x20A, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00);
+    RX0(10000, 0x30A, 0x01, 0x00, 0x00, 0x00);
+    EQ(urrt_co_rpdo_status(&co, 0, 10000), URRT_CO_RPDO_FRESH);
+    EQ(urrt_co_rpdo_status(&co, 0, 110000), URRT_CO_RPDO_FRESH);  /* 100 ms: still within */
+    EQ(urrt_co_rpdo_status(&co, 0, 110001), URRT_CO_RPDO_DEADLINE);
+    EQ(urrt_co_rpdo_status(&co, 1, 900000), URRT_CO_RPDO_FRESH);  /* no event timer */
+    /* The manager's heartbeat: lost at 150 ms after its last, for every RPDO. */
+    RX0(20000, 0x701, 0x05);
+    EQ(urrt_co_rpdo_status(&co, 1, 170000), URRT_CO_RPDO_FRESH);
+    EQ(urrt_co_rpdo_status(&co, 1, 170001), URRT_CO_RPDO_HEARTBEAT_LOST);
+    EQ(wake_until(0x08A, 20000, 999000), 110001); /* RPDO1's deadline first */
+    EQ(wake_until(0x08A, 110001, 999000), 170001);
+    EQ(urrt_co_rpdo_status(&co, 1, 170001), URRT_CO_RPDO_HEARTBEAT_LOST);
+    RX0(180000, 0x701, 0x05);
+    EQ(urrt_co_rpdo_status(&co, 1, 180000), URRT_CO_RPDO_FRESH);
+    /* The manager switches RPDO2 off, then on: no data until the next. */
+    SDO(190000, 0x23, 0x01, 0x14, 0x01, 0x0A, 0x03, 0x00, 0x80);
+    EQ(urrt_co_rpdo_status(&co, 1, 190000), URRT_CO_RPDO_NOT_VALID);
+    SDO(190000, 0x23, 0x01, 0x14, 0x01, 0x0A, 0x03, 0x00, 0x00);
+    EQ(urrt_co_rpdo_status(&co, 1, 190000), URRT_CO_RPDO_NO_DATA);
+    RX0(200000, 0x30A, 0x01, 0x00, 0x00, 0x00);
+    EQ(urrt_co_rpdo_status(&co, 1, 200000), URRT_CO_RPDO_FRESH);
+    /* NMT: pre-operational and stopped are silence; back in OPERATIONAL, no data until the next. */
+    nmt(0x80, NODE, 210000);
+    EQ(urrt_co_rpdo_status(&co, 1, 210000), URRT_CO_RPDO_NOT_OPERATIONAL);
+    nmt(0x02, NODE, 220000);
+    EQ(urrt_co_rpdo_status(&co, 1, 220000), URRT_CO_RPDO_NOT_OPERATIONAL);
+    nmt(0x01, NODE, 230000);
+    EQ(urrt_co_rpdo_status(&co, 1, 230000), URRT_CO_RPDO_NO_DATA);
+    RX0(240000, 0x30A, 0x01, 0x00, 0x00, 0x00);
+    EQ(urrt_co_rpdo_status(&co, 1, 240000), URRT_CO_RPDO_FRESH);
+}
+
 /* ---- robustness ----------------------------------------------------------------------- */
 
 static bool state_known(void)
@@ -1135,6 +1697,56 @@ static void test_random(void)
     EQ(bad, 0);
 }
 
+/* Every frame of 0..8 bytes on the receiving side's ids, and random ones, on
+ * the node with RPDOs: the invariants of test_lengths and test_random. */
+static void test_rx_robustness(void)
+{
+    static const uint32_t ids[] = {0x20A, 0x30A, 0x701, 0x702, 0x080, 0x000};
+    uint64_t now = 0;
+    unsigned bad = 0;
+    unsigned i;
+    co_fixture_rx_desc(&desc);
+    setup_rx();
+    nmt(0x01, NODE, 0);
+    test_rng_seed(20260107);
+    for (i = 0; i < RANDOM_FRAMES / 2u; i++) {
+        uint8_t data[8];
+        unsigned k;
+        unsigned len = pick(9);
+        uint32_t id = pick(4) == 0 ? 0x60A : ids[pick(6)];
+        size_t n;
+        for (k = 0; k < 8; k++) {
+            data[k] = (uint8_t)test_rng();
+        }
+        if (id == 0x60A) {
+            /* SDO requests to the receiving side's objects. */
+            static const uint8_t cmds[] = {0x40, 0x2B, 0x2F, 0x23, 0x22};
+            static const uint16_t idx[] = {0x1400, 0x1401, 0x1402, 0x1600, 0x1601, 0x1016, 0x2200, 0x2201};
+            uint16_t index = idx[pick(8)];
+            data[0] = cmds[pick(5)];
+            data[1] = (uint8_t)(index & 0xFF);
+            data[2] = (uint8_t)(index >> 8);
+            data[3] = (uint8_t)pick(7);
+            data[7] = (uint8_t)(data[7] & (pick(2) != 0 ? 0x00 : 0x80)); /* COB-IDs valid or not */
+            len = 8;
+        }
+        if (id == 0 && len == 2 && data[0] >= 0x81 && pick(4) != 0) {
+            data[0] = 0x01;
+        }
+        now += pick(20000);
+        n = rx(id, data, len, now);
+        bad += n > 2u;
+        check_outputs("random receiving-side frame");
+        n = run(now);
+        bad += n > 2u + 1u + URRT_CO_CONDITIONS + URRT_CO_RX_CONDITIONS + 2u;
+        check_outputs("random receiving-side run");
+        bad += !state_known();
+        bad += urrt_co_deadline(&co) <= now;
+        bad += urrt_co_rpdo_status(&co, 0, now) > URRT_CO_RPDO_DEADLINE;
+    }
+    EQ(bad, 0);
+}
+
 int main(void)
 {
     test_init();
@@ -1155,5 +1767,15 @@ int main(void)
     test_emcy();
     test_lengths();
     test_random();
+    test_rx_init();
+    test_rx_sdo_reads();
+    test_rx_sdo_writes();
+    test_rpdo_processing();
+    test_rpdo_deadline();
+    test_rpdo_deadline_write();
+    test_consumer_heartbeat();
+    test_consumer_write();
+    test_rpdo_status();
+    test_rx_robustness();
     return check_report();
 }

@@ -14,7 +14,7 @@ typedef struct stack_mark {
     unsigned bytes;
 } stack_mark;
 
-static stack_mark stack_marks[89];
+static stack_mark stack_marks[92];
 static unsigned stack_mark_count;
 
 /* fn's mark: the paint below sp, lowest the deepest word it changed. */
@@ -177,57 +177,113 @@ static void stack_sdo(urrt_co *co, uint8_t cmd, uint16_t index, uint8_t sub, uin
  * kind of frame (an SDO upload of a robot value packs its frame, a SYNC
  * sends a TPDO, a write of a TPDO's parameters moves its id and period),
  * urrt_co_run with the core's frames, a heartbeat and EMCYs. */
+/* The node's storage, for both nodes in turn (the Cortex-M0 board's RAM is small). */
+static urrt_co stack_node;
+static urrt_co_tpdo_state stack_tpdo_states[2];
+static uint32_t stack_vars[CO_FIXTURE_RX_VARS];
+
 static void stack_co(void)
 {
-    static urrt_co co;
-    static urrt_co_tpdo_state tpdo_states[2];
-    static uint32_t vars[2];
+    urrt_co *const co_ = &stack_node;
+    urrt_co_tpdo_state *const tpdo_states = stack_tpdo_states;
+    uint32_t *const vars = stack_vars;
     static const uint8_t nmt_start[2] = {URRT_CO_NMT_START, 0};
     static const uint8_t sync[1] = {1};
     size_t bad;
     urrt_cantx_init(&core_tx, &tables, core_states, core_robots, core_values, 8, NULL, NULL);
     STACK(urrt_co_strerror, (URRT_CO_E_OBJECT));
-    STACK(urrt_co_init, (&co, &co_fixture_node, &core_tx, tpdo_states, vars, 2, &bad));
-    STACK(urrt_co_start, (&co, 0, stack_emit, NULL));
+    STACK(urrt_co_init, (co_, &co_fixture_node, &core_tx, tpdo_states, vars, 2, &bad));
+    STACK(urrt_co_start, (co_, 0, stack_emit, NULL));
     urrt_cantx_on_packet(&core_tx, 0, &st, 1000);
-    STACK(urrt_co_on_frame, (&co, 0x000, 0, nmt_start, 2, 1000, stack_emit, NULL));
-    stack_sdo(&co, 0x40, 0x2000, 1, 0, 1000);             /* a robot value: its frame packed */
-    stack_sdo(&co, 0x40, 0x1018, 2, 0, 1000);             /* identity */
-    stack_sdo(&co, 0x2B, 0x2100, 0, 500, 1000);           /* a variable */
-    stack_sdo(&co, 0x40, 0x1008, 0, 0, 1000);             /* device name: a segmented upload */
-    stack_sdo(&co, 0x60, 0, 0, 0, 1000);                  /* its first segment */
-    stack_sdo(&co, 0x23, 0x1800, 1, 0x8000018Au, 1000);   /* TPDO1 invalid, */
-    stack_sdo(&co, 0x2B, 0x1800, 5, 20, 1000);            /* its event timer, */
-    stack_sdo(&co, 0x23, 0x1800, 1, 0x0000019Au, 1000);   /* valid at a new id */
-    stack_sdo(&co, 0x2F, 0x1801, 2, 1, 1000);             /* TPDO2 on every SYNC */
-    stack_sdo(&co, 0x23, 0x1234, 0, 0, 1000);             /* an abort */
+    STACK(urrt_co_on_frame, (co_, 0x000, 0, nmt_start, 2, 1000, stack_emit, NULL));
+    stack_sdo(co_, 0x40, 0x2000, 1, 0, 1000);             /* a robot value: its frame packed */
+    stack_sdo(co_, 0x40, 0x1018, 2, 0, 1000);             /* identity */
+    stack_sdo(co_, 0x2B, 0x2100, 0, 500, 1000);           /* a variable */
+    stack_sdo(co_, 0x40, 0x1008, 0, 0, 1000);             /* device name: a segmented upload */
+    stack_sdo(co_, 0x60, 0, 0, 0, 1000);                  /* its first segment */
+    stack_sdo(co_, 0x23, 0x1800, 1, 0x8000018Au, 1000);   /* TPDO1 invalid, */
+    stack_sdo(co_, 0x2B, 0x1800, 5, 20, 1000);            /* its event timer, */
+    stack_sdo(co_, 0x23, 0x1800, 1, 0x0000019Au, 1000);   /* valid at a new id */
+    stack_sdo(co_, 0x2F, 0x1801, 2, 1, 1000);             /* TPDO2 on every SYNC */
+    stack_sdo(co_, 0x23, 0x1234, 0, 0, 1000);             /* an abort */
     urrt_cantx_on_packet(&core_tx, 0, &st, 2000); /* new values: the SYNC's TPDO packs them */
-    STACK(urrt_co_on_frame, (&co, 0x080, 0, sync, 1, 2000, stack_emit, NULL));
+    STACK(urrt_co_on_frame, (co_, 0x080, 0, sync, 1, 2000, stack_emit, NULL));
     urrt_cantx_on_packet(&core_tx, 0, &st, 3000); /* and TPDO1's, due since its new id */
-    STACK(urrt_co_run, (&co, 3000, stack_emit, NULL));
-    STACK(urrt_co_run, (&co, 100000, stack_emit, NULL));  /* stale data: EMCY, heartbeat, TPDO1 */
-    STACK(urrt_co_set_error_passive, (&co, true));
-    STACK(urrt_co_run, (&co, 200000, stack_emit, NULL));
-    STACK(urrt_co_deadline, (&co));
-    STACK(urrt_co_state, (&co));
+    STACK(urrt_co_run, (co_, 3000, stack_emit, NULL));
+    STACK(urrt_co_run, (co_, 100000, stack_emit, NULL));  /* stale data: EMCY, heartbeat, TPDO1 */
+    STACK(urrt_co_set_error_passive, (co_, true));
+    STACK(urrt_co_run, (co_, 200000, stack_emit, NULL));
+    STACK(urrt_co_deadline, (co_));
+    STACK(urrt_co_state, (co_));
     STACK(urrt_co_state_name, (URRT_CO_STOPPED));
-    STACK(urrt_co_error_register, (&co));
-    STACK(urrt_co_tpdo_cob_default, (&co, 0));
-    STACK(urrt_co_comm_instances, (&co, &urrt_co_comm_table[0]));
+    STACK(urrt_co_error_register, (co_));
+    STACK(urrt_co_tpdo_cob_default, (co_, 0));
+    STACK(urrt_co_comm_instances, (co_, &urrt_co_comm_table[0]));
     {
         uint32_t ids[URRT_CO_RX_IDS_MAX];
-        STACK(urrt_co_rx_ids, (&co, ids));
+        STACK(urrt_co_rx_ids, (co_, ids));
     }
     {
         urrt_co_value v;
         uint32_t low, high;
-        STACK(urrt_co_comm_read, (&co, &urrt_co_comm_table[0], 0, 0, &v)); /* 0x1000 */
+        STACK(urrt_co_comm_read, (co_, &urrt_co_comm_table[0], 0, 0, &v)); /* 0x1000 */
         STACK(urrt_co_comm_name, (&urrt_co_comm_table[urrt_co_comm_count - 1u])); /* the longest walk */
         STACK(urrt_co_comm_limits, (&urrt_co_comm_table[0], &low, &high));
     }
-    CHECK(urrt_co_state(&co) == URRT_CO_OPERATIONAL && urrt_co_error_register(&co) != 0,
-          "CANopen node operational with an error in the stack test", "stack", urrt_co_state(&co),
-          urrt_co_error_register(&co));
+    CHECK(urrt_co_state(co_) == URRT_CO_OPERATIONAL && urrt_co_error_register(co_) != 0,
+          "CANopen node operational with an error in the stack test", "stack", urrt_co_state(co_),
+          urrt_co_error_register(co_));
+}
+
+/* The node with RPDOs and a consumer heartbeat (co_fixture_rx_node): its
+ * init, the SDO writes of 0x1400 and 0x1016, RPDOs acted on at once and at a
+ * SYNC, a short one, heartbeats, and runs that raise and reset the receiving
+ * side's EMCYs; each urrt_co_ function's mark is the worst of both nodes. */
+static void stack_co_rx(void)
+{
+    urrt_co *const co_ = &stack_node;
+    urrt_co_tpdo_state *const tpdo_states = stack_tpdo_states;
+    uint32_t *const vars = stack_vars;
+    static urrt_co_rpdo_state rpdo_states[2];
+    static urrt_co_consumer consumer_states[2];
+    static uint64_t written[CO_FIXTURE_RX_VARS];
+    static const urrt_co_rx_storage rx = {rpdo_states, consumer_states, written};
+    static const uint8_t nmt_start[2] = {URRT_CO_NMT_START, 0};
+    static const uint8_t rpdo1[7] = {0xF4, 0x01, 0x01, 0x78, 0x56, 0x34, 0x12};
+    static const uint8_t rpdo2[4] = {0x9C, 0x00, 0x10, 0x00};
+    static const uint8_t heartbeat[1] = {0x05};
+    size_t bad;
+    urrt_cantx_init(&core_tx, &tables, core_states, core_robots, core_values, 8, NULL, NULL);
+    STACK(urrt_co_init_rx, (co_, &co_fixture_rx_node, &core_tx, tpdo_states, vars, CO_FIXTURE_RX_VARS, &rx, &bad));
+    STACK(urrt_co_start, (co_, 0, stack_emit, NULL));
+    STACK(urrt_co_on_frame, (co_, 0x000, 0, nmt_start, 2, 1000, stack_emit, NULL));
+    stack_sdo(co_, 0x23, 0x1400, 1, 0x8000020Au, 1000); /* RPDO1 off, */
+    stack_sdo(co_, 0x23, 0x1400, 1, 0x0000020Au, 1000); /* on again */
+    stack_sdo(co_, 0x2B, 0x1400, 5, 50, 1000);          /* its deadline */
+    stack_sdo(co_, 0x23, 0x1016, 1, 0x00010014u, 1000); /* node 1, 20 ms */
+    stack_sdo(co_, 0x23, 0x1016, 2, 0x00010014u, 1000); /* node 1 twice: an abort */
+    stack_sdo(co_, 0x40, 0x1600, 3, 0, 1000);           /* a mapping entry */
+    stack_sdo(co_, 0x2B, 0x2200, 1, 500, 1000);         /* a variable an RPDO writes */
+    STACK(urrt_co_on_frame, (co_, 0x20A, 0, rpdo1, 7, 2000, stack_emit, NULL));    /* at once */
+    STACK(urrt_co_on_frame, (co_, 0x20A, 0, rpdo1, 3, 2000, stack_emit, NULL));    /* too short */
+    STACK(urrt_co_on_frame, (co_, 0x30A, 0, rpdo2, 4, 2000, stack_emit, NULL));    /* kept, */
+    STACK(urrt_co_on_frame, (co_, 0x080, 0, NULL, 0, 3000, stack_emit, NULL));     /* acted on at the SYNC */
+    STACK(urrt_co_on_frame, (co_, 0x701, 0, heartbeat, 1, 3000, stack_emit, NULL));
+    STACK(urrt_co_rpdo_status, (co_, 0, 3000)); /* the heartbeat watched, RPDO1's deadline too */
+    STACK(urrt_co_run, (co_, 3000, stack_emit, NULL));        /* EMCY 0x8210 */
+    STACK(urrt_co_deadline, (co_));
+    STACK(urrt_co_run, (co_, 60000, stack_emit, NULL));       /* 0x8250, 0x8130 */
+    STACK(urrt_co_on_frame, (co_, 0x20A, 0, rpdo1, 7, 61000, stack_emit, NULL)); /* ends 0x8210, 0x8250 */
+    STACK(urrt_co_run, (co_, 61000, stack_emit, NULL));
+    STACK(urrt_co_rpdo_status, (co_, 0, 61000));
+    STACK(urrt_co_rpdo_cob_default, (co_, 1));
+    STACK(urrt_co_comm_instances, (co_, &urrt_co_comm_table[urrt_co_comm_count - 1u]));
+    {
+        uint32_t ids[URRT_CO_RX_IDS_MAX];
+        STACK(urrt_co_rx_ids, (co_, ids));
+    }
+    CHECK(vars[5] == 0x9C && co_->values_refused == 0 && urrt_co_error_register(co_) != 0,
+          "the CANopen node with RPDOs took them in the stack test", "stack", vars[5], co_->values_refused);
 }
 
 /* Eight CAN signals of every byte order and type, a bit mask among them, over one
@@ -369,6 +425,7 @@ static void test_stack(void)
     urrt_decode(v3->packet, v3->length, &st);
     stack_cantx(sigs);
     stack_co();
+    stack_co_rx();
 
     for (i = 0; i < stack_mark_count; i++) {
         target_puts("stack: ");
@@ -377,5 +434,5 @@ static void test_stack(void)
         target_put_uint(stack_marks[i].bytes);
         target_puts("\n");
     }
-    CHECK(stack_mark_count == 89, "public functions measured", name, stack_mark_count, 89);
+    CHECK(stack_mark_count == 92, "public functions measured", name, stack_mark_count, 92);
 }
