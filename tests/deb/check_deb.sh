@@ -84,11 +84,14 @@ for h in $headers; do
   check "contents: /usr/include/${h##*/}, as $h (liburrt.a is compiled from it)" cmp -s "$h" "$T/pkg/usr/include/${h##*/}" ||
     echo "  install it with the library: gateway/install/install.mk installs each LIB_SRCS module's header (LIB_INSTALL_HDRS)"
 done
-# A program using a function of each header, built with the package's pkg-config file alone.
+# A program that includes every header and uses a function of each module's (a header with a
+# lib/ source of its name: a seam such as urrt_co_internal.h declares none), built with the
+# package's pkg-config file alone.
 nm -g --defined-only "$T/pkg$lib" 2>/dev/null | awk '$2 == "T" { print $3 }' | sort -u > "$T/defined"
 { for h in $headers; do echo "#include <${h##*/}>"; done
   echo 'typedef void (*fn)(void);'; echo 'static volatile fn used[] = {'
   for h in $headers; do
+    [ -f "${h%.h}.c" ] || continue
     f=$(grep -oE "\\<$(basename "$h" .h)_[a-z0-9_]+\\(" "$h" | tr -d '(' | sort -u | comm -12 - "$T/defined" | head -n 1)
     echo "    (fn)&${f:-no_function_of_$(basename "$h" .h)_in_liburrt},"
   done
@@ -97,7 +100,7 @@ pcdir=$T/pkg${lib%/*}/pkgconfig
 flags=$(PKG_CONFIG_SYSROOT_DIR="$T/pkg" PKG_CONFIG_LIBDIR="$pcdir" pkg-config --cflags --libs urrt 2>&1)
 ${CC:-cc} -std=c99 -Wall -Wextra -Wpedantic -Werror -o "$T/use" "$T/use.c" $flags > "$T/use.log" 2>&1; rc=$?
 sed 's/^/cc: /' "$T/use.log"
-check "a program using a function of each header ($(echo $(grep -o '&[a-z0-9_]*' "$T/use.c" | tr -d '&'))) builds with \`pkg-config urrt\` alone ($(echo $flags | sed "s|$T/pkg|PKG|g"))" \
+check "a program including every header and using a function of each module's ($(echo $(grep -o '&[a-z0-9_]*' "$T/use.c" | tr -d '&'))) builds with \`pkg-config urrt\` alone ($(echo $flags | sed "s|$T/pkg|PKG|g"))" \
   sh -c "[ $rc = 0 ] && '$T/use'"
 
 # What a robot is read over, as the package's own --print-keys says: named in the installed pages,
