@@ -3,7 +3,7 @@
 # the configuration front end (conf), the command-line helpers (cli), and the
 # RTDE session on a robot link (rtde_source: urrt-gateway and urrt-dump),
 # RTDE captures (rtde_capture: written by urrt-dump, read by all three), and
-# the RTDE-only values' units and reading (rtde_only: the gateway's outputs).
+# the RTDE-only values' units and reading (rtde_only: the gateway's outputs, urrt-dump).
 #
 # Every gateway/ folder compiles its .c files with GW_CFLAGS: -MMD -MP let the
 # compiler tell make which headers an object depends on, so no .mk lists them.

@@ -17,7 +17,8 @@ $(BUILD)/bin/urrt-sim: $(BUILD)/gateway/tools/urrt-sim.o $(SIM_MODEL_OBJ) $(SIM_
 	@mkdir -p $(@D)
 	$(CC) $(OPT) -o $@ $^ -lm
 
-$(BUILD)/bin/urrt-dump: $(BUILD)/gateway/tools/urrt-dump.o $(CLI_OBJ) $(RTDE_SOURCE_OBJ) $(RTDE_CAPTURE_OBJ) $(LIBPORT) $(LIBURRT)
+$(BUILD)/bin/urrt-dump: $(BUILD)/gateway/tools/urrt-dump.o $(CLI_OBJ) $(RTDE_SOURCE_OBJ) $(RTDE_CAPTURE_OBJ) $(RTDE_ONLY_OBJ) \
+  $(LIBPORT) $(LIBURRT)
 	@mkdir -p $(@D)
 	$(CC) $(OPT) -o $@ $^ -lm
 

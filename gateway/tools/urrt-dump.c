@@ -28,6 +28,7 @@
 #include "cli.h"
 #include "port.h"
 #include "rtde_capture.h"
+#include "rtde_only.h"
 #include "rtde_source.h"
 #include "urrt.h"
 #include "urrt_rtde.h"
@@ -445,18 +446,6 @@ static const urrt_rtde *rtde_session_of(const dump *d)
     return d->replay != NULL ? rtde_replay_session(d->replay) : NULL;
 }
 
-/* Elements of an RTDE-only variable's value (3 for a VECTOR3D, ...). */
-static unsigned rtde_elems(int var)
-{
-    switch (urrt_rtde_var_type(var)) {
-    case URRT_RTDE_T_VECTOR3D: return 3;
-    case URRT_RTDE_T_VECTOR6D:
-    case URRT_RTDE_T_VECTOR6INT32:
-    case URRT_RTDE_T_VECTOR6UINT32: return 6;
-    default: return 1;
-    }
-}
-
 /* Element i of an RTDE-only value in its own type: integers exact. */
 static void print_rtde_elem(FILE *out, const urrt_rtde_values *vals, int var, unsigned i, bool json)
 {
@@ -475,7 +464,7 @@ static void print_rtde_elem(FILE *out, const urrt_rtde_values *vals, int var, un
 
 static unsigned key_elems(unsigned key)
 {
-    return key < KEY_RTDE ? urrt_field((urrt_field_id)key)->count : rtde_elems((int)(key - KEY_RTDE));
+    return key < KEY_RTDE ? urrt_field((urrt_field_id)key)->count : rtde_only_elements((int)(key - KEY_RTDE));
 }
 
 static bool key_present(const sample *s, unsigned key)
@@ -759,7 +748,7 @@ static void print_table_rtde(FILE *out, const urrt_rtde_values *vals, int var)
 {
     urrt_rtde_type t = urrt_rtde_var_type(var);
     bool doubles = t == URRT_RTDE_T_DOUBLE || t == URRT_RTDE_T_VECTOR3D || t == URRT_RTDE_T_VECTOR6D;
-    for (unsigned i = 0; i < rtde_elems(var); i++) {
+    for (unsigned i = 0; i < rtde_only_elements(var); i++) {
         if (doubles) {
             fprintf(out, " %10.6g", ((const double *)urrt_rtde_value(vals, var))[i]);
         } else {
