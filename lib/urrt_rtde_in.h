@@ -64,6 +64,9 @@ extern "C" {
 /* The most registers in one input recipe: a CAN FD frame of single bits, or
  * a CANopen RPDO's 64 bits, is one recipe. */
 #define URRT_RTDE_IN_MAX_VARS 64
+/* The most input recipes one session sets up: a recipe id is a byte, 0 is
+ * "refused", and the output recipe holds one. */
+#define URRT_RTDE_IN_MAX_RECIPES 254
 /* The values of the largest recipe (doubles): 8 bytes each. */
 #define URRT_RTDE_IN_DATA_MAX (URRT_RTDE_IN_MAX_VARS * 8)
 /* An input data package: header, recipe id, values. */

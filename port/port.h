@@ -348,14 +348,18 @@ typedef struct urrt_canlink_config {
     uint32_t reopen_interval_ms;
     uint32_t retry_interval_ms; /* held frames retried at least this often */
     uint32_t hold_max_ms;       /* a held frame older than this is stale: dropped */
-    const uint32_t *rx_ids;     /* 11-bit standard ids to receive, filtered in the kernel
-                                   (CAN_RAW_FILTER); NULL or rx_id_count 0: receive nothing.
-                                   Copied by urrt_canlink_new. */
+    const uint32_t *rx_ids;     /* ids to receive, filtered in the kernel (CAN_RAW_FILTER):
+                                   11-bit standard ids, or a 29-bit id with
+                                   URRT_CANLINK_RX_EXTENDED; NULL or rx_id_count 0: receive
+                                   nothing. Copied by urrt_canlink_new. */
     size_t rx_id_count;         /* at most URRT_CANLINK_RX_IDS_MAX */
     bool log_caller_clock;      /* log: links: each line carries the now_us given to
                                    urrt_canlink_send (seconds.microseconds of that clock)
                                    instead of the wall clock (urrt-gateway --replay) */
 } urrt_canlink_config;
+
+/* An rx id with this bit is a 29-bit (extended) id: 0x18FF0010 | this. */
+#define URRT_CANLINK_RX_EXTENDED 0x80000000u
 
 /* The kernel's limit on one socket's filter list (CAN_RAW_FILTER_MAX). */
 #define URRT_CANLINK_RX_IDS_MAX 512

@@ -96,6 +96,11 @@ void can_map_free(struct can_map *map)
         free(map->frames[i].meta);
     }
     free(map->frames);
+    for (i = 0; i < map->input_count; i++) {
+        free(map->inputs[i].sigs);
+        free(map->inputs[i].meta);
+    }
+    free(map->inputs);
     free(map->robots);
     free(map->interface);
     for (i = 0; i < map->file_count; i++) {
@@ -258,6 +263,17 @@ static bool dbc_name(void *obj, const struct conf_key *key, const char *value, s
     return true;
 }
 
+static bool can_inputs_rate(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
+                            size_t n)
+{
+    struct can_map *map = obj;
+    char reason[CONF_WHY_MAX];
+    (void)at;
+    return conf_rate_hz(value, key->min, key->max, &map->inputs_min_rate_hz, reason, sizeof reason) ||
+           conf_fail(why, n, "%s = '%s': %s (a robot program's rtde_set_watchdog needs updates faster than its "
+                     "min_frequency)", key->name, value, reason);
+}
+
 #define YES_NO "%1$s = '%2$s': use yes or no"
 
 const struct conf_key can_map_can_keys[CAN_MAP_CK_COUNT] = {
@@ -294,7 +310,11 @@ const struct conf_key can_map_can_keys[CAN_MAP_CK_COUNT] = {
     [CAN_MAP_CK_NODE] = {"node", CONF_FN, CONF_FIELD(struct can_map, node), 0, 0, dbc_name, NULL, false, "NAME",
                          "URRT_GATEWAY", NULL, "DBC node name of the gateway"},
     [CAN_MAP_CK_RECEIVER] = {"receiver", CONF_FN, CONF_FIELD(struct can_map, receiver), 0, 0, dbc_name, NULL, false,
-                             "NAME", "Vector__XXX", NULL, "DBC receiver of every signal (Vector__XXX: none)"},
+                             "NAME", "Vector__XXX", NULL,
+                             "DBC receiver of every signal, and the transmitter of the [input]s (Vector__XXX: none)"},
+    [CAN_MAP_CK_INPUTS_MIN_RATE] = {"inputs_min_rate", CONF_FN, 0, 1, 1, 500, can_inputs_rate, NULL, false,
+                                    "N Hz", "10 Hz", NULL,
+                                    "fresh input registers are written at least this often, changed or not"},
 };
 
 void can_map_can_begin(struct can_map *map, struct conf_at at)
@@ -308,6 +328,7 @@ void can_map_can_begin(struct can_map *map, struct conf_at at)
 
 /* ---- [frame NAME] ------------------------------------------------------------------ */
 
+/* A frame of either kind by name: DBC message names are unique. */
 static struct can_map_frame *frame_named(const struct can_map *map, const char *name)
 {
     for (size_t i = 0; i < map->frame_count; i++) {
@@ -315,46 +336,79 @@ static struct can_map_frame *frame_named(const struct can_map *map, const char *
             return &map->frames[i];
         }
     }
+    for (size_t i = 0; i < map->input_count; i++) {
+        if (strcmp(map->inputs[i].name, name) == 0) {
+            return &map->inputs[i];
+        }
+    }
     return NULL;
+}
+
+static const char *frame_kind(const struct can_map_frame *f)
+{
+    return f->input ? "input" : "frame";
+}
+
+/* A new [frame NAME] or [input NAME] at the end of its array. */
+static struct can_map_frame *new_frame(struct can_map *map, bool input, const char *name, struct conf_at at,
+                                       char *why, size_t n)
+{
+    const char *kind = input ? "input" : "frame";
+    struct can_map_frame *f = frame_named(map, name);
+    struct can_map_frame **frames = input ? &map->inputs : &map->frames;
+    size_t *count = input ? &map->input_count : &map->frame_count;
+    size_t *capacity = input ? &map->input_capacity : &map->frame_capacity;
+    map->configured = true;
+    if (!conf_name(name, CONF_NAME_C, CAN_MAP_NAME_MAX, NULL, 0)) {
+        conf_fail(why, n, "[%s %s]: the frame name is its DBC name, a C identifier of at most %d characters", kind,
+                  name, CAN_MAP_NAME_MAX);
+        return NULL;
+    }
+    if (strcmp(name, CAN_MAP_HEARTBEAT_NAME) == 0) {
+        conf_fail(why, n, "[%s %s]: that name is the heartbeat's", kind, CAN_MAP_HEARTBEAT_NAME);
+        return NULL;
+    }
+    if (f != NULL) {
+        conf_fail(why, n, "[%s %s]: [%s %s] is already defined at line %d: frame names must be unique (the DBC "
+                  "names each message)", kind, name, frame_kind(f), name, f->loc.line);
+        return NULL;
+    }
+    if (*count == *capacity) {
+        size_t cap = *capacity ? 2 * *capacity : 8;
+        struct can_map_frame *grown = realloc(*frames, cap * sizeof *grown);
+        if (grown == NULL) {
+            conf_fail(why, n, "out of memory");
+            return NULL;
+        }
+        *frames = grown;
+        *capacity = cap;
+    }
+    f = &(*frames)[(*count)++];
+    memset(f, 0, sizeof *f);
+    snprintf(f->name, sizeof f->name, "%s", name);
+    f->input = input;
+    f->loc.file = intern_file(map, at.file);
+    f->loc.line = at.line;
+    if (input) {
+        (void)conf_key_defaults(can_map_input_keys, CAN_MAP_IK_COUNT, f, NULL, 0);
+    } else {
+        (void)conf_key_defaults(can_map_frame_keys, CAN_MAP_FK_COUNT, f, NULL, 0);
+    }
+    f->alive_index = -1;
+    f->valid_index = -1;
+    return f;
 }
 
 struct can_map_frame *can_map_frame_begin(struct can_map *map, const char *name, struct conf_at at, char *why,
                                           size_t n)
 {
-    struct can_map_frame *f = frame_named(map, name);
-    map->configured = true;
-    if (!conf_name(name, CONF_NAME_C, CAN_MAP_NAME_MAX, NULL, 0)) {
-        conf_fail(why, n, "[frame %s]: the frame name is its DBC name, a C identifier of at most %d characters", name,
-            CAN_MAP_NAME_MAX);
-        return NULL;
-    }
-    if (strcmp(name, CAN_MAP_HEARTBEAT_NAME) == 0) {
-        conf_fail(why, n, "[frame %s]: that name is the heartbeat's", CAN_MAP_HEARTBEAT_NAME);
-        return NULL;
-    }
-    if (f != NULL) {
-        conf_fail(why, n, "[frame %s] is already defined at line %d: frame names must be unique", name, f->loc.line);
-        return NULL;
-    }
-    if (map->frame_count == map->frame_capacity) {
-        size_t cap = map->frame_capacity ? 2 * map->frame_capacity : 8;
-        struct can_map_frame *grown = realloc(map->frames, cap * sizeof *grown);
-        if (grown == NULL) {
-            conf_fail(why, n, "out of memory");
-            return NULL;
-        }
-        map->frames = grown;
-        map->frame_capacity = cap;
-    }
-    f = &map->frames[map->frame_count++];
-    memset(f, 0, sizeof *f);
-    snprintf(f->name, sizeof f->name, "%s", name);
-    f->loc.file = intern_file(map, at.file);
-    f->loc.line = at.line;
-    (void)conf_key_defaults(can_map_frame_keys, CAN_MAP_FK_COUNT, f, NULL, 0);
-    f->alive_index = -1;
-    f->valid_index = -1;
-    return f;
+    return new_frame(map, false, name, at, why, n);
+}
+
+struct can_map_frame *can_map_input_begin(struct can_map *map, const char *name, struct conf_at at, char *why,
+                                          size_t n)
+{
+    return new_frame(map, true, name, at, why, n);
 }
 
 static int add_signal(struct can_map_frame *f, const urrt_can_signal *sig, const struct can_map_signal *meta)
@@ -770,6 +824,49 @@ static bool signal_rest(struct signal_parse *s, char **words, int nwords, char *
     return signal_limits(s, why, n) && signal_invalid(s, why, n);
 }
 
+/* RTDE inputs other than the general purpose registers: each acts on
+ * hardware (speed, outputs, a force) with no robot program deciding, so no
+ * [input] writes one. Named here for the reason; urrt_rtde_in_writable is
+ * the rule. */
+static const char *const hardware_inputs[] = {
+    "speed_slider_mask", "speed_slider_fraction", "standard_digital_output_mask", "standard_digital_output",
+    "configurable_digital_output_mask", "configurable_digital_output", "tool_digital_output_mask",
+    "tool_digital_output", "standard_analog_output_mask", "standard_analog_output_type", "standard_analog_output_0",
+    "standard_analog_output_1", "external_force_torque",
+};
+
+#define WRITABLE_REGISTERS \
+    "input_int_register_N, input_double_register_N (N 0..47), input_bit_register_N (N 64..127), " \
+    "input_bit_registers0_to_31, input_bit_registers32_to_63"
+
+/* Before an [input]'s signal is parsed: a hardware input, refused with why. */
+static bool input_hardware(const char *word, char *why, size_t n)
+{
+    size_t len = strcspn(word, "[");
+    for (size_t i = 0; i < sizeof hardware_inputs / sizeof hardware_inputs[0]; i++) {
+        if (strlen(hardware_inputs[i]) == len && strncmp(word, hardware_inputs[i], len) == 0) {
+            return conf_fail(why, n, "signal: %s is an RTDE input that acts on the robot's hardware with no robot "
+                             "program deciding: urrt never writes it; an [input] writes only general purpose "
+                             "input registers (" WRITABLE_REGISTERS ")", hardware_inputs[i]);
+        }
+    }
+    return true;
+}
+
+/* An [input]'s signal, parsed: a writable register, received as the PLC sends it. */
+static bool input_signal(const struct signal_parse *s, char *why, size_t n)
+{
+    if (s->meta.role != CAN_MAP_ROLE_RTDE || !urrt_rtde_in_writable(s->meta.var)) {
+        return conf_fail(why, n, "signal: %s is not an input register: an [input] writes only general purpose input "
+                         "registers (" WRITABLE_REGISTERS "); a value the robot sends goes in a [frame]", s->value);
+    }
+    if (s->have_invalid) {
+        return conf_fail(why, n, "signal: invalid= is for frames the gateway sends; an [input]'s value outside "
+                         "min..max is refused and counted");
+    }
+    return true;
+}
+
 static bool frame_signal(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
                          size_t n)
 {
@@ -796,14 +893,15 @@ static bool frame_signal(void *obj, const struct conf_key *key, const char *valu
     s.meta.role = CAN_MAP_ROLE_FIELD;
     s.meta.loc.file = at.file;
     s.meta.loc.line = at.line;
-    if (!signal_field(&s, words[0], why, n) || !signal_place(&s, words[1], why, n)) {
+    if ((f->input && !input_hardware(words[0], why, n)) || !signal_field(&s, words[0], why, n) ||
+        !signal_place(&s, words[1], why, n)) {
         return false;
     }
     if (s.length < 1 || s.length > 64) {
-        return conf_fail(why, n, "[frame %s] signal '%s': length %u: give 1..64 bits", f->name, words[0],
+        return conf_fail(why, n, "[%s %s] signal '%s': length %u: give 1..64 bits", frame_kind(f), f->name, words[0],
                          (unsigned)s.length);
     }
-    if (!signal_rest(&s, words, nwords, why, n)) {
+    if (!signal_rest(&s, words, nwords, why, n) || (f->input && !input_signal(&s, why, n))) {
         return false;
     }
     if (!s.have_unit) {
@@ -824,8 +922,8 @@ static bool frame_signal(void *obj, const struct conf_key *key, const char *valu
     }
     other = signal_named(f, s.meta.name);
     if (other >= 0) {
-        return conf_fail(why, n, "signal name '%s' already used in [frame %s] (line %d): add name=OTHER", s.meta.name,
-                   f->name, f->meta[other].loc.line);
+        return conf_fail(why, n, "signal name '%s' already used in [%s %s] (line %d): add name=OTHER", s.meta.name,
+                   frame_kind(f), f->name, f->meta[other].loc.line);
     }
     if (urrt_can_signal_check(&s.sig, URRT_CAN_MAX_LEN) < 0) {
         return conf_fail(why, n, "signal: does not fit even a 64-byte frame");
@@ -955,10 +1053,67 @@ const struct conf_key can_map_frame_keys[CAN_MAP_FK_COUNT] = {
                            NULL, "at least one", "one field element; the key again for each signal"},
 };
 
+/* on_silence = stop | hold | value V */
+static bool input_silence(void *obj, const struct conf_key *key, const char *value, struct conf_at at, char *why,
+                          size_t n)
+{
+    struct can_map_frame *f = obj;
+    char reason[CONF_WHY_MAX];
+    (void)key, (void)at;
+    if (strcmp(value, "stop") == 0) {
+        f->silence = CAN_MAP_SILENCE_STOP;
+    } else if (strcmp(value, "hold") == 0) {
+        f->silence = CAN_MAP_SILENCE_HOLD;
+    } else if (strncmp(value, "value", 5) == 0 && isspace((unsigned char)value[5])) {
+        const char *v = value + 5;
+        while (isspace((unsigned char)*v)) {
+            v++;
+        }
+        if (!conf_number(v, -DBL_MAX, DBL_MAX, &f->silence_value, reason, sizeof reason)) {
+            return conf_fail(why, n, "on_silence = '%s': value takes a finite number (value 0): %s", value, reason);
+        }
+        f->silence = CAN_MAP_SILENCE_VALUE;
+    } else {
+        return conf_fail(why, n, "on_silence = '%s': use stop (the program's RTDE watchdog acts), hold (the last "
+                         "values go on) or value V (V goes to every register of the frame)", value);
+    }
+    return true;
+}
+
+const struct conf_key can_map_input_keys[CAN_MAP_IK_COUNT] = {
+    [CAN_MAP_IK_ID] = {"id", CONF_UINT, CONF_FIELD(struct can_map_frame, id), 0, UINT32_MAX, NULL,
+                       "%1$s = '%2$s' is not a number (0x201 or 513)", false, NULL, NULL, "required",
+                       "the CAN id the PLC sends the frame on"},
+    [CAN_MAP_IK_EXTENDED] = {"extended", CONF_BOOL, CONF_FIELD(struct can_map_frame, extended), 0, 0, NULL,
+                             "%1$s = '%2$s': use yes (29-bit id) or no (11-bit id)", false, NULL, "no", NULL,
+                             "a 29-bit id"},
+    [CAN_MAP_IK_FD] = {"fd", CONF_BOOL, CONF_FIELD(struct can_map_frame, fd), 0, 0, NULL,
+                       "%1$s = '%2$s': use yes (CAN FD frame) or no (classic CAN)", false, NULL, "no", NULL,
+                       "a CAN FD frame"},
+    [CAN_MAP_IK_LENGTH] = {"length", CONF_UINT, CONF_FIELD(struct can_map_frame, len), 0, URRT_CAN_MAX_LEN, NULL,
+                           "%1$s = '%2$s': give the payload length in bytes, 0..8 (FD: up to 64)", false, NULL, "8",
+                           NULL, "payload bytes; a frame of another length is refused and counted"},
+    [CAN_MAP_IK_ROBOT] = {"robot", CONF_FN, CONF_FIELD(struct can_map_frame, robot), 0, 0, robot_name, NULL, false,
+                          "NAME", NULL, "the only robot", "robot whose input registers the frame writes"},
+    [CAN_MAP_IK_TIMEOUT] = {"timeout_ms", CONF_MS, CONF_FIELD(struct can_map_frame, timeout_ms), 1, 60000, NULL,
+                            "%1$s = '%2$s': give 1..60000 milliseconds", false, NULL, NULL, "required",
+                            "no frame for longer than this: the PLC is silent (on_silence)"},
+    [CAN_MAP_IK_ON_SILENCE] = {"on_silence", CONF_FN, 0, 0, 0, 0, input_silence, NULL, false,
+                               "stop|hold|value V", "stop", NULL,
+                               "what the registers get while the PLC is silent: nothing (stop), the last values, V"},
+    [CAN_MAP_IK_COMMENT] = {"comment", CONF_FN, 0, 0, 0, 0, frame_comment, NULL, false, "TEXT", NULL, "none",
+                            "text for the DBC"},
+    [CAN_MAP_IK_SIGNAL] = {"signal", CONF_FN, 0, 0, 0, 0, frame_signal, NULL, true,
+                           "REGISTER @START|LENGTH ...", NULL, "at least one",
+                           "one input register (or bits of one); the key again for each signal"},
+};
+
 bool can_map_set(struct can_map *map, struct can_map_frame *frame, const struct conf_key *key, const char *value,
                  struct conf_at at, char *why, size_t n)
 {
-    const struct conf_key *table = frame != NULL ? can_map_frame_keys : can_map_can_keys;
+    const struct conf_key *table = frame == NULL ? can_map_can_keys
+                                   : frame->input ? can_map_input_keys
+                                                  : can_map_frame_keys;
     struct can_map_loc *loc = frame != NULL ? &frame->key_loc[key - table] : &map->key_loc[key - table];
     at.file = intern_file(map, at.file);
     if (!conf_key_set(key, frame != NULL ? (void *)frame : (void *)map, value, at, why, n)) {
@@ -1190,15 +1345,189 @@ static void check_frame(struct finish *fin, struct can_map_frame *f)
     }
 }
 
-static const char *id_owner(const struct can_map *map, size_t frame, char *buf, size_t size, int *line)
+/* ---- [input NAME]: frames the gateway receives ------------------------------------------ */
+
+static void add_notice(struct can_map *map, struct can_map_loc loc, const char *text);
+
+/* The bits of its register a signal writes: a mask's bits= run, else all. */
+static uint64_t signal_reg_bits(const urrt_can_signal *sig, const struct can_map_signal *meta)
 {
-    if (frame == map->frame_count) {
-        *line = map->key_loc[CAN_MAP_CK_HB_ID].line;
-        return "the heartbeat";
+    unsigned first = URRT_CAN_SIG_MASK_FIRST(sig->flags);
+    if (!meta->bitmask) {
+        return ~UINT64_C(0);
     }
-    *line = loc_or(map->frames[frame].key_loc[CAN_MAP_FK_ID], map->frames[frame].loc).line;
-    snprintf(buf, size, "[frame %s]", map->frames[frame].name);
-    return buf;
+    return (sig->length >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << sig->length) - 1) << first;
+}
+
+/* The frame's recipe: each register once, in the order of its first
+ * signal; a register that two signals write is refused unless both carry
+ * disjoint bits of one mask. */
+static void input_registers(struct finish *fin, struct can_map_frame *f, const char *what)
+{
+    f->reg_count = 0;
+    for (size_t i = 0; i < f->count; i++) {
+        const struct can_map_signal *m = &f->meta[i];
+        uint64_t bits = signal_reg_bits(&f->sigs[i], m);
+        bool seen = false;
+        if (m->bitmask && (bits >> 32) != 0) {
+            char name[URRT_RTDE_NAME_MAX];
+            (void)urrt_rtde_var_name(m->var, name, sizeof name);
+            problem(fin, m->loc, "%s signal '%s': %s has 32 bits (0..31): bits=%u-%u is past them", what, m->name,
+                    name, URRT_CAN_SIG_MASK_FIRST(f->sigs[i].flags),
+                    URRT_CAN_SIG_MASK_FIRST(f->sigs[i].flags) + f->sigs[i].length - 1u);
+        }
+        for (size_t k = 0; k < i && !seen; k++) {
+            if (f->meta[k].var != m->var) {
+                continue;
+            }
+            seen = true;
+            if (!m->bitmask || (signal_reg_bits(&f->sigs[k], &f->meta[k]) & bits) != 0) {
+                problem(fin, m->loc, "%s signal '%s' writes the register signal '%s' (line %d) writes: one register, "
+                        "one signal (bits of a mask: disjoint bits=)", what, m->name, f->meta[k].name,
+                        f->meta[k].loc.line);
+            }
+        }
+        if (!seen && f->reg_count == URRT_RTDE_IN_MAX_VARS) {
+            problem(fin, m->loc, "%s writes more than %d registers: one input recipe takes at most %d; split the "
+                    "frame", what, URRT_RTDE_IN_MAX_VARS, URRT_RTDE_IN_MAX_VARS);
+        } else if (!seen) {
+            f->regs[f->reg_count++] = (uint16_t)m->var;
+        }
+    }
+}
+
+/* on_silence = value V: a value every register of the frame takes (lib's
+ * own check, on a recipe of the frame's registers). */
+static void check_silence_value(struct finish *fin, const struct can_map_frame *f, const char *what)
+{
+    urrt_rtde_in in;
+    if (f->silence != CAN_MAP_SILENCE_VALUE || f->reg_count == 0 ||
+        urrt_rtde_in_init(&in, f->regs, f->reg_count) != URRT_OK) {
+        return;
+    }
+    for (size_t i = 0; i < f->reg_count; i++) {
+        if (urrt_rtde_in_set_double(&in, i, f->silence_value) != URRT_OK) {
+            char name[URRT_RTDE_NAME_MAX];
+            (void)urrt_rtde_var_name(f->regs[i], name, sizeof name);
+            problem(fin, loc_or(f->key_loc[CAN_MAP_IK_ON_SILENCE], f->loc),
+                    "%s on_silence = value %.17g: %s does not take it (an integer register an integer in its "
+                    "range, a bit 0 or 1, a mask word 0..4294967295)", what, f->silence_value, name);
+            return;
+        }
+    }
+}
+
+static void check_input(struct finish *fin, struct can_map_frame *f)
+{
+    char what[64];
+    snprintf(what, sizeof what, "[input %s]", f->name);
+    check_frame_id(fin, f, what);
+    check_frame_length(fin, f, what);
+    if (!resolve_robot(fin->map, f->robot, &f->robot_index)) {
+        robot_problem(fin->map, fin->err, fin->errlen, loc_or(f->key_loc[CAN_MAP_IK_ROBOT], f->loc), what, f->robot);
+        fin->errors++;
+        f->robot_index = 0;
+    }
+    if (f->key_loc[CAN_MAP_IK_TIMEOUT].line == 0) {
+        problem(fin, f->loc, "%s has no timeout_ms: after how long without the frame is the PLC silent? (the PLC's "
+                "period and some margin, e.g. timeout_ms = 100 for a 20 ms frame)", what);
+    }
+    if (f->count == 0) {
+        problem(fin, f->loc, "%s has no signal (signal = input_int_register_24 @0|32 intel signed, ...)", what);
+    }
+    if (urrt_can_length_valid(f->len, f->fd)) {
+        check_frame_layout(fin, f, what);
+    }
+    input_registers(fin, f, what);
+    check_silence_value(fin, f, what);
+}
+
+/* One register, one source: no two [input]s of a robot write it. */
+static void check_input_sources(struct finish *fin)
+{
+    const struct can_map *map = fin->map;
+    size_t per_robot[64] = {0};
+    for (size_t i = 0; i < map->input_count; i++) {
+        const struct can_map_frame *f = &map->inputs[i];
+        if (f->robot_index < sizeof per_robot / sizeof per_robot[0] &&
+            ++per_robot[f->robot_index] == URRT_RTDE_IN_MAX_RECIPES + 1) {
+            problem(fin, f->loc, "[input %s]: more than %d [input]s write robot %s's registers: a session takes "
+                    "%d input recipes; join frames", f->name, URRT_RTDE_IN_MAX_RECIPES,
+                    map->robots[f->robot_index].name, URRT_RTDE_IN_MAX_RECIPES);
+        }
+        for (size_t k = 0; k < f->count; k++) {
+            for (size_t j = 0; j < i; j++) {
+                const struct can_map_frame *g = &map->inputs[j];
+                for (size_t l = 0; g->robot_index == f->robot_index && l < g->count; l++) {
+                    if (g->meta[l].var == f->meta[k].var) {
+                        problem(fin, f->meta[k].loc, "[input %s] signal '%s': its register is written by [input %s] "
+                                "signal '%s' (line %d) already: one register, one source", f->name, f->meta[k].name,
+                                g->name, g->meta[l].name, g->meta[l].loc.line);
+                        j = i; /* once per signal */
+                        break;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/* Registers 0..23 (and bits 0..63) are an enabled fieldbus adapter's: say
+ * so where a user picked one. */
+static void notice_fieldbus_registers(struct can_map *map)
+{
+    for (size_t i = 0; i < map->input_count; i++) {
+        const struct can_map_frame *f = &map->inputs[i];
+        for (size_t k = 0; k < f->count; k++) {
+            int var = f->meta[k].var;
+            bool low = (var >= URRT_RTDE_V_INPUT_INT_REGISTER && var < URRT_RTDE_V_INPUT_INT_REGISTER + 24) ||
+                       (var >= URRT_RTDE_V_INPUT_DOUBLE_REGISTER && var < URRT_RTDE_V_INPUT_DOUBLE_REGISTER + 24) ||
+                       var == URRT_RTDE_V_INPUT_BIT_REGISTERS0_TO_31 || var == URRT_RTDE_V_INPUT_BIT_REGISTERS32_TO_63;
+            char text[400], name[URRT_RTDE_NAME_MAX];
+            bool again = false;
+            for (size_t j = 0; j < k; j++) {
+                again = again || f->meta[j].var == var;
+            }
+            if (!low || again) {
+                continue;
+            }
+            (void)urrt_rtde_var_name(var, name, sizeof name);
+            snprintf(text, sizeof text, "%s: registers 0..23 (bits 0..63) belong to a fieldbus adapter "
+                     "(EtherNet/IP, PROFINET, Modbus) while one is enabled, and the controller then answers IN_USE; "
+                     "24..47 (bits 64..127) are the RTDE clients'", name);
+            add_notice(map, f->meta[k].loc, text);
+        }
+    }
+}
+
+/* The frames with an id, for the duplicate check: the [frame]s, the
+ * heartbeat (number frame_count), then the [input]s. */
+static size_t id_count(const struct can_map *map)
+{
+    return map->frame_count + 1 + map->input_count;
+}
+
+static const struct can_map_frame *id_frame(const struct can_map *map, size_t k)
+{
+    return k < map->frame_count ? &map->frames[k] : k > map->frame_count ? &map->inputs[k - map->frame_count - 1] : NULL;
+}
+
+/* Frame k's id, the kind of it and where it was given (line 0: not given,
+ * reported as missing); its name for a message into buf. */
+static struct can_map_loc id_of(const struct can_map *map, size_t k, uint32_t *id, bool *extended, char *buf,
+                                size_t size)
+{
+    const struct can_map_frame *f = id_frame(map, k);
+    if (f == NULL) {
+        *id = map->hb_id;
+        *extended = map->hb_extended;
+        snprintf(buf, size, "the heartbeat");
+        return map->key_loc[CAN_MAP_CK_HB_ID];
+    }
+    *id = f->id;
+    *extended = f->extended;
+    snprintf(buf, size, "[%s %s]", frame_kind(f), f->name);
+    return f->key_loc[CAN_MAP_FK_ID];
 }
 
 /* [can]'s own keys, and the heartbeat's robot. */
@@ -1234,33 +1563,29 @@ static void check_can(struct finish *fin, struct can_map_loc can_loc)
         fin->errors++;
         map->hb_robot_index = 0;
     }
-    if (map->frame_count == 0) {
-        problem(fin, can_loc, "[can] without any [frame NAME] section: nothing to send");
+    if (map->frame_count == 0 && map->input_count == 0) {
+        problem(fin, can_loc, "[can] without any [frame NAME] or [input NAME] section: nothing to send or receive");
     }
 }
 
-/* Duplicate ids: the heartbeat counts as frame number frame_count. */
+/* Duplicate ids, the [input]s' among them: one id has one transmitter. */
 static void check_ids(struct finish *fin)
 {
     const struct can_map *map = fin->map;
-    for (size_t i = 0; i <= map->frame_count; i++) {
-        bool hb = i == map->frame_count;
-        uint32_t id_i = hb ? map->hb_id : map->frames[i].id;
-        bool ext_i = hb ? map->hb_extended : map->frames[i].extended;
-        if (hb ? map->key_loc[CAN_MAP_CK_HB_ID].line == 0 : map->frames[i].key_loc[CAN_MAP_FK_ID].line == 0) {
+    for (size_t i = 0; i < id_count(map); i++) {
+        char who_i[64], who_j[64];
+        uint32_t id_i, id_j;
+        bool ext_i, ext_j;
+        struct can_map_loc at = id_of(map, i, &id_i, &ext_i, who_i, sizeof who_i);
+        if (at.line == 0) {
             continue; /* reported as missing */
         }
         for (size_t j = 0; j < i; j++) {
-            if (map->frames[j].id == id_i && map->frames[j].extended == ext_i &&
-                map->frames[j].key_loc[CAN_MAP_FK_ID].line != 0) {
-                char bi[64], bj[64];
-                int li, lj;
-                const char *who_i = id_owner(map, i, bi, sizeof bi, &li);
-                const char *who_j = id_owner(map, j, bj, sizeof bj, &lj);
-                struct can_map_loc at = hb ? map->key_loc[CAN_MAP_CK_HB_ID]
-                                           : loc_or(map->frames[i].key_loc[CAN_MAP_FK_ID], map->frames[i].loc);
-                problem(fin, at, "%s id 0x%X is already used by %s (line %d)", who_i, (unsigned)id_i, who_j, lj);
-                (void)li;
+            struct can_map_loc other = id_of(map, j, &id_j, &ext_j, who_j, sizeof who_j);
+            if (other.line != 0 && id_j == id_i && ext_j == ext_i) {
+                bool received = id_frame(map, i) != NULL && id_frame(map, i)->input;
+                problem(fin, at, "%s id 0x%X is already used by %s (line %d)%s", who_i, (unsigned)id_i, who_j,
+                        other.line, received ? ": the PLC's frames need ids of their own" : "");
                 break;
             }
         }
@@ -1496,11 +1821,18 @@ int can_map_finish(struct can_map *map, const struct can_map_robot *robots, size
     if (!map->configured) {
         return 0;
     }
-    can_loc = map->can_loc.line ? map->can_loc : (map->frame_count ? map->frames[0].loc : map->can_loc);
+    can_loc = map->can_loc.line ? map->can_loc
+              : map->frame_count ? map->frames[0].loc
+              : map->input_count ? map->inputs[0].loc
+                                 : map->can_loc;
     check_can(&fin, can_loc);
     for (size_t i = 0; i < map->frame_count; i++) {
         check_frame(&fin, &map->frames[i]);
     }
+    for (size_t i = 0; i < map->input_count; i++) {
+        check_input(&fin, &map->inputs[i]);
+    }
+    check_input_sources(&fin);
     check_ids(&fin);
     check_load(&fin, can_loc);
     if (fin.errors > 0) {
@@ -1508,5 +1840,25 @@ int can_map_finish(struct can_map *map, const struct can_map_robot *robots, size
         return -1;
     }
     notice_dropped_bits(map);
+    notice_fieldbus_registers(map);
     return 0;
+}
+
+size_t can_map_input_ids(const struct can_map *map, uint32_t *ids, size_t max)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < map->input_count && n < max; i++) {
+        ids[n++] = map->inputs[i].id | (map->inputs[i].extended ? URRT_CANLINK_RX_EXTENDED : 0u);
+    }
+    return n;
+}
+
+const struct can_map_frame *can_map_input_of(const struct can_map *map, uint32_t id, bool extended)
+{
+    for (size_t i = 0; i < map->input_count; i++) {
+        if (map->inputs[i].id == id && map->inputs[i].extended == extended) {
+            return &map->inputs[i];
+        }
+    }
+    return NULL;
 }

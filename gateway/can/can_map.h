@@ -32,6 +32,7 @@
 #include "urrt.h"
 #include "urrt_can.h"
 #include "urrt_cantx.h"
+#include "urrt_rtde_in.h"
 
 #define CAN_MAP_NAME_MAX 32           /* DBC names: C identifiers of at most 32 characters */
 #define CAN_MAP_UNIT_MAX 24
@@ -74,6 +75,14 @@ enum can_map_stale_policy {
     CAN_MAP_STALE_INVALID    /* the frame goes on with the validity bit cleared */
 };
 
+/* What an [input NAME] frame's registers get when the PLC falls silent
+ * (the frame's timeout, the CAN interface down or bus-off). */
+enum can_map_silence {
+    CAN_MAP_SILENCE_STOP = 0, /* nothing more is sent: the robot program's own rtde_set_watchdog acts */
+    CAN_MAP_SILENCE_HOLD,     /* the last values go on being sent (the watchdog sees a living PLC) */
+    CAN_MAP_SILENCE_VALUE     /* silence_value goes to every register of the frame */
+};
+
 /* Keys of a [frame NAME] section, for duplicate detection and messages. */
 enum can_map_frame_key {
     CAN_MAP_FK_ID, CAN_MAP_FK_EXTENDED, CAN_MAP_FK_FD, CAN_MAP_FK_LENGTH, CAN_MAP_FK_PERIOD,
@@ -81,8 +90,19 @@ enum can_map_frame_key {
     CAN_MAP_FK_STALE_POLICY, CAN_MAP_FK_COMMENT, CAN_MAP_FK_SIGNAL, CAN_MAP_FK_COUNT
 };
 
+/* Keys of an [input NAME] section: a frame the gateway receives, whose
+ * signals write a robot's input registers over RTDE. Its places in key_loc
+ * are its own; the first four are the [frame] keys' (id, extended, fd,
+ * length), so that the checks of both read them alike. */
+enum can_map_input_key {
+    CAN_MAP_IK_ID = CAN_MAP_FK_ID, CAN_MAP_IK_EXTENDED = CAN_MAP_FK_EXTENDED, CAN_MAP_IK_FD = CAN_MAP_FK_FD,
+    CAN_MAP_IK_LENGTH = CAN_MAP_FK_LENGTH, CAN_MAP_IK_ROBOT, CAN_MAP_IK_TIMEOUT, CAN_MAP_IK_ON_SILENCE,
+    CAN_MAP_IK_COMMENT, CAN_MAP_IK_SIGNAL, CAN_MAP_IK_COUNT
+};
+
 struct can_map_frame {
     char name[CAN_MAP_NAME_MAX + 1];
+    bool input;                             /* an [input NAME]: received, its signals input registers */
     char comment[128];
     struct can_map_loc loc;                 /* the section's header */
     struct can_map_loc key_loc[CAN_MAP_FK_COUNT];
@@ -104,6 +124,14 @@ struct can_map_frame {
     size_t count;
     size_t capacity;
     double load;                            /* worst-case share of the bus (0.027 = 2.7 %) */
+    /* An [input]'s: */
+    uint32_t timeout_ms;                    /* silent longer than this: on_silence */
+    enum can_map_silence silence;
+    double silence_value;                   /* CAN_MAP_SILENCE_VALUE's */
+    /* Its input recipe, set by can_map_finish: the registers its signals
+     * write, each once, in the order of their first signal. */
+    uint16_t regs[URRT_RTDE_IN_MAX_VARS];
+    size_t reg_count;
 };
 
 /* Keys of the [can] section. */
@@ -111,7 +139,7 @@ enum can_map_can_key {
     CAN_MAP_CK_INTERFACE, CAN_MAP_CK_FD, CAN_MAP_CK_BITRATE, CAN_MAP_CK_DATA_BITRATE,
     CAN_MAP_CK_MAX_LOAD, CAN_MAP_CK_HB_ID, CAN_MAP_CK_HB_EXTENDED, CAN_MAP_CK_HB_PERIOD,
     CAN_MAP_CK_HB_ROBOT, CAN_MAP_CK_STALE_AFTER, CAN_MAP_CK_GENERATION, CAN_MAP_CK_NODE,
-    CAN_MAP_CK_RECEIVER, CAN_MAP_CK_COUNT
+    CAN_MAP_CK_RECEIVER, CAN_MAP_CK_INPUTS_MIN_RATE, CAN_MAP_CK_COUNT
 };
 
 /* A robot as the gateway knows it: name, and the period it sends packets at
@@ -146,9 +174,10 @@ struct can_map_robot_rt {
     uint32_t period_us;
 };
 
-/* The keys of [can] and of [frame NAME], in the order of their enums. */
+/* The keys of [can], [frame NAME] and [input NAME], in the order of their enums. */
 extern const struct conf_key can_map_can_keys[CAN_MAP_CK_COUNT];
 extern const struct conf_key can_map_frame_keys[CAN_MAP_FK_COUNT];
+extern const struct conf_key can_map_input_keys[CAN_MAP_IK_COUNT];
 
 /* Traffic the bus carries beside the map's frames and its heartbeat, which
  * another front end adds before can_map_finish (canopen_map: the CANopen
@@ -187,11 +216,16 @@ struct can_map {
     uint32_t stale_after_ms;                /* default for frames, and the heartbeat's "data stale" */
     urrt_generation generation;             /* numbering of robot mode value tables in the DBC */
     char node[CAN_MAP_NAME_MAX + 1];        /* DBC node of the gateway */
-    char receiver[CAN_MAP_NAME_MAX + 1];    /* DBC receiver of every signal */
+    char receiver[CAN_MAP_NAME_MAX + 1];    /* DBC receiver of every signal; the [input]s' transmitter */
+    double inputs_min_rate_hz;              /* fresh input registers are sent at least this often */
     /* [frame NAME] */
     struct can_map_frame *frames;
     size_t frame_count;
     size_t frame_capacity;
+    /* [input NAME] */
+    struct can_map_frame *inputs;
+    size_t input_count;
+    size_t input_capacity;
     /* Robots (copied by can_map_finish). */
     struct can_map_robot_rt *robots;
     size_t robot_count;
@@ -227,14 +261,19 @@ void can_map_set_reporter(struct can_map *map, can_map_report_fn fn, void *ctx);
 void can_map_can_begin(struct can_map *map, struct conf_at at);
 struct can_map_frame *can_map_frame_begin(struct can_map *map, const char *name, struct conf_at at, char *why,
                                           size_t n);
+struct can_map_frame *can_map_input_begin(struct can_map *map, const char *name, struct conf_at at, char *why,
+                                          size_t n);
 bool can_map_set(struct can_map *map, struct can_map_frame *frame, const struct conf_key *key, const char *value,
                  struct conf_at at, char *why, size_t n);
 
 /*
  * Checks that need the whole file and the gateway's robots: overlaps and
- * lengths, duplicate and out-of-range ids (heartbeat included), robot
- * names, periods faster than a robot sends, worst-case bus load. Resolves
- * robot names and computes loads. Returns 0, or -1 with every problem found
+ * lengths, duplicate and out-of-range ids (heartbeat and [input]s
+ * included), robot names, periods faster than a robot sends, worst-case bus
+ * load; an [input]'s timeout, its registers (each written by one signal of
+ * one frame, bit masks by disjoint bits=, at most URRT_RTDE_IN_MAX_VARS of
+ * them, on_silence's value one each register takes). Resolves robot names,
+ * computes loads and the [input]s' recipes (regs). Returns 0, or -1 with every problem found
  * in err as "FILE:LINE: reason" lines separated by '\n' (as many as fit).
  * A map with no CAN configuration at all finishes with 0 and stays
  * disabled (can_map_enabled() false).
@@ -255,6 +294,13 @@ bool can_map_enabled(const struct can_map *map);
  */
 size_t can_map_notice_count(const struct can_map *map);
 const char *can_map_notice(const struct can_map *map, size_t i);
+
+/* The ids the [input]s are received on, for the link's filter: a 29-bit
+ * one with URRT_CANLINK_RX_EXTENDED. At most max; returns how many. */
+size_t can_map_input_ids(const struct can_map *map, uint32_t *ids, size_t max);
+
+/* The [input] a received frame is (same id, same kind of id), or NULL. */
+const struct can_map_frame *can_map_input_of(const struct can_map *map, uint32_t id, bool extended);
 
 /* The CAN link's configuration from [can]: interface, fd, and fd_brs (FD
  * frames switch to data_bitrate when it is above bitrate). cfg must hold

@@ -21,6 +21,13 @@ struct rtde_source {
     void *event_ctx;
     rtde_source_tap_fn tap_fn;
     void *tap_ctx;
+    urrt_rtde_in *in;                     /* the input recipes (NULL: a reader) */
+    size_t in_count;
+    uint64_t in_sessions;                 /* sessions streaming with every input recipe accepted */
+    uint64_t in_busy;                     /* input packages the link's queue had no room for */
+    unsigned in_use_tries;                /* IN_USE refusals in a row (RTDE_SOURCE_IN_USE_RETRIES) */
+    int in_refusal;                       /* the last input setup refused: error, register */
+    int in_refusal_var;
     bool dropped;                         /* this connection was dropped: ignore its bytes */
     uint8_t first[4];                     /* the connection's first bytes: a RealTime length? */
     size_t first_len;
@@ -69,11 +76,28 @@ rtde_source *rtde_source_new(const rtde_source_config *cfg, char *why, size_t wh
                                                  : "; fix the configuration");
         return NULL;
     }
-    src = calloc(1, sizeof *src);
-    if (src == NULL) {
-        snprintf(why, why_size, "out of memory for an RTDE source");
+    if (cfg->input_count > URRT_RTDE_IN_MAX_RECIPES) {
+        snprintf(why, why_size, "%zu input recipes: a session takes at most %d; write fewer frames' registers",
+                 cfg->input_count, URRT_RTDE_IN_MAX_RECIPES);
         return NULL;
     }
+    src = calloc(1, sizeof *src);
+    if (src == NULL || (cfg->input_count > 0 && (src->in = calloc(cfg->input_count, sizeof *src->in)) == NULL)) {
+        snprintf(why, why_size, "out of memory for an RTDE source");
+        free(src);
+        return NULL;
+    }
+    for (size_t g = 0; g < cfg->input_count; g++) {
+        r = urrt_rtde_in_init(&src->in[g], cfg->inputs[g].vars, cfg->inputs[g].count);
+        if (r < 0) {
+            snprintf(why, why_size, "input recipe %zu is refused: %s; fix the configuration", g + 1,
+                     urrt_rtde_strerror(r));
+            rtde_source_free(src);
+            return NULL;
+        }
+    }
+    src->in_count = cfg->input_count;
+    src->in_refusal_var = -1;
     urrt_rtde_init(&src->session);
     snprintf(src->name, sizeof src->name, "%s", cfg->name != NULL ? cfg->name : "robot");
     memcpy(src->wanted, cfg->vars, cfg->count * sizeof cfg->vars[0]);
@@ -89,6 +113,9 @@ rtde_source *rtde_source_new(const rtde_source_config *cfg, char *why, size_t wh
 
 void rtde_source_free(rtde_source *src)
 {
+    if (src != NULL) {
+        free(src->in);
+    }
     free(src);
 }
 
@@ -97,7 +124,7 @@ static void flush(rtde_source *src)
 {
     uint8_t out[URRT_RTDE_REQUEST_MAX];
     int n;
-    while ((n = urrt_rtde_output(&src->session, out, sizeof out)) > 0) {
+    while ((n = urrt_rtde_in_output(&src->session, src->in, src->in_count, out, sizeof out)) > 0) {
         if (urrt_link_send(src->link, out, (size_t)n) != URRT_OK) {
             urrt_link_drop(src->link, URRT_LINK_DROP_PROTOCOL, "RTDE: the request queue is full");
             src->dropped = true;
@@ -133,6 +160,7 @@ static void on_connected(void *ctx, urrt_link *link, uint64_t now_us)
         drop(src, URRT_LINK_DROP_CONFIG, why);
         return;
     }
+    urrt_rtde_in_begin(src->in, src->in_count);
     flush(src);
 }
 
@@ -190,6 +218,15 @@ static void config_reason(const rtde_source *src, const urrt_rtde_event *ev, cha
         snprintf(why, size, "RTDE: rtde_frequency %g Hz is past this %" PRIu32 ".%" PRIu32 " controller's maximum "
                  "of %g Hz: lower it or use auto", src->session.frequency, src->session.controller[0],
                  src->session.controller[1], max);
+    } else if (ev->error == URRT_RTDE_E_IN_USE) {
+        append_name(names, sizeof names, &len, ev->var);
+        snprintf(why, size, "RTDE: controller version %s refuses to let this client write %s%s (IN_USE): another "
+                 "RTDE client, or an enabled fieldbus adapter (EtherNet/IP, PROFINET, Modbus: registers 0..23), "
+                 "holds it; write registers 24..47 (bits 64..127), or free it on the controller", version, names,
+                 ev->not_found > 1 ? " and more" : "");
+    } else if (ev->error == URRT_RTDE_E_INPUTS_PROTOCOL) {
+        snprintf(why, size, "RTDE: controller version %s speaks RTDE protocol 1 only, and urrt writes input "
+                 "registers with protocol 2: update the controller or remove the [input] frames", version);
     } else if (ev->error == URRT_RTDE_E_TYPE_MISMATCH) {
         append_name(names, sizeof names, &len, ev->var);
         snprintf(why, size, "RTDE: controller version %s sends %s in a type urrt does not know for it: "
@@ -232,6 +269,25 @@ static void log_text(const rtde_source *src, const urrt_rtde_event *ev)
              (int)ev->source_len, ev->source_len > 0 ? ev->source : "", (int)ev->text_len, ev->text);
 }
 
+/* A configuration error ends the session with the long backoff, but an
+ * input setup's IN_USE is first tried again with the usual one: right after
+ * a reconnect the controller may still hold this client's old connection. */
+static urrt_link_drop_kind config_drop_kind(rtde_source *src, const urrt_rtde_event *ev)
+{
+    if (ev->error == URRT_RTDE_E_IN_USE || ev->error == URRT_RTDE_E_NOT_FOUND) {
+        bool input = ev->error == URRT_RTDE_E_IN_USE || urrt_rtde_in_writable(ev->var);
+        if (input) {
+            src->in_refusal = ev->error;
+            src->in_refusal_var = ev->var;
+        }
+    }
+    if (ev->error == URRT_RTDE_E_IN_USE && src->in_use_tries < RTDE_SOURCE_IN_USE_RETRIES) {
+        src->in_use_tries++;
+        return URRT_LINK_DROP_PROTOCOL;
+    }
+    return URRT_LINK_DROP_CONFIG;
+}
+
 /* Acts on one event; false when the connection ended. */
 static bool on_event(rtde_source *src, const urrt_rtde_event *ev, uint64_t rx_us)
 {
@@ -252,7 +308,13 @@ static bool on_event(rtde_source *src, const urrt_rtde_event *ev, uint64_t rx_us
         break;
     case URRT_RTDE_EV_CONFIG:
         config_reason(src, ev, why, sizeof why);
-        drop(src, URRT_LINK_DROP_CONFIG, why);
+        drop(src, config_drop_kind(src, ev), why);
+        break;
+    case URRT_RTDE_EV_INPUTS:
+        src->in_use_tries = 0;
+        break;
+    case URRT_RTDE_EV_STARTED:
+        src->in_sessions += src->in_count > 0;
         break;
     default: break;
     }
@@ -275,7 +337,8 @@ static void on_received(void *ctx, urrt_link *link, const uint8_t *data, size_t 
     while (len > 0 && !src->dropped) {
         size_t used = 0;
         urrt_rtde_event ev;
-        int k = urrt_rtde_feed(&src->session, data, len, &used, &ev, &src->state, &src->values);
+        int k = urrt_rtde_in_feed(&src->session, src->in, src->in_count, data, len, &used, &ev, &src->state,
+                                  &src->values);
         /* Tapped as the session takes them, each piece before what it
          * leads to: a recorder that stops at a package (urrt-dump -n N -w)
          * holds exactly the bytes up to it. */
@@ -313,6 +376,53 @@ const urrt_rtde_values *rtde_source_values(const rtde_source *src)
 const urrt_rtde *rtde_source_session(const rtde_source *src)
 {
     return &src->session;
+}
+
+urrt_rtde_in *rtde_source_in(rtde_source *src, size_t g)
+{
+    return g < src->in_count ? &src->in[g] : NULL;
+}
+
+bool rtde_source_input_ready(const rtde_source *src, size_t g)
+{
+    return g < src->in_count && !src->dropped && urrt_rtde_in_ready(&src->session, &src->in[g]);
+}
+
+int rtde_source_send_input(rtde_source *src, size_t g)
+{
+    uint8_t out[URRT_RTDE_IN_PACKAGE_MAX];
+    int n;
+    if (!rtde_source_input_ready(src, g)) {
+        return 0;
+    }
+    n = urrt_rtde_in_package(&src->session, &src->in[g], out, sizeof out);
+    if (n <= 0) {
+        return 0; /* a register without a value: nothing is invented for it */
+    }
+    if (urrt_link_send(src->link, out, (size_t)n) != URRT_OK) {
+        src->in_busy++; /* the controller does not read: the next package carries the newest values */
+        return 0;
+    }
+    if (src->tap_fn != NULL) {
+        src->tap_fn(src->tap_ctx, RTDE_SOURCE_TAP_SENT, out, (size_t)n);
+    }
+    return 1;
+}
+
+uint64_t rtde_source_input_sessions(const rtde_source *src)
+{
+    return src->in_sessions;
+}
+
+uint64_t rtde_source_input_busy(const rtde_source *src)
+{
+    return src->in_busy;
+}
+
+int rtde_source_input_refusal(const rtde_source *src, int *var)
+{
+    *var = src->in_refusal_var;
+    return src->in_refusal;
 }
 
 size_t rtde_source_recipe_text(const rtde_source *src, char *out, size_t size)

@@ -46,8 +46,21 @@
 #include "port.h"
 #include "urrt.h"
 #include "urrt_rtde.h"
+#include "urrt_rtde_in.h"
 
 typedef struct rtde_source rtde_source;
+
+/* An input recipe (lib/urrt_rtde_in.h): registers written together, in
+ * the order their values are given. */
+typedef struct rtde_source_input {
+    const uint16_t *vars;    /* writable urrt_rtde_var ids (urrt_rtde_in_writable), distinct */
+    size_t count;            /* 1..URRT_RTDE_IN_MAX_VARS */
+} rtde_source_input;
+
+/* An IN_USE right after a reconnect is often the controller still holding
+ * this client's previous connection: the setup is tried again this many
+ * times with the link's usual backoff, then only every backoff_max_ms. */
+#define RTDE_SOURCE_IN_USE_RETRIES 3
 
 typedef struct rtde_source_config {
     const char *name;        /* robot name for log lines */
@@ -56,6 +69,12 @@ typedef struct rtde_source_config {
                                 NULL: every var required */
     size_t count;            /* 1..URRT_RTDE_MAX_VARS */
     double frequency;        /* Hz, 0 for the controller's rate (125 CB3, 500 e-Series) */
+    /* Input recipes (none for a reader: the session sends exactly V v O S).
+     * Each is set up after the output recipe and before start, at every
+     * connect; nothing is written for one until its caller gives values and
+     * sends it (rtde_source_send_input). Copied. */
+    const rtde_source_input *inputs;
+    size_t input_count;      /* 0..URRT_RTDE_IN_MAX_RECIPES */
 } rtde_source_config;
 
 /* Checks the recipe (urrt_rtde_begin's rules: distinct known ids, the
@@ -81,6 +100,33 @@ const urrt_rtde_values *rtde_source_values(const rtde_source *src);
 /* The session, for its statistics, protocol, controller version
  * (controller[]) and urrt_rtde_up(). */
 const urrt_rtde *rtde_source_session(const rtde_source *src);
+
+/* Input recipe g (0 <= g < input_count), for its values
+ * (urrt_rtde_in_set_int, _set_double, _forget) and its counters. */
+urrt_rtde_in *rtde_source_in(rtde_source *src, size_t g);
+
+/* Input recipe g's package, with the values it holds, queued on the link:
+ * 1; 0 when it cannot go now (the session does not stream or the
+ * controller has not accepted the recipe in this session: urrt_rtde_in_ready;
+ * a register without a value; the link's queue full: counted in
+ * input_busy); never a drop. */
+int rtde_source_send_input(rtde_source *src, size_t g);
+
+/* Whether input recipe g can be sent now (urrt_rtde_in_ready). */
+bool rtde_source_input_ready(const rtde_source *src, size_t g);
+
+/* Sessions that started streaming with every input recipe accepted: a
+ * caller that sees it change sends its current values at once (a robot
+ * link that dropped and came back). */
+uint64_t rtde_source_input_sessions(const rtde_source *src);
+
+/* Input packages the link's queue had no room for. */
+uint64_t rtde_source_input_busy(const rtde_source *src);
+
+/* The last refusal of an input recipe's setup (URRT_RTDE_E_IN_USE or
+ * URRT_RTDE_E_NOT_FOUND; 0: none since start) and the register it named
+ * (-1: none). */
+int rtde_source_input_refusal(const rtde_source *src, int *var);
 
 /* The recipe of the current (or last) session as a comma-separated name
  * list into out (NUL-terminated, truncated to size); returns its length. */

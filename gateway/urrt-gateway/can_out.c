@@ -5,6 +5,7 @@
 #include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 struct can_out {
     gateway *gw;
@@ -17,16 +18,28 @@ struct can_out {
     gw_watch watch;         /* the link's socket, in the loop's wait */
     uint64_t refused;       /* frames the link refused (cannot happen with a checked map) */
     uint64_t emcys;         /* EMCY frames the node sent (metrics.h) */
+    can_out_receiver receiver; /* the [input]s' (frame NULL: none); ids owned */
     bool robot_up[GW_MAX_ROBOTS];
 };
+
+/* The link's filter: the node's ids, then the receiver's. */
+static int set_rx_ids(can_out *out)
+{
+    uint32_t ids[URRT_CANLINK_RX_IDS_MAX];
+    size_t n = out->node != NULL ? urrt_co_rx_ids(out->node, ids) : 0;
+    for (size_t i = 0; i < out->receiver.id_count && n < URRT_CANLINK_RX_IDS_MAX; i++) {
+        ids[n++] = out->receiver.ids[i];
+    }
+    return urrt_canlink_set_rx_ids(out->link, ids, n);
+}
 
 /* The link's filter follows the node's ids: a manager moved the SYNC
  * (0x1005), or a reset moved it back. */
 static void follow_rx_ids(can_out *out)
 {
     uint32_t ids[URRT_CO_RX_IDS_MAX];
-    size_t n = urrt_co_rx_ids(out->node, ids);
-    if (urrt_canlink_set_rx_ids(out->link, ids, n) == 0) {
+    (void)urrt_co_rx_ids(out->node, ids);
+    if (set_rx_ids(out) == 0) {
         out->rx_seen = out->node->rx_changes;
         urrt_log(URRT_LOG_NOTICE, "CANopen: SYNC now on 0x%03X (0x1005); the CAN link receives 0x%03X 0x%03X 0x%03X",
                  (unsigned)ids[1], (unsigned)ids[0], (unsigned)ids[1], (unsigned)ids[2]);
@@ -85,6 +98,9 @@ static void on_frame(void *ctx, const urrt_can_frame *frame, uint64_t rx_us)
 {
     can_out *out = ctx;
     unsigned flags = frame->extended ? URRT_CO_RX_EXTENDED : 0u;
+    if ((out->receiver.frame != NULL && out->receiver.frame(out->receiver.ctx, frame, rx_us)) || out->node == NULL) {
+        return;
+    }
     out->node_us = rx_us > out->node_us ? rx_us : out->node_us;
     urrt_co_on_frame(out->node, frame->id, flags, frame->data, frame->len, out->node_us, emit, out);
 }
@@ -123,6 +139,10 @@ static void on_tick(void *ctx, uint64_t now_us)
         }
     }
     urrt_canlink_service(out->link, now_us);
+    if (out->receiver.link != NULL) {
+        out->receiver.link(out->receiver.ctx, urrt_canlink_get_state(out->link) == URRT_CANLINK_UP,
+                           urrt_canlink_get_stats(out->link)->bus_off, now_us);
+    }
     run_due(out, now_us);
     keep_watch(out);
 }
@@ -156,10 +176,11 @@ static unsigned on_counters(void *ctx, const gw_robot *robot, gw_counter *counte
         {"can_bus_off", s->bus_off},
         {"can_restarts", s->restarts},
         {"can_clamped", can_run_clamped(out->run)},
-        {"can_received", s->received},          /* a CANopen node's only: it receives */
+        {"can_received", s->received},          /* where the link receives: a node, [input]s */
         {"can_rx_overflows", s->rx_overflows},
     };
-    unsigned count = sizeof all / sizeof all[0] - (out->node != NULL ? 0u : 2u);
+    bool receives = out->node != NULL || out->receiver.frame != NULL;
+    unsigned count = sizeof all / sizeof all[0] - (receives ? 0u : 2u);
     unsigned n = 0;
     (void)robot;
     for (; n < max && n < count; n++) {
@@ -184,7 +205,23 @@ static void on_close(void *ctx)
 {
     can_out *out = ctx;
     urrt_canlink_free(out->link);
+    free((void *)out->receiver.ids);
     free(out);
+}
+
+bool can_out_set_receiver(can_out *out, const can_out_receiver *receiver)
+{
+    uint32_t *ids = malloc((receiver->id_count ? receiver->id_count : 1) * sizeof *ids);
+    if (ids == NULL) {
+        urrt_log(URRT_LOG_ERR, "CAN output: out of memory for the receive ids");
+        return false;
+    }
+    memcpy(ids, receiver->ids, receiver->id_count * sizeof *ids);
+    free((void *)out->receiver.ids);
+    out->receiver = *receiver;
+    out->receiver.ids = ids;
+    urrt_canlink_set_rx(out->link, on_frame, out);
+    return set_rx_ids(out) == 0;
 }
 
 can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run, struct co_run *node)

@@ -25,6 +25,20 @@ can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run
 gw_output can_out_output(can_out *out);
 
 /* What the metrics (metrics.h) and systemd's status (notify.h) say of it. */
+/* Who else receives on the link (the PLC's [input] frames, plc_in.h): its
+ * ids join the link's filter beside a CANopen node's, each frame received
+ * goes to frame() first (true: taken; false: the node's, if any), and
+ * link() hears the link's state at every tick of the output. */
+typedef struct can_out_receiver {
+    bool (*frame)(void *ctx, const urrt_can_frame *frame, uint64_t rx_us);
+    void (*link)(void *ctx, bool up, uint64_t bus_off, uint64_t now_us);
+    void *ctx;
+    const uint32_t *ids;     /* as urrt_canlink_config.rx_ids; copied */
+    size_t id_count;
+} can_out_receiver;
+/* False (logged) when the link cannot take the ids. */
+bool can_out_set_receiver(can_out *out, const can_out_receiver *receiver);
+
 typedef struct can_out_info {
     const urrt_canlink_stats *link;
     bool up;                 /* the interface is open and up */

@@ -780,6 +780,16 @@ static bool frame_begin(config_ctx *ctx, gw_config *cfg, const char *name)
     return ctx->frame != NULL;
 }
 
+static bool input_begin(config_ctx *ctx, gw_config *cfg, const char *name)
+{
+    char why[CONF_WHY_MAX];
+    ctx->frame = can_map_input_begin(&cfg->can, name, (struct conf_at){ctx->path, ctx->line}, why, sizeof why);
+    if (ctx->frame == NULL) {
+        config_error(ctx, ctx->line, "%s", why);
+    }
+    return ctx->frame != NULL;
+}
+
 static bool can_set(config_ctx *ctx, gw_config *cfg, const struct conf_key *key, const char *value, char *why,
                     size_t n)
 {
@@ -879,6 +889,25 @@ static void recipe_add_can(config_ctx *ctx, gw_config *cfg, gw_robot_config *rob
     }
 }
 
+/* The registers robot index's [input]s write are read back: in its output
+ * recipe and on NAME.RTDE, so that what the controller holds is seen (an
+ * input register is an RTDE output too). */
+static void add_read_back(gw_config *cfg, gw_robot_config *robot, unsigned index)
+{
+    for (size_t f = 0; cfg->can.finished && f < cfg->can.input_count; f++) {
+        const struct can_map_frame *in = &cfg->can.inputs[f];
+        for (size_t k = 0; in->robot_index == index && k < in->reg_count; k++) {
+            bool listed = false;
+            for (size_t i = 0; i < robot->rtde_value_count && !listed; i++) {
+                listed = robot->rtde_values[i] == in->regs[k];
+            }
+            if (!listed && robot->rtde_value_count < URRT_RTDE_MAX_VARS) {
+                robot->rtde_values[robot->rtde_value_count++] = in->regs[k];
+            }
+        }
+    }
+}
+
 /* The bytes of the recipe's name list on the wire (names and commas). */
 static size_t recipe_names_length(const gw_robot_config *robot)
 {
@@ -908,6 +937,7 @@ static void build_recipe(config_ctx *ctx, gw_config *cfg, gw_robot_config *robot
         recipe_add(robot, v, true);
     }
     recipe_add_can(ctx, cfg, robot, index);
+    add_read_back(cfg, robot, index);
     for (size_t i = 0; i < robot->rtde_value_count; i++) {
         recipe_add(robot, robot->rtde_values[i], false);
     }
@@ -938,6 +968,19 @@ static void refuse_rtde_signals(config_ctx *ctx, gw_config *cfg, const gw_robot_
     }
 }
 
+/* A realtime robot's [input]s: RealTime cannot write. */
+static void refuse_inputs(config_ctx *ctx, gw_config *cfg, const gw_robot_config *robot, unsigned index)
+{
+    for (size_t f = 0; cfg->can.finished && f < cfg->can.input_count; f++) {
+        const struct can_map_frame *in = &cfg->can.inputs[f];
+        if (in->robot_index == index) {
+            config_error(ctx, in->loc.line, "[input %s] writes robot \"%s\"'s input registers, and that robot reads "
+                         "RealTime, which never writes: add \"source = rtde\" to [robot %s] (RTDE, port 30004) or "
+                         "remove the [input]", in->name, robot->name, robot->name);
+        }
+    }
+}
+
 static void build_recipes(config_ctx *ctx, gw_config *cfg)
 {
     for (unsigned i = 0; i < cfg->robot_count; i++) {
@@ -945,6 +988,7 @@ static void build_recipes(config_ctx *ctx, gw_config *cfg)
             build_recipe(ctx, cfg, &cfg->robots[i], i);
         } else {
             refuse_rtde_signals(ctx, cfg, &cfg->robots[i], i);
+            refuse_inputs(ctx, cfg, &cfg->robots[i], i);
         }
     }
 }
@@ -980,6 +1024,8 @@ static const config_section config_sections[] = {
      "the CAN output (optional; docs/can.md)", NULL, 0},
     {"frame", true, true, frame_begin, can_map_frame_keys, CAN_MAP_FK_COUNT, NULL, can_set, NULL,
      "one per CAN frame; NAME is its DBC name", canopen_map_frame_keys, CANOPEN_FK_COUNT},
+    {"input", true, true, input_begin, can_map_input_keys, CAN_MAP_IK_COUNT, NULL, can_set, NULL,
+     "one per CAN frame the PLC sends; its signals write input registers (docs/can.md)", NULL, 0},
     {"canopen", false, false, canopen_begin, canopen_map_keys, CANOPEN_K_COUNT, NULL, canopen_set, NULL,
      "the CAN output as a CANopen node, its [frame]s TPDOs (optional; docs/canopen.md)", NULL, 0},
 };

@@ -3,6 +3,8 @@
 #define _GNU_SOURCE
 #include "gateway.h"
 
+#include "plc_in.h"
+
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
@@ -207,11 +209,15 @@ static void dispatch(gw_robot *robot, const uint8_t *bytes, size_t length, uint6
 static bool rtde_attach(gw_robot *robot)
 {
     char why[256];
+    rtde_source_input inputs[URRT_RTDE_IN_MAX_RECIPES];
     rtde_source_config rc = {.name = robot->cfg->name,
                              .vars = robot->cfg->recipe,
                              .optional = robot->cfg->recipe_optional,
                              .count = robot->cfg->recipe_count,
-                             .frequency = robot->cfg->rtde_frequency};
+                             .frequency = robot->cfg->rtde_frequency,
+                             .inputs = inputs};
+    /* The [input]s' registers, one input recipe per frame (plc_in.h). */
+    rc.input_count = plc_in_recipes(&robot->gw->cfg->can, robot->index, inputs, URRT_RTDE_IN_MAX_RECIPES);
     robot->rtde = rtde_source_new(&rc, why, sizeof why);
     if (robot->rtde == NULL) {
         urrt_log(URRT_LOG_ERR, "robot %s: %s", robot->cfg->name, why);

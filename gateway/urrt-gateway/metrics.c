@@ -20,12 +20,14 @@
 /* The text of one robot at most, and of everything else. */
 #define METRICS_ROBOT_BYTES 4096u
 #define METRICS_BASE_BYTES 16384u
+#define METRICS_INPUT_BYTES 1024u
 
 struct gw_metrics {
     gateway *gw;
     const gw_config *cfg;
     lcm_out *lcm;
     can_out *can;
+    plc_in *inputs;
     char *tmp_path;           /* PATH.tmp: same directory, so the rename is atomic */
     uint64_t interval_us;
     uint64_t next_us;
@@ -170,6 +172,53 @@ static void can(gw_metrics *m)
     put(m, "urrt_canopen_emcy_total %" PRIu64 "\n", ci.emcys);
 }
 
+/* One sample per [input] of one of its counters. */
+typedef uint64_t (*input_value_fn)(const plc_in_counts *c);
+static uint64_t in_frames(const plc_in_counts *c) { return c->frames; }
+static uint64_t in_bad(const plc_in_counts *c) { return c->bad_frames; }
+static uint64_t in_refused(const plc_in_counts *c) { return c->refused; }
+static uint64_t in_written(const plc_in_counts *c) { return c->written; }
+static uint64_t in_silences(const plc_in_counts *c) { return c->silences; }
+static uint64_t in_fresh(const plc_in_counts *c) { return c->fresh; }
+
+static void input_family(gw_metrics *m, const char *name, const char *type, const char *help, input_value_fn value)
+{
+    family(m, name, type, help);
+    for (size_t i = 0; i < plc_in_count(m->inputs); i++) {
+        const struct can_map_frame *f = plc_in_frame(m->inputs, i);
+        plc_in_counts c;
+        plc_in_get_counts(m->inputs, i, &c);
+        put(m, "%s{robot=\"%s\",input=\"%s\"} %" PRIu64 "\n", name, m->gw->robots[f->robot_index].cfg->name,
+            f->name, value(&c));
+    }
+}
+
+static void inputs(gw_metrics *m)
+{
+    input_family(m, "urrt_input_frames_total", "counter", "frames the PLC sent on the [input]'s id", in_frames);
+    input_family(m, "urrt_input_bad_frames_total", "counter", "of them, not of the configured length or kind: not "
+                 "used", in_bad);
+    input_family(m, "urrt_input_refused_total", "counter", "values refused: outside min..max, or not one the "
+                 "register takes", in_refused);
+    input_family(m, "urrt_input_written_total", "counter", "RTDE input packages written with the [input]'s "
+                 "registers", in_written);
+    input_family(m, "urrt_input_silences_total", "counter", "times the PLC fell silent (timeout, CAN down, "
+                 "bus-off)", in_silences);
+    input_family(m, "urrt_input_fresh", "gauge", "1 while the [input]'s data is fresh", in_fresh);
+    family(m, "urrt_input_register_refused", "gauge", "1 for the last input register the controller refused to "
+           "let this client write, and why (in_use, not_found)");
+    for (unsigned i = 0; i < m->gw->robot_count; i++) {
+        const gw_robot *r = &m->gw->robots[i];
+        char name[URRT_RTDE_NAME_MAX];
+        int var = -1;
+        int why = r->rtde != NULL ? rtde_source_input_refusal(r->rtde, &var) : 0;
+        if (why != 0 && urrt_rtde_var_name(var, name, sizeof name) > 0) {
+            put(m, "urrt_input_register_refused{robot=\"%s\",register=\"%s\",reason=\"%s\"} 1\n", r->cfg->name,
+                name, why == URRT_RTDE_E_IN_USE ? "in_use" : "not_found");
+        }
+    }
+}
+
 static bool write_all(int fd, const char *buf, size_t len)
 {
     while (len > 0) {
@@ -222,6 +271,9 @@ static void on_tick(void *ctx, uint64_t now_us)
     if (m->can != NULL) {
         can(m);
     }
+    if (m->inputs != NULL) {
+        inputs(m);
+    }
     family(m, "urrt_metrics_write_errors_total", "counter", "times this file could not be written");
     put(m, "urrt_metrics_write_errors_total %" PRIu64 "\n", m->write_errors);
     if (m->overflow) {
@@ -256,7 +308,8 @@ static void on_close(void *ctx)
     free(m);
 }
 
-gw_metrics *gw_metrics_new(gateway *gw, const gw_config *cfg, lcm_out *lcm_output, can_out *can_output)
+gw_metrics *gw_metrics_new(gateway *gw, const gw_config *cfg, lcm_out *lcm_output, can_out *can_output,
+                           plc_in *inputs_output)
 {
     gw_metrics *m = calloc(1, sizeof *m);
     if (m == NULL || asprintf(&m->tmp_path, "%s.tmp", cfg->metrics_file) < 0) {
@@ -264,7 +317,8 @@ gw_metrics *gw_metrics_new(gateway *gw, const gw_config *cfg, lcm_out *lcm_outpu
         free(m);
         return NULL;
     }
-    m->size = METRICS_BASE_BYTES + (size_t)gw->robot_count * METRICS_ROBOT_BYTES;
+    m->size = METRICS_BASE_BYTES + (size_t)gw->robot_count * METRICS_ROBOT_BYTES +
+              cfg->can.input_count * METRICS_INPUT_BYTES;
     if ((m->buf = malloc(m->size)) == NULL) {
         urrt_log(URRT_LOG_ERR, "metrics: out of memory");
         free(m->tmp_path);
@@ -275,6 +329,7 @@ gw_metrics *gw_metrics_new(gateway *gw, const gw_config *cfg, lcm_out *lcm_outpu
     m->cfg = cfg;
     m->lcm = lcm_output;
     m->can = can_output;
+    m->inputs = inputs_output;
     m->interval_us = (uint64_t)cfg->metrics_interval_ms * 1000u;
     m->next_us = urrt_port_monotonic_us(); /* the first file at once */
     return m;

@@ -24,6 +24,7 @@
 #include "lcm_out.h"
 #include "metrics.h"
 #include "notify.h"
+#include "plc_in.h"
 #include "port.h"
 #include "urrt.h"
 
@@ -123,6 +124,35 @@ static void print_recipe(const gw_robot_config *r)
     printf("\n");
 }
 
+/* "writes robot arm: input_int_register_24 <- [input plc_cmd] job (0x201), ..."
+ * : what an [input] writes, from where, its timeout, silence policy and rate. */
+static void describe_input(const struct can_map *map, const struct can_map_frame *f, char *buf, size_t size)
+{
+    static const char *const policy[] = {
+        [CAN_MAP_SILENCE_STOP] = "stop (nothing written: the program's rtde_set_watchdog acts)",
+        [CAN_MAP_SILENCE_HOLD] = "hold (the last values go on: the program's watchdog does not see the silence)",
+        [CAN_MAP_SILENCE_VALUE] = "value",
+    };
+    size_t used = 0;
+    int w = snprintf(buf, size, "input %s (0x%X%s): robot %s:", f->name, (unsigned)f->id, f->extended ? ", 29-bit" : "",
+                     map->robots[f->robot_index].name);
+    used += w > 0 ? (size_t)w : 0;
+    for (size_t i = 0; i < f->count && used < size; i++) {
+        char name[URRT_RTDE_NAME_MAX];
+        (void)urrt_rtde_var_name(f->meta[i].var, name, sizeof name);
+        w = snprintf(buf + used, size - used, "%s %s <- %s", i ? "," : "", name, f->meta[i].name);
+        used += w > 0 ? (size_t)w : 0;
+    }
+    if (used < size) {
+        w = snprintf(buf + used, size - used, "; every change and at least %g Hz while fresh; silent after %u ms: "
+                     "on_silence = %s", map->inputs_min_rate_hz, (unsigned)f->timeout_ms, policy[f->silence]);
+        used += w > 0 ? (size_t)w : 0;
+    }
+    if (used < size && f->silence == CAN_MAP_SILENCE_VALUE) {
+        snprintf(buf + used, size - used, " %.17g", f->silence_value);
+    }
+}
+
 static void print_plan(const gw_config *cfg, const char *url)
 {
     printf("%s: valid\n", cfg->path);
@@ -133,6 +163,11 @@ static void print_plan(const gw_config *cfg, const char *url)
         printf("can %s\n", line);
         for (size_t i = 0; i < can_map_notice_count(&cfg->can); i++) {
             printf("notice: %s\n", can_map_notice(&cfg->can, i));
+        }
+        for (size_t i = 0; i < cfg->can.input_count; i++) {
+            char text[600];
+            describe_input(&cfg->can, &cfg->can.inputs[i], text, sizeof text);
+            printf("%s\n", text);
         }
     }
     if (cfg->co_run != NULL) {
@@ -345,14 +380,45 @@ static int load_config(gw_config *cfg, const options *o)
     return -1;
 }
 
+/* The PLC's [input] frames: received by the CAN output's link, written to
+ * the robots' input registers. NULL (logged) when it cannot start. */
+static plc_in *add_inputs(gateway *gw, const gw_config *cfg, can_out *can)
+{
+    uint32_t ids[URRT_CANLINK_RX_IDS_MAX];
+    plc_in *in = plc_in_new(gw, &cfg->can);
+    gw_output output;
+    can_out_receiver receiver = {.frame = plc_in_on_frame, .link = plc_in_link, .ctx = in, .ids = ids};
+    if (in == NULL) {
+        return NULL;
+    }
+    output = plc_in_output(in);
+    if (!gw_add_output(gw, &output)) { /* then closed, and freed, with the gateway */
+        output.close(in);
+        return NULL;
+    }
+    receiver.id_count = can_map_input_ids(&cfg->can, ids, URRT_CANLINK_RX_IDS_MAX);
+    if (!can_out_set_receiver(can, &receiver)) {
+        urrt_log(URRT_LOG_ERR, "the CAN link cannot receive the [input] frames' ids (see above); fix them in %s",
+                 cfg->path);
+        return NULL;
+    }
+    for (size_t i = 0; i < cfg->can.input_count; i++) {
+        char line[600];
+        describe_input(&cfg->can, &cfg->can.inputs[i], line, sizeof line);
+        urrt_log(URRT_LOG_NOTICE, "%s", line);
+    }
+    return in;
+}
+
 /* The metrics file's writer ([gateway] metrics_file) and systemd's watchdog
  * and status (when started by it), after the outputs they report on. False
  * (logged) when out of memory. */
-static bool add_supervision(gateway *gw, const gw_config *cfg, lcm_out *lcm, can_out *can, gw_notify **notify)
+static bool add_supervision(gateway *gw, const gw_config *cfg, lcm_out *lcm, can_out *can, plc_in *inputs,
+                            gw_notify **notify)
 {
     gw_output output;
     if (cfg->metrics_file != NULL) {
-        gw_metrics *m = gw_metrics_new(gw, cfg, lcm, can);
+        gw_metrics *m = gw_metrics_new(gw, cfg, lcm, can, inputs);
         if (m == NULL) {
             return false;
         }
@@ -373,6 +439,7 @@ static int run(gw_config *cfg, const options *o)
     gateway gw;
     lcm_out *lcm;
     can_out *can = NULL;
+    plc_in *inputs = NULL;
     gw_notify *notify;
     gw_output output;
     cli_handle_signals(&running);
@@ -406,8 +473,12 @@ static int run(gw_config *cfg, const options *o)
             co_run_describe(cfg->co_run, line, sizeof line);
             urrt_log(URRT_LOG_NOTICE, "CANopen %s", line);
         }
+        if (cfg->can.input_count > 0 && (inputs = add_inputs(&gw, cfg, can)) == NULL) {
+            gw_close(&gw);
+            return CLI_EXIT_RUNTIME;
+        }
     }
-    if (!add_supervision(&gw, cfg, lcm, can, &notify)) {
+    if (!add_supervision(&gw, cfg, lcm, can, inputs, &notify)) {
         gw_close(&gw);
         return CLI_EXIT_RUNTIME;
     }

@@ -13,7 +13,7 @@ DEMO_LCM_URL ?= udpm://239.255.76.68:7668?ttl=0
 
 # ---- urrt-gateway ------------------------------------------------------------------
 GATEWAY_OBJS := $(addprefix $(BUILD)/gateway/urrt-gateway/,urrt-gateway.o gateway.o freshness.o config.o lcm_out.o \
-                  can_out.o notify.o metrics.o)
+                  can_out.o plc_in.o notify.o metrics.o)
 # Other folders append their objects (the CAN side); read at link time.
 GATEWAY_EXTRA_OBJS ?=
 GATEWAY_LIBS := -llcm -lm

@@ -512,17 +512,19 @@ static int check_interface(urrt_canlink *can, int sock, bool at_creation, unsign
     return (ifr.ifr_flags & IFF_UP) ? 1 : 0;
 }
 
-/* What the socket receives: exactly the rx ids as 11-bit data frames (the
- * mask takes in the EFF and RTR flags, so a 29-bit frame or a remote
- * request with the same number does not pass; no ids: an empty list, no data
+/* What the socket receives: exactly the rx ids as data frames of their
+ * kind, 11-bit or 29-bit (the mask takes in the EFF and RTR flags, so a
+ * frame of the other kind or a remote request with the same number does
+ * not pass; no ids: an empty list, no data
  * frames at all), every error frame, the kernel's receive time and its
  * count of frames dropped on a full receive queue. NULL, or what failed. */
 static bool set_filter(const urrt_canlink *can, int sock)
 {
     struct can_filter filters[URRT_CANLINK_RX_IDS_MAX];
     for (size_t i = 0; i < can->rx_count; i++) {
-        filters[i].can_id = can->rx_ids[i];
-        filters[i].can_mask = CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG;
+        bool extended = (can->rx_ids[i] & URRT_CANLINK_RX_EXTENDED) != 0;
+        filters[i].can_id = extended ? (can->rx_ids[i] & CAN_EFF_MASK) | CAN_EFF_FLAG : can->rx_ids[i];
+        filters[i].can_mask = (extended ? CAN_EFF_MASK : CAN_SFF_MASK) | CAN_EFF_FLAG | CAN_RTR_FLAG;
     }
     return setsockopt(sock, SOL_CAN_RAW, CAN_RAW_FILTER, can->rx_count ? filters : NULL,
                       (socklen_t)(can->rx_count * sizeof(filters[0]))) == 0;
@@ -865,9 +867,11 @@ static bool copy_rx_ids(urrt_canlink *can, const char *name, const uint32_t *ids
         return false;
     }
     for (size_t i = 0; i < n; i++) {
-        if (ids[i] > CAN_SFF_MASK) {
-            urrt_log(URRT_LOG_ERR, "CAN link %s: receive id 0x%X is not an 11-bit standard id (0 to 0x7FF)",
-                     name, (unsigned)ids[i]);
+        bool extended = (ids[i] & URRT_CANLINK_RX_EXTENDED) != 0;
+        if ((ids[i] & ~URRT_CANLINK_RX_EXTENDED) > (extended ? CAN_EFF_MASK : CAN_SFF_MASK)) {
+            urrt_log(URRT_LOG_ERR, "CAN link %s: receive id 0x%X is not an %s id (0 to 0x%X)", name,
+                     (unsigned)(ids[i] & ~URRT_CANLINK_RX_EXTENDED), extended ? "29-bit extended" : "11-bit standard",
+                     extended ? (unsigned)CAN_EFF_MASK : (unsigned)CAN_SFF_MASK);
             return false;
         }
     }

@@ -1,0 +1,407 @@
+/* SPDX-License-Identifier: MIT */
+/* plc_in.c: see plc_in.h. */
+#include "plc_in.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "urrt_can.h"
+#include "urrt_rtde_in.h"
+
+/* A frame's log lines (refused values, wrong lengths) at most this often. */
+#define PLC_IN_LOG_US (10u * 1000000u)
+
+/* One [input]: its frame, its robot's session, and what the PLC last said. */
+struct plc_group {
+    const struct can_map_frame *f;
+    gw_robot *robot;
+    size_t recipe;            /* its input recipe's index in the robot's source */
+    uint64_t rx_us;           /* the last good frame's receipt */
+    uint64_t sent_us;         /* the last package sent */
+    uint64_t sessions;        /* rtde_source_input_sessions at that send */
+    uint64_t logged_us;       /* the last refused value or bad frame logged */
+    bool ever;                /* the PLC wrote since start: before, nothing is sent */
+    bool fresh;
+    bool changed;             /* a value changed since the last package */
+    plc_in_counts counts;
+};
+
+struct plc_in {
+    gateway *gw;
+    const struct can_map *map;
+    struct plc_group *groups;
+    size_t count;
+    uint64_t period_us;       /* 1 / inputs_min_rate */
+    uint64_t bus_off_seen;
+    bool link_up;
+    uint64_t due_us;          /* the earliest timeout or refresh */
+};
+
+size_t plc_in_recipes(const struct can_map *map, size_t robot, rtde_source_input *out, size_t max)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < map->input_count; i++) {
+        if (map->inputs[i].robot_index == robot && n < max) {
+            out[n].vars = map->inputs[i].regs;
+            out[n++].count = map->inputs[i].reg_count;
+        }
+    }
+    return n;
+}
+
+static urrt_rtde_in *recipe_of(const struct plc_group *g)
+{
+    return g->robot->rtde != NULL ? rtde_source_in(g->robot->rtde, g->recipe) : NULL;
+}
+
+static void names_of(const struct can_map_frame *f, char *out, size_t size)
+{
+    size_t used = 0;
+    out[0] = '\0';
+    for (size_t k = 0; k < f->reg_count && used < size; k++) {
+        char name[URRT_RTDE_NAME_MAX];
+        int w;
+        (void)urrt_rtde_var_name(f->regs[k], name, sizeof name);
+        w = snprintf(out + used, size - used, "%s%s", k ? ", " : "", name);
+        used += w > 0 ? (size_t)w : 0;
+    }
+}
+
+/* ---- sending ---------------------------------------------------------------------- */
+
+/* Whether the group's registers are written now: the PLC wrote them, and
+ * its data is fresh or its on_silence sends something. */
+static bool writing(const struct plc_group *g)
+{
+    return g->ever && (g->fresh || g->f->silence != CAN_MAP_SILENCE_STOP);
+}
+
+/* The package, if a value changed, the session is new, or the minimum rate
+ * asks for it. */
+static void send_due(plc_in *in, struct plc_group *g, uint64_t now_us)
+{
+    rtde_source *src = g->robot->rtde;
+    uint64_t sessions;
+    if (!writing(g) || src == NULL) {
+        return;
+    }
+    sessions = rtde_source_input_sessions(src);
+    if (!g->changed && sessions == g->sessions && now_us - g->sent_us < in->period_us) {
+        return;
+    }
+    if (rtde_source_send_input(src, g->recipe) == 1) {
+        g->counts.written++;
+        g->sent_us = now_us;
+        g->sessions = sessions;
+        g->changed = false;
+    }
+}
+
+static void plan(plc_in *in)
+{
+    uint64_t due = UINT64_MAX;
+    for (size_t i = 0; i < in->count; i++) {
+        const struct plc_group *g = &in->groups[i];
+        uint64_t timeout = g->rx_us + (uint64_t)g->f->timeout_ms * 1000u;
+        uint64_t refresh = g->sent_us + in->period_us;
+        if (g->fresh && timeout < due) {
+            due = timeout;
+        }
+        if (writing(g) && refresh < due) {
+            due = refresh;
+        }
+    }
+    in->due_us = due;
+}
+
+/* ---- silence ----------------------------------------------------------------------- */
+
+static void fall_silent(struct plc_group *g, const char *why)
+{
+    static const char *const does[] = {
+        [CAN_MAP_SILENCE_STOP] = "nothing more is written (on_silence = stop): the robot program's "
+                                 "rtde_set_watchdog acts",
+        [CAN_MAP_SILENCE_HOLD] = "their last values go on being written (on_silence = hold)",
+        [CAN_MAP_SILENCE_VALUE] = "the on_silence value goes to them",
+    };
+    urrt_rtde_in *recipe = recipe_of(g);
+    char names[512];
+    g->fresh = false;
+    g->counts.silences++;
+    names_of(g->f, names, sizeof names);
+    urrt_log(URRT_LOG_WARNING, "[input %s]: the PLC is silent (%s): %s: %s", g->f->name, why, names,
+             does[g->f->silence]);
+    if (recipe == NULL) {
+        return;
+    }
+    if (g->f->silence == CAN_MAP_SILENCE_STOP) {
+        urrt_rtde_in_forget(recipe);
+    } else if (g->f->silence == CAN_MAP_SILENCE_VALUE) {
+        for (size_t k = 0; k < g->f->reg_count; k++) {
+            (void)urrt_rtde_in_set_double(recipe, k, g->f->silence_value); /* checked by can_map_finish */
+        }
+        g->changed = true;
+    }
+}
+
+/* ---- receiving --------------------------------------------------------------------- */
+
+/* Register k of the frame from its signals: a mask's bits gathered from
+ * each signal's bits=, any other value through its one signal's scaling
+ * and checked against min..max. Handed to lib, which checks it against the
+ * register's type. False: refused (counted), the register without a value. */
+static bool take_register(struct plc_group *g, urrt_rtde_in *recipe, size_t k, const urrt_can_frame *frame)
+{
+    const struct can_map_frame *f = g->f;
+    uint64_t word = 0;
+    double value = 0;
+    bool mask = false;
+    for (size_t i = 0; i < f->count; i++) {
+        const urrt_can_signal *sig = &f->sigs[i];
+        uint64_t raw = 0;
+        if (f->meta[i].var != f->regs[k]) {
+            continue;
+        }
+        if (f->meta[i].bitmask) {
+            mask = true;
+            (void)urrt_can_get_raw(sig, frame->data, frame->len, &raw); /* the layout was checked */
+            word |= raw << URRT_CAN_SIG_MASK_FIRST(sig->flags);
+        } else if (urrt_can_unpack(sig, frame->data, frame->len, &value) < 0 || !(value >= sig->min) ||
+                   !(value <= sig->max)) {
+            /* lib keeps no value for a register whose value it refuses: NaN,
+             * which no register takes, leaves this one without a value too. */
+            (void)urrt_rtde_in_set_double(recipe, k, NAN);
+            return false;
+        }
+    }
+    return (mask ? urrt_rtde_in_set_int(recipe, k, (int64_t)word) : urrt_rtde_in_set_double(recipe, k, value)) ==
+           URRT_OK;
+}
+
+static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, ...)
+{
+    char text[400];
+    va_list ap;
+    if (g->logged_us != 0 && now_us - g->logged_us < PLC_IN_LOG_US) {
+        return;
+    }
+    g->logged_us = now_us;
+    va_start(ap, fmt);
+    vsnprintf(text, sizeof text, fmt, ap);
+    va_end(ap);
+    urrt_log(URRT_LOG_WARNING, "[input %s]: %s", g->f->name, text);
+}
+
+static void take_frame(plc_in *in, struct plc_group *g, const urrt_can_frame *frame, uint64_t rx_us)
+{
+    urrt_rtde_in *recipe = recipe_of(g);
+    uint64_t now = urrt_port_monotonic_us();
+    uint8_t before[URRT_RTDE_IN_DATA_MAX], given[sizeof recipe->given];
+    size_t refused = 0;
+    g->counts.frames++;
+    if (frame->len != g->f->len || frame->fd != g->f->fd) {
+        g->counts.bad_frames++;
+        log_limited(g, now, "a %s frame of %u bytes on 0x%X, configured %s of %u: not used (%" PRIu64 " so far)",
+                    frame->fd ? "CAN FD" : "classic", (unsigned)frame->len, (unsigned)frame->id,
+                    g->f->fd ? "CAN FD" : "classic", (unsigned)g->f->len, g->counts.bad_frames);
+        return;
+    }
+    if (recipe == NULL) {
+        return;
+    }
+    memcpy(before, recipe->data, recipe->data_size);
+    memcpy(given, recipe->given, sizeof given);
+    for (size_t k = 0; k < g->f->reg_count; k++) {
+        refused += !take_register(g, recipe, k, frame);
+    }
+    if (refused > 0) {
+        g->counts.refused += refused;
+        log_limited(g, now, "%zu value%s refused (outside min..max, or not one the register takes): nothing is "
+                    "written for %s until a good one comes (%" PRIu64 " refused so far)", refused,
+                    refused == 1 ? "" : "s", refused == 1 ? "it" : "them", g->counts.refused);
+    }
+    if (!g->fresh && g->ever) {
+        urrt_log(URRT_LOG_NOTICE, "[input %s]: the PLC writes again", g->f->name);
+    }
+    g->changed = g->changed || memcmp(before, recipe->data, recipe->data_size) != 0 ||
+                 memcmp(given, recipe->given, sizeof given) != 0 || !g->fresh;
+    g->ever = g->fresh = true;
+    g->rx_us = rx_us < now ? rx_us : now;
+    send_due(in, g, now);
+}
+
+bool plc_in_on_frame(void *ctx, const urrt_can_frame *frame, uint64_t rx_us)
+{
+    plc_in *in = ctx;
+    const struct can_map_frame *f = can_map_input_of(in->map, frame->id, frame->extended);
+    if (f == NULL) {
+        return false;
+    }
+    take_frame(in, &in->groups[f - in->map->inputs], frame, rx_us);
+    plan(in);
+    return true;
+}
+
+void plc_in_link(void *ctx, bool up, uint64_t bus_off, uint64_t now_us)
+{
+    plc_in *in = ctx;
+    const char *why = !up ? "the CAN interface is down" : bus_off != in->bus_off_seen ? "the CAN controller went bus-off" : NULL;
+    (void)now_us;
+    in->link_up = up;
+    in->bus_off_seen = bus_off;
+    for (size_t i = 0; why != NULL && i < in->count; i++) {
+        if (in->groups[i].fresh) {
+            fall_silent(&in->groups[i], why);
+        }
+    }
+    plan(in);
+}
+
+/* ---- the output -------------------------------------------------------------------- */
+
+static void on_tick(void *ctx, uint64_t now_us)
+{
+    plc_in *in = ctx;
+    for (size_t i = 0; i < in->count; i++) {
+        struct plc_group *g = &in->groups[i];
+        if (g->fresh && now_us - g->rx_us > (uint64_t)g->f->timeout_ms * 1000u) {
+            char why[64];
+            snprintf(why, sizeof why, "no frame for %u ms", (unsigned)g->f->timeout_ms);
+            fall_silent(g, why);
+        }
+        send_due(in, g, now_us);
+    }
+    plan(in);
+}
+
+/* Packets carry the robot's state; what the PLC wrote comes from the CAN link. */
+static void on_packet(void *ctx, gw_robot *robot, const gw_packet *pkt)
+{
+    (void)ctx, (void)robot, (void)pkt;
+}
+
+static uint64_t on_deadline(void *ctx)
+{
+    return ((plc_in *)ctx)->due_us;
+}
+
+static unsigned on_counters(void *ctx, const gw_robot *robot, gw_counter *out, unsigned max)
+{
+    plc_in *in = ctx;
+    uint64_t frames = 0, bad = 0, refused = 0, written = 0, silences = 0, in_use = 0, not_found = 0;
+    for (size_t i = 0; i < in->count; i++) {
+        const struct plc_group *g = &in->groups[i];
+        const urrt_rtde_in *recipe = recipe_of(g);
+        if (g->robot != robot) {
+            continue;
+        }
+        frames += g->counts.frames;
+        bad += g->counts.bad_frames;
+        refused += g->counts.refused;
+        written += g->counts.written;
+        silences += g->counts.silences;
+        in_use += recipe != NULL ? recipe->stats.in_use : 0;
+        not_found += recipe != NULL ? recipe->stats.not_found : 0;
+    }
+    const gw_counter all[] = {
+        {"inputs_frames", frames},     {"inputs_bad_frames", bad},  {"inputs_refused", refused},
+        {"inputs_written", written},   {"inputs_silences", silences},
+        {"inputs_busy", robot->rtde != NULL ? rtde_source_input_busy(robot->rtde) : 0},
+        {"inputs_in_use", in_use},     {"inputs_not_found", not_found},
+    };
+    unsigned n = 0;
+    for (; n < max && n < sizeof all / sizeof all[0]; n++) {
+        out[n] = all[n];
+    }
+    return n;
+}
+
+static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *buf, size_t size)
+{
+    plc_in *in = ctx;
+    unsigned fresh = 0, total = 0;
+    uint64_t written = 0, refused = 0;
+    (void)now_us;
+    for (size_t i = 0; i < in->count; i++) {
+        if (in->groups[i].robot == robot) {
+            total++;
+            fresh += in->groups[i].fresh;
+            written += in->groups[i].counts.written;
+            refused += in->groups[i].counts.refused;
+        }
+    }
+    return total == 0 ? 0
+                      : snprintf(buf, size, " | inputs %u/%u fresh, written %" PRIu64 ", refused %" PRIu64, fresh,
+                                 total, written, refused);
+}
+
+static void on_close(void *ctx)
+{
+    plc_in *in = ctx;
+    free(in->groups);
+    free(in);
+}
+
+plc_in *plc_in_new(gateway *gw, const struct can_map *map)
+{
+    plc_in *in = calloc(1, sizeof *in);
+    size_t per_robot[GW_MAX_ROBOTS] = {0};
+    if (in == NULL || (in->groups = calloc(map->input_count ? map->input_count : 1, sizeof *in->groups)) == NULL) {
+        urrt_log(URRT_LOG_ERR, "PLC inputs: out of memory");
+        free(in);
+        return NULL;
+    }
+    in->gw = gw;
+    in->map = map;
+    in->count = map->input_count;
+    in->period_us = (uint64_t)(1e6 / map->inputs_min_rate_hz);
+    in->link_up = true;
+    in->due_us = UINT64_MAX;
+    for (size_t i = 0; i < in->count; i++) {
+        struct plc_group *g = &in->groups[i];
+        size_t r = map->inputs[i].robot_index;
+        g->f = &map->inputs[i];
+        g->robot = &gw->robots[r];
+        g->recipe = per_robot[r]++;
+    }
+    return in;
+}
+
+gw_output plc_in_output(plc_in *in)
+{
+    gw_output o = {
+        .name = "inputs",
+        .ctx = in,
+        .packet = on_packet,
+        .tick = on_tick,
+        .deadline = on_deadline,
+        .counters = on_counters,
+        .summary = on_summary,
+        .close = on_close,
+    };
+    return o;
+}
+
+size_t plc_in_count(const plc_in *in)
+{
+    return in->count;
+}
+
+const struct can_map_frame *plc_in_frame(const plc_in *in, size_t i)
+{
+    return i < in->count ? in->groups[i].f : NULL;
+}
+
+void plc_in_get_counts(const plc_in *in, size_t i, plc_in_counts *out)
+{
+    memset(out, 0, sizeof *out);
+    if (i < in->count) {
+        *out = in->groups[i].counts;
+        out->fresh = in->groups[i].fresh;
+    }
+}

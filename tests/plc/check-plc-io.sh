@@ -1,0 +1,23 @@
+#!/bin/bash
+# SPDX-License-Identifier: MIT
+# make check-plc-io: stages Debian's Python with python3-can for the VM
+# (tests/canopen/stage-python.sh), boots the VM once (tests/vm/run.sh) with urrt-sim,
+# urrt-gateway, docs/examples/plc-io.ini and the PLC (plc_io.sh inside). Prints the
+# total "N passed, N failed" last.
+#   tests/plc/check-plc-io.sh BUILD
+set -u
+build=$1
+here=$(dirname "$0")
+. tests/lib.sh
+. tests/vm/counts.sh
+out=$build/vm/check-plc-io
+rm -rf "$out"
+if tests/canopen/stage-python.sh "$build/plc/py"; then
+  counted "the VM run (plc_io.sh)" tests/vm/run.sh --out "$out" --script "$here/plc_io.sh" --timeout 300 \
+    --vcan 'vcan0:16' --files "tests/lib.sh tests/vm/counts.sh $build/plc/py $build/bin/urrt-sim \
+      $build/bin/urrt-gateway docs/examples/plc-io.ini $here/plc_io.py tests/gateway/tools/rtde_peer.py \
+      $here/plc_io.sh"
+else
+  fail "could not stage Python for the VM (see above)"
+fi
+finish
