@@ -53,6 +53,14 @@ static void put_rtde_refusal(FILE *out, const struct can_map *map, const struct 
             }
         }
     }
+    for (size_t i = 0; i < map->input_count; i++) {
+        const struct can_map_frame *f = &map->inputs[i];
+        if (!is_rtde(robots, map, f->robot_index)) {
+            fprintf(out, "#error \"[input %s] (line %d) writes input registers over RTDE: its robot is read over "
+                         "RealTime, which never writes; give the robot source = rtde\"\n",
+                    f->name, f->loc.line);
+        }
+    }
 }
 
 static const char *const stale_names[] = {
@@ -128,6 +136,15 @@ static void put_frame_tables(FILE *out, const struct can_map_frame *f, const urr
     fprintf(out, "};\n\n");
 }
 
+/* A frame's flags (urrt_cantx_frame.flags) as urrt_cantx.h's macros. */
+static const char *flag_names(uint8_t flags)
+{
+    return flags == (URRT_CANTX_EXTENDED | URRT_CANTX_FD) ? "URRT_CANTX_EXTENDED | URRT_CANTX_FD"
+           : flags == URRT_CANTX_EXTENDED                 ? "URRT_CANTX_EXTENDED"
+           : flags == URRT_CANTX_FD                       ? "URRT_CANTX_FD"
+                                                          : "0";
+}
+
 /* fill: the frame has a fill function of put_rtde_fill's (frame_NAME_fill). */
 static void put_frame(FILE *out, const char *name, const urrt_cantx_frame *t, bool heartbeat, bool fill)
 {
@@ -140,11 +157,7 @@ static void put_frame(FILE *out, const char *name, const urrt_cantx_frame *t, bo
         fprintf(out, "frame_%s_signals, frame_%s_sources, %u", name, name, t->signal_count);
     }
     fprintf(out, ", %u, %s, 0x%" PRIX32 ", %" PRIu32 ", %" PRIu32 ", %s, %u, %s}, /* %s */\n", t->len,
-            t->flags == (URRT_CANTX_EXTENDED | URRT_CANTX_FD) ? "URRT_CANTX_EXTENDED | URRT_CANTX_FD"
-            : t->flags == URRT_CANTX_EXTENDED                 ? "URRT_CANTX_EXTENDED"
-            : t->flags == URRT_CANTX_FD                       ? "URRT_CANTX_FD"
-                                                              : "0",
-            t->id, t->period_us, t->stale_after_us, stale_names[t->stale], t->robot,
+            flag_names(t->flags), t->id, t->period_us, t->stale_after_us, stale_names[t->stale], t->robot,
             heartbeat ? "urrt_cantx_heartbeat_fill" : fill ? fill_name : "NULL", name);
 }
 
@@ -356,6 +369,107 @@ static void put_storage(FILE *out, const urrt_cantx_tables *t)
             values, values);
 }
 
+/* ---- [input]s: the frames the PLC sends, for a firmware that writes registers --------- */
+
+static const char *const silence_names[] = {
+    [CAN_MAP_SILENCE_STOP] = "URRT_GATEWAY_SILENCE_STOP",
+    [CAN_MAP_SILENCE_HOLD] = "URRT_GATEWAY_SILENCE_HOLD",
+    [CAN_MAP_SILENCE_VALUE] = "URRT_GATEWAY_SILENCE_VALUE",
+};
+
+/* The type of urrt_gateway_inputs: lib/ has none (a frame received and its
+ * registers are the gateway's notion, not lib's), so the file defines it,
+ * and a firmware that declares the table repeats it. */
+static void put_input_type(FILE *out)
+{
+    fputs("/*\n"
+          " * An [input NAME]: a frame the PLC sends, whose signals write input registers of\n"
+          " * robot `robot` over RTDE (lib/urrt_rtde_in.h: one urrt_rtde_in per [input],\n"
+          " * urrt_rtde_in_init(&in, regs, reg_count)). A frame of its id and kind of id\n"
+          " * (URRT_CANTX_EXTENDED) with another length, or another URRT_CANTX_FD, is not used.\n"
+          " * Register regs[k] from the signals i with vars[i] == regs[k]: a bit mask\n"
+          " * (URRT_CAN_SIG_MASK) bit for bit, urrt_can_get_raw's raw shifted up by\n"
+          " * URRT_CAN_SIG_MASK_FIRST and or-ed together, urrt_rtde_in_set_int; any other\n"
+          " * value by urrt_can_unpack (raw * factor + offset), refused outside min..max\n"
+          " * (never clamped), then urrt_rtde_in_set_double, which checks the register's type.\n"
+          " * No frame for timeout_ms: the PLC is silent, and its registers get `silence`.\n"
+          " */\n"
+          "enum urrt_gateway_silence {\n"
+          "    URRT_GATEWAY_SILENCE_STOP = 0, /* nothing more is sent (urrt_rtde_in_forget): the program's\n"
+          "                                      rtde_set_watchdog acts */\n"
+          "    URRT_GATEWAY_SILENCE_HOLD = 1, /* the last values go on being sent */\n"
+          "    URRT_GATEWAY_SILENCE_VALUE = 2 /* silence_value goes to every register of the frame */\n"
+          "};\n"
+          "typedef struct urrt_gateway_input {\n"
+          "    const urrt_can_signal *signals; /* place and scaling (urrt_can.h) */\n"
+          "    const uint16_t *vars;           /* per signal: the register it writes (urrt_rtde.h's id) */\n"
+          "    const uint16_t *regs;           /* the input recipe: each register once */\n"
+          "    uint16_t signal_count;\n"
+          "    uint16_t reg_count;\n"
+          "    uint8_t len;                    /* payload bytes */\n"
+          "    uint8_t flags;                  /* URRT_CANTX_EXTENDED, URRT_CANTX_FD */\n"
+          "    uint32_t id;\n"
+          "    uint32_t timeout_ms;            /* no frame for longer than this: the PLC is silent */\n"
+          "    uint8_t silence;                /* enum urrt_gateway_silence: on_silence */\n"
+          "    uint8_t robot;                  /* the robot whose registers it writes */\n"
+          "    double silence_value;           /* URRT_GATEWAY_SILENCE_VALUE's */\n"
+          "} urrt_gateway_input;\n\n",
+          out);
+}
+
+/* A register as lib/urrt_rtde.h's enum names it, and its RTDE name. */
+static void put_register(FILE *out, int var, const char *what)
+{
+    char name[URRT_RTDE_NAME_MAX];
+    (void)urrt_rtde_var_name(var, name, sizeof name);
+    fputs("    ", out);
+    put_var_id(out, var);
+    fprintf(out, ", /* %s%s */\n", name, what);
+}
+
+/* [input NAME]'s signals (the very descriptors the gateway unpacks with),
+ * the register of each, its recipe. */
+static void put_input_tables(FILE *out, const struct can_map_frame *f)
+{
+    fprintf(out, "/* [input %s] */\nstatic const urrt_can_signal input_%s_signals[%zu] = {\n", f->name, f->name,
+            f->count);
+    for (size_t k = 0; k < f->count; k++) {
+        put_signal(out, &f->sigs[k], f->meta[k].name);
+    }
+    fprintf(out, "};\nstatic const uint16_t input_%s_vars[%zu] = {\n", f->name, f->count);
+    for (size_t k = 0; k < f->count; k++) {
+        char what[CAN_MAP_NAME_MAX + 8];
+        snprintf(what, sizeof what, " <- %s", f->meta[k].name);
+        put_register(out, f->meta[k].var, what);
+    }
+    fprintf(out, "};\nstatic const uint16_t input_%s_regs[%zu] = {\n", f->name, f->reg_count);
+    for (size_t k = 0; k < f->reg_count; k++) {
+        put_register(out, f->regs[k], "");
+    }
+    fprintf(out, "};\n\n");
+}
+
+static void put_inputs(FILE *out, const struct can_map *map)
+{
+    fprintf(out, "\n/* The [input]s: what the PLC sends, and the registers it writes. */\n");
+    put_input_type(out);
+    for (size_t i = 0; i < map->input_count; i++) {
+        put_input_tables(out, &map->inputs[i]);
+    }
+    fprintf(out, "const urrt_gateway_input urrt_gateway_inputs[%zu] = {\n", map->input_count);
+    for (size_t i = 0; i < map->input_count; i++) {
+        const struct can_map_frame *f = &map->inputs[i];
+        uint8_t flags = (uint8_t)((f->extended ? URRT_CANTX_EXTENDED : 0u) | (f->fd ? URRT_CANTX_FD : 0u));
+        fprintf(out, "    {input_%s_signals, input_%s_vars, input_%s_regs, %zu, %zu, %u, %s, 0x%" PRIX32 ", %" PRIu32
+                     ", %s, %zu, ",
+                f->name, f->name, f->name, f->count, f->reg_count, (unsigned)f->len, flag_names(flags), f->id,
+                f->timeout_ms, silence_names[f->silence], f->robot_index);
+        put_double(out, f->silence == CAN_MAP_SILENCE_VALUE ? f->silence_value : 0.0);
+        fprintf(out, "}, /* %s */\n", f->name);
+    }
+    fprintf(out, "};\nconst size_t urrt_gateway_input_count = %zu;\n", map->input_count);
+}
+
 /* ---- the CANopen node: its urrt_co_desc, from co_run's ---------------------------- */
 
 static const char *const co_type_names[] = {
@@ -451,6 +565,16 @@ int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run,
 {
     const urrt_cantx_tables *t = can_run_tx(run)->tables;
     bool rtde = false;
+    char path[512];
+    size_t used = 0;
+    /* The path in a C comment: a "*" + "/" in it would end the comment. */
+    for (const char *p = source != NULL ? source : "?"; *p != '\0' && used + 3 < sizeof path; p++) {
+        path[used++] = *p;
+        if (p[0] == '*' && p[1] == '/') {
+            path[used++] = ' ';
+        }
+    }
+    path[used] = '\0';
     for (size_t i = 0; i < map->robot_count; i++) {
         rtde = rtde || is_rtde(robots, map, i);
     }
@@ -461,7 +585,7 @@ int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run,
                  " *     extern const urrt_cantx_tables urrt_gateway_tables;\n"
                  " *     int urrt_gateway_cantx_init(urrt_cantx *tx, size_t *bad_frame, size_t *bad_signal);\n"
                  " * (urrt_cantx_init and urrt_cantx_prepare over the storage below). Robots by index:",
-            URRT_VERSION_STRING, source);
+            URRT_VERSION_STRING, path);
     for (size_t i = 0; i < map->robot_count; i++) {
         fprintf(out, " %zu %s%s", i, map->robots[i].name, is_rtde(robots, map, i) ? " (RTDE)" : "");
     }
@@ -476,6 +600,15 @@ int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run,
                      " * *values must stay as they are until the next package's",
                 t->robot_count, t->robot_count, t->robot_count);
     }
+    if (map->input_count > 0) {
+        fprintf(out, ".\n * The [input]s, the frames the PLC sends, whose signals write robots' input\n"
+                     " * registers over RTDE (lib/urrt_rtde_in.h, which a firmware that writes links):\n"
+                     " *     extern const urrt_gateway_input urrt_gateway_inputs[%zu];\n"
+                     " *     extern const size_t urrt_gateway_input_count;\n"
+                     " * lib/ has no type for them: urrt_gateway_input's typedef is below, and a\n"
+                     " * firmware that declares the table repeats it",
+                map->input_count);
+    }
     if (node != NULL) {
         fprintf(out, ".\n * The CANopen node ([canopen]), over urrt_cantx_init's tx:\n"
                      " *     extern const urrt_co_desc urrt_gateway_node;\n"
@@ -484,7 +617,8 @@ int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run,
                 (int)CO_RUN_RX_IDS);
     }
     fprintf(out, ".\n */\n#include <stdbool.h>\n#include <stddef.h>\n#include <stdint.h>\n\n#include \"%s\"\n%s\n",
-            node != NULL ? "urrt_co.h" : "urrt_cantx.h", rtde ? "#include \"urrt_rtde.h\"\n" : "");
+            node != NULL ? "urrt_co.h" : "urrt_cantx.h",
+            rtde || map->input_count > 0 ? "#include \"urrt_rtde.h\"\n" : "");
     put_rtde_refusal(out, map, robots);
     if (rtde) {
         put_rtde_reading(out, map, robots, t->robot_count);
@@ -505,6 +639,9 @@ int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run,
     put_storage(out, t);
     if (rtde) {
         put_rtde_recipes(out, map, robots, t->robot_count);
+    }
+    if (map->input_count > 0) {
+        put_inputs(out, map);
     }
     if (node != NULL) {
         put_node(out, node);

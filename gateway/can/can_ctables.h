@@ -8,7 +8,11 @@
  * without a mapping written by hand; with [canopen], the CANopen node's
  * urrt_co_desc too; for a robot read over RTDE (source = rtde), the
  * recipe its firmware asks for and how its RTDE-only values reach the
- * frames.
+ * frames; with [input]s, the frames the PLC sends (urrt_gateway_inputs:
+ * id, kind, length, timeout_ms, on_silence and its value, the signals as
+ * urrt_can_signal tables, the register each writes as lib/urrt_rtde.h's
+ * URRT_RTDE_V_ id and the input recipe), in a type the file defines, since
+ * lib/ has none.
  * docs/firmware.md shows one in use.
  */
 #ifndef URRT_GATEWAY_CAN_CTABLES_H
@@ -35,7 +39,9 @@ struct can_ctables_robot {
  * (NULL: all by RealTime); for an RTDE robot the source also holds the
  * recipe a firmware asks for (the timestamp and what its CAN signals need)
  * and the fill functions that read its RTDE-only values as rtde_only.h
- * does. 0, or -1 when the stream failed. */
+ * does; an [input] of a robot that is not read over RTDE is an #error in
+ * the source. Without [input]s nothing of theirs is written, not even
+ * their type. 0, or -1 when the stream failed. */
 int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run, struct co_run *node,
                       const struct can_ctables_robot *robots, const char *source);
 

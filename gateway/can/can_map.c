@@ -13,6 +13,7 @@
 #include <strings.h>
 
 #include "rtde_only.h"
+#include "urrt_co.h"
 #include "urrt_rtde.h"
 
 /* ---- reporting ------------------------------------------------------------------- */
@@ -153,14 +154,19 @@ static void load_parts(const struct can_map *map, char *buf, size_t size)
 
 int can_map_describe(const struct can_map *map, char *buf, size_t size)
 {
-    char parts[256];
+    char parts[256], received[48] = "";
     if (!can_map_enabled(map)) {
         return snprintf(buf, size, "no CAN output configured");
     }
     load_parts(map, parts, sizeof parts);
-    return snprintf(buf, size, "%zu frame%s + %s 0x%X on %s, worst-case bus load %.1f%% of %u bit/s%s (max %u%%): %s",
-                    map->frame_count, map->frame_count == 1 ? "" : "s", map->hb_name, (unsigned)map->hb_id,
-                    map->interface ? map->interface : "?", map->load * 100.0, (unsigned)map->bitrate,
+    if (map->input_count > 0) {
+        /* The PLC's frames are its own bus load, not counted here. */
+        snprintf(received, sizeof received, " (and %zu [input]%s received)", map->input_count,
+                 map->input_count == 1 ? "" : "s");
+    }
+    return snprintf(buf, size, "%zu frame%s + %s 0x%X on %s%s, worst-case bus load %.1f%% of %u bit/s%s (max %u%%): "
+                    "%s", map->frame_count, map->frame_count == 1 ? "" : "s", map->hb_name, (unsigned)map->hb_id,
+                    map->interface ? map->interface : "?", received, map->load * 100.0, (unsigned)map->bitrate,
                     map->data_bitrate > map->bitrate ? " with an FD data phase" : "", map->max_load_percent, parts);
 }
 
@@ -366,6 +372,11 @@ static struct can_map_frame *new_frame(struct can_map *map, bool input, const ch
     }
     if (strcmp(name, CAN_MAP_HEARTBEAT_NAME) == 0) {
         conf_fail(why, n, "[%s %s]: that name is the heartbeat's", kind, CAN_MAP_HEARTBEAT_NAME);
+        return NULL;
+    }
+    if (f != NULL && f->input == input) {
+        conf_fail(why, n, "[%s %s] is already defined at line %d: frame names must be unique (the DBC names each "
+                  "message)", kind, name, f->loc.line);
         return NULL;
     }
     if (f != NULL) {
@@ -1372,9 +1383,9 @@ static void input_registers(struct finish *fin, struct can_map_frame *f, const c
         if (m->bitmask && (bits >> 32) != 0) {
             char name[URRT_RTDE_NAME_MAX];
             (void)urrt_rtde_var_name(m->var, name, sizeof name);
-            problem(fin, m->loc, "%s signal '%s': %s has 32 bits (0..31): bits=%u-%u is past them", what, m->name,
-                    name, URRT_CAN_SIG_MASK_FIRST(f->sigs[i].flags),
-                    URRT_CAN_SIG_MASK_FIRST(f->sigs[i].flags) + f->sigs[i].length - 1u);
+            problem(fin, m->loc, "%s signal '%s' carries bits %u-%u of %s, which has 32 (0..31): shorten it, or "
+                    "pick them with bits=", what, m->name, URRT_CAN_SIG_MASK_FIRST(f->sigs[i].flags),
+                    URRT_CAN_SIG_MASK_FIRST(f->sigs[i].flags) + f->sigs[i].length - 1u, name);
         }
         for (size_t k = 0; k < i && !seen; k++) {
             if (f->meta[k].var != m->var) {
@@ -1390,6 +1401,7 @@ static void input_registers(struct finish *fin, struct can_map_frame *f, const c
         if (!seen && f->reg_count == URRT_RTDE_IN_MAX_VARS) {
             problem(fin, m->loc, "%s writes more than %d registers: one input recipe takes at most %d; split the "
                     "frame", what, URRT_RTDE_IN_MAX_VARS, URRT_RTDE_IN_MAX_VARS);
+            return; /* once a frame */
         } else if (!seen) {
             f->regs[f->reg_count++] = (uint16_t)m->var;
         }
@@ -1412,6 +1424,15 @@ static void check_silence_value(struct finish *fin, const struct can_map_frame *
             problem(fin, loc_or(f->key_loc[CAN_MAP_IK_ON_SILENCE], f->loc),
                     "%s on_silence = value %.17g: %s does not take it (an integer register an integer in its "
                     "range, a bit 0 or 1, a mask word 0..4294967295)", what, f->silence_value, name);
+            return;
+        }
+    }
+    for (size_t k = 0; k < f->count; k++) {
+        const urrt_can_signal *sig = &f->sigs[k];
+        if (!f->meta[k].bitmask && !(f->silence_value >= sig->min && f->silence_value <= sig->max)) {
+            problem(fin, loc_or(f->key_loc[CAN_MAP_IK_ON_SILENCE], f->loc),
+                    "%s on_silence = value %.17g is outside signal '%s''s min..max (%.17g..%.17g): a value the PLC "
+                    "could never send", what, f->silence_value, f->meta[k].name, sig->min, sig->max);
             return;
         }
     }
@@ -1442,11 +1463,18 @@ static void check_input(struct finish *fin, struct can_map_frame *f)
     check_silence_value(fin, f, what);
 }
 
-/* One register, one source: no two [input]s of a robot write it. */
+/* One register, one source: no two [input]s of a robot write it. And the
+ * kernel's receive filter holds every [input]'s id beside a CANopen node's. */
 static void check_input_sources(struct finish *fin)
 {
     const struct can_map *map = fin->map;
     size_t per_robot[64] = {0};
+    if (map->input_count > URRT_CANLINK_RX_IDS_MAX - URRT_CO_RX_IDS_MAX) {
+        problem(fin, map->inputs[URRT_CANLINK_RX_IDS_MAX - URRT_CO_RX_IDS_MAX].loc, "[input %s]: more than %d "
+                "[input]s: the CAN socket's receive filter takes %d ids, %d of them kept for a CANopen node's",
+                map->inputs[URRT_CANLINK_RX_IDS_MAX - URRT_CO_RX_IDS_MAX].name,
+                URRT_CANLINK_RX_IDS_MAX - URRT_CO_RX_IDS_MAX, URRT_CANLINK_RX_IDS_MAX, URRT_CO_RX_IDS_MAX);
+    }
     for (size_t i = 0; i < map->input_count; i++) {
         const struct can_map_frame *f = &map->inputs[i];
         if (f->robot_index < sizeof per_robot / sizeof per_robot[0] &&

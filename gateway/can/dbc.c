@@ -212,6 +212,9 @@ static bool any_fd(const struct can_map *map)
     for (size_t i = 0; i < map->frame_count; i++) {
         fd |= map->frames[i].fd;
     }
+    for (size_t i = 0; i < map->input_count; i++) {
+        fd |= map->inputs[i].fd;
+    }
     return fd;
 }
 
@@ -235,23 +238,34 @@ static void put_header(FILE *out, const struct can_map *map)
     }
 }
 
-/* Frames, then the heartbeat. */
+/* A frame and its signals: sent by transmitter, each signal received by receiver. */
+static void put_message(FILE *out, const struct can_map_frame *f, const char *transmitter, const char *receiver)
+{
+    fprintf(out, "BO_ %lu %s: %u %s\n", dbc_id(f->id, f->extended), f->name, (unsigned)f->len, transmitter);
+    for (size_t k = 0; k < f->count; k++) {
+        put_signal(out, f->meta[k].name, &f->sigs[k], f->meta[k].unit, receiver);
+    }
+    fprintf(out, "\n");
+}
+
+/* What the gateway sends (the frames, then the heartbeat), then what it
+ * receives: each [input], sent by the PLC ([can] receiver: its node, or
+ * Vector__XXX, "no node"), its signals received by the gateway's node. */
 static void put_frames(FILE *out, const struct can_map *map, unsigned long hb)
 {
     for (size_t i = 0; i < map->frame_count; i++) {
-        const struct can_map_frame *f = &map->frames[i];
-        fprintf(out, "BO_ %lu %s: %u %s\n", dbc_id(f->id, f->extended), f->name, (unsigned)f->len, map->node);
-        for (size_t k = 0; k < f->count; k++) {
-            put_signal(out, f->meta[k].name, &f->sigs[k], f->meta[k].unit, map->receiver);
-        }
-        fprintf(out, "\n");
+        put_message(out, &map->frames[i], map->node, map->receiver);
     }
     fprintf(out, "BO_ %lu %s: %u %s\n", hb, CAN_MAP_HEARTBEAT_NAME, URRT_CANTX_HB_LEN, map->node);
     for (size_t k = 0; k < URRT_CANTX_HB_COUNT; k++) {
         const struct can_map_hb_signal *h = &can_map_heartbeat_layout[k];
         put_signal(out, h->name, &urrt_cantx_heartbeat_signals[k], h->unit, map->receiver);
     }
-    fprintf(out, "\n\n");
+    fprintf(out, "\n");
+    for (size_t i = 0; i < map->input_count; i++) {
+        put_message(out, &map->inputs[i], map->receiver, map->node);
+    }
+    fprintf(out, "\n");
 }
 
 static void put_frame_comment(FILE *out, const struct can_map *map, const struct can_map_frame *f)
@@ -293,6 +307,62 @@ static void put_frame_comment(FILE *out, const struct can_map *map, const struct
     }
 }
 
+/* An [input]'s on_silence, as the configuration writes it. */
+static void put_silence(FILE *out, const struct can_map_frame *f, bool why)
+{
+    char value[40];
+    switch (f->silence) {
+    case CAN_MAP_SILENCE_HOLD:
+        fprintf(out, "on_silence = hold%s", why ? " (the last values go on being written)" : "");
+        break;
+    case CAN_MAP_SILENCE_VALUE:
+        fprintf(out, "on_silence = value %s%s", dbc_number(f->silence_value, value, sizeof value),
+                why ? " (written to every register of the frame)" : "");
+        break;
+    default:
+        fprintf(out, "on_silence = stop%s",
+                why ? " (nothing more is written: the robot program's rtde_set_watchdog acts)" : "");
+        break;
+    }
+}
+
+/* An [input]'s comments: the frame (its comment=, who sends it, the robot
+ * it writes, its timeout and silence policy), and each signal's register. */
+static void put_input_comment(FILE *out, const struct can_map *map, const struct can_map_frame *f)
+{
+    unsigned long id = dbc_id(f->id, f->extended);
+    const char *robot = f->robot_index < map->robot_count ? map->robots[f->robot_index].name : f->robot;
+    fprintf(out, "CM_ BO_ %lu \"", id);
+    if (f->comment[0] != '\0') {
+        put_text(out, f->comment);
+        fprintf(out, ". ");
+    }
+    fprintf(out, "Sent by %s, received by %s, which writes robot ",
+            strcmp(map->receiver, "Vector__XXX") != 0 ? map->receiver : "the PLC", map->node);
+    put_text(out, robot);
+    fprintf(out, "'s input registers over RTDE from it; no frame for %u ms is a silent PLC: ", (unsigned)f->timeout_ms);
+    put_silence(out, f, true);
+    fprintf(out, ".\";\n");
+    for (size_t k = 0; k < f->count; k++) {
+        const struct can_map_signal *m = &f->meta[k];
+        char name[URRT_RTDE_NAME_MAX];
+        (void)urrt_rtde_var_name(m->var, name, sizeof name);
+        fprintf(out, "CM_ SG_ %lu %s \"%s: RTDE input %s, written by urrt-gateway to robot ", id, m->name, name,
+                urrt_rtde_type_name(urrt_rtde_var_type(m->var)));
+        put_text(out, robot);
+        if (m->bitmask) {
+            fprintf(out, "; a bit mask, taken bit for bit (never scaled): bit n of this signal is bit %u+n of the "
+                         "register",
+                    URRT_CAN_SIG_MASK_FIRST(f->sigs[k].flags));
+        } else {
+            fprintf(out, " as raw * factor + offset; a value outside min..max is refused and counted, never clamped");
+        }
+        fprintf(out, "; [input %s] timeout_ms = %u, ", f->name, (unsigned)f->timeout_ms);
+        put_silence(out, f, false);
+        fprintf(out, "\";\n");
+    }
+}
+
 static void put_comments(FILE *out, const struct can_map *map, const char *source, unsigned long hb)
 {
     fprintf(out, "CM_ \"Generated by urrt-gateway %s: Universal Robots RealTime data on CAN. "
@@ -316,6 +386,9 @@ static void put_comments(FILE *out, const struct can_map *map, const char *sourc
         fprintf(out, "CM_ SG_ %lu %s \"", hb, can_map_heartbeat_layout[k].name);
         put_text(out, can_map_heartbeat_layout[k].comment);
         fprintf(out, "\";\n");
+    }
+    for (size_t i = 0; i < map->input_count; i++) {
+        put_input_comment(out, map, &map->inputs[i]);
     }
 }
 
@@ -341,6 +414,17 @@ static void put_attribute_definitions(FILE *out, bool fd, bool brs)
     fprintf(out, "BA_DEF_DEF_ \"DBName\" \"\";\n");
 }
 
+/*
+ * The frames in order (put_frames'): the [frame]s, the heartbeat, the
+ * [input]s. An [input]'s cycle is the PLC's own choice (any period well
+ * below its timeout_ms), which the configuration does not know: it gets no
+ * GenMsgCycleTime, whose BA_DEF_DEF_ 0 then stands, "none given" (canmatrix
+ * reads cycle_time 0, as for a frame without the attribute; CANdb++ shows
+ * 0), rather than a made-up period a PLC's interaction layer would send at.
+ * Its GenMsgSendType is Cyclic, written out like every frame's: the gateway
+ * needs the frame again and again (timeout_ms without it is a silent PLC),
+ * which Spontaneous ("on change") would not say; the timeout is in its CM_.
+ */
 static void put_attributes(FILE *out, const struct can_map *map, unsigned long hb)
 {
     bool fd_any = any_fd(map);
@@ -349,12 +433,18 @@ static void put_attributes(FILE *out, const struct can_map *map, unsigned long h
     fprintf(out, "BA_ \"BusType\" \"%s\";\n", fd_any ? "CAN FD" : "CAN");
     fprintf(out, "BA_ \"Baudrate\" %u;\n", (unsigned)(map->bitrate > 1000000 ? 1000000 : map->bitrate));
     fprintf(out, "BA_ \"DBName\" \"urrt_gateway\";\n");
-    for (size_t i = 0; i <= map->frame_count; i++) {
-        const struct can_map_frame *f = i < map->frame_count ? &map->frames[i] : NULL;
+    for (size_t i = 0; i <= map->frame_count + map->input_count; i++) {
+        bool input = i > map->frame_count;
+        const struct can_map_frame *f = i < map->frame_count ? &map->frames[i]
+                                        : input              ? &map->inputs[i - map->frame_count - 1]
+                                                             : NULL;
         bool ext = f ? f->extended : map->hb_extended;
         bool fd = f ? f->fd : false;
         unsigned long id = f ? dbc_id(f->id, f->extended) : hb;
-        fprintf(out, "BA_ \"GenMsgCycleTime\" BO_ %lu %u;\n", id, f ? cycle_ms(map, f) : (unsigned)map->hb_period_ms);
+        if (!input) {
+            fprintf(out, "BA_ \"GenMsgCycleTime\" BO_ %lu %u;\n", id,
+                    f ? cycle_ms(map, f) : (unsigned)map->hb_period_ms);
+        }
         fprintf(out, "BA_ \"GenMsgSendType\" BO_ %lu 0;\n", id);
         fprintf(out, "BA_ \"VFrameFormat\" BO_ %lu %d;\n", id,
                 fd ? (ext ? FORMAT_EXTENDED_FD : FORMAT_STANDARD_FD) : (ext ? FORMAT_EXTENDED : FORMAT_STANDARD));
@@ -410,8 +500,8 @@ static void put_values(FILE *out, const struct can_map *map, unsigned long hb)
         }
     }
     put_heartbeat_values(out, map, hb);
-    for (size_t i = 0; i < map->frame_count; i++) {
-        const struct can_map_frame *f = &map->frames[i];
+    for (size_t i = 0; i < map->frame_count + map->input_count; i++) {
+        const struct can_map_frame *f = i < map->frame_count ? &map->frames[i] : &map->inputs[i - map->frame_count];
         for (size_t k = 0; k < f->count; k++) {
             if (f->sigs[k].type == URRT_CAN_FLOAT32 || f->sigs[k].type == URRT_CAN_FLOAT64) {
                 fprintf(out, "SIG_VALTYPE_ %lu %s : %d;\n", dbc_id(f->id, f->extended), f->meta[k].name,

@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * dbc: the DBC file describing what urrt-gateway sends on CAN, written from
- * the same mapping (struct can_map) that packs the frames, so that the file
- * handed to the PLC engineer cannot disagree with the bus.
+ * dbc: the DBC file describing what urrt-gateway sends on CAN, and what it
+ * receives, written from the same mapping (struct can_map) that packs and
+ * unpacks the frames, so that the file handed to the PLC engineer cannot
+ * disagree with the bus.
  *
  * What it writes (Vector's conventions, as CANdb++ and python3-canmatrix
  * read them): one node for the gateway (BU_), each configured frame and the
@@ -13,6 +14,14 @@
  * (StandardCAN, ExtendedCAN, StandardCAN_FD, ExtendedCAN_FD), CANFD_BRS,
  * value tables (VAL_) for the enumerations and comments (CM_) naming each
  * signal's field, element and RealTime column.
+ *
+ * The frames it receives, each [input NAME], follow the heartbeat: a BO_
+ * whose transmitter is the PLC ([can] receiver, or Vector__XXX, "no
+ * node"), its signals received by the gateway's node (BU_ names both), with
+ * the same SG_ syntax, VFrameFormat and CANFD_BRS, GenMsgSendType Cyclic and
+ * no GenMsgCycleTime (the PLC picks its period: see put_attributes), and
+ * comments naming the register each signal writes, the frame's timeout_ms
+ * and on_silence.
  */
 #ifndef URRT_GATEWAY_DBC_H
 #define URRT_GATEWAY_DBC_H

@@ -310,11 +310,12 @@ static bool on_event(rtde_source *src, const urrt_rtde_event *ev, uint64_t rx_us
         config_reason(src, ev, why, sizeof why);
         drop(src, config_drop_kind(src, ev), why);
         break;
-    case URRT_RTDE_EV_INPUTS:
-        src->in_use_tries = 0;
-        break;
     case URRT_RTDE_EV_STARTED:
+        /* Every input recipe was accepted: a refusal is over. */
         src->in_sessions += src->in_count > 0;
+        src->in_use_tries = 0;
+        src->in_refusal = 0;
+        src->in_refusal_var = -1;
         break;
     default: break;
     }
@@ -391,7 +392,7 @@ bool rtde_source_input_ready(const rtde_source *src, size_t g)
 int rtde_source_send_input(rtde_source *src, size_t g)
 {
     uint8_t out[URRT_RTDE_IN_PACKAGE_MAX];
-    int n;
+    int n, r;
     if (!rtde_source_input_ready(src, g)) {
         return 0;
     }
@@ -399,8 +400,11 @@ int rtde_source_send_input(rtde_source *src, size_t g)
     if (n <= 0) {
         return 0; /* a register without a value: nothing is invented for it */
     }
-    if (urrt_link_send(src->link, out, (size_t)n) != URRT_OK) {
-        src->in_busy++; /* the controller does not read: the next package carries the newest values */
+    r = urrt_link_send(src->link, out, (size_t)n);
+    if (r != URRT_OK) {
+        /* A full queue: the controller does not read, and the next package
+         * carries the newest values. Otherwise the connection just ended. */
+        src->in_busy += r == URRT_E_NO_SPACE;
         return 0;
     }
     if (src->tap_fn != NULL) {

@@ -123,9 +123,9 @@ uint64_t rtde_source_input_sessions(const rtde_source *src);
 /* Input packages the link's queue had no room for. */
 uint64_t rtde_source_input_busy(const rtde_source *src);
 
-/* The last refusal of an input recipe's setup (URRT_RTDE_E_IN_USE or
- * URRT_RTDE_E_NOT_FOUND; 0: none since start) and the register it named
- * (-1: none). */
+/* The refusal of an input recipe's setup that keeps the session from
+ * starting (URRT_RTDE_E_IN_USE or URRT_RTDE_E_NOT_FOUND; 0: none, or a
+ * session started since) and the register it named (-1: none). */
 int rtde_source_input_refusal(const rtde_source *src, int *var);
 
 /* The recipe of the current (or last) session as a comma-separated name

@@ -24,7 +24,6 @@ typedef struct can_out can_out;
 can_out *can_out_new(gateway *gw, const struct can_map *map, struct can_run *run, struct co_run *node);
 gw_output can_out_output(can_out *out);
 
-/* What the metrics (metrics.h) and systemd's status (notify.h) say of it. */
 /* Who else receives on the link (the PLC's [input] frames, plc_in.h): its
  * ids join the link's filter beside a CANopen node's, each frame received
  * goes to frame() first (true: taken; false: the node's, if any), and
@@ -39,6 +38,7 @@ typedef struct can_out_receiver {
 /* False (logged) when the link cannot take the ids. */
 bool can_out_set_receiver(can_out *out, const can_out_receiver *receiver);
 
+/* What the metrics (metrics.h) and systemd's status (notify.h) say of it. */
 typedef struct can_out_info {
     const urrt_canlink_stats *link;
     bool up;                 /* the interface is open and up */

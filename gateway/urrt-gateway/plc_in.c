@@ -80,27 +80,37 @@ static bool writing(const struct plc_group *g)
     return g->ever && (g->fresh || g->f->silence != CAN_MAP_SILENCE_STOP);
 }
 
+/* Whether the group's package can go now: its robot's session streams with
+ * the recipe accepted. */
+static bool ready(const struct plc_group *g)
+{
+    return g->robot->rtde != NULL && rtde_source_input_ready(g->robot->rtde, g->recipe);
+}
+
 /* The package, if a value changed, the session is new, or the minimum rate
- * asks for it. */
+ * asks for it. One that cannot go now (a register without a value, the
+ * robot link's queue full) is tried again a period later; a session that is
+ * not ready is waited for: its start is news, which ticks every output. */
 static void send_due(plc_in *in, struct plc_group *g, uint64_t now_us)
 {
-    rtde_source *src = g->robot->rtde;
     uint64_t sessions;
-    if (!writing(g) || src == NULL) {
+    if (!writing(g) || !ready(g)) {
         return;
     }
-    sessions = rtde_source_input_sessions(src);
+    sessions = rtde_source_input_sessions(g->robot->rtde);
     if (!g->changed && sessions == g->sessions && now_us - g->sent_us < in->period_us) {
         return;
     }
-    if (rtde_source_send_input(src, g->recipe) == 1) {
+    g->sent_us = now_us;
+    if (rtde_source_send_input(g->robot->rtde, g->recipe) == 1) {
         g->counts.written++;
-        g->sent_us = now_us;
         g->sessions = sessions;
         g->changed = false;
     }
 }
 
+/* The earliest of the fresh groups' timeouts and the writable groups'
+ * refreshes: the output's deadline, kept here so that asking costs nothing. */
 static void plan(plc_in *in)
 {
     uint64_t due = UINT64_MAX;
@@ -111,7 +121,7 @@ static void plan(plc_in *in)
         if (g->fresh && timeout < due) {
             due = timeout;
         }
-        if (writing(g) && refresh < due) {
+        if (writing(g) && ready(g) && refresh < due) {
             due = refresh;
         }
     }
@@ -294,12 +304,14 @@ static unsigned on_counters(void *ctx, const gw_robot *robot, gw_counter *out, u
 {
     plc_in *in = ctx;
     uint64_t frames = 0, bad = 0, refused = 0, written = 0, silences = 0, in_use = 0, not_found = 0;
+    unsigned groups = 0;
     for (size_t i = 0; i < in->count; i++) {
         const struct plc_group *g = &in->groups[i];
         const urrt_rtde_in *recipe = recipe_of(g);
         if (g->robot != robot) {
             continue;
         }
+        groups++;
         frames += g->counts.frames;
         bad += g->counts.bad_frames;
         refused += g->counts.refused;
@@ -315,7 +327,7 @@ static unsigned on_counters(void *ctx, const gw_robot *robot, gw_counter *out, u
         {"inputs_in_use", in_use},     {"inputs_not_found", not_found},
     };
     unsigned n = 0;
-    for (; n < max && n < sizeof all / sizeof all[0]; n++) {
+    for (; groups > 0 && n < max && n < sizeof all / sizeof all[0]; n++) {
         out[n] = all[n];
     }
     return n;

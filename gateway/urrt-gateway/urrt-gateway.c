@@ -134,7 +134,8 @@ static void describe_input(const struct can_map *map, const struct can_map_frame
         [CAN_MAP_SILENCE_VALUE] = "value",
     };
     size_t used = 0;
-    int w = snprintf(buf, size, "input %s (0x%X%s): robot %s:", f->name, (unsigned)f->id, f->extended ? ", 29-bit" : "",
+    int w = snprintf(buf, size, f->extended ? "input %s (0x%08X, 29-bit): robot %s:" : "input %s (0x%03X): robot %s:",
+                     f->name, (unsigned)f->id,
                      map->robots[f->robot_index].name);
     used += w > 0 ? (size_t)w : 0;
     for (size_t i = 0; i < f->count && used < size; i++) {

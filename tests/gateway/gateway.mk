@@ -12,7 +12,8 @@
 #   bench-gateway   latency robot -> subscriber and CPU per packet beside a
 #                   minimal relay (bench_relay.c), 1/10/50 robots, the CPU per
 #                   packet at 50 robots against 10, highest rate, and the 500 Hz
-#                   robots one core serves
+#                   robots one core serves; then bench-plc-io (the PLC's frames
+#                   written as input registers, in the VM)
 GWT := $(BUILD)/tests/gateway
 GWT_CFLAGS := $(PROG_WARN) $(OPT) $(CPPFLAGS) -I$(LCMGEN)
 
@@ -84,3 +85,5 @@ bench-gateway: $(BUILD)/bin/urrt-gateway $(GWT)/bench_gateway $(GWT)/bench_relay
 	@echo "bench-gateway: CPU per packet at 50 robots against 10 (the loop's cost per wake-up must not grow with the robots)"
 	@$(BENCH_GW) --gateway $(BUILD)/bin/urrt-gateway --robots 10 --versus 50 --rounds 3
 	@$(BENCH_GW) --gateway $(BUILD)/bin/urrt-gateway --robots 10 --versus 50 --rounds 3 --focused-hz 50
+	@echo "bench-gateway: the PLC's answers (tests/plc/check-plc-io.mk), in the VM: its frame to the input package, beside a package to its frame"
+	@$(MAKE) --no-print-directory bench-plc-io

@@ -257,11 +257,11 @@ def check_sources(keys, files):
 
 def check_keys(build):
     keys = table_keys(os.path.join(build, "bin", "urrt-gateway"))
-    check(len(keys) == 6 and len(keys.get("robot", {})) >= 7, "--print-keys lists the sections' keys (%s)" %
+    check(len(keys) == 7 and len(keys.get("robot", {})) >= 7, "--print-keys lists the sections' keys (%s)" %
           ", ".join("%s: %d" % (s, len(k)) for s, k in keys.items()))
-    check_man_keys(keys, "gateway/man/urrt-gateway.ini.5.md", ["gateway", "lcm", "robot", "canopen"])
+    check_man_keys(keys, "gateway/man/urrt-gateway.ini.5.md", ["gateway", "lcm", "robot", "input", "canopen"])
     check_doc_tables(keys, "docs/gateway.md", r"### `\[(\w+)[ \w]*\]`", ["gateway", "lcm", "robot"])
-    check_doc_tables(keys, "docs/can.md", r"## `\[(\w+)[ \w]*\]`", ["can", "frame"])
+    check_doc_tables(keys, "docs/can.md", r"##+ `\[(\w+)[ \w]*\]`", ["can", "frame", "input"])
     check_doc_tables(keys, "docs/canopen.md", r"## `\[(\w+)[ \w]*\]`", ["canopen"])
     check_example(keys, "gateway/install/urrt-gateway.example.ini", ["gateway", "lcm", "robot"])
     check_named(keys, [os.path.join(build, "man", p) for p in ("urrt-gateway.8", "urrt-gateway.ini.5")])

@@ -81,13 +81,31 @@ class Counts:
         return ok
 
 
+SIZES = {'BOOL': 1, 'UINT8': 1, 'UINT32': 4, 'UINT64': 8, 'INT32': 4, 'DOUBLE': 8, 'VECTOR3D': 24,
+         'VECTOR6D': 48, 'VECTOR6INT32': 24, 'VECTOR6UINT32': 24}
+
+
 class Conn:
     """One connection of the gateway through the proxy."""
 
     def __init__(self):
         self.sent = []        # (t, type letter, payload) from the gateway, in order
         self.i_replies = []   # (t, payload) of the controller's 'I' replies
+        self.readback = []    # (t, input_int_register_24) of each data package the controller sent
+        self.at = None        # that register's offset in a data package's payload
         self.closed = False
+
+    def controller_package(self, kind, p, now):
+        """The output recipe's reply gives the register's place; each data package its value."""
+        if kind == b'I':
+            self.i_replies.append((now, p))
+        elif kind == b'O':
+            names = next((q[8:].decode().split(',') for _, k, q in self.sent if k == b'O'), [])
+            types = p[1:].decode().split(',')
+            if NAMES[0] in names and len(types) == len(names):
+                self.at = 1 + sum(SIZES.get(t, 0) for t in types[:names.index(NAMES[0])])
+        elif kind == b'U' and self.at is not None and len(p) >= self.at + 4:
+            self.readback.append((now, struct.unpack_from('>i', p, self.at)[0]))
 
 
 class Proxy(threading.Thread):
@@ -140,7 +158,8 @@ class Proxy(threading.Thread):
                 client.sendall(data)
                 pk, from_sim = self.packages(from_sim + data)
                 with self.lock:
-                    conn.i_replies += [(now, p) for k, p in pk if k == b'I']
+                    for k, p in pk:
+                        conn.controller_package(k, p, now)
         self.cut.clear()
         conn.closed = True
         client.close()
@@ -154,6 +173,11 @@ class Proxy(threading.Thread):
     def snapshot(self):
         with self.lock:
             return [(list(c.sent), list(c.i_replies), c.closed) for c in self.conns]
+
+    def readbacks(self, since=0.0):
+        """(t, value) of input_int_register_24 in every data package after since."""
+        with self.lock:
+            return sorted(x for c in self.conns for x in c.readback if x[0] >= since)
 
     def packages_u(self, since=0.0):
         """Every input package the gateway sent after since: (t, job, start, door)."""
@@ -206,9 +230,11 @@ class Plc:
 
     def send(self, job, start, door):
         data = struct.pack('<HB', job, (start & 1) | (door & 1) << 1) + bytes(5)
+        # Stamped before the send: the gateway may answer before send() returns.
+        t = time.monotonic()
         try:
             self.bus.send(self.can.Message(arbitration_id=COMMAND_ID, is_extended_id=False, data=data))
-            self.sent.append((time.monotonic(), job, start, door))
+            self.sent.append((t, job, start, door))
             return True
         except self.can.CanError:
             self.send_errors += 1
@@ -301,6 +327,21 @@ def phase_follow(c, proxy, plc, rate):
             trips.append(echoed[0] - t_sent)
     c.check('every job comes back in robot_answer\'s job_echo (%d of %d)' % (len(trips), len(jobs_sent)),
             len(trips) == len(jobs_sent))
+    # The register on the controller: from the package that wrote a job to the
+    # first data package that reads it back, in controller cycles.
+    rb = proxy.readbacks(t0)
+    cycles = []
+    for job in jobs_sent:
+        t_u = min((u[0] for u in us if u[1] == job), default=None)
+        seen = [t for t, v in rb if v == job and t_u is not None and t >= t_u]
+        if seen:
+            cycles.append((seen[0] - t_u) * rate)
+    c.check('every job is read back in the controller\'s data packages (%d of %d)' % (len(cycles), len(jobs_sent)),
+            len(cycles) == len(jobs_sent))
+    if cycles:
+        cycles.sort()
+        print('input package -> the register read back: median %.2f cycles, p99 %.2f cycles (of %.0f ms)' %
+              (statistics.median(cycles), cycles[min(len(cycles) - 1, int(0.99 * len(cycles)))], 1e3 / rate))
     states = [s for t, s, _, v in plc.answers if t >= t0 and v]
     c.check('robot_answer\'s program_state (output_int_register_24) advances', len(states) > 10 and
             all(b >= a for a, b in zip(states, states[1:])) and states[-1] > states[0])
@@ -408,7 +449,78 @@ def phase_down(c, proxy, plc):
     subprocess.run(['ip', 'link', 'set', 'vcan0', 'up'], check=False)
 
 
+def pct(xs, q):
+    xs = sorted(xs)
+    return xs[min(len(xs) - 1, int(q * len(xs)))] if xs else float('nan')
+
+
+def phase_bench(proxy, plc, rate, frames):
+    """make bench-plc-io: a new job in every frame; robot_answer goes with every
+    package (period_ms = every), so that both directions are timed alike:
+    write  the PLC's frame sent -> its input package at the proxy (receipt, decode,
+           check, pack, send)
+    read   a data package at the proxy -> its value in robot_answer at the PLC
+           (receipt, RTDE decode, pack, send)
+    Both cross the proxy and vcan0 once. Prints name value lines."""
+    t0 = time.monotonic()
+    plc.run(frames * PERIOD, lambda n: (1000 + n % 8000, 1, 1))
+    time.sleep(0.5)
+    sent = [x for x in plc.sent if x[0] >= t0]
+    us = proxy.packages_u(t0)
+    rb = proxy.readbacks(t0)
+    answers = [a for a in plc.answers if a[0] >= t0]
+    write, read, cycles, trip = [], [], [], []
+    for t, job, _, _ in sent:
+        u = next((x[0] for x in us if x[1] == job and x[0] >= t), None)
+        if u is None:
+            continue
+        write.append(u - t)
+        pkg = next((x[0] for x in rb if x[1] == job and x[0] >= u), None)
+        if pkg is None:
+            continue
+        cycles.append((pkg - u) * rate)
+        ans = next((x[0] for x in answers if x[2] == job and x[0] >= pkg), None)
+        if ans is not None:
+            read.append(ans - pkg)
+            trip.append(ans - t)
+    changed = len({x[1] for x in sent})
+    print('frames %d' % len(sent))
+    print('*packages_per_changed_frame %.3f' % (len(us) / changed if changed else float('nan')))
+    for name, xs, unit in (('write_ms', write, 1e3), ('read_ms', read, 1e3), ('round_trip_ms', trip, 1e3)):
+        print('%s_median %.3f' % (name, pct(xs, 0.5) * unit))
+        print('%s_p99 %.3f' % (name, pct(xs, 0.99) * unit))
+    print('register_visible_cycles_median %.2f' % pct(cycles, 0.5))
+    print('register_visible_cycles_p99 %.2f' % pct(cycles, 0.99))
+    print('*write_over_read_median %.2f' % (pct(write, 0.5) / pct(read, 0.5) if read else float('nan')))
+    print('*write_over_read_p99 %.2f' % (pct(write, 0.99) / pct(read, 0.99) if read else float('nan')))
+
+
+def check_lcm(path):
+    """What LCM carried over the run (lcm_sub's lines): NAME.RTDE holds the register
+    read back, with the jobs the PLC wrote; NAME.GATEWAY counts the inputs."""
+    import json
+    c = Counts()
+    readback, counters = set(), {}
+    with open(path) as f:
+        for line in f:
+            m = json.loads(line)
+            if m['ch'] == 'arm1.RTDE' and NAMES[0] in m['names']:
+                readback.add(round(m['values'][m['names'].index(NAMES[0])]))
+            elif m['ch'] == 'arm1.GATEWAY':
+                counters = m['counters']
+    c.check('arm1.RTDE carries %s read back, with the jobs the PLC wrote' % NAMES[0],
+            {100, 129, 500, 502, 701} <= readback, str(sorted(readback)[:12]))
+    c.check('arm1.GATEWAY counts the PLC\'s frames, the values refused and the packages written (%s)' %
+            {k: v for k, v in counters.items() if k.startswith('inputs_')},
+            counters.get('inputs_frames', 0) > 300 and counters.get('inputs_refused') == 15 and
+            counters.get('inputs_written', 0) > 50 and counters.get('inputs_silences', 0) >= 1)
+    print('%d passed, %d failed' % (c.passed, c.failed))
+    return 0 if c.failed == 0 else 1
+
+
 def main():
+    if sys.argv[1:2] == ['--lcm']:
+        return check_lcm(sys.argv[2])
     ap = argparse.ArgumentParser()
     ap.add_argument('--channel', required=True)
     ap.add_argument('--sim-port', type=int, required=True)
@@ -416,6 +528,7 @@ def main():
     ap.add_argument('--ready', required=True)
     ap.add_argument('--metrics', required=True)
     ap.add_argument('--rate', type=int, required=True, help='the controller\'s cycles per second')
+    ap.add_argument('--bench', type=int, default=0, help='time N frames both ways (make bench-plc-io), no checks')
     a = ap.parse_args()
     c = Counts()
     proxy = Proxy(a.sim_port)
@@ -425,6 +538,11 @@ def main():
     os.rename(a.proxy_port_file + '.tmp', a.proxy_port_file)
     plc = Plc(a.channel)
     try:
+        if a.bench:
+            open(a.ready, 'w').close()
+            wait_for(lambda: any('S' in session_types(x[0]) for x in proxy.snapshot()))
+            phase_bench(proxy, plc, a.rate, a.bench)
+            return 0
         sent = phase_in_use(c, proxy, a.sim_port, a.ready)
         if sent is not None:
             phase_handshake(c, proxy, sent)
@@ -448,4 +566,6 @@ if __name__ == '__main__':
     # os._exit: the proxy's and the bus reader's threads are daemons, and their
     # ending at the interpreter's exit needs libgcc_s, which the VM's staged
     # Python does not carry.
-    os._exit(main())
+    rc = main()
+    sys.stdout.flush()
+    os._exit(rc)

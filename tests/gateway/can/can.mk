@@ -2,10 +2,15 @@
 # tests/gateway/can/can.mk: the gateway's CAN mapping (gateway/can/), on top of lib/urrt_can.
 #   check-can-map      tests/gateway/can/test_can_map.c: configurations loaded by the gateway's
 #                      loader and their rejections with FILE:LINE, bus load, the urrt_cantx
-#                      tables, scheduling and the heartbeat on a fake clock, the DBC text
+#                      tables, scheduling and the heartbeat on a fake clock, the DBC text;
+#                      [input NAME] frames: their recipes, every refusal with FILE:LINE, their DBC
 #   check-can-map-san  the same under ASan + UBSan, lib/ and gateway/ compiled with them
 #   check-can-dbc      DBCs and payloads against python3-canmatrix and an independent
-#                      Python reference; the example configurations in docs/examples/
+#                      Python reference; the example configurations in docs/examples/; then
+#                      check_dbc_input.py: the [input] frames (the PLC's) in the DBC, their values
+#                      both ways between canmatrix and lib/urrt_can with the map's table, and their
+#                      C tables compiled under lib/'s warnings (host and Cortex-M4) and decoding
+#                      canmatrix's payloads through ctables_input.c
 #   check-replay-rtde  urrt-gateway --replay of RTDE captures of urrt-sim's sessions: the frames
 #                      against canmatrix and against the RealTime capture's, CANopen with
 #                      --replay-rx, the refusals (check_replay_rtde.py; processes: a timing suite)
@@ -39,8 +44,12 @@ check-can-map: $(CANT)/test_can_map
 check-can-map-san: $(CANT)/test_can_map_san
 	$(call suite,$@,ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $<)
 
-check-can-dbc: $(CANT)/can_tool
-	$(call suite,$@,$(PYTHON) tests/gateway/can/test_dbc.py --tool $< --work $(CANT)/work)
+# The [input] half runs after the rest (a failure there stops the suite); the C tables it
+# writes are compiled by it with $(CC) and lib/'s flags, and with target.mk's Cortex-M4 compiler.
+check-can-dbc: $(CANT)/can_tool $(LIBURRT) tests/gateway/can/ctables_input.c
+	$(call suite,$@,$(PYTHON) tests/gateway/can/test_dbc.py --tool $< --work $(CANT)/work && \
+	  $(PYTHON) tests/gateway/can/check_dbc_input.py --tool $< --work $(CANT)/work-input --cc "$(CC)" \
+	    --cflags "$(LIB_WARN)" --liburrt $(LIBURRT) --target-cc "$(TGT_CM) $(TGT_M4)")
 
 check-replay-rtde: $(BUILD)/bin/urrt-sim $(BUILD)/bin/urrt-gateway
 	$(call suite,$@,timeout -k 5 120 $(PYTHON) tests/gateway/can/check_replay_rtde.py $(BUILD))

@@ -10,11 +10,13 @@
  * usage: can_tool COMMAND CONFIG
  *   validate   load and check; prints "ok load=PERCENT" or the errors (exit 1)
  *   dbc        the DBC on stdout
- *   pack       reads lines "FRAME NAME=VALUE ..." and prints
+ *   ctables    the C tables on stdout (--print-c-tables)
+ *   pack       reads lines "FRAME NAME=VALUE ..." (FRAME a [frame] or an [input]) and prints
  *              "HEX OUTCOME..." per line: the payload (zeros elsewhere) packed
  *              with urrt_can_pack, and each signal's outcome (0 ok,
  *              1 saturated, 2 NaN); VALUE is a C double ("nan", "inf" too)
- *   unpack     reads lines "FRAME HEX" and prints "NAME=%.17g ..." per line
+ *   unpack     reads lines "FRAME HEX" and prints "NAME=%.17g ..." per line (urrt_can_unpack
+ *              with the map's signal table, as the gateway receives an [input])
  *   run        reads a script and prints every emitted frame as
  *              "T_US ID#HEX" (ids in candump's notation, "##" + flags for FD):
  *                packet T_US ROBOT FIELD[ELEM]=VALUE ...  a packet (only the
@@ -29,11 +31,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "can_ctables.h"
 #include "can_map.h"
 #include "can_run.h"
 #include "config.h"
 #include "dbc.h"
 
+/* A [frame] or an [input] by name (DBC names are unique among both). */
 static struct can_map_frame *frame_by_name(struct can_map *map, const char *name)
 {
     size_t i;
@@ -42,7 +46,24 @@ static struct can_map_frame *frame_by_name(struct can_map *map, const char *name
             return &map->frames[i];
         }
     }
+    for (i = 0; i < map->input_count; i++) {
+        if (strcmp(map->inputs[i].name, name) == 0) {
+            return &map->inputs[i];
+        }
+    }
     return NULL;
+}
+
+/* The C tables as urrt-gateway --print-c-tables writes them. */
+static int cmd_ctables(gw_config *cfg)
+{
+    struct can_ctables_robot robots[GW_MAX_ROBOTS];
+    for (unsigned i = 0; i < cfg->robot_count && i < GW_MAX_ROBOTS; i++) {
+        robots[i].rtde = cfg->robots[i].source == GW_SOURCE_RTDE;
+        robots[i].frequency = cfg->robots[i].rtde_frequency;
+        robots[i].port = cfg->robots[i].port;
+    }
+    return can_ctables_write(stdout, &cfg->can, cfg->can_run, cfg->co_run, robots, cfg->path) != 0;
 }
 
 static int signal_index(const struct can_map_frame *f, const char *name, size_t len)
@@ -232,7 +253,7 @@ int main(int argc, char **argv)
     int rc;
 
     if (argc != 3) {
-        fprintf(stderr, "usage: can_tool validate|dbc|pack|unpack|run CONFIG\n");
+        fprintf(stderr, "usage: can_tool validate|dbc|ctables|pack|unpack|run CONFIG\n");
         return 2;
     }
     cmd = argv[1];
@@ -253,6 +274,8 @@ int main(int argc, char **argv)
         rc = 0;
     } else if (strcmp(cmd, "dbc") == 0) {
         rc = dbc_write(stdout, map, argv[2]) < 0;
+    } else if (strcmp(cmd, "ctables") == 0) {
+        rc = cmd_ctables(&cfg);
     } else if (strcmp(cmd, "pack") == 0) {
         rc = cmd_pack(map);
     } else if (strcmp(cmd, "unpack") == 0) {

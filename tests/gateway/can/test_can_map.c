@@ -4,7 +4,8 @@
  * (configurations loaded as the gateway loads them, and their rejections
  * with FILE:LINE, bus load against hand-computed figures, scheduling,
  * staleness, alive counters and the heartbeat on a fake clock) and the DBC
- * text. The bit packing underneath is tests/lib/test_can.c's; the DBC and
+ * text; [input NAME] frames (the PLC's): what they hold, every refusal with
+ * its message and line, their DBC text. The bit packing underneath is tests/lib/test_can.c's; the DBC and
  * bulk packing are checked against python3-canmatrix by test_dbc.py.
  */
 #include <math.h>
@@ -258,7 +259,7 @@ static const struct rejection rejections[] = {
      "t.ini:1: [can] has no interface"},
     {"[can]\ninterface = can0\n[frame a]\nid = 1\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
      "t.ini:1: [can] has no heartbeat_id"},
-    {CAN_HEAD, "t.ini:1: [can] without any [frame NAME] section"},
+    {CAN_HEAD, "t.ini:1: [can] without any [frame NAME] or [input NAME] section: nothing to send or receive"},
     {CAN_HEAD "[frame a]\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n", "t.ini:4: [frame a] has no id"},
     {CAN_HEAD "[frame a]\nid = 0x800\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n",
      "t.ini:5: [frame a] id 0x800 is past 0x7FF, the largest 11-bit id: set extended = yes"},
@@ -1375,6 +1376,389 @@ static void test_rtde_values(void)
     }
 }
 
+/* ---- [input NAME]: frames the gateway receives, writing input registers ---------------------- */
+
+/* The first message of err: its first line. */
+static void first_line(const char *err, char *out, size_t size)
+{
+    snprintf(out, size, "%.*s", (int)strcspn(err, "\n"), err);
+}
+
+/* 0x18FF1234 with DBC's extended flag: 0x80000000 | id. */
+#define IN_CMD_DBC_ID "2566853172"
+
+static const char *const input_config =
+    CAN_HEAD                                                                                     /* lines 1-3 */
+    "fd = yes\ndata_bitrate = 2000000\nreceiver = CELL_PLC\n"                                    /* 4-6 */
+    "[input cmd]\nid = 0x18FF1234\nextended = yes\nfd = yes\nlength = 16\ntimeout_ms = 250\n"  /* 7-12 */
+    "on_silence = value 1\ncomment = Cell PLC setpoints\n"                                       /* 13-14 */
+    "signal = input_bit_registers32_to_63 @24|4 intel unsigned bits=4-7 name=mask_hi\n"         /* 15 */
+    "signal = input_double_register_30 @7|16 motorola signed factor=0.01 offset=0.5 min=-100 max=200 unit=mm "
+    "name=setpoint\n"                                                                            /* 16 */
+    "signal = input_bit_registers32_to_63 @16|4 intel unsigned bits=0-3 name=mask_lo\n"         /* 17 */
+    "signal = input_int_register_25 @32|32 intel signed name=count\n"                            /* 18 */
+    "signal = input_bit_register_100 @64|1 intel unsigned name=flag\n"                           /* 19 */
+    "[input stop]\nid = 0x210\ntimeout_ms = 50\non_silence = hold\n"                            /* 20-23 */
+    "signal = input_int_register_26 @0|8 intel unsigned\n"                                       /* 24 */
+    RTDE_ROBOT;
+
+static void inputs_accepted(void)
+{
+    gw_config cfg;
+    char err[4096] = "";
+    int errors = load_cfg(&cfg, input_config, err, sizeof err);
+    const struct can_map *map = &cfg.can;
+    CHECK(errors == 0, "[input]s load: %s", err);
+    if (errors != 0) {
+        gw_config_free(&cfg);
+        return;
+    }
+    CHECK_EQ_INT(map->frame_count, 0);
+    CHECK_EQ_INT(map->input_count, 2);
+    {
+        const struct can_map_frame *f = &map->inputs[0];
+        const uint16_t want[] = {URRT_RTDE_V_INPUT_BIT_REGISTERS32_TO_63, URRT_RTDE_V_INPUT_DOUBLE_REGISTER + 30,
+                                 URRT_RTDE_V_INPUT_INT_REGISTER + 25, URRT_RTDE_V_INPUT_BIT_REGISTER + 36};
+        char name[URRT_RTDE_NAME_MAX];
+        CHECK_EQ_STR(f->name, "cmd");
+        CHECK(f->input && f->id == 0x18FF1234 && f->extended && f->fd && f->len == 16, "cmd: id, kind, length");
+        CHECK_EQ_INT(f->timeout_ms, 250);
+        CHECK(f->silence == CAN_MAP_SILENCE_VALUE && f->silence_value == 1.0, "cmd: on_silence = value 1");
+        CHECK_EQ_STR(f->comment, "Cell PLC setpoints");
+        CHECK_EQ_INT(f->robot_index, 0);
+        CHECK_EQ_INT(f->loc.line, 7);
+        CHECK_EQ_INT(f->count, 5);
+        /* The recipe: each register once, in the order of its first signal (the mask's two
+         * signals are one register). */
+        CHECK_EQ_INT(f->reg_count, 4);
+        for (size_t k = 0; k < 4 && k < f->reg_count; k++) {
+            CHECK(f->regs[k] == want[k], "cmd regs[%zu] = %u, want %u", k, f->regs[k], want[k]);
+        }
+        CHECK(urrt_rtde_var_name(f->regs[3], name, sizeof name) > 0 && strcmp(name, "input_bit_register_100") == 0,
+              "regs[3] is input_bit_register_100: %s", name);
+        /* The signals as configured: received raw * factor + offset, min..max bounds what is taken. */
+        CHECK(f->meta[0].bitmask && f->meta[2].bitmask && !f->meta[1].bitmask, "the mask's signals are masks");
+        CHECK(f->sigs[0].flags == URRT_CAN_SIG_MASK(4) && f->sigs[0].start == 24 && f->sigs[0].length == 4,
+              "mask_hi: bits=4-7 at @24|4");
+        CHECK(f->sigs[2].flags == URRT_CAN_SIG_MASK(0) && f->sigs[2].start == 16, "mask_lo: bits=0-3 at @16|4");
+        CHECK(f->sigs[1].factor == 0.01 && f->sigs[1].offset == 0.5 && f->sigs[1].min == -100 &&
+                  f->sigs[1].max == 200 && f->sigs[1].byte_order == URRT_CAN_MOTOROLA &&
+                  f->sigs[1].type == URRT_CAN_SIGNED && f->sigs[1].start == 7 && f->sigs[1].length == 16,
+              "setpoint: motorola signed 0.01, 0.5, -100..200");
+        CHECK_EQ_STR(f->meta[1].unit, "mm");
+        CHECK_EQ_STR(f->meta[1].name, "setpoint");
+        CHECK(f->meta[1].role == CAN_MAP_ROLE_RTDE && f->meta[1].var == URRT_RTDE_V_INPUT_DOUBLE_REGISTER + 30,
+              "setpoint writes input_double_register_30");
+        CHECK(f->sigs[3].min == -2147483648.0 && f->sigs[3].max == 2147483647.0, "count: its type's whole range");
+        CHECK(f->sigs[4].invalid_raw == 0 && (f->sigs[4].flags & URRT_CAN_SIG_INVALID_RAW) == 0, "no invalid raw");
+        CHECK_EQ_INT(f->meta[4].loc.line, 19);
+    }
+    {
+        const struct can_map_frame *f = &map->inputs[1];
+        CHECK_EQ_STR(f->name, "stop");
+        CHECK(f->id == 0x210 && !f->extended && !f->fd && f->len == 8, "stop: defaults 11-bit, classic, 8 bytes");
+        CHECK(f->timeout_ms == 50 && f->silence == CAN_MAP_SILENCE_HOLD, "stop: 50 ms, hold");
+        CHECK(f->reg_count == 1 && f->regs[0] == URRT_RTDE_V_INPUT_INT_REGISTER + 26, "stop: its one register");
+        CHECK_EQ_STR(f->comment, "");
+    }
+    {
+        uint32_t ids[4] = {0};
+        CHECK_EQ_INT(can_map_input_ids(map, ids, 4), 2);
+        CHECK(ids[0] == (0x18FF1234u | URRT_CANLINK_RX_EXTENDED) && ids[1] == 0x210, "receive ids 0x%X 0x%X",
+              (unsigned)ids[0], (unsigned)ids[1]);
+        CHECK_EQ_INT(can_map_input_ids(map, ids, 1), 1);
+        CHECK(can_map_input_of(map, 0x18FF1234, true) == &map->inputs[0], "input of a 29-bit id");
+        CHECK(can_map_input_of(map, 0x18FF1234, false) == NULL, "an 11-bit frame is not a 29-bit [input]");
+        CHECK(can_map_input_of(map, 0x210, false) == &map->inputs[1] && can_map_input_of(map, 0x211, false) == NULL,
+              "input of an 11-bit id");
+    }
+    {
+        char *text = NULL;
+        size_t size = 0;
+        FILE *out = open_memstream(&text, &size);
+        CHECK_EQ_INT(dbc_write(out, map, "t.ini"), 0);
+        fclose(out);
+        CHECK(strstr(text, "BU_: URRT_GATEWAY CELL_PLC\n") != NULL, "BU_ names both nodes");
+        CHECK(strstr(text, "BO_ " IN_CMD_DBC_ID " cmd: 16 CELL_PLC\n") != NULL, "cmd BO_: sent by the PLC");
+        CHECK(strstr(text, " SG_ setpoint : 7|16@0- (0.01,0.5) [-100|200] \"mm\" URRT_GATEWAY\n") != NULL,
+              "setpoint SG_: received by the gateway");
+        CHECK(strstr(text, " SG_ mask_hi : 24|4@1+ (1,0) [0|15] \"\" URRT_GATEWAY\n") != NULL, "mask_hi SG_");
+        CHECK(strstr(text, "BO_ 528 stop: 8 CELL_PLC\n") != NULL, "stop BO_");
+        CHECK(strstr(text, "BA_ \"VFrameFormat\" BO_ " IN_CMD_DBC_ID " 15;\n") != NULL, "cmd: ExtendedCAN_FD");
+        CHECK(strstr(text, "BA_ \"CANFD_BRS\" BO_ " IN_CMD_DBC_ID " 1;\n") != NULL, "cmd: bit rate switch");
+        CHECK(strstr(text, "BA_ \"GenMsgSendType\" BO_ 528 0;\n") != NULL, "stop: Cyclic");
+        CHECK(strstr(text, "BA_ \"GenMsgCycleTime\" BO_ 528") == NULL &&
+                  strstr(text, "BA_ \"GenMsgCycleTime\" BO_ " IN_CMD_DBC_ID) == NULL,
+              "no cycle time for a frame the PLC sends");
+        CHECK(strstr(text, "CM_ BO_ " IN_CMD_DBC_ID " \"Cell PLC setpoints. Sent by CELL_PLC, received by "
+                           "URRT_GATEWAY, which writes robot arm's input registers over RTDE from it; no frame for "
+                           "250 ms is a silent PLC: on_silence = value 1 (written to every register of the "
+                           "frame).\";\n") != NULL,
+              "cmd CM_ BO_");
+        CHECK(strstr(text, "CM_ SG_ " IN_CMD_DBC_ID " setpoint \"input_double_register_30: RTDE input DOUBLE, "
+                           "written by urrt-gateway to robot arm as raw * factor + offset; a value outside "
+                           "min..max is refused and counted, never clamped; [input cmd] timeout_ms = 250, "
+                           "on_silence = value 1\";\n") != NULL,
+              "setpoint CM_ SG_");
+        CHECK(strstr(text, "CM_ SG_ " IN_CMD_DBC_ID " mask_hi \"input_bit_registers32_to_63: RTDE input UINT32, "
+                           "written by urrt-gateway to robot arm; a bit mask, taken bit for bit (never scaled): bit "
+                           "n of this signal is bit 4+n of the register; [input cmd] timeout_ms = 250, on_silence "
+                           "= value 1\";\n") != NULL,
+              "mask_hi CM_ SG_");
+        CHECK(strstr(text, "CM_ SG_ 528 input_int_register_26 \"input_int_register_26: RTDE input INT32, written "
+                           "by urrt-gateway to robot arm as raw * factor + offset; a value outside min..max is "
+                           "refused and counted, never clamped; [input stop] timeout_ms = 50, on_silence = "
+                           "hold\";\n") != NULL,
+              "stop's CM_ SG_");
+        free(text);
+    }
+    gw_config_free(&cfg);
+}
+
+/* docs/examples/plc-io.ini, as shipped. */
+static void inputs_example(void)
+{
+    gw_config cfg;
+    char *messages = NULL;
+    size_t size = 0;
+    FILE *out = open_memstream(&messages, &size);
+    int errors = gw_config_load(&cfg, "docs/examples/plc-io.ini", out);
+    fclose(out);
+    CHECK(errors == 0, "plc-io.ini: %s", messages);
+    if (errors == 0) {
+        const struct can_map_frame *f = &cfg.can.inputs[0];
+        CHECK(cfg.can.input_count == 1 && cfg.can.frame_count == 1, "one [input], one [frame]");
+        CHECK_EQ_STR(f->name, "plc_command");
+        CHECK(f->id == 0x200 && !f->extended && !f->fd && f->len == 8, "plc_command: 0x200, classic, 8 bytes");
+        CHECK(f->timeout_ms == 100 && f->silence == CAN_MAP_SILENCE_STOP, "plc_command: 100 ms, stop");
+        CHECK(f->reg_count == 3 && f->regs[0] == URRT_RTDE_V_INPUT_INT_REGISTER + 24 &&
+                  f->regs[1] == URRT_RTDE_V_INPUT_BIT_REGISTER + 0 && f->regs[2] == URRT_RTDE_V_INPUT_BIT_REGISTER + 1,
+              "plc_command's recipe: input_int_register_24, input_bit_register_64, input_bit_register_65");
+        CHECK(f->sigs[0].max == 9999 && f->sigs[0].min == 0, "job_number: 0..9999");
+        CHECK(cfg.can.inputs_min_rate_hz == 10.0, "inputs_min_rate = 10 Hz");
+        CHECK_EQ_STR(cfg.can.receiver, "PLC");
+    }
+    gw_config_free(&cfg);
+    free(messages);
+}
+
+/* Each refusal: the whole first message, its line. */
+static const struct rejection input_rejections[] = {
+    {CAN_HEAD "[input a]\nid = 0x200\nsignal = input_int_register_24 @0|16 intel signed\n" RTDE_ROBOT,
+     "t.ini:4: [input a] has no timeout_ms: after how long without the frame is the PLC silent? (the PLC's period "
+     "and some margin, e.g. timeout_ms = 100 for a 20 ms frame)"},
+    {CAN_HEAD "[input a]\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel signed\n" RTDE_ROBOT,
+     "t.ini:4: [input a] has no id"},
+    {CAN_HEAD "[input a]\ntimeout_ms = 0\n" RTDE_ROBOT, "t.ini:5: timeout_ms = '0': give 1..60000 milliseconds"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\non_silence = later\n" RTDE_ROBOT,
+     "t.ini:7: on_silence = 'later': use stop (the program's RTDE watchdog acts), hold (the last values go on) or "
+     "value V (V goes to every register of the frame)"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\non_silence = value x\n" RTDE_ROBOT,
+     "t.ini:7: on_silence = 'value x': value takes a finite number (value 0): not a number (write it in decimal, "
+     "e.g. 2.5)"},
+    {CAN_HEAD "[input a]\nperiod_ms = 10\n" RTDE_ROBOT, "t.ini:5: unknown key \"period_ms\" in [input a] (keys: id, extended, fd, length, robot, "
+                                             "timeout_ms, on_silence, comment, signal)"},
+    /* Ids: one id, one transmitter. */
+    {CAN_HEAD "[frame f]\nid = 0x200\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n"
+              "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel signed\n" RTDE_ROBOT,
+     "t.ini:9: [input a] id 0x200 is already used by [frame f] (line 5): the PLC's frames need ids of their own"},
+    {CAN_HEAD "[input a]\nid = 0x701\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel signed\n"
+              RTDE_ROBOT,
+     "t.ini:5: [input a] id 0x701 is already used by the heartbeat (line 3): the PLC's frames need ids of their own"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel signed\n"
+              "[input b]\nid = 0x200\ntimeout_ms = 100\nsignal = input_int_register_25 @0|16 intel signed\n" RTDE_ROBOT,
+     "t.ini:9: [input b] id 0x200 is already used by [input a] (line 5): the PLC's frames need ids of their own"},
+    {CAN_HEAD "[input a]\nid = 0x800\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel signed\n"
+              RTDE_ROBOT,
+     "t.ini:5: [input a] id 0x800 is past 0x7FF, the largest 11-bit id: set extended = yes for a 29-bit id"},
+    {CAN_HEAD "[frame a]\nid = 0x100\nperiod_ms = 10\nsignal = time @0|8 intel unsigned\n[input a]\nid = 0x200\n"
+              RTDE_ROBOT,
+     "t.ini:8: [input a]: [frame a] is already defined at line 4: frame names must be unique (the DBC names each "
+     "message)"},
+    {CAN_HEAD "[input a]\nid = 0x200\n[input a]\nid = 0x201\n" RTDE_ROBOT,
+     "t.ini:6: [input a] is already defined at line 4: frame names must be unique (the DBC names each message)"},
+    {CAN_HEAD "[input urrt_heartbeat]\nid = 0x200\n" RTDE_ROBOT, "t.ini:4: [input urrt_heartbeat]: that name is the "
+                                                                 "heartbeat's"},
+    /* What a signal may write: general purpose input registers only. */
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = speed_slider_fraction @0|16 intel unsigned\n"
+              RTDE_ROBOT,
+     "t.ini:7: signal: speed_slider_fraction is an RTDE input that acts on the robot's hardware with no robot "
+     "program deciding: urrt never writes it; an [input] writes only general purpose input registers "
+     "(input_int_register_N, input_double_register_N (N 0..47), input_bit_register_N (N 64..127), "
+     "input_bit_registers0_to_31, input_bit_registers32_to_63)"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = standard_digital_output_mask @0|8 intel unsigned\n"
+              RTDE_ROBOT,
+     "t.ini:7: signal: standard_digital_output_mask is an RTDE input that acts on the robot's hardware with no "
+     "robot program deciding: urrt never writes it; an [input] writes only general purpose input registers "
+     "(input_int_register_N, input_double_register_N (N 0..47), input_bit_register_N (N 64..127), "
+     "input_bit_registers0_to_31, input_bit_registers32_to_63)"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = actual_q[0] @0|16 intel signed\n" RTDE_ROBOT,
+     "t.ini:7: signal: q_actual is not an input register: an [input] writes only general purpose input registers "
+     "(input_int_register_N, input_double_register_N (N 0..47), input_bit_register_N (N 64..127), "
+     "input_bit_registers0_to_31, input_bit_registers32_to_63); a value the robot sends goes in a [frame]"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = output_int_register_24 @0|16 intel signed\n"
+              RTDE_ROBOT,
+     "t.ini:7: signal: output_int_register_24 is not an input register: an [input] writes only general purpose "
+     "input registers (input_int_register_N, input_double_register_N (N 0..47), input_bit_register_N (N 64..127), "
+     "input_bit_registers0_to_31, input_bit_registers32_to_63); a value the robot sends goes in a [frame]"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = input_bit_register_63 @0|1 intel unsigned\n"
+              RTDE_ROBOT,
+     "t.ini:7: signal: no field 'input_bit_register_63' (field names as in docs/protocol.md: q_actual, tcp_force, "
+     "robot_mode, ...; RTDE-only values by their RTDE names: output_int_register_24, ...)"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel signed invalid=0\n"
+              RTDE_ROBOT,
+     "t.ini:7: signal: invalid= is for frames the gateway sends; an [input]'s value outside min..max is refused "
+     "and counted"},
+    /* One register, one signal, one source. */
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel signed\n"
+              "signal = input_int_register_24 @16|16 intel signed name=again\n" RTDE_ROBOT,
+     "t.ini:8: [input a] signal 'again' writes the register signal 'input_int_register_24' (line 7) writes: one "
+     "register, one signal (bits of a mask: disjoint bits=)"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\n"
+              "signal = input_bit_registers32_to_63 @0|4 intel unsigned bits=0-3 name=m1\n"
+              "signal = input_bit_registers32_to_63 @8|4 intel unsigned bits=3-6 name=m2\n" RTDE_ROBOT,
+     "t.ini:8: [input a] signal 'm2' writes the register signal 'm1' (line 7) writes: one register, one signal "
+     "(bits of a mask: disjoint bits=)"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel signed\n"
+              "[input b]\nid = 0x201\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel signed name=b24\n"
+              RTDE_ROBOT,
+     "t.ini:11: [input b] signal 'b24': its register is written by [input a] signal 'input_int_register_24' "
+     "(line 7) already: one register, one source"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\n"
+              "signal = input_bit_registers0_to_31 @0|4 intel unsigned bits=30-33\n" RTDE_ROBOT,
+     "t.ini:7: [input a] signal 'input_bit_registers0_to_31' carries bits 30-33 of input_bit_registers0_to_31, "
+     "which has 32 (0..31): shorten it, or pick them with bits="},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\n"
+              "signal = input_bit_registers0_to_31 @0|40 intel unsigned\n" RTDE_ROBOT,
+     "t.ini:7: [input a] signal 'input_bit_registers0_to_31' carries bits 0-39 of input_bit_registers0_to_31, "
+     "which has 32 (0..31): shorten it, or pick them with bits="},
+    /* on_silence = value V: a value every register of the frame takes. */
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\non_silence = value 0.5\n"
+              "signal = input_int_register_24 @0|16 intel signed\n" RTDE_ROBOT,
+     "t.ini:7: [input a] on_silence = value 0.5: input_int_register_24 does not take it (an integer register an "
+     "integer in its range, a bit 0 or 1, a mask word 0..4294967295)"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\non_silence = value 2\n"
+              "signal = input_double_register_24 @0|16 intel signed\n"
+              "signal = input_bit_register_64 @16|1 intel unsigned\n" RTDE_ROBOT,
+     "t.ini:7: [input a] on_silence = value 2: input_bit_register_64 does not take it (an integer register an "
+     "integer in its range, a bit 0 or 1, a mask word 0..4294967295)"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\non_silence = value -1\n"
+              "signal = input_int_register_24 @0|16 intel signed min=0\n" RTDE_ROBOT,
+     "t.ini:7: [input a] on_silence = value -1 is outside signal 'input_int_register_24''s min..max (0..32767): "
+     "a value the PLC could never send"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\non_silence = value -1\n"
+              "signal = input_bit_registers32_to_63 @0|8 intel unsigned\n" RTDE_ROBOT,
+     "t.ini:7: [input a] on_silence = value -1: input_bit_registers32_to_63 does not take it (an integer register "
+     "an integer in its range, a bit 0 or 1, a mask word 0..4294967295)"},
+    /* Signals, lengths, FD. */
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\n" RTDE_ROBOT,
+     "t.ini:4: [input a] has no signal (signal = input_int_register_24 @0|32 intel signed, ...)"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nlength = 12\nsignal = input_int_register_24 @0|16 intel "
+              "signed\n" RTDE_ROBOT,
+     "t.ini:7: [input a] length 12: a classic CAN frame carries at most 8 bytes (fd = yes for up to 64)"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nfd = yes\nlength = 12\n"
+              "signal = input_int_register_24 @0|16 intel signed\n" RTDE_ROBOT,
+     "t.ini:7: [input a] is a CAN FD frame but [can] fd is not yes"},
+    {CAN_HEAD "fd = yes\n[input a]\nid = 0x200\ntimeout_ms = 100\nfd = yes\nlength = 10\n"
+              "signal = input_int_register_24 @0|16 intel signed\n" RTDE_ROBOT,
+     "t.ini:9: [input a] length 10 is not a CAN FD length (0-8, 12, 16, 20, 24, 32, 48, 64): use 12"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nlength = 2\nsignal = input_int_register_24 @8|16 intel "
+              "signed\n" RTDE_ROBOT,
+     "t.ini:8: [input a] signal 'input_int_register_24' (@8|16) reaches byte 2, past the frame's length 2"},
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel signed\n"
+              "signal = input_int_register_25 @8|16 intel signed\n" RTDE_ROBOT,
+     "t.ini:8: [input a] signal 'input_int_register_25' overlaps signal 'input_int_register_24' (line 7)"},
+    /* The robot: one that reads RealTime never writes. */
+    {CAN_HEAD "[input a]\nid = 0x200\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel signed\n"
+              "[robot arm]\nhost = h\n",
+     "t.ini:4: [input a] writes robot \"arm\"'s input registers, and that robot reads RealTime, which never "
+     "writes: add \"source = rtde\" to [robot arm] (RTDE, port 30004) or remove the [input]"},
+    {CAN_HEAD "[input a]\nid = 0x200\nrobot = bob\ntimeout_ms = 100\nsignal = input_int_register_24 @0|16 intel "
+              "signed\n" RTDE_ROBOT,
+     "t.ini:6: [input a]: unknown robot 'bob' (robots: arm)"},
+};
+
+static void inputs_rejections(void)
+{
+    for (size_t i = 0; i < sizeof input_rejections / sizeof input_rejections[0]; i++) {
+        gw_config cfg;
+        char err[4096] = "", first[1024];
+        const char *want = input_rejections[i].expect;
+        int errors = load_cfg(&cfg, input_rejections[i].config, err, sizeof err);
+        first_line(err, first, sizeof first);
+        CHECK(errors > 0 && strcmp(first, want) == 0, "[input] rejection %zu:\n  got:  %s\n  want: %s", i, first,
+              want);
+        gw_config_free(&cfg);
+    }
+}
+
+/* An FD [input] of 64 bytes writing bit registers 64..127 (lines 10..73), and with one more
+ * register, input_int_register_24, at line 74. */
+static void many_registers(char *text, size_t size, bool one_more)
+{
+    int n = snprintf(text, size, CAN_HEAD "fd = yes\n[input a]\nid = 0x200\nfd = yes\nlength = 64\ntimeout_ms = 100\n");
+    for (int b = 0; b < 64; b++) {
+        n += snprintf(text + n, size - (size_t)n, "signal = input_bit_register_%d @%d|1 intel unsigned\n", 64 + b, b);
+    }
+    snprintf(text + n, size - (size_t)n, "%s%s", one_more ? "signal = input_int_register_24 @64|32 intel signed\n" : "",
+             RTDE_ROBOT);
+}
+
+/* One input recipe takes URRT_RTDE_IN_MAX_VARS (64) registers. */
+static void inputs_too_many_registers(void)
+{
+    char text[8192];
+    gw_config cfg;
+    char err[4096] = "", first[1024];
+    many_registers(text, sizeof text, true);
+    CHECK(load_cfg(&cfg, text, err, sizeof err) > 0, "65 registers in one [input] accepted");
+    first_line(err, first, sizeof first);
+    CHECK_EQ_STR(first, "t.ini:74: [input a] writes more than 64 registers: one input recipe takes at most 64; split "
+                        "the frame");
+    gw_config_free(&cfg);
+    many_registers(text, sizeof text, false);
+    CHECK(load_cfg(&cfg, text, err, sizeof err) == 0, "64 registers: %s", err);
+    CHECK(cfg.can.input_count == 1 && cfg.can.inputs[0].reg_count == 64 &&
+              cfg.can.inputs[0].regs[0] == URRT_RTDE_V_INPUT_BIT_REGISTER &&
+              cfg.can.inputs[0].regs[63] == URRT_RTDE_V_INPUT_BIT_REGISTER + 63,
+          "64 registers, in order");
+    gw_config_free(&cfg);
+}
+
+/* What the refusals leave: one id of each kind, one register per robot. */
+static void inputs_accepted_apart(void)
+{
+    gw_config cfg;
+    char err[4096] = "";
+    int errors = load_cfg(&cfg,
+                          CAN_HEAD "heartbeat_robot = left\n"
+                          "[input a]\nid = 0x200\nrobot = left\ntimeout_ms = 100\n"
+                          "signal = input_int_register_24 @0|16 intel signed\n"
+                          "[input b]\nid = 0x200\nextended = yes\nrobot = right\ntimeout_ms = 100\n"
+                          "signal = input_int_register_24 @0|16 intel signed\n"
+                          "[robot left]\nhost = h\nversion = 5.10\nsource = rtde\n"
+                          "[robot right]\nhost = h2\nversion = 5.10\nsource = rtde\n",
+                          err, sizeof err);
+    CHECK(errors == 0, "an 11-bit and a 29-bit id 0x200, one register on two robots: %s", err);
+    if (errors == 0) {
+        CHECK(cfg.can.input_count == 2 && cfg.can.inputs[0].robot_index == 0 && cfg.can.inputs[1].robot_index == 1,
+              "each [input] its robot");
+        CHECK(can_map_input_of(&cfg.can, 0x200, false) == &cfg.can.inputs[0] &&
+                  can_map_input_of(&cfg.can, 0x200, true) == &cfg.can.inputs[1],
+              "0x200 and 29-bit 0x200 are two frames");
+    }
+    gw_config_free(&cfg);
+}
+
+static void test_inputs(void)
+{
+    inputs_accepted();
+    inputs_example();
+    inputs_rejections();
+    inputs_accepted_apart();
+    inputs_too_many_registers();
+}
+
 int main(void)
 {
     test_config_good();
@@ -1389,5 +1773,6 @@ int main(void)
     test_masks();
     test_dbc_text();
     test_rtde_values();
+    test_inputs();
     return check_report();
 }

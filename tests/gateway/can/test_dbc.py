@@ -12,6 +12,10 @@
   lengths, signals across bytes, 1 to 64 bits, signed, unsigned, float32 and
   float64, classic and FD frames. Random payloads decode the same through
   urrt_can_unpack and canmatrix.
+- [input NAME] frames (the PLC's, which the gateway receives) are in the DBC
+  too, sent by [can] receiver, their signals received by [can] node
+  (check_dbc_input.py has the rest of them: values through canmatrix and
+  the gateway's own unpacking, both ways, and the C tables).
 - docs/examples/*.ini validate and give DBCs that canmatrix loads, and the
   frames the scheduler emits for a scripted robot decode through the DBC to
   the robot's values within the scaling (canopen.ini, j1939.ini).
@@ -245,11 +249,12 @@ def parse_config(path):
                 can['generation'] = int(value[0])
         elif section == 'canopen' and key == 'node_id':
             can['node_id'] = int(value, 0)
-        elif section and section.startswith('frame '):
-            name = section.split(None, 1)[1]
+        elif section and (section.startswith('frame ') or section.startswith('input ')):
+            kind, name = section.split(None, 1)
             if name not in frames:
                 frames[name] = {'name': name, 'extended': False, 'fd': False, 'length': 8, 'signals': [],
-                                'policy': 'stop', 'stale': None, 'every': False}
+                                'policy': 'stop', 'stale': None, 'every': False, 'input': kind == 'input',
+                                'timeout': None, 'silence': 'stop', 'robot': None, 'comment': None}
                 order.append(name)
             f = frames[name]
             if key == 'id':
@@ -273,11 +278,17 @@ def parse_config(path):
                 f['stale'] = int(value)
             elif key == 'comment':
                 f['comment'] = value
+            elif key == 'timeout_ms':
+                f['timeout'] = int(value)
+            elif key == 'on_silence':
+                f['silence'] = ' '.join(value.split())
+            elif key == 'robot':
+                f['robot'] = value
     for f in frames.values():
         if f['stale'] is None:
             f['stale'] = can['stale']
     if 'node_id' in can:
-        canopen_ids(can, [frames[n] for n in order])
+        canopen_ids(can, [frames[n] for n in order if not frames[n]['input']])
     return can, [frames[n] for n in order]
 
 
@@ -436,15 +447,27 @@ def compare_dbc(label, db, can, frames, robot_period_us):
               d.size == f['length'] and d.is_fd == f['fd'])
         check(ok, '%s: %s id, format and length' % (label, f['name']),
               (hex(d.arbitration_id.id), d.arbitration_id.extended, d.size, d.is_fd))
-        cycle = -(-robot_period_us // 1000) if f['every'] else f['period']
-        check(d.cycle_time == cycle, '%s: %s GenMsgCycleTime' % (label, f['name']), (d.cycle_time, cycle))
+        if f['input']:  # the PLC's period is its own: no GenMsgCycleTime (its default 0)
+            check(d.cycle_time == 0 and 'GenMsgCycleTime' not in d.attributes,
+                  '%s: %s has no GenMsgCycleTime' % (label, f['name']), d.attributes)
+        else:
+            cycle = -(-robot_period_us // 1000) if f['every'] else f['period']
+            check(d.cycle_time == cycle, '%s: %s GenMsgCycleTime' % (label, f['name']), (d.cycle_time, cycle))
         fmt = ('Extended' if f['extended'] else 'Standard') + 'CAN' + ('_FD' if f['fd'] else '')
         check(d.attributes.get('VFrameFormat') == fmt and d.attributes.get('GenMsgSendType') == 'Cyclic',
               '%s: %s VFrameFormat and GenMsgSendType' % (label, f['name']), d.attributes)
         if f['fd']:
             brs = '1' if can['data_bitrate'] > can['bitrate'] else '0'
             check(d.attributes.get('CANFD_BRS') == brs, '%s: %s CANFD_BRS' % (label, f['name']), d.attributes)
-        check(d.transmitters == [can['node']], '%s: %s transmitter' % (label, f['name']), d.transmitters)
+        if f['input']:  # sent by the PLC ([can] receiver; Vector__XXX: no node, which canmatrix drops)
+            want_tx = [] if can['receiver'] == 'Vector__XXX' else [can['receiver']]
+            check(d.transmitters == want_tx, '%s: %s is sent by the PLC' % (label, f['name']), d.transmitters)
+            check(d.comment is not None and d.comment.startswith(f['comment'] + '. ' if f['comment'] else 'Sent by ')
+                  and ('no frame for %d ms is a silent PLC: on_silence = %s' % (f['timeout'], f['silence']))
+                  in d.comment, '%s: %s comment: its comment=, timeout and on_silence' % (label, f['name']),
+                  d.comment)
+        else:
+            check(d.transmitters == [can['node']], '%s: %s transmitter' % (label, f['name']), d.transmitters)
         check(len(d.signals) == len(f['signals']), '%s: %s signal count' % (label, f['name']))
         for s in f['signals']:
             ds = d.signal_by_name(s['name'])
@@ -456,7 +479,10 @@ def compare_dbc(label, db, can, frames, robot_period_us):
                     s['type'] in ('float32', 'float64'), s['factor'], s['offset'], s['min'], s['max'], s['unit'])
             check(got == want, '%s: %s.%s layout and scaling' % (label, f['name'], s['name']),
                   '%s vs %s' % (got, want))
-            if can['receiver'] != 'Vector__XXX':
+            if f['input']:
+                check(ds.receivers == [can['node']], '%s: %s.%s is received by the gateway' % (
+                    label, f['name'], s['name']), ds.receivers)
+            elif can['receiver'] != 'Vector__XXX':
                 check(ds.receivers == [can['receiver']], '%s: %s.%s receiver' % (label, f['name'], s['name']),
                       ds.receivers)
             if s['role'] == 'field':
@@ -466,7 +492,18 @@ def compare_dbc(label, db, can, frames, robot_period_us):
                 check(ds.comment is not None and ds.comment.startswith(ref + ':') and
                       ('column %d' % (col + s['elem'])) in ds.comment,
                       '%s: %s.%s comment names the field and column' % (label, f['name'], s['name']), ds.comment)
-            if s['role'] == 'rtde':
+            if s['role'] == 'rtde' and f['input']:
+                info = RTDE_ONLY[s['field']]
+                want = '%s: RTDE input %s, written by urrt-gateway to robot ' % (s['field'], info['type'])
+                check(ds.comment is not None and ds.comment.startswith(want) and ds.comment.endswith(
+                      '; [input %s] timeout_ms = %d, on_silence = %s' % (f['name'], f['timeout'], f['silence'])),
+                      '%s: %s.%s comment names the register, the timeout and on_silence' % (
+                          label, f['name'], s['name']), ds.comment)
+                if s['mask']:
+                    check('bit n of this signal is bit %d+n of the register' % s['first'] in ds.comment,
+                          '%s: %s.%s comment: a mask from bit %d' % (label, f['name'], s['name'], s['first']),
+                          ds.comment)
+            elif s['role'] == 'rtde':
                 info = RTDE_ONLY[s['field']]
                 ref = '%s[%d]' % (s['field'], s['elem']) if info['count'] > 1 else s['field']
                 check(ds.comment is not None and ds.comment.startswith('%s: RTDE output %s' % (ref, info['type'])),

@@ -19,7 +19,12 @@
  *     valid and unique id, a C identifier as name and a CAN length, every
  *     signal is a unique C identifier that fits its frame without overlap,
  *     with finite scaling and min <= max; every reference names a frame and
- *     signal that exist;
+ *     signal that exist; the frames the gateway sends come first, the
+ *     heartbeat last of them, then exactly the [input]s, each sent by [can]
+ *     receiver with its configured id, length and signals, each signal
+ *     received by [can] node;
+ *   - its C tables (--print-c-tables) are written, free of control
+ *     characters, with one urrt_gateway_inputs entry per [input];
  *   - loading the same bytes again gives the same messages and the same DBC;
  *   - the scheduler runs on it (packets with ordinary, huge and NaN values, a
  *     stall, the link down): each frame sent is a configured one, with its
@@ -40,6 +45,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "can_ctables.h"
 #include "can_map.h"
 #include "can_run.h"
 #include "config.h"
@@ -247,12 +253,14 @@ static void check_accepted(const gw_config *cfg)
 
 struct dbc_signal {
     char name[CAN_MAP_NAME_MAX + 1];
+    char receiver[CAN_MAP_NAME_MAX + 1];
     unsigned len;
 };
 
 struct dbc_frame {
     unsigned long id;
     char name[CAN_MAP_NAME_MAX + 1];
+    char transmitter[CAN_MAP_NAME_MAX + 1];
     unsigned len;
     struct dbc_signal *sig; /* nsig of dbc_read.sigs */
     unsigned nsig;
@@ -346,6 +354,7 @@ static void dbc_bo(struct dbc_read *d, const char *line)
     memset(f, 0, sizeof *f);
     f->id = id;
     memcpy(f->name, line + name_at, (size_t)(name_end - name_at));
+    snprintf(f->transmitter, sizeof f->transmitter, "%s", node);
     f->len = len;
     f->sig = d->sigs + d->nsigs;
 }
@@ -387,6 +396,7 @@ static void dbc_sg(struct dbc_read *d, const char *line)
     }
     dbc_place(f, name, start, length, order);
     snprintf(f->sig[f->nsig].name, sizeof f->sig[0].name, "%s", name);
+    snprintf(f->sig[f->nsig].receiver, sizeof f->sig[0].receiver, "%s", receiver);
     f->sig[f->nsig++].len = length;
     d->nsigs++;
 }
@@ -485,7 +495,47 @@ static void dbc_other(const struct dbc_read *d, const char *line)
     }
 }
 
-static void dbc_check(const char *text, size_t len)
+/* The order of the frames and who sends them: the map's [frame]s and the
+ * heartbeat, sent by the gateway's node, then its [input]s, sent by the PLC
+ * ([can] receiver) to the gateway, each as configured. */
+static void dbc_directions(const struct dbc_read *d, const struct can_map *map)
+{
+    size_t sent = d->count;
+    for (unsigned i = 0; i < d->count; i++) {
+        if (strcmp(d->frames[i].name, CAN_MAP_HEARTBEAT_NAME) == 0) {
+            sent = i + 1;
+        }
+    }
+    if (sent != map->frame_count + 1 || d->count != sent + map->input_count) {
+        violated("DBC: %u frames, the heartbeat at %zu; the map has %zu frames and %zu inputs", d->count, sent,
+                 map->frame_count, map->input_count);
+    }
+    for (size_t i = 0; i < sent; i++) {
+        if (strcmp(d->frames[i].transmitter, map->node) != 0) {
+            violated("DBC: frame %s is sent by %s, not the gateway's node %s", d->frames[i].name,
+                     d->frames[i].transmitter, map->node);
+        }
+    }
+    for (size_t i = 0; i < map->input_count; i++) {
+        const struct can_map_frame *in = &map->inputs[i];
+        const struct dbc_frame *f = &d->frames[sent + i];
+        unsigned long id = in->extended ? (unsigned long)in->id | 0x80000000ul : (unsigned long)in->id;
+        if (f->id != id || strcmp(f->name, in->name) != 0 || f->len != in->len || f->nsig != in->count ||
+            strcmp(f->transmitter, map->receiver) != 0) {
+            violated("DBC: [input %s] is BO_ %lu %s: %u %s with %u signals; configured %lu, %u bytes, %zu signals, "
+                     "sent by %s", in->name, f->id, f->name, f->len, f->transmitter, f->nsig, id, (unsigned)in->len,
+                     in->count, map->receiver);
+        }
+        for (unsigned k = 0; k < f->nsig; k++) {
+            if (strcmp(f->sig[k].receiver, map->node) != 0 || strcmp(f->sig[k].name, in->meta[k].name) != 0) {
+                violated("DBC: [input %s] signal %s is received by %s, not the gateway's node %s", in->name,
+                         f->sig[k].name, f->sig[k].receiver, map->node);
+            }
+        }
+    }
+}
+
+static void dbc_check(const char *text, size_t len, const struct can_map *map)
 {
     struct dbc_read d;
     char *copy = strndup(text, len);
@@ -521,9 +571,7 @@ static void dbc_check(const char *text, size_t len)
             dbc_other(&d, line);
         }
     }
-    if (d.count < 1 || strcmp(d.frames[d.count - 1].name, CAN_MAP_HEARTBEAT_NAME) != 0) {
-        violated("DBC: the heartbeat frame is not the last frame");
-    }
+    dbc_directions(&d, map);
     for (unsigned i = 0; i < d.count; i++) {
         if (d.frames[i].nsig == 0) {
             violated("DBC: frame %s has no signal", d.frames[i].name);
@@ -546,6 +594,41 @@ static char *write_dbc(const gw_config *cfg, size_t *len)
     }
     fclose(out);
     return text;
+}
+
+/* ---- the C tables ------------------------------------------------------------------- */
+
+/* --print-c-tables, as urrt-gateway writes it: written, without control
+ * characters, with one urrt_gateway_inputs entry per [input]. */
+static void check_ctables(const gw_config *cfg)
+{
+    struct can_ctables_robot robots[GW_MAX_ROBOTS];
+    char *text = NULL;
+    size_t len = 0;
+    size_t entries = 0;
+    char want[64];
+    FILE *out = open_memstream(&text, &len);
+    if (out == NULL) {
+        abort();
+    }
+    for (unsigned i = 0; i < cfg->robot_count && i < GW_MAX_ROBOTS; i++) {
+        robots[i].rtde = cfg->robots[i].source == GW_SOURCE_RTDE;
+        robots[i].frequency = cfg->robots[i].rtde_frequency;
+        robots[i].port = cfg->robots[i].port;
+    }
+    if (can_ctables_write(out, &cfg->can, cfg->can_run, cfg->co_run, robots, cfg->path) != 0) {
+        violated("can_ctables_write failed on an accepted configuration");
+    }
+    fclose(out);
+    no_control("the C tables", text, len, false);
+    for (const char *p = strstr(text, "\n    {input_"); p != NULL; p = strstr(p + 1, "\n    {input_")) {
+        entries++;
+    }
+    snprintf(want, sizeof want, "urrt_gateway_inputs[%zu] = {", cfg->can.input_count);
+    if (entries != cfg->can.input_count || (cfg->can.input_count > 0) != (strstr(text, want) != NULL)) {
+        violated("C tables: %zu urrt_gateway_inputs entries for %zu [input]s", entries, cfg->can.input_count);
+    }
+    free(text);
 }
 
 /* ---- the scheduler ------------------------------------------------------------------- */
@@ -689,8 +772,9 @@ static void check_can_only(const char *data, size_t size)
     if (l.errors == 0 && l.cfg.can_run != NULL) {
         size_t dbc_len;
         char *dbc = write_dbc(&l.cfg, &dbc_len);
-        dbc_check(dbc, dbc_len);
+        dbc_check(dbc, dbc_len, &l.cfg.can);
         free(dbc);
+        check_ctables(&l.cfg);
         run_schedule(&l.cfg.can, l.cfg.can_run);
     }
     unload(&l);
@@ -729,9 +813,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (len_a != len_b || memcmp(dbc_a, dbc_b, len_a) != 0) {
                 violated("two loads of the same bytes give different DBCs");
             }
-            dbc_check(dbc_a, len_a);
+            dbc_check(dbc_a, len_a, &a.cfg.can);
             free(dbc_a);
             free(dbc_b);
+            check_ctables(&a.cfg);
             run_schedule(&a.cfg.can, a.cfg.can_run);
         }
     }

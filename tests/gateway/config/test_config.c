@@ -466,7 +466,7 @@ static void test_refusals(void)
          "t.ini:2: host \"[fe80::1]\": write the address without brackets (host = fe80::1)\n"
          "t.ini:1: [robot a] has no host: add \"host = ADDRESS\"\n"},
         {"[robot a]\nhost = h\n" CAN_TEXT "[frame f]\nid = 0x100\n[frame f]\nperiod_ms = 10\n",
-         "t.ini:8: [frame f] is already defined at line 6: frame names must be unique\n"
+         "t.ini:8: [frame f] is already defined at line 6: frame names must be unique (the DBC names each message)\n"
          "t.ini:6: [frame f] has no period_ms (milliseconds, or every)\n"
          "t.ini:6: [frame f] has no signal (signal = FIELD[ELEM] @START|LENGTH ...)\n"},
     };
@@ -651,7 +651,7 @@ static void test_causes_first(void)
          "t.ini:1: [robot arm1] has no host: add \"host = ADDRESS\"\n"},
         {"[lcm]\nstate_rate = 10 Hz\n[robto arm1]\nhost = h\n",
          "t.ini:3: unknown section [robto arm1]: did you mean [robot NAME]? (sections: [gateway], [robot NAME], "
-         "[lcm], [can], [frame NAME], [canopen])\n"
+         "[lcm], [can], [frame NAME], [input NAME], [canopen])\n"
          "t.ini: no robot: edit t.ini and add a section \"[robot NAME]\" with \"host = ADDRESS\" (the installed "
          "file has one commented out)\n"},
         {"[robot a]\nhost = h\n" CAN_TEXT "[frame f]\nid = 0x100\nperoid_ms = 10\nsignal = time @0|8 intel unsigned\n",
