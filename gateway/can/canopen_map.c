@@ -175,6 +175,11 @@ uint32_t canopen_predefined_tpdo_id(unsigned n, uint32_t node_id)
     return n >= 1u && n <= 4u ? 0x180u + 0x100u * (n - 1u) + node_id : 0u;
 }
 
+uint32_t canopen_predefined_rpdo_id(unsigned n, uint32_t node_id)
+{
+    return n >= 1u && n <= URRT_CO_MAX_RPDOS ? 0x200u + 0x100u * (n - 1u) + node_id : 0u;
+}
+
 /* CiA 301 (as lib/urrt_co.c keeps them): NMT, SYNC and EMCY, SDO, NMT error control, LSS. */
 bool canopen_id_restricted(uint32_t id)
 {
@@ -311,6 +316,32 @@ static int frame_id(struct canopen_map *co, struct can_map *can, size_t i, bool 
     return 0;
 }
 
+/* [input] i is RPDO i + 1, on its pre-defined COB-ID: CiA 301's set has
+ * four, and the manager moves one by 0x1400 + n sub 1 if it wants. */
+static int input_id(struct canopen_map *co, struct can_map *can, size_t i)
+{
+    struct can_map_frame *f = &can->inputs[i];
+    unsigned n = (unsigned)i + 1u;
+    uint32_t pre = canopen_predefined_rpdo_id(n, co->node_id);
+    if (pre == 0) {
+        problem(can, f->loc, "[input %s] would be RPDO%u: the node receives RPDO1..%u (CiA 301's pre-defined "
+                "set): join it with another [input], at most %u with [canopen]", f->name, n,
+                (unsigned)URRT_CO_MAX_RPDOS, (unsigned)URRT_CO_MAX_RPDOS);
+        return 1;
+    }
+    if (f->key_loc[CAN_MAP_IK_ID].line != 0 && (f->id != pre || f->extended)) {
+        problem(can, f->key_loc[CAN_MAP_IK_ID], "[input %s] id = 0x%X is not RPDO%u's COB-ID for node_id %u (0x%03X): "
+                "remove id (it follows from node_id; the manager may move it through 0x%04X sub 1)", f->name,
+                (unsigned)f->id, n, (unsigned)co->node_id, (unsigned)pre, 0x1400u + n - 1u);
+        return 1;
+    }
+    f->id = pre; /* as if the file said it, on the header's line */
+    if (f->key_loc[CAN_MAP_IK_ID].line == 0) {
+        f->key_loc[CAN_MAP_IK_ID] = f->loc;
+    }
+    return 0;
+}
+
 /* [can]'s heartbeat frame is the node's status TPDO (off by default); the
  * NMT heartbeat at 0x700 + node id replaces it on the bus. */
 static int status_id(struct canopen_map *co, struct can_map *can)
@@ -371,20 +402,24 @@ int canopen_map_prepare(struct canopen_map *co, struct can_map *can)
     for (size_t i = 0; i < can->frame_count && co->tpdo_of != NULL; i++) {
         errors += frame_id(co, can, i, has_node);
     }
+    for (size_t i = 0; i < can->input_count; i++) {
+        errors += input_id(co, can, i);
+    }
     node_traffic(co, can);
     return errors + status_id(co, can);
 }
 
 /* ---- after can_map_finish: the PDO layout ---------------------------------------------- */
 
-static int check_frame(const struct canopen_map *co, const struct can_map *can, size_t i)
+/* A PDO's layout: classic, 11-bit, at most 8 bytes, each signal an object
+ * of whole bytes of its own. what: "[frame x]", pdo: "TPDO3". */
+static int pdo_layout(const struct can_map *can, const struct can_map_frame *f, const char *what, const char *pdo)
 {
-    const struct can_map_frame *f = &can->frames[i];
     uint8_t owner[URRT_CAN_CLASSIC_MAX_LEN];
     int errors = 0;
     if (f->extended || f->fd || f->len > URRT_CAN_CLASSIC_MAX_LEN) {
-        problem(can, f->loc, "[frame %s] (TPDO%u) is %s: a TPDO is a classic CAN frame with an 11-bit id, 0..8 bytes",
-                f->name, co->tpdo_of[i], f->extended ? "extended (29-bit)" : "CAN FD or longer than 8 bytes");
+        problem(can, f->loc, "%s (%s) is %s: a PDO is a classic CAN frame with an 11-bit id, 0..8 bytes", what, pdo,
+                f->extended ? "extended (29-bit)" : "CAN FD or longer than 8 bytes");
         return 1;
     }
     memset(owner, 0xFF, sizeof owner);
@@ -394,15 +429,21 @@ static int check_frame(const struct canopen_map *co, const struct can_map *can, 
         unsigned bytes;
         unsigned first = f->sigs[k].start / 8u;
         if (!canopen_signal_object(&f->sigs[k], &f->meta[k], &type, &bytes, why, sizeof why)) {
-            problem(can, f->meta[k].loc, "[frame %s] signal %s %s", f->name, f->meta[k].name, why);
+            problem(can, f->meta[k].loc, "%s signal %s %s", what, f->meta[k].name, why);
+            errors++;
+            continue;
+        }
+        if (f->input && type == URRT_CO_REAL32) {
+            problem(can, f->meta[k].loc, "%s signal %s is float32: an RPDO writes INTEGERn and UNSIGNEDn objects: "
+                    "send an integer and scale it (factor=0.001)", what, f->meta[k].name);
             errors++;
             continue;
         }
         for (unsigned b = first; b < first + bytes; b++) {
             if (b >= f->len || owner[b] != 0xFF) {
                 problem(can, f->meta[k].loc,
-                        "[frame %s] signal %s: its %u-byte object needs byte %u %s: a PDO maps whole bytes, one "
-                        "signal each", f->name, f->meta[k].name, bytes, b,
+                        "%s signal %s: its %u-byte object needs byte %u %s: a PDO maps whole bytes, one "
+                        "signal each", what, f->meta[k].name, bytes, b,
                         b >= f->len ? "past the frame's length" : "that another signal uses");
                 errors++;
                 break;
@@ -411,6 +452,14 @@ static int check_frame(const struct canopen_map *co, const struct can_map *can, 
         }
     }
     return errors;
+}
+
+static int check_frame(const struct canopen_map *co, const struct can_map *can, size_t i)
+{
+    char what[48], pdo[16];
+    snprintf(what, sizeof what, "[frame %s]", can->frames[i].name);
+    snprintf(pdo, sizeof pdo, "TPDO%u", co->tpdo_of[i]);
+    return pdo_layout(can, &can->frames[i], what, pdo);
 }
 
 int canopen_map_orphans(const struct canopen_map *co, const struct can_map *can)
@@ -428,9 +477,42 @@ int canopen_map_orphans(const struct canopen_map *co, const struct can_map *can)
     return errors;
 }
 
+/* An [input] on one of the node's own ids would take its frames (an [input]
+ * sees every frame first) or answer for it: refused, naming the id's role. */
+static int check_input_ids(const struct canopen_map *co, const struct can_map *can)
+{
+    const uint32_t n = co->node_id;
+    const struct { uint32_t id; const char *role; } node[] = {
+        {0x000u, "NMT"}, {0x080u, "SYNC (0x1005's default)"}, {0x080u + n, "the node's EMCY (0x080 + node_id)"},
+        {0x580u + n, "the node's SDO answers (0x580 + node_id)"},
+        {0x600u + n, "the node's SDO requests (0x600 + node_id)"},
+        {0x700u + n, "the node's heartbeat (0x700 + node_id)"},
+    };
+    int errors = 0;
+    for (size_t i = 0; i < can->input_count; i++) {
+        const struct can_map_frame *f = &can->inputs[i];
+        for (size_t k = 0; k < sizeof node / sizeof node[0] && !f->extended; k++) {
+            if (f->id == node[k].id) {
+                problem(can, loc_or(f->key_loc[CAN_MAP_IK_ID], f->loc), "[input %s] id 0x%03X is %s, with node_id "
+                        "%u: give the PLC's frame an id of its own", f->name, (unsigned)f->id, node[k].role,
+                        (unsigned)n);
+                errors++;
+                break;
+            }
+        }
+    }
+    return errors;
+}
+
 int canopen_map_check(const struct canopen_map *co, const struct can_map *can)
 {
-    int errors = 0;
+    int errors = check_input_ids(co, can);
+    for (size_t i = 0; i < can->input_count; i++) {
+        char what[48], pdo[16];
+        snprintf(what, sizeof what, "[input %s]", can->inputs[i].name);
+        snprintf(pdo, sizeof pdo, "RPDO%u", (unsigned)i + 1u);
+        errors += pdo_layout(can, &can->inputs[i], what, pdo);
+    }
     for (size_t i = 0; i < can->frame_count; i++) {
         errors += check_frame(co, can, i);
         if (co->frames[i].sync_every != 0 && can->frames[i].every) {

@@ -36,6 +36,7 @@
 #define CANOPEN_MAX_TPDOS 512u
 #define CANOPEN_STATUS_INDEX 0x2000u  /* the gateway's status: one sub per heartbeat signal */
 #define CANOPEN_VALUES_INDEX 0x2100u  /* TPDO n's values: 0x2100 + n - 1, one sub per signal */
+#define CANOPEN_INPUTS_INDEX 0x2200u  /* RPDO n's registers: 0x2200 + n - 1, one sub per signal, rww */
 #define CANOPEN_DUMMY_U8 0x0005u      /* CiA 301's UNSIGNED8 dummy: a byte no signal owns */
 #define CANOPEN_STATUS_ID_BASE 0x680u /* the status TPDO's id past TPDO4: 0x680 + node id */
 /* The node's traffic beside its TPDOs in the worst-case bus load
@@ -105,7 +106,8 @@ bool canopen_map_frame_set(struct canopen_map *co, size_t frame, const struct co
 /*
  * Before can_map_finish: TPDO numbers (unique, 1..n without a gap), each
  * frame's id from the node id (TPDO1..4: 0x180/0x280/0x380/0x480 + node id;
- * any other id needs own_id = yes), the [can] keys a node replaces, the
+ * any other id needs own_id = yes), each [input] RPDO1..4 in order, its id
+ * the RPDO's pre-defined one (0x200/0x300/0x400/0x500 + node id), the [can] keys a node replaces, the
  * status TPDO's id, and the node's heartbeat, EMCY and SDO as traffic for
  * the bus load (can_map_add_traffic; the parts named TPDOs and status TPDO).
  * Problems go to can's reporter. Returns the number found.
@@ -116,9 +118,10 @@ int canopen_map_prepare(struct canopen_map *co, struct can_map *can);
  * their number. */
 int canopen_map_orphans(const struct canopen_map *co, const struct can_map *can);
 
-/* After can_map_finish accepted can: each frame a classic 11-bit TPDO of at
- * most 8 bytes, each signal Intel, byte-aligned, of an object type, its
- * bytes its own. Returns the number of problems (to can's reporter). */
+/* After can_map_finish accepted can: each frame a classic 11-bit TPDO, and
+ * each [input] an RPDO, of at most 8 bytes, each signal Intel,
+ * byte-aligned, of an object type, its bytes its own; no [input] on one of
+ * the node's own ids. Returns the number of problems (to can's reporter). */
 int canopen_map_check(const struct canopen_map *co, const struct can_map *can);
 
 /* What a TPDO signal becomes: the object's type (URRT_CO_*) and size in
@@ -128,6 +131,8 @@ bool canopen_signal_object(const urrt_can_signal *sig, const struct can_map_sign
 
 /* The pre-defined COB-ID of TPDO n (1..4) for the node; 0 past TPDO4. */
 uint32_t canopen_predefined_tpdo_id(unsigned n, uint32_t node_id);
+/* The pre-defined COB-ID of RPDO n (1..4) for the node; 0 past RPDO4. */
+uint32_t canopen_predefined_rpdo_id(unsigned n, uint32_t node_id);
 
 /* A CAN-ID CiA 301 keeps for NMT, SYNC, EMCY, SDO, heartbeat and LSS. */
 bool canopen_id_restricted(uint32_t id);

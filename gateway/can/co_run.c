@@ -2,6 +2,8 @@
 /* co_run.c: see co_run.h. */
 #include "co_run.h"
 
+#include "urrt_rtde.h"
+
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,8 +19,18 @@ struct co_run {
     uint32_t *mappings;             /* URRT_CO_MAX_MAPPED per TPDO */
     urrt_co_object *objects;
     urrt_co_tpdo_state *states;
-    uint32_t var;                   /* no variables: urrt_co_init wants storage all the same */
-    uint32_t rx_ids[URRT_CO_RX_IDS_MAX]; /* urrt_co_rx_ids' first CO_RUN_RX_IDS */
+    /* The [input]s' RPDOs: their variables, one per signal, [input] i's from
+     * first_var[i] on, in signal order. */
+    urrt_co_rpdo rpdos[URRT_CO_MAX_RPDOS];
+    uint32_t rpdo_maps[URRT_CO_MAX_RPDOS][URRT_CO_RPDO_MAX_MAPPED];
+    urrt_co_rpdo_state rpdo_states[URRT_CO_MAX_RPDOS];
+    urrt_co_consumer consumers[1];
+    uint32_t consumer_default;      /* 0x1016 sub 1: off until the manager writes it */
+    size_t first_var[URRT_CO_MAX_RPDOS + 1];
+    uint32_t *vars;                 /* at least one: urrt_co_init wants storage all the same */
+    uint64_t *written_us;
+    uint32_t rx_ids[URRT_CO_RX_IDS_MAX]; /* urrt_co_rx_ids after a reset */
+    size_t rx_count;
 };
 
 void co_run_free(struct co_run *run)
@@ -30,6 +42,8 @@ void co_run_free(struct co_run *run)
     free(run->mappings);
     free(run->objects);
     free(run->states);
+    free(run->vars);
+    free(run->written_us);
     free(run);
 }
 
@@ -127,6 +141,67 @@ static void frame_tpdos(struct co_run *r, const struct canopen_map *co, const st
     }
 }
 
+/* The raw range of an [input] signal's object: what the node stores (a
+ * write outside is refused, never clamped). A BOOL register takes 0 or 1. */
+static void input_range(const urrt_can_signal *sig, const struct can_map_signal *meta, uint32_t *min, uint32_t *max)
+{
+    unsigned len = sig->length;
+    if (sig->type == URRT_CAN_SIGNED) {
+        /* A whole INTEGERn (canopen_signal_object): its lowest and highest, as its bits. */
+        *min = (uint32_t)1u << (len - 1u);
+        *max = ((uint32_t)1u << (len - 1u)) - 1u;
+    } else {
+        *min = 0;
+        *max = len >= 32u ? UINT32_MAX : ((uint32_t)1u << len) - 1u;
+    }
+    if (!meta->bitmask && meta->var >= URRT_RTDE_V_INPUT_BIT_REGISTER &&
+        meta->var < URRT_RTDE_V_INPUT_BIT_REGISTER + 64 && *max > 1u) {
+        *max = 1u;
+    }
+}
+
+/* [input] i as RPDO i + 1: a writable object per signal (0x2200 + i, sub
+ * k + 1) in a variable of its own, mapped byte by byte, a dummy byte where
+ * no signal is; its event timer the [input]'s timeout_ms, acted on at once
+ * (type 254). */
+static void input_rpdos(struct co_run *r, const struct can_map *can, size_t *objects)
+{
+    size_t var = 0;
+    for (size_t i = 0; i < can->input_count && i < URRT_CO_MAX_RPDOS; i++) {
+        const struct can_map_frame *f = &can->inputs[i];
+        uint8_t count = 0;
+        r->first_var[i] = var;
+        for (size_t k = 0; k < f->count; k++) {
+            uint8_t type = 0;
+            unsigned bytes;
+            urrt_co_object o = {(uint16_t)(CANOPEN_INPUTS_INDEX + i), (uint8_t)(k + 1u), 0, URRT_CO_RW, URRT_CO_VAR,
+                                0, (uint16_t)var++, 0, 0, 0};
+            (void)canopen_signal_object(&f->sigs[k], &f->meta[k], &type, &bytes, NULL, 0);
+            o.type = type;
+            input_range(&f->sigs[k], &f->meta[k], &o.min, &o.max);
+            r->objects[(*objects)++] = o;
+        }
+        for (unsigned byte = 0; byte < f->len; byte++) {
+            uint32_t entry = map_entry(CANOPEN_DUMMY_U8, 0, 8);
+            for (size_t k = 0; k < f->count; k++) {
+                uint8_t type;
+                unsigned bytes;
+                if (f->sigs[k].start / 8u == byte &&
+                    canopen_signal_object(&f->sigs[k], &f->meta[k], &type, &bytes, NULL, 0)) {
+                    entry = map_entry((uint16_t)(CANOPEN_INPUTS_INDEX + i), (uint8_t)(k + 1u), 8u * bytes);
+                    byte += bytes - 1u;
+                    break;
+                }
+            }
+            r->rpdo_maps[i][count++] = entry;
+        }
+        r->rpdos[i] = (urrt_co_rpdo){r->rpdo_maps[i], URRT_CO_COB_DEFAULT,
+                                     (uint16_t)(f->timeout_ms < UINT16_MAX ? f->timeout_ms : UINT16_MAX), TYPE_EVENT,
+                                     count};
+    }
+    r->first_var[can->input_count < URRT_CO_MAX_RPDOS ? can->input_count : URRT_CO_MAX_RPDOS] = var;
+}
+
 static void describe(struct co_run *r, const struct canopen_map *co, const struct can_map *can, size_t tpdos,
                      size_t objects)
 {
@@ -148,12 +223,20 @@ static void describe(struct co_run *r, const struct canopen_map *co, const struc
     d->tpdo_count = tpdos;
     d->objects = r->objects;
     d->object_count = objects;
+    d->rpdos = can->input_count > 0 ? r->rpdos : NULL;
+    d->rpdo_count = can->input_count;
+    /* 0x1016 sub 1, off: the manager says whose heartbeat to watch, and how closely. */
+    d->consumers = can->input_count > 0 ? &r->consumer_default : NULL;
+    d->consumer_count = can->input_count > 0 ? 1u : 0u;
 }
 
-static int node_init(struct co_run *r, struct can_run *run, char *err, size_t errlen)
+static int node_init(struct co_run *r, struct can_run *run, size_t vars, char *err, size_t errlen)
 {
     size_t bad;
-    int rc = urrt_co_init(&r->co, &r->desc, can_run_tx(run), r->states, &r->var, 1, &bad);
+    urrt_co_rx_storage rx = {r->rpdo_states, r->consumers, r->written_us};
+    int rc = r->desc.rpdo_count > 0
+                 ? urrt_co_init_rx(&r->co, &r->desc, can_run_tx(run), r->states, r->vars, vars, &rx, &bad)
+                 : urrt_co_init(&r->co, &r->desc, can_run_tx(run), r->states, r->vars, 1, &bad);
     if (rc < 0) {
         snprintf(err, errlen, "the CANopen node (lib/urrt_co) refuses the configuration (%s %zu): %s",
                  rc == URRT_CO_E_OBJECT ? "object" : "TPDO", bad == SIZE_MAX ? 0 : bad + 1, urrt_co_strerror(rc));
@@ -166,30 +249,39 @@ struct co_run *co_run_build(const struct canopen_map *co, const struct can_map *
 {
     size_t tpdos = can->frame_count + 1u;
     size_t objects = URRT_CANTX_HB_COUNT;
+    size_t vars = 0;
     size_t made = 0;
     struct co_run *r = calloc(1, sizeof *r);
     for (size_t i = 0; i < can->frame_count; i++) {
         objects += can->frames[i].count;
     }
+    for (size_t i = 0; i < can->input_count; i++) {
+        vars += can->inputs[i].count;
+    }
+    objects += vars;
     if (r != NULL) {
         r->tpdos = calloc(tpdos, sizeof *r->tpdos);
         r->mappings = calloc(tpdos * URRT_CO_MAX_MAPPED, sizeof *r->mappings);
         r->objects = calloc(objects, sizeof *r->objects);
         r->states = calloc(tpdos, sizeof *r->states);
+        r->vars = calloc(vars ? vars : 1, sizeof *r->vars);
+        r->written_us = calloc(vars ? vars : 1, sizeof *r->written_us);
     }
-    if (r == NULL || r->tpdos == NULL || r->mappings == NULL || r->objects == NULL || r->states == NULL) {
+    if (r == NULL || r->tpdos == NULL || r->mappings == NULL || r->objects == NULL || r->states == NULL ||
+        r->vars == NULL || r->written_us == NULL) {
         co_run_free(r);
         snprintf(err, errlen, "CANopen node: out of memory");
         return NULL;
     }
     frame_tpdos(r, co, can, &made);
     status_tpdo(r, can, can_run_heartbeat_index(run), tpdos - 1u, &made);
+    input_rpdos(r, can, &made);
     describe(r, co, can, tpdos, made);
-    if (node_init(r, run, err, errlen) < 0) {
+    if (node_init(r, run, vars, err, errlen) < 0) {
         co_run_free(r);
         return NULL;
     }
-    (void)urrt_co_rx_ids(&r->co, r->rx_ids);
+    r->rx_count = urrt_co_rx_ids(&r->co, r->rx_ids);
     return r;
 }
 
@@ -218,8 +310,28 @@ bool co_run_mapped(const struct co_run *run, uint16_t index, uint8_t sub)
 
 const uint32_t *co_run_rx_ids(const struct co_run *run, size_t *count)
 {
-    *count = CO_RUN_RX_IDS;
+    *count = run->rx_count;
     return run->rx_ids;
+}
+
+uint32_t co_run_input_raw(const struct co_run *run, size_t input, size_t signal)
+{
+    return run->vars[run->first_var[input] + signal];
+}
+
+uint64_t co_run_input_var_written_us(const struct co_run *run, size_t input, size_t signal)
+{
+    return run->written_us[run->first_var[input] + signal];
+}
+
+uint64_t co_run_input_written_us(const struct co_run *run, size_t input)
+{
+    uint64_t newest = URRT_CANTX_NEVER;
+    for (size_t v = run->first_var[input]; v < run->first_var[input + 1u]; v++) {
+        uint64_t w = run->written_us[v];
+        newest = w == URRT_CANTX_NEVER ? newest : newest == URRT_CANTX_NEVER || w > newest ? w : newest;
+    }
+    return newest;
 }
 
 /* snprintf at the end of what buf holds so far (*len: snprintf's total). */
@@ -251,5 +363,12 @@ int co_run_describe(const struct co_run *run, char *buf, size_t size)
            d->tpdo_count, (unsigned)(urrt_co_tpdo_cob_default(&run->co, status) & 0x7FFu),
            (unsigned)d->heartbeat_ms, 0x700u + d->node_id, 0x080u + d->node_id, SDO_RX_BASE + d->node_id,
            0x580u + d->node_id, canopen_nmt_start_name(d->nmt_start));
+    for (size_t n = 0; n < d->rpdo_count; n++) {
+        append(buf, size, &len, "%s RPDO%zu at 0x%X", n == 0 ? "; receives" : ",", n + 1u,
+               (unsigned)(urrt_co_rpdo_cob_default(&run->co, n) & 0x7FFu));
+    }
+    if (d->consumer_count > 0) {
+        append(buf, size, &len, ", the manager's heartbeat watched once 0x1016 sub 1 names it");
+    }
     return len;
 }

@@ -18,7 +18,14 @@
  *     its whole-byte values mapped, a dummy byte for each byte of bit fields;
  *   0x2000 sub 1..13: H's signals (the gateway's state, data age, counters);
  *   0x2100 + k - 1 sub 1..: TPDO k's signals (robot values, alive counter,
- *     validity bit), read-only, PDO-mappable.
+ *     validity bit), read-only, PDO-mappable;
+ * and for [input]s I1..Im (m <= 4):
+ *   RPDO j (j = 1..m): Ij, its pre-defined COB-ID, type 254, its event timer
+ *     Ij's timeout_ms (the deadline), mapped one entry per signal
+ *     (0x2200 + j - 1, sub s + 1), a dummy byte where no signal is;
+ *   0x2200 + j - 1 sub 1..: Ij's signals, raw, writable (by RPDO or SDO),
+ *     each in a variable of its own (co_run_input_raw);
+ *   0x1016 sub 1: the manager's heartbeat, off until the manager sets it.
  */
 #ifndef URRT_GATEWAY_CO_RUN_H
 #define URRT_GATEWAY_CO_RUN_H
@@ -32,7 +39,7 @@
 #include "canopen_map.h"
 #include "urrt_co.h"
 
-#define CO_RUN_RX_IDS 3u /* NMT 0x000, SYNC 0x080, SDO request 0x600 + node id (no RPDOs, no 0x1016 yet) */
+#define CO_RUN_RX_IDS 3u /* NMT 0x000, SYNC 0x080, SDO request 0x600 + node id: a node without [input]s */
 
 struct co_run;
 
@@ -49,6 +56,15 @@ const urrt_co_desc *co_run_desc(const struct co_run *run);
  * link's filter starts with. A manager's write to 0x1005 changes them on the
  * running node (urrt_co.rx_changes), which can_out follows. */
 const uint32_t *co_run_rx_ids(const struct co_run *run, size_t *count);
+
+/* [input] i's signal k as the node holds it: raw, as its object's type
+ * (INTEGERn not sign-extended). */
+uint32_t co_run_input_raw(const struct co_run *run, size_t input, size_t signal);
+/* When an RPDO or SDO write last stored one of [input] i's variables, on the
+ * node's clock; URRT_CANTX_NEVER before the first. */
+uint64_t co_run_input_written_us(const struct co_run *run, size_t input);
+/* The same for signal k's variable alone. */
+uint64_t co_run_input_var_written_us(const struct co_run *run, size_t input, size_t signal);
 
 /* Whether a TPDO's mapping names the object (the EDS's PDOMapping). */
 bool co_run_mapped(const struct co_run *run, uint16_t index, uint8_t sub);

@@ -34,15 +34,22 @@ static int set_rx_ids(can_out *out)
 }
 
 /* The link's filter follows the node's ids: a manager moved the SYNC
- * (0x1005), or a reset moved it back. */
+ * (0x1005), an RPDO (0x1400 sub 1) or named a heartbeat to watch (0x1016),
+ * or a reset moved them back. */
 static void follow_rx_ids(can_out *out)
 {
     uint32_t ids[URRT_CO_RX_IDS_MAX];
-    (void)urrt_co_rx_ids(out->node, ids);
+    size_t n = urrt_co_rx_ids(out->node, ids);
     if (set_rx_ids(out) == 0) {
+        char list[8 * URRT_CO_RX_IDS_MAX + 1] = "";
+        size_t used = 0;
+        for (size_t i = 0; i < n && used < sizeof list; i++) {
+            int w = snprintf(list + used, sizeof list - used, " 0x%03X", (unsigned)ids[i]);
+            used += w > 0 ? (size_t)w : 0;
+        }
         out->rx_seen = out->node->rx_changes;
-        urrt_log(URRT_LOG_NOTICE, "CANopen: SYNC now on 0x%03X (0x1005); the CAN link receives 0x%03X 0x%03X 0x%03X",
-                 (unsigned)ids[1], (unsigned)ids[0], (unsigned)ids[1], (unsigned)ids[2]);
+        urrt_log(URRT_LOG_NOTICE, "CANopen: the node's receive ids changed (a manager's write to 0x1005, 0x1400+n "
+                 "or 0x1016, or a reset): the CAN link receives%s", list);
     }
 }
 
@@ -86,6 +93,9 @@ static void run_due(can_out *out, uint64_t now_us)
         node_link(out);
         out->node_us = now_us > out->node_us ? now_us : out->node_us;
         urrt_co_run(out->node, out->node_us, emit, out);
+        if (out->receiver.node != NULL) {
+            out->receiver.node(out->receiver.ctx, out->node_us);
+        }
         return;
     }
     can_run_due(out->run, now_us, urrt_canlink_get_stats(out->link), emit, out);
@@ -103,6 +113,9 @@ static void on_frame(void *ctx, const urrt_can_frame *frame, uint64_t rx_us)
     }
     out->node_us = rx_us > out->node_us ? rx_us : out->node_us;
     urrt_co_on_frame(out->node, frame->id, flags, frame->data, frame->len, out->node_us, emit, out);
+    if (out->receiver.node != NULL) {
+        out->receiver.node(out->receiver.ctx, out->node_us);
+    }
 }
 
 /* After each call into the link: its socket (reopened, or waiting to

@@ -26,11 +26,14 @@ gw_output can_out_output(can_out *out);
 
 /* Who else receives on the link (the PLC's [input] frames, plc_in.h): its
  * ids join the link's filter beside a CANopen node's, each frame received
- * goes to frame() first (true: taken; false: the node's, if any), and
- * link() hears the link's state at every tick of the output. */
+ * goes to frame() first (true: taken; false: the node's, if any), link()
+ * hears the link's state at every tick of the output, and node() (with a
+ * CANopen node) runs after the node handled a frame or ran. Each may be
+ * NULL. */
 typedef struct can_out_receiver {
     bool (*frame)(void *ctx, const urrt_can_frame *frame, uint64_t rx_us);
     void (*link)(void *ctx, bool up, uint64_t bus_off, uint64_t now_us);
+    void (*node)(void *ctx, uint64_t now_us);
     void *ctx;
     const uint32_t *ids;     /* as urrt_canlink_config.rx_ids; copied */
     size_t id_count;

@@ -20,6 +20,8 @@ struct plc_group {
     const struct can_map_frame *f;
     gw_robot *robot;
     size_t recipe;            /* its input recipe's index in the robot's source */
+    size_t input;             /* its index among the [input]s: with [canopen], RPDO input + 1 */
+    uint64_t written_seen;    /* with [canopen]: the node's newest write taken */
     uint64_t rx_us;           /* the last good frame's receipt */
     uint64_t sent_us;         /* the last package sent */
     uint64_t sessions;        /* rtde_source_input_sessions at that send */
@@ -33,6 +35,7 @@ struct plc_group {
 struct plc_in {
     gateway *gw;
     const struct can_map *map;
+    struct co_run *node;      /* with [canopen]: the [input]s are its RPDOs; NULL: plain frames */
     struct plc_group *groups;
     size_t count;
     uint64_t period_us;       /* 1 / inputs_min_rate */
@@ -160,11 +163,18 @@ static void fall_silent(struct plc_group *g, const char *why)
 
 /* ---- receiving --------------------------------------------------------------------- */
 
-/* Register k of the frame from its signals: a mask's bits gathered from
- * each signal's bits=, any other value through its one signal's scaling
- * and checked against min..max. Handed to lib, which checks it against the
- * register's type. False: refused (counted), the register without a value. */
-static bool take_register(struct plc_group *g, urrt_rtde_in *recipe, size_t k, const urrt_can_frame *frame)
+/* What became of a register's value. */
+enum take { TAKEN, REFUSED, ABSENT };
+
+/* Register k of the frame from its signals' raw values (raws[i] for
+ * signal i, as the frame or the CANopen node holds it; bit i of absent: the
+ * node holds none fresh for it): a mask's bits gathered from each signal's
+ * bits=, any other value through its one signal's scaling and checked
+ * against min..max. Handed to lib, which checks it against the register's
+ * type. Refused or absent, the register has no value: nothing is written
+ * for it until a good one comes. */
+static enum take take_register(struct plc_group *g, urrt_rtde_in *recipe, size_t k, const uint64_t *raws,
+                               uint64_t absent)
 {
     const struct can_map_frame *f = g->f;
     uint64_t word = 0;
@@ -172,24 +182,31 @@ static bool take_register(struct plc_group *g, urrt_rtde_in *recipe, size_t k, c
     bool mask = false;
     for (size_t i = 0; i < f->count; i++) {
         const urrt_can_signal *sig = &f->sigs[i];
-        uint64_t raw = 0;
         if (f->meta[i].var != f->regs[k]) {
             continue;
         }
+        /* lib keeps no value for a register whose value it refuses: NaN,
+         * which no register takes, leaves this one without a value. */
+        if ((absent >> i & 1u) != 0) {
+            (void)urrt_rtde_in_set_double(recipe, k, NAN);
+            return ABSENT;
+        }
         if (f->meta[i].bitmask) {
             mask = true;
-            (void)urrt_can_get_raw(sig, frame->data, frame->len, &raw); /* the layout was checked */
-            word |= raw << URRT_CAN_SIG_MASK_FIRST(sig->flags);
-        } else if (urrt_can_unpack(sig, frame->data, frame->len, &value) < 0 || !(value >= sig->min) ||
-                   !(value <= sig->max)) {
-            /* lib keeps no value for a register whose value it refuses: NaN,
-             * which no register takes, leaves this one without a value too. */
+            word |= (sig->length >= 64 ? raws[i] : raws[i] & ((UINT64_C(1) << sig->length) - 1u))
+                    << URRT_CAN_SIG_MASK_FIRST(sig->flags);
+            continue;
+        }
+        value = urrt_can_from_raw(sig, raws[i]);
+        if (!(value >= sig->min) || !(value <= sig->max)) {
             (void)urrt_rtde_in_set_double(recipe, k, NAN);
-            return false;
+            return REFUSED;
         }
     }
     return (mask ? urrt_rtde_in_set_int(recipe, k, (int64_t)word) : urrt_rtde_in_set_double(recipe, k, value)) ==
-           URRT_OK;
+                   URRT_OK
+               ? TAKEN
+               : REFUSED;
 }
 
 static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
@@ -207,27 +224,21 @@ static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, .
     urrt_log(URRT_LOG_WARNING, "[input %s]: %s", g->f->name, text);
 }
 
-static void take_frame(plc_in *in, struct plc_group *g, const urrt_can_frame *frame, uint64_t rx_us)
+/* What the PLC wrote, at at_us: each register taken from raws (see
+ * take_register), the package sent if a value changed. */
+static void take_values(plc_in *in, struct plc_group *g, const uint64_t *raws, uint64_t absent, uint64_t at_us)
 {
     urrt_rtde_in *recipe = recipe_of(g);
     uint64_t now = urrt_port_monotonic_us();
     uint8_t before[URRT_RTDE_IN_DATA_MAX], given[sizeof recipe->given];
     size_t refused = 0;
-    g->counts.frames++;
-    if (frame->len != g->f->len || frame->fd != g->f->fd) {
-        g->counts.bad_frames++;
-        log_limited(g, now, "a %s frame of %u bytes on 0x%X, configured %s of %u: not used (%" PRIu64 " so far)",
-                    frame->fd ? "CAN FD" : "classic", (unsigned)frame->len, (unsigned)frame->id,
-                    g->f->fd ? "CAN FD" : "classic", (unsigned)g->f->len, g->counts.bad_frames);
-        return;
-    }
     if (recipe == NULL) {
         return;
     }
     memcpy(before, recipe->data, recipe->data_size);
     memcpy(given, recipe->given, sizeof given);
     for (size_t k = 0; k < g->f->reg_count; k++) {
-        refused += !take_register(g, recipe, k, frame);
+        refused += take_register(g, recipe, k, raws, absent) == REFUSED;
     }
     if (refused > 0) {
         g->counts.refused += refused;
@@ -241,16 +252,88 @@ static void take_frame(plc_in *in, struct plc_group *g, const urrt_can_frame *fr
     g->changed = g->changed || memcmp(before, recipe->data, recipe->data_size) != 0 ||
                  memcmp(given, recipe->given, sizeof given) != 0 || !g->fresh;
     g->ever = g->fresh = true;
-    g->rx_us = rx_us < now ? rx_us : now;
+    g->rx_us = at_us < now ? at_us : now;
     send_due(in, g, now);
+}
+
+static void take_frame(plc_in *in, struct plc_group *g, const urrt_can_frame *frame, uint64_t rx_us)
+{
+    uint64_t raws[URRT_CAN_MAX_LEN * 8];
+    g->counts.frames++;
+    if (frame->len != g->f->len || frame->fd != g->f->fd) {
+        g->counts.bad_frames++;
+        log_limited(g, urrt_port_monotonic_us(), "a %s frame of %u bytes on 0x%X, configured %s of %u: not used (%"
+                    PRIu64 " so far)", frame->fd ? "CAN FD" : "classic", (unsigned)frame->len, (unsigned)frame->id,
+                    g->f->fd ? "CAN FD" : "classic", (unsigned)g->f->len, g->counts.bad_frames);
+        return;
+    }
+    for (size_t i = 0; i < g->f->count && i < sizeof raws / sizeof raws[0]; i++) {
+        raws[i] = 0;
+        (void)urrt_can_get_raw(&g->f->sigs[i], frame->data, frame->len, &raws[i]); /* the layout was checked */
+    }
+    take_values(in, g, raws, 0, rx_us);
+}
+
+/* ---- through the CANopen node: its RPDOs and SDO writes ---------------------------- */
+
+/* The node's own reasons for [input] g to be silent (urrt_co_rpdo_status:
+ * its NMT state, the manager's heartbeat), or NULL. */
+static const char *node_state(const plc_in *in, const struct plc_group *g, uint64_t now_us)
+{
+    switch (urrt_co_rpdo_status(co_run_node(in->node), g->input, now_us)) {
+    case URRT_CO_RPDO_NOT_OPERATIONAL: return "the CANopen node is not OPERATIONAL";
+    case URRT_CO_RPDO_HEARTBEAT_LOST: return "the manager's heartbeat is lost (0x1016)";
+    default: return NULL;
+    }
+}
+
+/* [input] g through the node: what an RPDO or SDO write stored since the
+ * last look, taken while the node may act on it (OPERATIONAL, the manager's
+ * heartbeat there) and younger than timeout_ms (a manager may write by SDO
+ * alone); silent on the node's reasons, or with no write for timeout_ms. */
+static void node_group(plc_in *in, struct plc_group *g, uint64_t now_us)
+{
+    uint64_t timeout_us = (uint64_t)g->f->timeout_ms * 1000u;
+    uint64_t written = co_run_input_written_us(in->node, g->input);
+    const char *why = node_state(in, g, now_us);
+    char buf[64];
+    if (why == NULL && written != URRT_CANTX_NEVER && written != g->written_seen && now_us - written <= timeout_us) {
+        uint64_t raws[URRT_CO_RPDO_MAX_MAPPED], absent = 0;
+        g->counts.frames++;
+        for (size_t i = 0; i < g->f->count && i < sizeof raws / sizeof raws[0]; i++) {
+            /* A variable is as old as its own last write: one the node refused in
+             * this RPDO (out of its object's range) keeps an older one. */
+            uint64_t w = co_run_input_var_written_us(in->node, g->input, i);
+            raws[i] = co_run_input_raw(in->node, g->input, i);
+            absent |= (uint64_t)(w == URRT_CANTX_NEVER || now_us - w > timeout_us) << i;
+        }
+        take_values(in, g, raws, absent, written);
+    }
+    g->written_seen = written;
+    if (why == NULL && now_us - g->rx_us > timeout_us) {
+        snprintf(buf, sizeof buf, "no RPDO%zu or SDO write for %u ms", g->input + 1u, (unsigned)g->f->timeout_ms);
+        why = buf;
+    }
+    if (g->fresh && why != NULL) {
+        fall_silent(g, why);
+    }
+}
+
+void plc_in_node(void *ctx, uint64_t now_us)
+{
+    plc_in *in = ctx;
+    for (size_t i = 0; in->node != NULL && i < in->count; i++) {
+        node_group(in, &in->groups[i], now_us);
+    }
+    plan(in);
 }
 
 bool plc_in_on_frame(void *ctx, const urrt_can_frame *frame, uint64_t rx_us)
 {
     plc_in *in = ctx;
     const struct can_map_frame *f = can_map_input_of(in->map, frame->id, frame->extended);
-    if (f == NULL) {
-        return false;
+    if (f == NULL || in->node != NULL) {
+        return false; /* with [canopen], the node takes its RPDOs */
     }
     take_frame(in, &in->groups[f - in->map->inputs], frame, rx_us);
     plan(in);
@@ -279,7 +362,9 @@ static void on_tick(void *ctx, uint64_t now_us)
     plc_in *in = ctx;
     for (size_t i = 0; i < in->count; i++) {
         struct plc_group *g = &in->groups[i];
-        if (g->fresh && now_us - g->rx_us > (uint64_t)g->f->timeout_ms * 1000u) {
+        if (in->node != NULL) {
+            node_group(in, g, now_us);
+        } else if (g->fresh && now_us - g->rx_us > (uint64_t)g->f->timeout_ms * 1000u) {
             char why[64];
             snprintf(why, sizeof why, "no frame for %u ms", (unsigned)g->f->timeout_ms);
             fall_silent(g, why);
@@ -359,7 +444,7 @@ static void on_close(void *ctx)
     free(in);
 }
 
-plc_in *plc_in_new(gateway *gw, const struct can_map *map)
+plc_in *plc_in_new(gateway *gw, const struct can_map *map, struct co_run *node)
 {
     plc_in *in = calloc(1, sizeof *in);
     size_t per_robot[GW_MAX_ROBOTS] = {0};
@@ -370,6 +455,7 @@ plc_in *plc_in_new(gateway *gw, const struct can_map *map)
     }
     in->gw = gw;
     in->map = map;
+    in->node = node;
     in->count = map->input_count;
     in->period_us = (uint64_t)(1e6 / map->inputs_min_rate_hz);
     in->link_up = true;
@@ -380,6 +466,8 @@ plc_in *plc_in_new(gateway *gw, const struct can_map *map)
         g->f = &map->inputs[i];
         g->robot = &gw->robots[r];
         g->recipe = per_robot[r]++;
+        g->input = i;
+        g->written_seen = URRT_CANTX_NEVER;
     }
     return in;
 }

@@ -33,13 +33,18 @@
 #include <stdint.h>
 
 #include "can_map.h"
+#include "co_run.h"
 #include "gateway.h"
 
 typedef struct plc_in plc_in;
 
 /* The [input]s of map, onto gw's robots' RTDE sessions (their sources were
- * made with these recipes: plc_in_recipes). NULL (logged) when out of memory. */
-plc_in *plc_in_new(gateway *gw, const struct can_map *map);
+ * made with these recipes: plc_in_recipes). With node (a [canopen]
+ * configuration's), each [input] is the node's RPDO of its number: its
+ * values come from the node's variables (RPDOs and SDO writes, see
+ * plc_in_node), and the node's state and the manager's heartbeat count as
+ * silence too. NULL (logged) when out of memory. */
+plc_in *plc_in_new(gateway *gw, const struct can_map *map, struct co_run *node);
 gw_output plc_in_output(plc_in *in);
 
 /* Robot `robot`'s input recipes, one per [input] of it, in the map's order,
@@ -50,6 +55,10 @@ size_t plc_in_recipes(const struct can_map *map, size_t robot, rtde_source_input
 /* A frame the CAN link received at rx_us: true when it is an [input]'s
  * (taken), false for anyone else's. */
 bool plc_in_on_frame(void *in, const urrt_can_frame *frame, uint64_t rx_us);
+
+/* With a CANopen node: it handled a frame, or ran; what it stored since is
+ * taken, its state judged. */
+void plc_in_node(void *in, uint64_t now_us);
 
 /* The CAN link cannot receive (down, or a bus-off counted since the last
  * call): every [input] is silent now. */

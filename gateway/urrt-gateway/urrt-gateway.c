@@ -126,17 +126,20 @@ static void print_recipe(const gw_robot_config *r)
 
 /* "writes robot arm: input_int_register_24 <- [input plc_cmd] job (0x201), ..."
  * : what an [input] writes, from where, its timeout, silence policy and rate. */
-static void describe_input(const struct can_map *map, const struct can_map_frame *f, char *buf, size_t size)
+static void describe_input(const gw_config *cfg, size_t input, char *buf, size_t size)
 {
+    const struct can_map *map = &cfg->can;
+    const struct can_map_frame *f = &map->inputs[input];
     static const char *const policy[] = {
         [CAN_MAP_SILENCE_STOP] = "stop (nothing written: the program's rtde_set_watchdog acts)",
         [CAN_MAP_SILENCE_HOLD] = "hold (the last values go on: the program's watchdog does not see the silence)",
         [CAN_MAP_SILENCE_VALUE] = "value",
     };
     size_t used = 0;
-    int w = snprintf(buf, size, f->extended ? "input %s (0x%08X, 29-bit): robot %s:" : "input %s (0x%03X): robot %s:",
-                     f->name, (unsigned)f->id,
-                     map->robots[f->robot_index].name);
+    int w = cfg->co_run != NULL ? snprintf(buf, size, "input %s (RPDO%zu, 0x%03X): robot %s:", f->name, input + 1u,
+                                           (unsigned)f->id, map->robots[f->robot_index].name)
+            : snprintf(buf, size, f->extended ? "input %s (0x%08X, 29-bit): robot %s:" : "input %s (0x%03X): robot %s:",
+                       f->name, (unsigned)f->id, map->robots[f->robot_index].name);
     used += w > 0 ? (size_t)w : 0;
     for (size_t i = 0; i < f->count && used < size; i++) {
         char name[URRT_RTDE_NAME_MAX];
@@ -159,7 +162,7 @@ static void print_plan(const gw_config *cfg, const char *url)
     printf("%s: valid\n", cfg->path);
     printf("lcm %s\n", url);
     if (can_map_enabled(&cfg->can)) {
-        char line[256];
+        char line[512];
         can_map_describe(&cfg->can, line, sizeof line);
         printf("can %s\n", line);
         for (size_t i = 0; i < can_map_notice_count(&cfg->can); i++) {
@@ -167,12 +170,12 @@ static void print_plan(const gw_config *cfg, const char *url)
         }
         for (size_t i = 0; i < cfg->can.input_count; i++) {
             char text[600];
-            describe_input(&cfg->can, &cfg->can.inputs[i], text, sizeof text);
+            describe_input(cfg, i, text, sizeof text);
             printf("%s\n", text);
         }
     }
     if (cfg->co_run != NULL) {
-        char line[256];
+        char line[512];
         co_run_describe(cfg->co_run, line, sizeof line);
         printf("canopen %s\n", line);
     }
@@ -386,9 +389,11 @@ static int load_config(gw_config *cfg, const options *o)
 static plc_in *add_inputs(gateway *gw, const gw_config *cfg, can_out *can)
 {
     uint32_t ids[URRT_CANLINK_RX_IDS_MAX];
-    plc_in *in = plc_in_new(gw, &cfg->can);
+    plc_in *in = plc_in_new(gw, &cfg->can, cfg->co_run);
     gw_output output;
-    can_out_receiver receiver = {.frame = plc_in_on_frame, .link = plc_in_link, .ctx = in, .ids = ids};
+    /* With [canopen] the [input]s are the node's RPDOs: their ids are its own. */
+    can_out_receiver receiver = {.frame = cfg->co_run == NULL ? plc_in_on_frame : NULL, .link = plc_in_link,
+                                 .node = cfg->co_run != NULL ? plc_in_node : NULL, .ctx = in, .ids = ids};
     if (in == NULL) {
         return NULL;
     }
@@ -397,7 +402,7 @@ static plc_in *add_inputs(gateway *gw, const gw_config *cfg, can_out *can)
         output.close(in);
         return NULL;
     }
-    receiver.id_count = can_map_input_ids(&cfg->can, ids, URRT_CANLINK_RX_IDS_MAX);
+    receiver.id_count = cfg->co_run == NULL ? can_map_input_ids(&cfg->can, ids, URRT_CANLINK_RX_IDS_MAX) : 0;
     if (!can_out_set_receiver(can, &receiver)) {
         urrt_log(URRT_LOG_ERR, "the CAN link cannot receive the [input] frames' ids (see above); fix them in %s",
                  cfg->path);
@@ -405,7 +410,7 @@ static plc_in *add_inputs(gateway *gw, const gw_config *cfg, can_out *can)
     }
     for (size_t i = 0; i < cfg->can.input_count; i++) {
         char line[600];
-        describe_input(&cfg->can, &cfg->can.inputs[i], line, sizeof line);
+        describe_input(cfg, i, line, sizeof line);
         urrt_log(URRT_LOG_NOTICE, "%s", line);
     }
     return in;
@@ -456,7 +461,7 @@ static int run(gw_config *cfg, const options *o)
     output = lcm_out_output(lcm);
     gw_add_output(&gw, &output);
     if (can_map_enabled(&cfg->can)) {
-        char line[256];
+        char line[512];
         can = can_out_new(&gw, &cfg->can, cfg->can_run, cfg->co_run);
         if (can == NULL) {
             urrt_log(URRT_LOG_ERR, "the CAN output cannot start (see above); fix [can] in %s", cfg->path);

@@ -5,6 +5,8 @@
 # bad SDO request, TPDOs, SYNC, stop, reset, the robot link cut (EMCY). On the host:
 # the EDS against CiA 306 (eds_check.py), every frame through tshark's CANopen
 # dissector, the TPDO values through the DBC against urrt-dump (canopen.post).
+# docs/examples/rtde-plc.ini, and plc-io-canopen.ini (a manager's RPDOs and SDO writes
+# become urrt-sim's registers: check-plc-io-co.sh, plc_io_co.py), in VMs of their own.
 #   check-canopen
 # (tshark: tests/wireshark/wireshark.mk; python3-can, qemu: tests/vm/vm.mk.)
 CHECKS += check-canopen

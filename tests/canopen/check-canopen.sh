@@ -4,7 +4,8 @@
 # (stage-python.sh), boots the VM once (tests/vm/run.sh) with urrt-sim,
 # urrt-gateway and the CANopen master (canopen.sh inside), then checks on the
 # host what it left (canopen.post: the EDS, tshark on every frame, the TPDO
-# values against urrt-dump). Prints the total "N passed, N failed" last.
+# values against urrt-dump); then the RTDE examples in VMs of their own
+# (check-rtde-plc.sh, check-plc-io-co.sh). Prints the total "N passed, N failed" last.
 #   tests/canopen/check-canopen.sh BUILD
 set -u
 build=$1
@@ -23,6 +24,8 @@ if "$here/stage-python.sh" "$build/canopen/py"; then
   counted "canopen.post" "$here/canopen.post" "$out/out" "$build/bin/urrt-dump" "$here/canopen.ini"
   echo "==== $here/check-rtde-plc.sh (docs/examples/rtde-plc.ini over urrt-sim's RTDE port, its own VM)"
   counted "check-rtde-plc.sh" "$here/check-rtde-plc.sh" "$build"
+  echo "==== $here/check-plc-io-co.sh (docs/examples/plc-io-canopen.ini: RPDOs to urrt-sim's registers, its own VM)"
+  counted "check-plc-io-co.sh" "$here/check-plc-io-co.sh" "$build"
 else
   fail "could not stage Python for the VM (see above)"
 fi
