@@ -507,6 +507,13 @@ static int check_input_ids(const struct canopen_map *co, const struct can_map *c
 int canopen_map_check(const struct canopen_map *co, const struct can_map *can)
 {
     int errors = check_input_ids(co, can);
+    if (can->input_count > 0 && co->tpdo_count >= CANOPEN_INPUTS_INDEX - CANOPEN_VALUES_INDEX) {
+        problem(can, can->inputs[0].loc, "[input %s]: with %zu TPDOs, TPDO%u's values take 0x%04X, the index of "
+                "RPDO1's registers: at most %u [frame]s beside [input]s", can->inputs[0].name, co->tpdo_count,
+                CANOPEN_INPUTS_INDEX - CANOPEN_VALUES_INDEX + 1u, CANOPEN_INPUTS_INDEX,
+                CANOPEN_INPUTS_INDEX - CANOPEN_VALUES_INDEX - 1u);
+        errors++;
+    }
     for (size_t i = 0; i < can->input_count; i++) {
         char what[48], pdo[16];
         snprintf(what, sizeof what, "[input %s]", can->inputs[i].name);

@@ -4,6 +4,7 @@
 
 #include "urrt_rtde.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -141,23 +142,56 @@ static void frame_tpdos(struct co_run *r, const struct canopen_map *co, const st
     }
 }
 
-/* The raw range of an [input] signal's object: what the node stores (a
- * write outside is refused, never clamped). A BOOL register takes 0 or 1. */
-static void input_range(const urrt_can_signal *sig, const struct can_map_signal *meta, uint32_t *min, uint32_t *max)
+/* A raw value (signed ones negative) as its object's bits. */
+static uint32_t bits_of(const urrt_can_signal *sig, int64_t raw)
+{
+    return (uint32_t)((uint64_t)raw & (sig->length >= 32u ? UINT32_MAX : ((uint32_t)1u << sig->length) - 1u));
+}
+
+/* Whether raw, scaled, is a value the signal's min..max accepts (can_in's rule). */
+static bool accepted(const urrt_can_signal *sig, int64_t raw)
+{
+    double v = urrt_can_from_raw(sig, bits_of(sig, raw));
+    return v >= sig->min && v <= sig->max;
+}
+
+/* The raw range of an [input] signal's object: the raw values whose
+ * physical value its min..max accepts (a BOOL register: 0 and 1), so that
+ * the node refuses what the gateway would (an SDO write is aborted, an
+ * RPDO value not stored and counted) and the EDS states the same limits. A
+ * mask takes its whole width. */
+static void input_range(const urrt_can_signal *sig, const struct can_map_signal *meta, uint32_t *min, uint32_t *max,
+                        uint32_t *def)
 {
     unsigned len = sig->length;
-    if (sig->type == URRT_CAN_SIGNED) {
-        /* A whole INTEGERn (canopen_signal_object): its lowest and highest, as its bits. */
-        *min = (uint32_t)1u << (len - 1u);
-        *max = ((uint32_t)1u << (len - 1u)) - 1u;
-    } else {
-        *min = 0;
-        *max = len >= 32u ? UINT32_MAX : ((uint32_t)1u << len) - 1u;
+    int64_t type_lo = sig->type == URRT_CAN_SIGNED ? -((int64_t)1 << (len - 1u)) : 0;
+    int64_t type_hi = sig->type == URRT_CAN_SIGNED ? ((int64_t)1 << (len - 1u)) - 1 : ((int64_t)1 << len) - 1;
+    int64_t lo = type_lo, hi = type_hi;
+    if (!meta->bitmask) {
+        /* The nearest raw values by the inverse scaling, then a step inward while
+         * the value scaled back falls outside: exact whatever the rounding. */
+        double a = (sig->min - sig->offset) / sig->factor, b = (sig->max - sig->offset) / sig->factor;
+        double first = ceil(a < b ? a : b), last = floor(a < b ? b : a);
+        lo = first > (double)type_hi ? type_hi : first < (double)type_lo ? type_lo : (int64_t)first;
+        hi = last < (double)type_lo ? type_lo : last > (double)type_hi ? type_hi : (int64_t)last;
+        while (lo < hi && !accepted(sig, lo)) {
+            lo++;
+        }
+        while (hi > lo && !accepted(sig, hi)) {
+            hi--;
+        }
+        lo = lo > type_lo && accepted(sig, lo - 1) ? lo - 1 : lo;
+        hi = hi < type_hi && accepted(sig, hi + 1) ? hi + 1 : hi;
     }
-    if (!meta->bitmask && meta->var >= URRT_RTDE_V_INPUT_BIT_REGISTER &&
-        meta->var < URRT_RTDE_V_INPUT_BIT_REGISTER + 64 && *max > 1u) {
-        *max = 1u;
+    if (!meta->bitmask && meta->var >= URRT_RTDE_V_INPUT_BIT_REGISTER && meta->var < URRT_RTDE_V_INPUT_BIT_REGISTER + 64) {
+        lo = lo > 0 ? lo : 0;
+        hi = hi < 1 ? hi : 1;
     }
+    *min = bits_of(sig, lo);
+    *max = bits_of(sig, hi);
+    /* What the variable holds before the first write, which is never
+     * forwarded (plc_in takes only written values): 0, or the limit nearest. */
+    *def = bits_of(sig, lo > 0 ? lo : hi < 0 ? hi : 0);
 }
 
 /* [input] i as RPDO i + 1: a writable object per signal (0x2200 + i, sub
@@ -178,7 +212,7 @@ static void input_rpdos(struct co_run *r, const struct can_map *can, size_t *obj
                                 0, (uint16_t)var++, 0, 0, 0};
             (void)canopen_signal_object(&f->sigs[k], &f->meta[k], &type, &bytes, NULL, 0);
             o.type = type;
-            input_range(&f->sigs[k], &f->meta[k], &o.min, &o.max);
+            input_range(&f->sigs[k], &f->meta[k], &o.min, &o.max, &o.def);
             r->objects[(*objects)++] = o;
         }
         for (unsigned byte = 0; byte < f->len; byte++) {

@@ -1,7 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /* eds.c: see eds.h. The object dictionary written here is lib/urrt_co.c's
- * (docs/canopen.md's table): communication objects as the node serves them,
- * the TPDOs and manufacturer objects from the node's description. */
+ * (docs/canopen.md's table): communication objects as the node serves them
+ * (the TPDOs', and with [input]s the RPDOs' and 0x1016), the manufacturer
+ * objects from the node's description: the TPDOs' signals, read-only, and
+ * the [input]s' variables (co_run.h: 0x2200 + i - 1 sub k + 1), rww. */
 #include "eds.h"
 
 #include <stdbool.h>
@@ -14,6 +16,8 @@
 
 #define ACCESS_RO "ro"
 #define ACCESS_RW "rw"
+#define ACCESS_WO "wo"
+#define ACCESS_RWW "rww" /* CiA 306: read/write, mappable to an RPDO (a process output of the manager) */
 #define OBJ_VAR 0x7u
 #define OBJ_ARRAY 0x8u
 #define OBJ_RECORD 0x9u
@@ -100,8 +104,9 @@ static void put_file_info(FILE *out, const urrt_co_desc *d, const char *source, 
         fprintf(out, "[FileInfo]\nFileName=urrt-node%u.eds\n", (unsigned)d->node_id);
     }
     fprintf(out, "FileVersion=1\nFileRevision=0\nEDSVersion=4.0\n");
-    fprintf(out, "Description=urrt-gateway CANopen node%s%s: Universal Robots RealTime data as TPDOs\n",
-            source ? " from " : "", source ? source : "");
+    fprintf(out, "Description=urrt-gateway CANopen node%s%s: Universal Robots RealTime data as TPDOs%s\n",
+            source ? " from " : "", source ? source : "",
+            d->rpdo_count > 0 ? ", robot input registers from RPDOs" : "");
     snprintf(when, sizeof when, "%02d:%02d%s", tm.tm_hour % 12 == 0 ? 12 : tm.tm_hour % 12, tm.tm_min,
              tm.tm_hour < 12 ? "AM" : "PM");
     fprintf(out, "CreationTime=%s\nModificationTime=%s\n", when, when);
@@ -122,8 +127,8 @@ static void put_device_info(FILE *out, const struct canopen_map *co, const struc
         fprintf(out, "BaudRate_%u=%d\n", baud_kbits[i], can->bitrate == baud_kbits[i] * 1000u);
     }
     fprintf(out, "SimpleBootUpMaster=0\nSimpleBootUpSlave=1\nGranularity=0\nDynamicChannelsSupported=0\n"
-                 "GroupMessaging=0\nNrOfRXPDO=0\nNrOfTXPDO=%zu\nLSS_Supported=0\n\n",
-            d->tpdo_count);
+                 "GroupMessaging=0\nNrOfRXPDO=%zu\nNrOfTXPDO=%zu\nLSS_Supported=0\n\n",
+            d->rpdo_count, d->tpdo_count);
 }
 
 static bool uses_dummy(const urrt_co_desc *d)
@@ -131,6 +136,26 @@ static bool uses_dummy(const urrt_co_desc *d)
     for (size_t n = 0; n < d->tpdo_count; n++) {
         for (size_t i = 0; i < d->tpdos[n].mapping_count; i++) {
             if (d->tpdos[n].mapping[i] >> 16 == CANOPEN_DUMMY_U8) {
+                return true;
+            }
+        }
+    }
+    for (size_t n = 0; n < d->rpdo_count; n++) {
+        for (size_t i = 0; i < d->rpdos[n].mapping_count; i++) {
+            if (d->rpdos[n].mapping[i] >> 16 == CANOPEN_DUMMY_U8) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+/* Whether an RPDO's mapping names the object (a variable's PDOMapping). */
+static bool rpdo_mapped(const urrt_co_desc *d, uint16_t index, uint8_t sub)
+{
+    for (size_t n = 0; n < d->rpdo_count; n++) {
+        for (size_t i = 0; i < d->rpdos[n].mapping_count; i++) {
+            if (d->rpdos[n].mapping[i] >> 8 == ((uint32_t)index << 8 | sub)) {
                 return true;
             }
         }
@@ -193,22 +218,76 @@ static void object_name(const struct can_map *can, const urrt_co_object *o, size
              dbc_number(sig->factor, f, sizeof f), dbc_number(sig->offset, off, sizeof off));
 }
 
+/* The [input] signal a variable of the description is (co_run.h: [input] i's
+ * signal k at 0x2200 + i sub k + 1), or NULL. */
+static const struct can_map_frame *input_of(const struct can_map *can, const urrt_co_object *o, size_t *signal)
+{
+    size_t i = (size_t)o->index - CANOPEN_INPUTS_INDEX;
+    if (o->kind != URRT_CO_VAR || o->index < CANOPEN_INPUTS_INDEX || i >= can->input_count || o->sub < 1u ||
+        o->sub > can->inputs[i].count) {
+        return NULL;
+    }
+    *signal = o->sub - 1u;
+    return &can->inputs[i];
+}
+
+/* What a variable of an [input] writes, in words, as object_name says what a
+ * TPDO's object carries: the signal, the register, the scaling. */
+static void input_name(const struct can_map_frame *f, size_t k, char *buf, size_t size)
+{
+    const struct can_map_signal *m = &f->meta[k];
+    char reg[48], fac[32], off[32];
+    value_name(m, reg, sizeof reg);
+    if (m->bitmask) {
+        snprintf(buf, size, "%s: %s, a bit mask as the robot takes it", m->name, reg);
+        return;
+    }
+    snprintf(buf, size, "%s: %s, %s = raw x %s + %s", m->name, reg, m->unit[0] ? m->unit : "1",
+             dbc_number(f->sigs[k].factor, fac, sizeof fac), dbc_number(f->sigs[k].offset, off, sizeof off));
+}
+
 static bool is_robot_value(const struct can_map *can, const urrt_co_object *o, size_t hb)
 {
-    if (o->frame == hb) {
+    if (o->kind != URRT_CO_SIGNAL || o->frame == hb) {
         return false;
     }
     enum can_map_role role = can->frames[o->frame].meta[o->item].role;
     return role == CAN_MAP_ROLE_FIELD || role == CAN_MAP_ROLE_RTDE;
 }
 
-/* [Comments]: two notes, then the scaling of every mapped robot value with its limits. */
+/* [Comments]' notes on the receiving side, with [input]s. */
+static const char *const rx_notes[] = {
+    "RPDO transmission type (0x14xx sub 2): 0..240 (acted on at the next SYNC), 254, 255 (at once); 241..253 are "
+    "refused",
+    "RPDO event timer (0x14xx sub 5): the deadline in ms, EMCY 0x8250 when late; an RPDO shorter than its mapping "
+    "is not processed, EMCY 0x8210 (byte 5: the RPDO)",
+    "0x1016 sub 1: the manager's heartbeat (node id << 16 | ms), off until written; EMCY 0x8130 when it is late",
+    "Robot input registers (0x22xx): physical = raw x factor + offset, as each ParameterName says; the node stores "
+    "a raw value within LowLimit..HighLimit, the gateway writes the register only with a value within the limits "
+    "below (never clamped)",
+};
+
+/* The physical limits an [input] signal's register is written within: its
+ * min..max, narrowed to what its object stores (LowLimit..HighLimit). */
+static void input_limits(const struct can_map_frame *f, size_t k, const urrt_co_object *o, double *lo, double *hi)
+{
+    const urrt_can_signal *sig = &f->sigs[k];
+    double a = urrt_can_from_raw(sig, o->min), b = urrt_can_from_raw(sig, o->max);
+    double low = a < b ? a : b, high = a < b ? b : a;
+    *lo = sig->min > low ? sig->min : low;
+    *hi = sig->max < high ? sig->max : high;
+}
+
+/* [Comments]: the notes, then the scaling of every mapped robot value with
+ * its limits, then with [input]s their notes and each register's scaling
+ * with the limits the gateway writes it within. */
 static void put_comments(FILE *out, const struct can_map *can, const urrt_co_desc *d, size_t hb)
 {
-    size_t lines = 4;
+    size_t lines = 4, signal;
     for (size_t i = 0; i < d->object_count; i++) {
-        lines += is_robot_value(can, &d->objects[i], hb);
+        lines += is_robot_value(can, &d->objects[i], hb) || input_of(can, &d->objects[i], &signal) != NULL;
     }
+    lines += d->rpdo_count > 0 ? COUNT(rx_notes) : 0u;
     fprintf(out, "[Comments]\nLines=%zu\n", lines);
     fprintf(out, "Line1=Robot values: physical = raw x factor + offset, as each ParameterName says "
                  "(docs/canopen.md)\n");
@@ -234,6 +313,26 @@ static void put_comments(FILE *out, const struct can_map *can, const urrt_co_des
                     dbc_number(sig->min, lo, sizeof lo), dbc_number(sig->max, hi, sizeof hi));
         }
     }
+    for (size_t i = 0; d->rpdo_count > 0 && i < COUNT(rx_notes); i++) {
+        fprintf(out, "Line%zu=%s\n", ++lines, rx_notes[i]);
+    }
+    for (size_t i = 0; i < d->object_count; i++) {
+        const urrt_co_object *o = &d->objects[i];
+        const struct can_map_frame *f = input_of(can, o, &signal);
+        char name[160], lo[32], hi[32];
+        double low, high;
+        if (f == NULL) {
+            continue;
+        }
+        input_name(f, signal, name, sizeof name);
+        if (f->meta[signal].bitmask) {
+            fprintf(out, "Line%zu=0x%04X sub %u %s: no limits\n", ++lines, o->index, o->sub, name);
+        } else {
+            input_limits(f, signal, o, &low, &high);
+            fprintf(out, "Line%zu=0x%04X sub %u %s, limits %s..%s\n", ++lines, o->index, o->sub, name,
+                    dbc_number(low, lo, sizeof lo), dbc_number(high, hi, sizeof hi));
+        }
+    }
     fputc('\n', out);
 }
 
@@ -250,6 +349,9 @@ static uint32_t predefined_id(const urrt_co_desc *d, const urrt_co_comm *row, si
     uint32_t pre;
     if (row->index == EMCY_INDEX) {
         return EMCY_BASE + d->node_id;
+    }
+    if ((row->flags & URRT_CO_PER_RPDO) != 0u) {
+        return canopen_predefined_rpdo_id((unsigned)n + 1u, d->node_id);
     }
     pre = canopen_predefined_tpdo_id((unsigned)n + 1u, d->node_id);
     return pre != 0 || n + 1u != d->tpdo_count ? pre : CANOPEN_STATUS_ID_BASE + d->node_id;
@@ -401,18 +503,61 @@ static int put_lists(FILE *out, const urrt_co *node, unsigned *work)
 
 /* ---- the objects -------------------------------------------------------------------------- */
 
+/* A variable's raw value as a decimal of its type (INTEGERn sign-extended). */
+static void var_number(uint8_t type, uint32_t raw, char *buf, size_t size)
+{
+    unsigned bits = type == URRT_CO_INTEGER8 || type == URRT_CO_UNSIGNED8    ? 8u
+                    : type == URRT_CO_INTEGER16 || type == URRT_CO_UNSIGNED16 ? 16u
+                                                                              : 32u;
+    uint32_t mask = bits == 32u ? UINT32_MAX : ((uint32_t)1u << bits) - 1u;
+    bool is_signed = type == URRT_CO_INTEGER8 || type == URRT_CO_INTEGER16 || type == URRT_CO_INTEGER32;
+    raw &= mask;
+    if (is_signed && (raw >> (bits - 1u) & 1u) != 0u) {
+        snprintf(buf, size, "-%lu", (unsigned long)(mask - raw) + 1ul);
+    } else {
+        snprintf(buf, size, "%lu", (unsigned long)raw);
+    }
+}
+
+/* A variable of the description (an [input]'s register): its name, its
+ * range as LowLimit/HighLimit, rww where an RPDO maps it. */
+static void put_variable(FILE *out, const struct can_map *can, const urrt_co_desc *d, const urrt_co_object *o)
+{
+    char what[200], low[16], high[16], def[16];
+    size_t signal;
+    const struct can_map_frame *f = input_of(can, o, &signal);
+    bool mapped = rpdo_mapped(d, o->index, o->sub);
+    const char *access = o->access == URRT_CO_RO ? ACCESS_RO : o->access == URRT_CO_WO ? ACCESS_WO
+                         : mapped                ? ACCESS_RWW
+                                                 : ACCESS_RW;
+    if (f != NULL) {
+        input_name(f, signal, what, sizeof what);
+    } else {
+        snprintf(what, sizeof what, "Variable 0x%04X sub %u", o->index, o->sub);
+    }
+    var_number(o->type, o->min, low, sizeof low);
+    var_number(o->type, o->max, high, sizeof high);
+    var_number(o->type, o->def, def, sizeof def);
+    put_var(out, &(struct eds_var){o->index, o->sub, what, o->type, access, def, mapped, low, high});
+}
+
 static void put_manufacturer(FILE *out, const struct co_run *run, const struct can_map *can, size_t hb,
                              const unsigned *indices, size_t count)
 {
     const urrt_co_desc *d = co_run_desc(run);
     for (size_t x = 0; x < count; x++) {
         unsigned highest = 0;
-        char name[96];
+        char name[160];
+        size_t input = (size_t)indices[x] - CANOPEN_INPUTS_INDEX;
         for (size_t i = 0; i < d->object_count; i++) {
             highest = d->objects[i].index == indices[x] && d->objects[i].sub > highest ? d->objects[i].sub : highest;
         }
         if (indices[x] == CANOPEN_STATUS_INDEX) {
             snprintf(name, sizeof name, "Gateway status (TPDO%zu, docs/can.md's heartbeat layout)", d->tpdo_count);
+        } else if (indices[x] >= CANOPEN_INPUTS_INDEX && input < can->input_count) {
+            const struct can_map_frame *f = &can->inputs[input];
+            snprintf(name, sizeof name, "RPDO%zu values ([input %s]: robot %s's input registers)", input + 1u, f->name,
+                     f->robot_index < can->robot_count ? can->robots[f->robot_index].name : f->robot);
         } else {
             unsigned tpdo = indices[x] - CANOPEN_VALUES_INDEX + 1u;
             snprintf(name, sizeof name, "TPDO%u values", tpdo);
@@ -423,6 +568,10 @@ static void put_manufacturer(FILE *out, const struct co_run *run, const struct c
             const urrt_co_object *o = &d->objects[i];
             char what[200];
             if (o->index != indices[x]) {
+                continue;
+            }
+            if (o->kind == URRT_CO_VAR) {
+                put_variable(out, can, d, o);
                 continue;
             }
             object_name(can, o, hb, what, sizeof what);

@@ -3,13 +3,12 @@
 #include "plc_in.h"
 
 #include <inttypes.h>
-#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "urrt_can.h"
+#include "can_in.h"
 #include "urrt_rtde_in.h"
 
 /* A frame's log lines (refused values, wrong lengths) at most this often. */
@@ -163,52 +162,6 @@ static void fall_silent(struct plc_group *g, const char *why)
 
 /* ---- receiving --------------------------------------------------------------------- */
 
-/* What became of a register's value. */
-enum take { TAKEN, REFUSED, ABSENT };
-
-/* Register k of the frame from its signals' raw values (raws[i] for
- * signal i, as the frame or the CANopen node holds it; bit i of absent: the
- * node holds none fresh for it): a mask's bits gathered from each signal's
- * bits=, any other value through its one signal's scaling and checked
- * against min..max. Handed to lib, which checks it against the register's
- * type. Refused or absent, the register has no value: nothing is written
- * for it until a good one comes. */
-static enum take take_register(struct plc_group *g, urrt_rtde_in *recipe, size_t k, const uint64_t *raws,
-                               uint64_t absent)
-{
-    const struct can_map_frame *f = g->f;
-    uint64_t word = 0;
-    double value = 0;
-    bool mask = false;
-    for (size_t i = 0; i < f->count; i++) {
-        const urrt_can_signal *sig = &f->sigs[i];
-        if (f->meta[i].var != f->regs[k]) {
-            continue;
-        }
-        /* lib keeps no value for a register whose value it refuses: NaN,
-         * which no register takes, leaves this one without a value. */
-        if ((absent >> i & 1u) != 0) {
-            (void)urrt_rtde_in_set_double(recipe, k, NAN);
-            return ABSENT;
-        }
-        if (f->meta[i].bitmask) {
-            mask = true;
-            word |= (sig->length >= 64 ? raws[i] : raws[i] & ((UINT64_C(1) << sig->length) - 1u))
-                    << URRT_CAN_SIG_MASK_FIRST(sig->flags);
-            continue;
-        }
-        value = urrt_can_from_raw(sig, raws[i]);
-        if (!(value >= sig->min) || !(value <= sig->max)) {
-            (void)urrt_rtde_in_set_double(recipe, k, NAN);
-            return REFUSED;
-        }
-    }
-    return (mask ? urrt_rtde_in_set_int(recipe, k, (int64_t)word) : urrt_rtde_in_set_double(recipe, k, value)) ==
-                   URRT_OK
-               ? TAKEN
-               : REFUSED;
-}
-
 static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, ...)
 {
@@ -225,7 +178,7 @@ static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, .
 }
 
 /* What the PLC wrote, at at_us: each register taken from raws (see
- * take_register), the package sent if a value changed. */
+ * can_in_take), the package sent if a value changed. */
 static void take_values(plc_in *in, struct plc_group *g, const uint64_t *raws, uint64_t absent, uint64_t at_us)
 {
     urrt_rtde_in *recipe = recipe_of(g);
@@ -237,9 +190,7 @@ static void take_values(plc_in *in, struct plc_group *g, const uint64_t *raws, u
     }
     memcpy(before, recipe->data, recipe->data_size);
     memcpy(given, recipe->given, sizeof given);
-    for (size_t k = 0; k < g->f->reg_count; k++) {
-        refused += take_register(g, recipe, k, raws, absent) == REFUSED;
-    }
+    refused = can_in_take(g->f, recipe, raws, absent);
     if (refused > 0) {
         g->counts.refused += refused;
         log_limited(g, now, "%zu value%s refused (outside min..max, or not one the register takes): nothing is "
@@ -258,18 +209,14 @@ static void take_values(plc_in *in, struct plc_group *g, const uint64_t *raws, u
 
 static void take_frame(plc_in *in, struct plc_group *g, const urrt_can_frame *frame, uint64_t rx_us)
 {
-    uint64_t raws[URRT_CAN_MAX_LEN * 8];
+    uint64_t raws[CAN_IN_MAX_SIGNALS];
     g->counts.frames++;
-    if (frame->len != g->f->len || frame->fd != g->f->fd) {
+    if (!can_in_raws(g->f, frame, raws)) {
         g->counts.bad_frames++;
         log_limited(g, urrt_port_monotonic_us(), "a %s frame of %u bytes on 0x%X, configured %s of %u: not used (%"
                     PRIu64 " so far)", frame->fd ? "CAN FD" : "classic", (unsigned)frame->len, (unsigned)frame->id,
                     g->f->fd ? "CAN FD" : "classic", (unsigned)g->f->len, g->counts.bad_frames);
         return;
-    }
-    for (size_t i = 0; i < g->f->count && i < sizeof raws / sizeof raws[0]; i++) {
-        raws[i] = 0;
-        (void)urrt_can_get_raw(&g->f->sigs[i], frame->data, frame->len, &raws[i]); /* the layout was checked */
     }
     take_values(in, g, raws, 0, rx_us);
 }

@@ -107,12 +107,13 @@ def variables(cp, node_id):
     return out
 
 
-def tpdos(cp, node_id):
-    """The TPDOs: [{'n': 1.., 'cob_id', 'type', 'event_ms', 'mapping': [(index, sub, bits)]}]."""
+def _pdos(cp, node_id, comm_base, map_base):
+    """The PDOs whose communication (comm_base + n) and mapping (map_base + n) objects
+    the EDS has: [{'n': 1.., 'cob_id', 'type', 'event_ms', 'mapping': [(index, sub, bits)]}]."""
     objs = objects(cp)
     out = []
     for n in range(512):
-        comm, mapping = 0x1800 + n, 0x1A00 + n
+        comm, mapping = comm_base + n, map_base + n
         if (comm, 1) not in objs or (mapping, 0) not in objs:
             continue
 
@@ -126,6 +127,17 @@ def tpdos(cp, node_id):
         out.append({'n': n + 1, 'cob_id': value(comm, 1), 'type': value(comm, 2),
                     'event_ms': value(comm, 5), 'mapping': entries})
     return out
+
+
+def tpdos(cp, node_id):
+    """The TPDOs: [{'n': 1.., 'cob_id', 'type', 'event_ms', 'mapping': [(index, sub, bits)]}]."""
+    return _pdos(cp, node_id, 0x1800, 0x1A00)
+
+
+def rpdos(cp, node_id):
+    """The RPDOs (0x1400+n, 0x1600+n), as tpdos gives the TPDOs: what a manager sends
+    the node, its COB-ID (cob_id & 0x7FF while bit 31 is clear) and its mapping."""
+    return _pdos(cp, node_id, 0x1400, 0x1600)
 
 
 def decode(data, mapping, objs):
@@ -145,3 +157,15 @@ def decode(data, mapping, objs):
             out.append((index, sub, pos, bits, raw))
         pos += bits
     return out
+
+
+def encode(values, mapping):
+    """An RPDO's bytes from its mapping: values {(index, sub): raw} (a negative raw as
+    two's complement of the entry's bits, a missing one 0), dummy entries 0; Intel order
+    from bit 0, as decode reads a TPDO."""
+    total, pos = 0, 0
+    for index, sub, bits in mapping:
+        raw = values.get((index, sub), 0) if index >= 0x1000 else 0
+        total |= (raw & ((1 << bits) - 1)) << pos
+        pos += bits
+    return total.to_bytes((pos + 7) // 8, 'little')

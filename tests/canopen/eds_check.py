@@ -17,6 +17,15 @@ ModificationDate "mm-dd-yyyy"; a LowLimit/HighLimit pair parses, is ordered and 
 DefaultValue; every TPDO COB-ID (0x18xx sub 1) has bit 30 set (no RTR: the node serves
 none); an object mapped from a bit-mask field (unit "bits" in lib/urrt.h's field table)
 carries no LowLimit/HighLimit and its [Comments] line no limits.
+
+The receiving side (CiA 301, CiA 306): each RPDO mapping (0x1600+n) names existing
+objects marked PDOMapping=1 and writable (rww, rw or wo) whose size matches the bit
+length, or a dummy of a known type, fits 64 bits, and has its communication object
+0x1400+n; a PDO mapping's sub 0 is the number of its entries; every RPDO COB-ID (0x14xx
+sub 1) is an 11-bit one with bit 29 clear, and no two valid RPDOs share one; AccessType
+rww or rwr only on a PDO-mappable object (PDOMapping=1); 0x1016 (consumer heartbeat) is
+an ARRAY of UNSIGNED32 whose sub 0 is its number of entries; LowLimit and HighLimit are
+values of the object's DataType.
 """
 import os
 import re
@@ -154,6 +163,37 @@ def check_pdos(c, cp, node_id):
             size = eds.DATA_TYPES.get(eds.parse_int(sec.get('DataType', '0')), ('', -1))[1]
             c.check('%s: %d bits = its type\'s size' % (where, bits), size * 8 == bits, '%d bytes' % size)
         c.check('TPDO%d mapping fits 64 bits (%d)' % (t['n'], total), total <= 64)
+    rps = eds.rpdos(cp, node_id)
+    for r in rps:
+        total = 0
+        for index, sub, bits in r['mapping']:
+            total += bits
+            if index < 0x1000:  # a dummy: the data type's own size
+                c.check('RPDO%d dummy 0x%04X of a known type, %d bits' % (r['n'], index, bits),
+                        index in eds.DATA_TYPES and eds.DATA_TYPES[index][1] * 8 == bits and sub == 0)
+                continue
+            sec = objs.get((index, sub))
+            where = 'RPDO%d maps 0x%04X sub %d' % (r['n'], index, sub)
+            if not c.check('%s: it exists' % where, sec is not None):
+                continue
+            c.check('%s: PDOMapping=1' % where, sec.get('PDOMapping', '0').strip() == '1')
+            access = sec.get('AccessType', '').strip().lower()
+            c.check('%s: writable (%s)' % (where, access), access in ('rww', 'rw', 'wo'))
+            size = eds.DATA_TYPES.get(eds.parse_int(sec.get('DataType', '0')), ('', -1))[1]
+            c.check('%s: %d bits = its type\'s size' % (where, bits), size * 8 == bits, '%d bytes' % size)
+        c.check('RPDO%d mapping fits 64 bits (%d)' % (r['n'], total), total <= 64)
+        cob = r['cob_id']
+        c.check('RPDO%d COB-ID 0x%08X: an 11-bit id, bit 29 clear' % (r['n'], cob), cob & 0x3FFFF800 == 0)
+    valid = [r['cob_id'] & 0x7FF for r in rps if not r['cob_id'] & 0x80000000]
+    c.check('no two valid RPDOs on one COB-ID', len(valid) == len(set(valid)), ' '.join('0x%X' % v for v in valid))
+    for base in (0x1600, 0x1A00):
+        for n in range(512):
+            name = '%04X' % (base + n)
+            if (base + n, 0) not in objs:
+                continue
+            entries = sum(1 for (i, s) in objs if i == base + n and s is not None and s > 0)
+            count = eds.resolve(objs[(base + n, 0)].get('DefaultValue', '-1'), node_id)
+            c.check('[%ssub0] %d = its %d entries' % (name, count, entries), count == entries)
     info = cp['DeviceInfo'] if cp.has_section('DeviceInfo') else {}
     c.check('NrOfTXPDO = %d TPDOs' % len(tps), eds.parse_int(info.get('NrOfTXPDO', '-1')) == len(tps))
     rx = sum(1 for n in range(512) if (0x1400 + n, 1) in objs)
@@ -161,6 +201,20 @@ def check_pdos(c, cp, node_id):
     for n in range(512):
         c.check('0x%04X has its communication object 0x%04X' % (0x1A00 + n, 0x1800 + n),
                 not cp.has_section('%04X' % (0x1A00 + n)) or cp.has_section('%04X' % (0x1800 + n)))
+        c.check('0x%04X has its communication object 0x%04X' % (0x1600 + n, 0x1400 + n),
+                not cp.has_section('%04X' % (0x1600 + n)) or cp.has_section('%04X' % (0x1400 + n)))
+
+
+def check_consumer_heartbeat(c, cp, node_id):
+    if not cp.has_section('1016'):
+        return
+    objs = eds.objects(cp)
+    c.check('[1016] is an ARRAY', eds.parse_int(cp['1016'].get('ObjectType', '0')) == 0x8)
+    subs = sorted(s for (i, s) in objs if i == 0x1016 and s is not None and s > 0)
+    count = eds.resolve(objs[(0x1016, 0)].get('DefaultValue', '-1'), node_id) if (0x1016, 0) in objs else -1
+    c.check('[1016sub0] %d = its %d entries' % (count, len(subs)), count == len(subs) == (subs[-1] if subs else 0))
+    for s in subs:
+        c.check('[1016sub%X] UNSIGNED32' % s, eds.parse_int(objs[(0x1016, s)].get('DataType', '0')) == 0x0007)
 
 
 def check_file_info(c, cp, path):
@@ -186,7 +240,16 @@ def check_limits(c, cp, node_id):
             lines = [v for v in comments.values() if v.startswith('0x%04X sub %d ' % (index, sub))]
             c.check('%s bit mask: its [Comments] line gives no limits' % where,
                     bool(lines) and all('limits' not in v or 'no limits' in v for v in lines), ' / '.join(lines))
+        access = sec.get('AccessType', '').strip().lower()
+        if access in ('rww', 'rwr'):
+            c.check('%s AccessType %s: PDO-mappable (PDOMapping=1)' % (where, access),
+                    sec.get('PDOMapping', '0').strip() == '1')
         if 'LowLimit' in sec or 'HighLimit' in sec:
+            dtype = eds.parse_int(sec.get('DataType', '0'))
+            if dtype in eds.DATA_TYPES:
+                for k in ('LowLimit', 'HighLimit'):
+                    c.check('%s %s "%s" is a %s' % (where, k, sec.get(k), eds.DATA_TYPES[dtype][0]),
+                            k not in sec or value_ok(dtype, sec[k], node_id))
             low, high = (eds.resolve(sec.get(k, '0'), node_id) for k in ('LowLimit', 'HighLimit'))
             default = eds.resolve(sec.get('DefaultValue', str(low)), node_id)
             c.check('%s limits %d..%d hold the default %d' % (where, low, high, default), low <= default <= high)
@@ -203,6 +266,7 @@ def check(path, node_id=1):
     check_lists(c, cp)
     check_objects(c, cp, node_id)
     check_pdos(c, cp, node_id)
+    check_consumer_heartbeat(c, cp, node_id)
     check_limits(c, cp, node_id)
     return c
 

@@ -23,9 +23,34 @@ CAN_TEST_SRCS = $(CAN_GATEWAY_OBJS:$(BUILD)/%.o=%.c) gateway/common/conf.c gatew
 CAN_TEST_OBJS := $(CAN_GATEWAY_OBJS) $(BUILD)/gateway/urrt-gateway/config.o $(CONF_OBJ)
 CAN_TEST_CFLAGS := $(PROG_WARN) $(CPPFLAGS) $(GATEWAY_INC) -Itests
 
-CHECKS += check-can-map check-can-map-san check-can-dbc check-replay-rtde
+CHECKS += check-can-map check-can-map-san check-can-dbc check-replay-rtde check-fuzz-can-in
 BENCHES += bench-can
-.PHONY: check-can-map check-can-map-san check-can-dbc check-replay-rtde bench-can
+.PHONY: check-can-map check-can-map-san check-can-dbc check-replay-rtde bench-can check-fuzz-can-in fuzz-can-in
+
+# The PLC's inputs as untrusted input (tests/gateway/can/fuzz_can_in.c): [input] frames
+# through can_in, and NMT, RPDOs and SDO requests through the CANopen node into them; lib/
+# and gateway/ instrumented. Seeds from can_in_seeds.py.
+CAN_IN_SEEDS := $(CANT)/can-in-seeds
+$(CANT)/fuzz_can_in: tests/gateway/can/fuzz_can_in.c $(CAN_TEST_SRCS) $(GATEWAY_HDRS) $(LIB_SRCS) $(LIB_HDRS) \
+  $(LIBPORT)
+	@mkdir -p $(@D)
+	$(FUZZ_CC) -std=gnu11 -Wall -Wextra -Wshadow -Werror -g -O1 -fsanitize=fuzzer,address,undefined \
+	  -fno-sanitize-recover=all $(CPPFLAGS) $(GATEWAY_INC) $< $(CAN_TEST_SRCS) $(LIB_SRCS) $(LIBPORT) -lm -o $@
+
+$(CAN_IN_SEEDS)/.stamp: tests/gateway/can/can_in_seeds.py
+	rm -rf $(@D)
+	$(PYTHON) $< $(@D)
+	touch $@
+
+check-fuzz-can-in: $(CANT)/fuzz_can_in $(CAN_IN_SEEDS)/.stamp
+	$(call suite,$@,sh tests/lib/fuzz.sh $(CANT)/fuzz_can_in $(CAN_IN_SEEDS) $(CANT)/fuzz-can-in-check \
+	  $(FUZZ_CHECK_SECONDS) --check)
+
+# make fuzz FUZZ_SECONDS=N: as long as asked; the corpus grows in $(CANT)/fuzz-can-in.
+fuzz-can-in: $(CANT)/fuzz_can_in $(CAN_IN_SEEDS)/.stamp
+	sh tests/lib/fuzz.sh $(CANT)/fuzz_can_in $(CAN_IN_SEEDS) $(CANT)/fuzz-can-in $(FUZZ_SECONDS)
+
+fuzz: fuzz-can-in
 
 # test_can_map, can_tool and bench_can: one source each, the same objects.
 $(CANT)/%: tests/gateway/can/%.c tests/check.h tests/testutil.h tests/gateway/bench.h $(CAN_TEST_OBJS) $(LIBPORT) $(LIBURRT)

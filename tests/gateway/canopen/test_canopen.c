@@ -9,13 +9,19 @@
  *
  * docs/canopen.md's table of the example's object dictionary, row for row.
  *
- * Usage: test_canopen EXAMPLE.ini GENERATED_TABLES.c CANOPEN.md
+ * A node with [input]s (RPDOs): its EDS read back (NrOfRXPDO, 0x1400+n,
+ * 0x1600+n, 0x1016, the 0x22xx variables), every value and limit of it
+ * against the node by SDO, SDO downloads and RPDO frames through the node.
+ * With EDS_CHECK.py (tests/canopen/eds_check.py), both EDSs pass CiA 306's rules.
+ *
+ * Usage: test_canopen EXAMPLE.ini GENERATED_TABLES.c CANOPEN.md [EDS_CHECK.py]
  *        test_canopen --table EXAMPLE.ini     (prints docs/canopen.md's table)
  */
 #define _GNU_SOURCE
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "check.h"
 #include "config.h"
@@ -257,8 +263,9 @@ static void sink_emit(void *ctx, const urrt_can_frame *frame, uint64_t now_us)
     s->count++;
 }
 
-/* The size an SDO upload of index/sub reports, or -1 (abort: *abort). */
-static long sdo_size(urrt_co *node, unsigned index, unsigned sub, uint32_t *abort)
+/* The size an SDO upload of index/sub reports, or -1 (abort: *abort); the
+ * value of an expedited one in *value (0 for a segmented one). */
+static long sdo_upload(urrt_co *node, unsigned index, unsigned sub, uint32_t *value, uint32_t *abort)
 {
     struct sink s = {0};
     uint8_t req[8] = {0x40, (uint8_t)index, (uint8_t)(index >> 8), (uint8_t)sub, 0, 0, 0, 0};
@@ -266,6 +273,7 @@ static long sdo_size(urrt_co *node, unsigned index, unsigned sub, uint32_t *abor
     urrt_co_on_frame(node, 0x605, 0, req, 8, 1000, sink_emit, &s);
     cs = s.last.data[0];
     *abort = 0;
+    *value = 0;
     if (s.count != 1 || s.last.id != 0x585) {
         return -2;
     }
@@ -279,7 +287,48 @@ static long sdo_size(urrt_co *node, unsigned index, unsigned sub, uint32_t *abor
         urrt_co_on_frame(node, 0x605, 0, abort_req, 8, 1000, sink_emit, &s); /* ends the segmented upload */
         return (long)s.last.data[4] | (long)s.last.data[5] << 8;
     }
+    for (int i = 0; i < 4 - ((cs >> 2) & 3); i++) {
+        *value |= (uint32_t)s.last.data[4 + i] << (8 * i);
+    }
     return 4 - ((cs >> 2) & 3);
+}
+
+/* An expedited SDO download of `bytes` bytes (1..4) of value to index/sub:
+ * 0 for the node's confirmation [0x60, idx, sub], its abort code, or
+ * UINT32_MAX for any other answer. */
+static uint32_t sdo_download(urrt_co *node, unsigned index, unsigned sub, uint32_t value, unsigned bytes)
+{
+    struct sink s = {0};
+    uint8_t req[8] = {(uint8_t)(0x23u | (4u - bytes) << 2), (uint8_t)index, (uint8_t)(index >> 8), (uint8_t)sub,
+                      (uint8_t)value, (uint8_t)(value >> 8), (uint8_t)(value >> 16), (uint8_t)(value >> 24)};
+    urrt_co_on_frame(node, 0x605, 0, req, 8, 1000, sink_emit, &s);
+    if (s.count != 1 || s.last.id != 0x585 || s.last.len != 8 || s.last.data[1] != req[1] ||
+        s.last.data[2] != req[2] || s.last.data[3] != req[3]) {
+        return UINT32_MAX;
+    }
+    if (s.last.data[0] == 0x80) {
+        return (uint32_t)s.last.data[4] | (uint32_t)s.last.data[5] << 8 | (uint32_t)s.last.data[6] << 16 |
+               (uint32_t)s.last.data[7] << 24;
+    }
+    return s.last.data[0] == 0x60 && s.last.data[4] == 0 && s.last.data[7] == 0 ? 0u : UINT32_MAX;
+}
+
+/* An EDS number (CiA 306): decimal (signed too), 0x hex, "$NODEID+0x.." for node 5. */
+static bool eds_number(const char *text, uint32_t *value)
+{
+    char *end = NULL;
+    uint32_t base = 0;
+    if (strncmp(text, "$NODEID+", 8) == 0) {
+        base = 5;
+        text += 8;
+    }
+    if (text[0] == '-') {
+        long long v = strtoll(text, &end, 10);
+        *value = (uint32_t)v;
+    } else {
+        *value = base + (uint32_t)strtoull(text, &end, 0);
+    }
+    return end != NULL && end != text && *end == '\0';
 }
 
 static long type_size(unsigned type)
@@ -292,11 +341,13 @@ static long type_size(unsigned type)
     }
 }
 
-/* One VAR section of the EDS: read by SDO, of the size its DataType says. */
+/* One VAR section of the EDS: read by SDO, of the size its DataType says,
+ * and (the node right after a reset) of its DefaultValue, where the value is
+ * the node's own: not 0x1001, 0x1003 nor a robot value's (manufacturer, ro). */
 static unsigned check_var(const char *eds, urrt_co *node, unsigned index, int sub)
 {
-    char name[32], buf[64];
-    uint32_t abort;
+    char name[32], buf[64], def[64], access[8];
+    uint32_t abort, value, want_value;
     long size, want;
     if (sub < 0) {
         snprintf(name, sizeof name, "%04X", index);
@@ -308,13 +359,24 @@ static unsigned check_var(const char *eds, urrt_co *node, unsigned index, int su
         return 0;
     }
     want = type_size((unsigned)strtoul(buf, NULL, 0));
-    size = sdo_size(node, index, sub < 0 ? 0u : (unsigned)sub, &abort);
+    size = sdo_upload(node, index, sub < 0 ? 0u : (unsigned)sub, &value, &abort);
     if (index == 0x1003 && sub > 0) {
         CHECK(size == -1 && abort == URRT_CO_ABORT_NO_DATA, "[%s]: no error recorded yet: 0x08000024", name);
     } else {
         CHECK(size >= 0 && (want == 0 || size == want), "[%s]: SDO size %ld (abort 0x%08X), EDS DataType %s", name,
               size, abort, buf);
     }
+    if (want == 0 || index == 0x1001 || index == 0x1003 || size != want ||
+        eds_get(eds, name, "DefaultValue", def, sizeof def) == NULL ||
+        eds_get(eds, name, "AccessType", access, sizeof access) == NULL ||
+        (index >= 0x2000 && sub > 0 && strcmp(access, "ro") == 0)) {
+        return 1;
+    }
+    CHECK(eds_number(def, &want_value), "[%s] DefaultValue %s is a number", name, def);
+    if (want < 4) {
+        want_value &= (UINT32_C(1) << (8 * want)) - 1u;
+    }
+    CHECK(value == want_value, "[%s]: SDO reads 0x%X, the EDS's DefaultValue %s", name, value, def);
     return 1;
 }
 
@@ -363,6 +425,18 @@ static void test_eds(gw_config *cfg)
     CHECK(eds_get(eds, "FileInfo", "FileName", buf, sizeof buf) && strcmp(buf, "urrt-node5.eds") == 0,
           "FileName on standard output: %s", buf);
     CHECK(eds_get(eds, "DeviceInfo", "NrOfTXPDO", buf, sizeof buf) && strcmp(buf, "5") == 0, "NrOfTXPDO %s", buf);
+    /* No [input]s: no RPDO, no 0x1016, no 0x22xx, as before RPDOs came. */
+    CHECK(eds_get(eds, "DeviceInfo", "NrOfRXPDO", buf, sizeof buf) && strcmp(buf, "0") == 0, "NrOfRXPDO %s", buf);
+    CHECK(strstr(eds, "\n[1400]\n") == NULL && strstr(eds, "\n[1600]\n") == NULL && strstr(eds, "\n[1016]\n") == NULL &&
+              strstr(eds, "\n[2200]\n") == NULL && strstr(eds, "=0x1400\n") == NULL && strstr(eds, "=0x1016\n") == NULL,
+          "without [input]s: no RPDO objects, no 0x1016");
+    {
+        char text[160];
+        CHECK(eds_get(eds, "FileInfo", "Description", text, sizeof text) &&
+                  strcmp(text, "urrt-gateway CANopen node from canopen.ini: Universal Robots RealTime data as TPDOs") ==
+                      0,
+              "Description %s", text);
+    }
     CHECK(eds_get(eds, "DeviceInfo", "BaudRate_500", buf, sizeof buf) && strcmp(buf, "1") == 0, "BaudRate_500");
     CHECK(eds_get(eds, "1800sub1", "DefaultValue", buf, sizeof buf) && strcmp(buf, "$NODEID+0x40000180") == 0, "%s", buf);
     CHECK(eds_get(eds, "1014", "DefaultValue", buf, sizeof buf) && strcmp(buf, "$NODEID+0x80") == 0, "%s", buf);
@@ -624,6 +698,411 @@ static void test_rtde_node(void)
     gw_config_free(&cfg);
 }
 
+/* ---- [input]s: RPDOs that write robot input registers ------------------------------------- */
+
+/* Two [input]s, RPDO1 at 0x205 (an UNSIGNED16 with max=9999, two BOOL registers, four dummy
+ * bytes) and RPDO2 at 0x305 (INTEGER32, a scaled INTEGER16, INTEGER8: 7 bytes). */
+static const char inputs_node[] =
+    "[robot arm1]\nhost = h\nsource = rtde\n[can]\ninterface = log:-\nbitrate = 500000\n[canopen]\nnode_id = 5\n"
+    "[frame robot_answer]\nperiod_ms = 20\n"
+    "signal = output_int_register_24 @0|32 intel signed name=program_state\n"
+    "signal = input_int_register_24 @32|16 intel unsigned name=job_echo\n"
+    "[input plc_command]\ntimeout_ms = 100\n"
+    "signal = input_int_register_24 @0|16 intel unsigned max=9999 name=job_number\n"
+    "signal = input_bit_register_64 @16|8 intel unsigned name=start\n"
+    "signal = input_bit_register_65 @24|8 intel unsigned name=door_closed\n"
+    "[input plc_setpoint]\ntimeout_ms = 250\nlength = 7\n"
+    "signal = input_int_register_25 @0|32 intel signed name=offset\n"
+    "signal = input_double_register_24 @32|16 intel signed factor=0.001 unit=m/s name=speed\n"
+    "signal = input_int_register_26 @48|8 intel signed name=trim\n";
+
+/* Key of [section] is want. */
+static void eds_is(const char *eds, const char *section, const char *key, const char *want)
+{
+    char buf[256];
+    const char *got = eds_get(eds, section, key, buf, sizeof buf);
+    CHECK(got != NULL && strcmp(got, want) == 0, "[%s] %s=%s, want %s", section, key, got ? got : "(none)", want);
+}
+
+/* Whether the list section names index. */
+static bool eds_lists(const char *eds, const char *list, unsigned index)
+{
+    char buf[64], key[16], want[16];
+    unsigned count = (unsigned)strtoul(eds_get(eds, list, "SupportedObjects", buf, sizeof buf) ? buf : "0", NULL, 0);
+    snprintf(want, sizeof want, "0x%04X", index);
+    for (unsigned i = 1; i <= count; i++) {
+        snprintf(key, sizeof key, "%u", i);
+        if (eds_get(eds, list, key, buf, sizeof buf) != NULL && strcmp(buf, want) == 0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* Every new object's section and keys, as the node serves them. */
+static void test_inputs_eds_text(const char *eds)
+{
+    static const struct { const char *section, *name, *type, *low, *high; } vars[] = {
+        {"2200sub1", "job_number: input_int_register_24, 1 = raw x 1 + 0", "0x0006", "0", "9999"},
+        {"2200sub2", "start: input_bit_register_64, 1 = raw x 1 + 0", "0x0005", "0", "1"},
+        {"2200sub3", "door_closed: input_bit_register_65, 1 = raw x 1 + 0", "0x0005", "0", "1"},
+        {"2201sub1", "offset: input_int_register_25, 1 = raw x 1 + 0", "0x0004", "-2147483648", "2147483647"},
+        {"2201sub2", "speed: input_double_register_24, m/s = raw x 0.001 + 0", "0x0003", "-32768", "32767"},
+        {"2201sub3", "trim: input_int_register_26, 1 = raw x 1 + 0", "0x0002", "-128", "127"},
+    };
+    static const char *const map1[] = {"0x22000110", "0x22000208", "0x22000308", "0x00050008",
+                                       "0x00050008", "0x00050008", "0x00050008"};
+    static const char *const map2[] = {"0x22010120", "0x22010210", "0x22010308"};
+    char sec[16];
+    eds_is(eds, "DeviceInfo", "NrOfRXPDO", "2");
+    eds_is(eds, "DeviceInfo", "NrOfTXPDO", "2");
+    eds_is(eds, "DummyUsage", "Dummy0005", "1");
+    eds_is(eds, "FileInfo", "Description", "urrt-gateway CANopen node from inputs.ini: Universal Robots RealTime "
+                                           "data as TPDOs, robot input registers from RPDOs");
+    for (unsigned n = 0; n < 2; n++) {
+        static const char *const cob[] = {"$NODEID+0x200", "$NODEID+0x300"}, *const timer[] = {"100", "250"};
+        unsigned comm = 0x1400 + n, map = 0x1600 + n;
+        CHECK(eds_lists(eds, "OptionalObjects", comm) && eds_lists(eds, "OptionalObjects", map),
+              "[OptionalObjects] lists 0x%04X and 0x%04X", comm, map);
+        snprintf(sec, sizeof sec, "%04X", comm);
+        eds_is(eds, sec, "ParameterName", "RPDO communication parameter");
+        eds_is(eds, sec, "ObjectType", "0x9");
+        eds_is(eds, sec, "SubNumber", "0x4"); /* subs 0, 1, 2, 5 */
+        snprintf(sec, sizeof sec, "%04Xsub0", comm);
+        eds_is(eds, sec, "AccessType", "ro");
+        eds_is(eds, sec, "DefaultValue", "5");
+        snprintf(sec, sizeof sec, "%04Xsub1", comm);
+        eds_is(eds, sec, "ParameterName", "COB-ID used by RPDO");
+        eds_is(eds, sec, "DataType", "0x0007");
+        eds_is(eds, sec, "AccessType", "rw");
+        eds_is(eds, sec, "DefaultValue", cob[n]);
+        snprintf(sec, sizeof sec, "%04Xsub2", comm);
+        eds_is(eds, sec, "DataType", "0x0005");
+        eds_is(eds, sec, "AccessType", "rw");
+        eds_is(eds, sec, "DefaultValue", "254");
+        snprintf(sec, sizeof sec, "%04Xsub3", comm);
+        CHECK(eds_get(eds, sec, "DataType", sec, sizeof sec) == NULL, "0x%04X has no sub 3", comm);
+        snprintf(sec, sizeof sec, "%04Xsub5", comm);
+        eds_is(eds, sec, "DataType", "0x0006");
+        eds_is(eds, sec, "AccessType", "rw");
+        eds_is(eds, sec, "DefaultValue", timer[n]);
+        snprintf(sec, sizeof sec, "%04X", map);
+        eds_is(eds, sec, "ParameterName", "RPDO mapping parameter");
+        eds_is(eds, sec, "SubNumber", n == 0 ? "0x8" : "0x4");
+        snprintf(sec, sizeof sec, "%04Xsub0", map);
+        eds_is(eds, sec, "AccessType", "ro");
+        eds_is(eds, sec, "DefaultValue", n == 0 ? "7" : "3");
+        for (unsigned k = 1; k <= (n == 0 ? 7u : 3u); k++) {
+            snprintf(sec, sizeof sec, "%04Xsub%X", map, k);
+            eds_is(eds, sec, "DataType", "0x0007");
+            eds_is(eds, sec, "AccessType", "ro"); /* static: the node refuses a write (0x06010002) */
+            eds_is(eds, sec, "PDOMapping", "0");
+            eds_is(eds, sec, "DefaultValue", n == 0 ? map1[k - 1] : map2[k - 1]);
+        }
+    }
+    CHECK(eds_get(eds, "1402", "ObjectType", sec, sizeof sec) == NULL, "no RPDO3");
+    CHECK(eds_lists(eds, "OptionalObjects", 0x1016), "[OptionalObjects] lists 0x1016");
+    eds_is(eds, "1016", "ObjectType", "0x8");
+    eds_is(eds, "1016", "SubNumber", "0x2");
+    eds_is(eds, "1016sub0", "DefaultValue", "1");
+    eds_is(eds, "1016sub0", "AccessType", "ro");
+    eds_is(eds, "1016sub1", "DataType", "0x0007");
+    eds_is(eds, "1016sub1", "AccessType", "rw");
+    eds_is(eds, "1016sub1", "DefaultValue", "0x00000000");
+    for (unsigned n = 0; n < 2; n++) {
+        snprintf(sec, sizeof sec, "%04X", 0x2200 + n);
+        CHECK(eds_lists(eds, "ManufacturerObjects", 0x2200 + n) && !eds_lists(eds, "OptionalObjects", 0x2200 + n),
+              "[ManufacturerObjects] lists 0x%04X", 0x2200 + n);
+        eds_is(eds, sec, "ObjectType", "0x9");
+        eds_is(eds, sec, "SubNumber", "0x4");
+        eds_is(eds, sec, "ParameterName", n == 0 ? "RPDO1 values ([input plc_command]: robot arm1's input registers)"
+                                                 : "RPDO2 values ([input plc_setpoint]: robot arm1's input registers)");
+        snprintf(sec, sizeof sec, "%04Xsub0", 0x2200 + n);
+        eds_is(eds, sec, "DataType", "0x0005");
+        eds_is(eds, sec, "AccessType", "ro");
+        eds_is(eds, sec, "DefaultValue", "3");
+    }
+    for (size_t i = 0; i < sizeof vars / sizeof vars[0]; i++) {
+        eds_is(eds, vars[i].section, "ParameterName", vars[i].name);
+        eds_is(eds, vars[i].section, "ObjectType", "0x7");
+        eds_is(eds, vars[i].section, "DataType", vars[i].type);
+        eds_is(eds, vars[i].section, "AccessType", "rww");
+        eds_is(eds, vars[i].section, "PDOMapping", "1");
+        eds_is(eds, vars[i].section, "LowLimit", vars[i].low);
+        eds_is(eds, vars[i].section, "HighLimit", vars[i].high);
+        eds_is(eds, vars[i].section, "DefaultValue", "0");
+    }
+    /* [Comments]: the limits the gateway writes each register within (max=9999, a BOOL's 0..1). */
+    CHECK(strstr(eds, "=0x2200 sub 1 job_number: input_int_register_24, 1 = raw x 1 + 0, limits 0..9999\n") != NULL,
+          "[Comments]: job_number within 0..9999");
+    CHECK(strstr(eds, "=0x2200 sub 2 start: input_bit_register_64, 1 = raw x 1 + 0, limits 0..1\n") != NULL,
+          "[Comments]: a BOOL register within 0..1");
+    CHECK(strstr(eds, "=0x2201 sub 2 speed: input_double_register_24, m/s = raw x 0.001 + 0, limits -32.768..32.767\n")
+              != NULL, "[Comments]: speed's scaled limits");
+    CHECK(strstr(eds, "241..253 are refused") != NULL && strstr(eds, "EMCY 0x8210") != NULL,
+          "[Comments]: the RPDO notes");
+}
+
+/* The limits of every writable variable the EDS gives agree with the node: the
+ * limit itself written and read back, one past it refused (0x06090031 above,
+ * 0x06090032 below) where the type holds it. Leaves the node's values changed. */
+static unsigned check_limits_by_sdo(const char *eds, urrt_co *node)
+{
+    unsigned checked = 0;
+    for (const char *p = strstr(eds, "\n["); p != NULL; p = strstr(p + 1, "\n[")) {
+        char section[32], buf[64], access[8];
+        unsigned index = 0, sub = 0;
+        int sublen = 0;
+        uint32_t low, high, value, abort;
+        long bytes;
+        if (sscanf(p + 1, "[%31[^]]]", section) != 1 || sscanf(section, "%4Xsub%X%n", &index, &sub, &sublen) != 2 ||
+            eds_get(eds, section, "AccessType", access, sizeof access) == NULL || strcmp(access, "ro") == 0 ||
+            eds_get(eds, section, "DataType", buf, sizeof buf) == NULL ||
+            eds_get(eds, section, "LowLimit", buf, sizeof buf) == NULL || !eds_number(buf, &low) ||
+            eds_get(eds, section, "HighLimit", buf, sizeof buf) == NULL || !eds_number(buf, &high)) {
+            continue;
+        }
+        eds_get(eds, section, "DataType", buf, sizeof buf);
+        unsigned type = (unsigned)strtoul(buf, NULL, 0);
+        bytes = type_size(type);
+        bool is_signed = type == URRT_CO_INTEGER8 || type == URRT_CO_INTEGER16 || type == URRT_CO_INTEGER32;
+        uint32_t mask = bytes == 4 ? UINT32_MAX : (UINT32_C(1) << (8 * bytes)) - 1u;
+        uint32_t type_max = is_signed ? mask >> 1 : mask, type_min = is_signed ? (mask >> 1) + 1u : 0u;
+        checked++;
+        for (int k = 0; k < 2; k++) {
+            uint32_t limit = (k == 0 ? low : high) & mask;
+            CHECK(sdo_download(node, index, sub, limit, (unsigned)bytes) == 0, "[%s]: %s 0x%X written", section,
+                  k == 0 ? "LowLimit" : "HighLimit", limit);
+            CHECK(sdo_upload(node, index, sub, &value, &abort) == bytes && value == limit, "[%s]: read back 0x%X",
+                  section, value);
+        }
+        if ((high & mask) != type_max) {
+            CHECK(sdo_download(node, index, sub, (high + 1u) & mask, (unsigned)bytes) == URRT_CO_ABORT_TOO_HIGH,
+                  "[%s]: HighLimit + 1 refused with 0x06090031", section);
+        }
+        if ((low & mask) != type_min) {
+            CHECK(sdo_download(node, index, sub, (low - 1u) & mask, (unsigned)bytes) == URRT_CO_ABORT_TOO_LOW,
+                  "[%s]: LowLimit - 1 refused with 0x06090032", section);
+        }
+    }
+    return checked;
+}
+
+/* tests/canopen/eds_check.py (CiA 306's rules) on the EDS written to a file of its own name. */
+static void run_eds_checker(gw_config *cfg, const char *checker, const char *what)
+{
+    char dir[] = "/tmp/urrt-eds-XXXXXX", path[64], cmd[512], line[512];
+    unsigned passed = 0, failed = 1;
+    bool summary = false;
+    FILE *out, *pipe;
+    if (mkdtemp(dir) == NULL) {
+        CHECK(0, "mkdtemp");
+        return;
+    }
+    snprintf(path, sizeof path, "%s/urrt-node5.eds", dir);
+    out = fopen(path, "w");
+    CHECK(out != NULL && eds_write(out, cfg->co_run, &cfg->co, &cfg->can, what, path) == 0, "EDS to %s", path);
+    if (out != NULL) {
+        fclose(out);
+    }
+    snprintf(cmd, sizeof cmd, "python3 %s %s 5 2>&1", checker, path);
+    pipe = popen(cmd, "r");
+    while (pipe != NULL && fgets(line, sizeof line, pipe) != NULL) {
+        if (strncmp(line, "FAIL", 4) == 0) {
+            fprintf(stderr, "%s: %s", what, line);
+        }
+        summary = sscanf(line, "%u passed, %u failed", &passed, &failed) == 2 || summary;
+    }
+    CHECK(pipe != NULL && pclose(pipe) == 0 && summary && failed == 0 && passed > 1000,
+          "%s: eds_check.py %u passed, %u failed", what, passed, failed);
+    remove(path);
+    rmdir(dir);
+}
+
+struct frames {
+    urrt_can_frame f[64];
+    unsigned count;
+};
+
+static void frames_emit(void *ctx, const urrt_can_frame *frame, uint64_t now_us)
+{
+    struct frames *s = ctx;
+    (void)now_us;
+    if (s->count < sizeof s->f / sizeof s->f[0]) {
+        s->f[s->count] = *frame;
+    }
+    s->count++;
+}
+
+/* EMCYs (0x085) among the frames with this code (bytes 0-1), or the error reset of it (bytes 3-4). */
+static unsigned emcys(const struct frames *s, unsigned code, bool reset, uint8_t rpdo)
+{
+    unsigned n = 0;
+    for (unsigned i = 0; i < s->count && i < sizeof s->f / sizeof s->f[0]; i++) {
+        const uint8_t *d = s->f[i].data;
+        unsigned at = reset ? 3u : 0u;
+        n += s->f[i].id == 0x085 && s->f[i].len == 8 && (unsigned)(d[at] | d[at + 1] << 8) == code && d[5] == rpdo &&
+             (!reset || (d[0] == 0 && d[1] == 0)) && (reset || (d[2] & 0x11u) == 0x11u);
+    }
+    return n;
+}
+
+static uint32_t read_u(urrt_co *node, unsigned index, unsigned sub)
+{
+    uint32_t value, abort;
+    long size = sdo_upload(node, index, sub, &value, &abort);
+    CHECK(size > 0, "0x%04X sub %u readable (abort 0x%08X)", index, sub, abort);
+    return value;
+}
+
+/* The node's SDO server on the [input]s' objects, frame by frame. */
+static void test_inputs_sdo(gw_config *cfg)
+{
+    urrt_co *node = co_run_node(cfg->co_run);
+    struct sink s = {0};
+    uint32_t before;
+    urrt_co_start(node, 0, sink_emit, &s);
+    /* An expedited download stores the value: read back by upload, and as the gateway takes it. */
+    CHECK(sdo_download(node, 0x2200, 1, 1234, 2) == 0, "0x2200 sub 1 = 1234: [60 00 22 01]");
+    CHECK_EQ_INT(read_u(node, 0x2200, 1), 1234);
+    CHECK_EQ_INT(co_run_input_raw(cfg->co_run, 0, 0), 1234);
+    CHECK(co_run_input_written_us(cfg->co_run, 0) != URRT_CANTX_NEVER, "the SDO write is recorded");
+    CHECK(sdo_download(node, 0x2201, 3, 0xFE, 1) == 0 && read_u(node, 0x2201, 3) == 0xFE, "INTEGER8 -2 stored");
+    CHECK_EQ_INT(co_run_input_raw(cfg->co_run, 1, 2), 0xFE);
+    /* A read-only robot value (TPDO1's 0x2100 sub 1). */
+    CHECK_EQ_INT(sdo_download(node, 0x2100, 1, 7, 4), URRT_CO_ABORT_READ_ONLY);
+    /* Lengths: 4 bytes into an UNSIGNED16, 1 byte into it, a request frame of 5 bytes. */
+    CHECK_EQ_INT(sdo_download(node, 0x2200, 1, 5, 4), URRT_CO_ABORT_TOO_LONG);
+    CHECK_EQ_INT(sdo_download(node, 0x2200, 1, 5, 1), URRT_CO_ABORT_TOO_SHORT);
+    {
+        static const uint8_t five[5] = {0x2B, 0x00, 0x22, 0x01, 0x05};
+        s.count = 0;
+        urrt_co_on_frame(node, 0x605, 0, five, sizeof five, 1000, sink_emit, &s);
+        CHECK(s.count == 1 && s.last.data[0] == 0x80 && s.last.data[1] == 0x00 && s.last.data[2] == 0x22 &&
+                  s.last.data[3] == 1 && s.last.data[4] == 0x10 && s.last.data[5] == 0x00 && s.last.data[6] == 0x07 &&
+                  s.last.data[7] == 0x06, "a 5-byte request: abort 0x06070010 for 0x2200 sub 1");
+    }
+    CHECK_EQ_INT(read_u(node, 0x2200, 1), 1234); /* none of them stored anything */
+    /* Past the object's range: 2 into a BOOL register's. */
+    before = read_u(node, 0x2200, 2);
+    CHECK_EQ_INT(sdo_download(node, 0x2200, 2, 2, 1), URRT_CO_ABORT_TOO_HIGH);
+    CHECK_EQ_INT(read_u(node, 0x2200, 2), before);
+    CHECK(sdo_download(node, 0x2200, 2, 1, 1) == 0 && read_u(node, 0x2200, 2) == 1, "1 into the BOOL's object");
+    /* The mapping is static (lib/urrt_co_rx.c: 0x1600+n has no write): read-only, sub 0 too. */
+    CHECK_EQ_INT(sdo_download(node, 0x1600, 1, 0x22000110u, 4), URRT_CO_ABORT_READ_ONLY);
+    CHECK_EQ_INT(sdo_download(node, 0x1600, 0, 0, 1), URRT_CO_ABORT_READ_ONLY);
+    CHECK_EQ_INT(read_u(node, 0x1600, 0), 7);
+    /* The RPDOs past the configured ones do not exist; RPDO transmission types 241..253 are refused. */
+    CHECK_EQ_INT(sdo_download(node, 0x1402, 2, 254, 1), URRT_CO_ABORT_NO_OBJECT);
+    CHECK_EQ_INT(sdo_download(node, 0x1400, 2, 241, 1), URRT_CO_ABORT_TOO_HIGH);
+    /* A reset node takes the defaults back. */
+    urrt_co_start(node, 0, sink_emit, &s);
+    CHECK_EQ_INT(read_u(node, 0x2200, 1), 0);
+    CHECK(co_run_input_written_us(cfg->co_run, 0) == URRT_CANTX_NEVER, "reset: no write recorded");
+}
+
+/* RPDOs as a manager sends them: acted on in OPERATIONAL only; a short one raises EMCY 0x8210 once. */
+static void test_inputs_rpdo(gw_config *cfg)
+{
+    static const uint8_t start[2] = {0x01, 0x05};
+    static const uint8_t rpdo1[8] = {0x0F, 0x27, 0x01, 0x00, 0, 0, 0, 0}; /* job 9999, start 1, door 0 */
+    static const uint8_t rpdo1_bad[8] = {0x2A, 0x00, 0x02, 0x01, 0, 0, 0, 0}; /* job 42, start 2 (refused), door 1 */
+    static const uint8_t rpdo2[7] = {0xFB, 0xFF, 0xFF, 0xFF, 0x18, 0xFC, 0x9C}; /* -5, -1000 (-1 m/s), -100 */
+    urrt_co *node = co_run_node(cfg->co_run);
+    struct frames f = {0};
+    size_t rx_count;
+    const uint32_t *rx = co_run_rx_ids(cfg->co_run, &rx_count);
+    uint32_t refused;
+    CHECK(rx_count == 5 && rx[0] == 0x000 && rx[1] == 0x080 && rx[2] == 0x605 && rx[3] == 0x205 && rx[4] == 0x305,
+          "rx ids: NMT, SYNC, SDO, RPDO1 0x205, RPDO2 0x305 (%zu)", rx_count);
+    urrt_co_start(node, 0, frames_emit, &f);
+    /* PRE-OPERATIONAL: not processed. */
+    urrt_co_on_frame(node, 0x205, 0, rpdo1, 8, 1000, frames_emit, &f);
+    CHECK_EQ_INT(read_u(node, 0x2200, 1), 0);
+    urrt_co_on_frame(node, 0x000, 0, start, 2, 2000, frames_emit, &f);
+    CHECK_EQ_INT(urrt_co_state(node), URRT_CO_OPERATIONAL);
+    f.count = 0;
+    CHECK_EQ_INT(urrt_co_on_frame(node, 0x205, 0, rpdo1, 8, 3000, frames_emit, &f), 0);
+    CHECK_EQ_INT(f.count, 0); /* an RPDO is never answered */
+    CHECK_EQ_INT(read_u(node, 0x2200, 1), 9999);
+    CHECK_EQ_INT(read_u(node, 0x2200, 2), 1);
+    CHECK_EQ_INT(read_u(node, 0x2200, 3), 0);
+    CHECK_EQ_INT(co_run_input_raw(cfg->co_run, 0, 0), 9999);
+    CHECK_EQ_INT(co_run_input_written_us(cfg->co_run, 0), 3000);
+    urrt_co_on_frame(node, 0x305, 0, rpdo2, 7, 3500, frames_emit, &f);
+    CHECK_EQ_INT(read_u(node, 0x2201, 1), 0xFFFFFFFBu);
+    CHECK_EQ_INT(read_u(node, 0x2201, 2), 0xFC18u);
+    CHECK_EQ_INT(read_u(node, 0x2201, 3), 0x9Cu);
+    /* A value past its object's range is not stored (never clamped), the others are. */
+    refused = node->values_refused;
+    urrt_co_on_frame(node, 0x205, 0, rpdo1_bad, 8, 4000, frames_emit, &f);
+    CHECK_EQ_INT(read_u(node, 0x2200, 1), 42);
+    CHECK_EQ_INT(read_u(node, 0x2200, 2), 1);
+    CHECK_EQ_INT(read_u(node, 0x2200, 3), 1);
+    CHECK_EQ_INT(node->values_refused, refused + 1u);
+    /* Shorter than its mapping (4 of 8 bytes): not processed, EMCY 0x8210 (byte 5: RPDO 1) once. */
+    urrt_co_run(node, 5000, frames_emit, &f);
+    f.count = 0;
+    urrt_co_on_frame(node, 0x205, 0, rpdo1, 4, 6000, frames_emit, &f);
+    CHECK(urrt_co_deadline(node) <= 6000, "a short RPDO makes the node due at once");
+    urrt_co_run(node, 6000, frames_emit, &f);
+    urrt_co_on_frame(node, 0x205, 0, rpdo1, 4, 7000, frames_emit, &f);
+    urrt_co_run(node, 7000, frames_emit, &f);
+    urrt_co_run(node, 8000, frames_emit, &f);
+    CHECK(emcys(&f, 0x8210, false, 1) == 1, "EMCY 0x8210 for RPDO1, once (%u frames)", f.count);
+    CHECK_EQ_INT(read_u(node, 0x2200, 1), 42);
+    CHECK(urrt_co_error_register(node) & 0x10u, "error register: communication");
+    /* The right length again: processed, the error reset names 0x8210 and RPDO 1. */
+    f.count = 0;
+    urrt_co_on_frame(node, 0x205, 0, rpdo1, 8, 9000, frames_emit, &f);
+    urrt_co_run(node, 9000, frames_emit, &f);
+    CHECK(emcys(&f, 0x8210, true, 1) == 1, "EMCY reset of 0x8210 for RPDO1");
+    CHECK_EQ_INT(read_u(node, 0x2200, 1), 9999);
+    /* Longer than its mapping (RPDO2, 8 bytes for 7): processed, the extra byte ignored. */
+    {
+        uint8_t longer[8] = {0x01, 0, 0, 0, 0x02, 0, 0x03, 0xAA};
+        urrt_co_on_frame(node, 0x305, 0, longer, 8, 9500, frames_emit, &f);
+        CHECK(read_u(node, 0x2201, 1) == 1 && read_u(node, 0x2201, 2) == 2 && read_u(node, 0x2201, 3) == 3,
+              "a longer RPDO2: processed");
+    }
+}
+
+static void test_inputs_node(const char *checker)
+{
+    gw_config cfg;
+    char *messages = NULL;
+    int errors = load(&cfg, inputs_node, &messages);
+    CHECK(errors == 0 && cfg.co_run != NULL, "a node with [input]s loads: %s", messages);
+    free(messages);
+    if (errors == 0 && cfg.co_run != NULL) {
+        char *eds = NULL;
+        size_t size = 0;
+        FILE *out = open_memstream(&eds, &size);
+        urrt_co *node = co_run_node(cfg.co_run);
+        struct sink s = {0};
+        unsigned vars;
+        const urrt_co_desc *d = co_run_desc(cfg.co_run);
+        CHECK_EQ_INT(d->rpdo_count, 2);
+        CHECK_EQ_INT(d->consumer_count, 1);
+        CHECK_EQ_INT(eds_write(out, cfg.co_run, &cfg.co, &cfg.can, "inputs.ini", NULL), 0);
+        fclose(out);
+        test_inputs_eds_text(eds);
+        /* Every object the lists name read back by SDO: sizes, and the defaults right after a reset. */
+        urrt_co_start(node, 0, sink_emit, &s);
+        vars = check_listed(eds, node, "MandatoryObjects") + check_listed(eds, node, "OptionalObjects") +
+               check_listed(eds, node, "ManufacturerObjects");
+        CHECK(vars > 60, "%u objects and sub-indices read by SDO", vars);
+        CHECK_EQ_INT(check_limits_by_sdo(eds, node), 6u + 2u); /* 0x22xx's six, TPDO1 and status sub 2 */
+        free(eds);
+        test_inputs_sdo(&cfg);
+        test_inputs_rpdo(&cfg);
+        if (checker != NULL) {
+            run_eds_checker(&cfg, checker, "inputs.ini");
+        }
+    }
+    gw_config_free(&cfg);
+}
+
 int main(int argc, char **argv)
 {
     gw_config cfg;
@@ -638,14 +1117,16 @@ int main(int argc, char **argv)
         gw_config_free(&cfg);
         return 0;
     }
-    if (argc != 4) {
-        fprintf(stderr, "usage: test_canopen EXAMPLE.ini TABLES.c CANOPEN.md | test_canopen --table EXAMPLE.ini\n");
+    if (argc != 4 && argc != 5) {
+        fprintf(stderr, "usage: test_canopen EXAMPLE.ini TABLES.c CANOPEN.md [EDS_CHECK.py] | "
+                        "test_canopen --table EXAMPLE.ini\n");
         return 2;
     }
     test_rejections();
     test_causes_first();
     test_bus_load();
     test_rtde_node();
+    test_inputs_node(argc == 5 ? argv[4] : NULL);
     CHECK(gw_config_load(&cfg, argv[1], stderr) == 0 && cfg.co_run != NULL, "%s loads, with its node", argv[1]);
     if (cfg.co_run != NULL) {
         test_description(&cfg);
@@ -654,6 +1135,9 @@ int main(int argc, char **argv)
         test_status_event_timer_zero(&cfg);
         test_dbc(&cfg);
         test_doc_table(&cfg, argv[3]);
+        if (argc == 5) {
+            run_eds_checker(&cfg, argv[4], "canopen.ini");
+        }
     }
     gw_config_free(&cfg);
     test_c_tables(argv[2]);
