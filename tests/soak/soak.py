@@ -66,7 +66,11 @@ PHASES = [
     ("freeze-after", ["--fault", "freeze-after=1000,for=1500"]),
     ("freeze-every", ["--fault", "freeze-every=1000,for=700"]),
     ("garbage", ["--fault", "garbage-every=50,bytes=37"]),
-    ("tiny-writes", ["--fault", "tiny-writes=7"]),
+    # 7-byte pieces at the CB3 rate: at 500 Hz, 80,000 writes a second took the
+    # simulator (under SCHED_FIFO) 0.6-0.9 of one of this machine's two cores, and
+    # the gateways, its subject, waited for a CPU 40-440 ms of every second (the
+    # per-phase "sched" lines): heartbeat gaps of up to 581 ms that were the soak's.
+    ("tiny-writes", ["--fault", "tiny-writes=7", "--rate", "125"]),
     ("coalesce", ["--fault", "coalesce=4"]),
     ("odd-length", ["--fault", "odd-length=200"]),
     ("restart", []),
@@ -483,6 +487,41 @@ class CoLog(CandumpLog):
                 self._violate("reset_early", reset_us, "EMCY 0x%04X reset and no TPDO1 after it" % code)
 
 
+def sched_sample(pid):
+    """(CPU time, time runnable but waiting for a CPU) of a process and its threads so
+    far, in ms: /proc/PID/schedstat, the kernel's own accounting."""
+    try:
+        with open("/proc/%d/schedstat" % pid) as f:
+            run_ns, wait_ns = (int(x) for x in f.read().split()[:2])
+        return run_ns / 1e6, wait_ns / 1e6
+    except (OSError, ValueError):
+        return 0.0, 0.0
+
+
+class Sched:
+    """Per phase, how much CPU each process had and how long it waited for one: what
+    tells a subject that cannot keep up from one the soak starves."""
+
+    def __init__(self):
+        self.start = {}
+        self.lines = []
+
+    def begin(self, procs):
+        """procs: name -> a Popen, or a pid."""
+        pids = {name: p if isinstance(p, int) else p.pid for name, p in procs.items() if p}
+        self.start = {name: (pid, sched_sample(pid), time.monotonic()) for name, pid in pids.items()}
+
+    def end(self, phase):
+        parts = []
+        for name, (pid, (run0, wait0), t0) in self.start.items():
+            run1, wait1 = sched_sample(pid)
+            seconds = max(time.monotonic() - t0, 1e-3)
+            parts.append("%s cpu %.0f ms/s, waited %.0f ms/s" % (name, (run1 - run0) / seconds,
+                                                                    (wait1 - wait0) / seconds))
+        if parts:
+            self.lines.append("soak: sched in %s: %s" % (phase, "; ".join(parts)))
+
+
 def proc_sample(pid):
     """(RSS in KiB, open descriptors) of a process."""
     with open("/proc/%d/status" % pid) as f:
@@ -572,6 +611,7 @@ def run(args):
     print("soak: %.1f min, %d phases of %d s (%d s per pass, %d passes), bound %d ms (+%d ms margin), dir %s" %
           (args.minutes, len(PHASES), args.phase_seconds, cycle_s, cycles, BOUND_MS, MARGIN_MS, s.dir))
     samples = {"can": [], "canopen": []}
+    sched = Sched()
     gw = co_gw = checker = None
     try:
         s.start_sim(PHASES[0][1])
@@ -608,6 +648,8 @@ def run(args):
                 s.start_sim(extra)
             end = min(time.monotonic() + args.phase_seconds, deadline)
             next_kill = time.monotonic() + RESTART_UP_S
+            sched.begin({"can gateway": gw, "canopen gateway": co_gw, "simulator": s.sim, "checker": checker,
+                         "soak.py": os.getpid()})
             while time.monotonic() < end:
                 for g, what in ((gw, "urrt-gateway"), (co_gw, "the CANopen urrt-gateway")):
                     if g.poll() is not None:
@@ -621,6 +663,7 @@ def run(args):
                 can.read()
                 co.read()
                 time.sleep(0.05)
+            sched.end(name)
             n += 1
             for key, g in (("can", gw), ("canopen", co_gw)):
                 rss, fds = proc_sample(g.pid)
@@ -645,6 +688,8 @@ def run(args):
         co.finish(end_us)
     finally:
         s.stop_all()
+    for line in sched.lines:
+        print(line)
     if report(s, can, co, samples, warm_phases, exits):
         subprocess.run(["rm", "-rf", s.dir])
     else:
@@ -825,7 +870,15 @@ def main():
     ap.add_argument("--minutes", type=float, default=10)
     ap.add_argument("--phase-seconds", type=int, default=10)
     ap.add_argument("--result")
+    ap.add_argument("--phases", help="only these phases, comma-separated (a quick look at one fault)")
     args = ap.parse_args()
+    if args.phases:
+        wanted = args.phases.split(",")
+        unknown = [p for p in wanted if p not in [name for name, _ in PHASES]]
+        if unknown:
+            print("soak: no phase %s (phases: %s)" % (", ".join(unknown), ", ".join(n for n, _ in PHASES)))
+            return 2
+        PHASES[:] = [ph for ph in PHASES if ph[0] in wanted]
     args.gateway = os.path.join(args.build, "bin", "urrt-gateway")
     args.sim = os.path.join(args.build, "bin", "urrt-sim")
     args.checker = os.path.join(args.build, "tests", "soak", "soak_lcm")
