@@ -327,6 +327,7 @@ static int input_id(struct canopen_map *co, struct can_map *can, size_t i)
         problem(can, f->loc, "[input %s] would be RPDO%u: the node receives RPDO1..%u (CiA 301's pre-defined "
                 "set): join it with another [input], at most %u with [canopen]", f->name, n,
                 (unsigned)URRT_CO_MAX_RPDOS, (unsigned)URRT_CO_MAX_RPDOS);
+        f->key_loc[CAN_MAP_IK_ID] = f->loc; /* no "has no id" from the same cause */
         return 1;
     }
     if (f->key_loc[CAN_MAP_IK_ID].line != 0 && (f->id != pre || f->extended)) {
@@ -477,41 +478,15 @@ int canopen_map_orphans(const struct canopen_map *co, const struct can_map *can)
     return errors;
 }
 
-/* An [input] on one of the node's own ids would take its frames (an [input]
- * sees every frame first) or answer for it: refused, naming the id's role. */
-static int check_input_ids(const struct canopen_map *co, const struct can_map *can)
-{
-    const uint32_t n = co->node_id;
-    const struct { uint32_t id; const char *role; } node[] = {
-        {0x000u, "NMT"}, {0x080u, "SYNC (0x1005's default)"}, {0x080u + n, "the node's EMCY (0x080 + node_id)"},
-        {0x580u + n, "the node's SDO answers (0x580 + node_id)"},
-        {0x600u + n, "the node's SDO requests (0x600 + node_id)"},
-        {0x700u + n, "the node's heartbeat (0x700 + node_id)"},
-    };
-    int errors = 0;
-    for (size_t i = 0; i < can->input_count; i++) {
-        const struct can_map_frame *f = &can->inputs[i];
-        for (size_t k = 0; k < sizeof node / sizeof node[0] && !f->extended; k++) {
-            if (f->id == node[k].id) {
-                problem(can, loc_or(f->key_loc[CAN_MAP_IK_ID], f->loc), "[input %s] id 0x%03X is %s, with node_id "
-                        "%u: give the PLC's frame an id of its own", f->name, (unsigned)f->id, node[k].role,
-                        (unsigned)n);
-                errors++;
-                break;
-            }
-        }
-    }
-    return errors;
-}
-
 int canopen_map_check(const struct canopen_map *co, const struct can_map *can)
 {
-    int errors = check_input_ids(co, can);
-    if (can->input_count > 0 && co->tpdo_count >= CANOPEN_INPUTS_INDEX - CANOPEN_VALUES_INDEX) {
-        problem(can, can->inputs[0].loc, "[input %s]: with %zu TPDOs, TPDO%u's values take 0x%04X, the index of "
-                "RPDO1's registers: at most %u [frame]s beside [input]s", can->inputs[0].name, co->tpdo_count,
-                CANOPEN_INPUTS_INDEX - CANOPEN_VALUES_INDEX + 1u, CANOPEN_INPUTS_INDEX,
-                CANOPEN_INPUTS_INDEX - CANOPEN_VALUES_INDEX - 1u);
+    int errors = 0;
+    /* TPDO n's values are at 0x2100 + n - 1: past TPDO256, RPDO1's registers' 0x2200. */
+    if (can->input_count > 0 && co->tpdo_count > CANOPEN_INPUTS_INDEX - CANOPEN_VALUES_INDEX) {
+        problem(can, can->inputs[0].loc, "[input %s]: with %zu [frame]s, TPDO%u's values would take 0x%04X, the "
+                "index of RPDO1's registers: at most %u [frame]s beside [input]s", can->inputs[0].name,
+                co->tpdo_count, CANOPEN_INPUTS_INDEX - CANOPEN_VALUES_INDEX + 1u, CANOPEN_INPUTS_INDEX,
+                CANOPEN_INPUTS_INDEX - CANOPEN_VALUES_INDEX);
         errors++;
     }
     for (size_t i = 0; i < can->input_count; i++) {

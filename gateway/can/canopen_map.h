@@ -120,8 +120,9 @@ int canopen_map_orphans(const struct canopen_map *co, const struct can_map *can)
 
 /* After can_map_finish accepted can: each frame a classic 11-bit TPDO, and
  * each [input] an RPDO, of at most 8 bytes, each signal Intel,
- * byte-aligned, of an object type, its bytes its own; no [input] on one of
- * the node's own ids. Returns the number of problems (to can's reporter). */
+ * byte-aligned, of an object type, its bytes its own (an RPDO's integers
+ * only); with [input]s, at most 256 [frame]s (their values' indices end
+ * below 0x2200). Returns the number of problems (to can's reporter). */
 int canopen_map_check(const struct canopen_map *co, const struct can_map *can);
 
 /* What a TPDO signal becomes: the object's type (URRT_CO_*) and size in

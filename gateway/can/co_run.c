@@ -26,6 +26,7 @@ struct co_run {
     uint32_t rpdo_maps[URRT_CO_MAX_RPDOS][URRT_CO_RPDO_MAX_MAPPED];
     urrt_co_rpdo_state rpdo_states[URRT_CO_MAX_RPDOS];
     urrt_co_consumer consumers[1];
+    urrt_co_rx_storage rx;          /* the node's receiving side: kept as long as the node */
     uint32_t consumer_default;      /* 0x1016 sub 1: off until the manager writes it */
     size_t first_var[URRT_CO_MAX_RPDOS + 1];
     uint32_t *vars;                 /* at least one: urrt_co_init wants storage all the same */
@@ -267,10 +268,13 @@ static void describe(struct co_run *r, const struct canopen_map *co, const struc
 static int node_init(struct co_run *r, struct can_run *run, size_t vars, char *err, size_t errlen)
 {
     size_t bad;
-    urrt_co_rx_storage rx = {r->rpdo_states, r->consumers, r->written_us};
-    int rc = r->desc.rpdo_count > 0
-                 ? urrt_co_init_rx(&r->co, &r->desc, can_run_tx(run), r->states, r->vars, vars, &rx, &bad)
-                 : urrt_co_init(&r->co, &r->desc, can_run_tx(run), r->states, r->vars, 1, &bad);
+    int rc;
+    r->rx.rpdos = r->rpdo_states;
+    r->rx.consumers = r->consumers;
+    r->rx.written_us = r->written_us;
+    rc = r->desc.rpdo_count > 0
+             ? urrt_co_init_rx(&r->co, &r->desc, can_run_tx(run), r->states, r->vars, vars, &r->rx, &bad)
+             : urrt_co_init(&r->co, &r->desc, can_run_tx(run), r->states, r->vars, 1, &bad);
     if (rc < 0) {
         snprintf(err, errlen, "the CANopen node (lib/urrt_co) refuses the configuration (%s %zu): %s",
                  rc == URRT_CO_E_OBJECT ? "object" : "TPDO", bad == SIZE_MAX ? 0 : bad + 1, urrt_co_strerror(rc));
@@ -388,13 +392,16 @@ int co_run_describe(const struct co_run *run, char *buf, size_t size)
     const urrt_co_desc *d = &run->desc;
     size_t status = d->tpdo_count - 1u;
     int len = 0;
-    append(buf, size, &len, "node %u: TPDO1..%zu at", (unsigned)d->node_id, status);
+    append(buf, size, &len, "node %u: ", (unsigned)d->node_id);
+    if (status > 0) {
+        append(buf, size, &len, "TPDO1..%zu at", status);
+    }
     for (size_t n = 0; n < status; n++) {
         append(buf, size, &len, " 0x%X", (unsigned)(urrt_co_tpdo_cob_default(&run->co, n) & 0x7FFu));
     }
     append(buf, size, &len,
-           ", status TPDO%zu at 0x%X (off until enabled), heartbeat %u ms at 0x%X, EMCY 0x%X, SDO 0x%X/0x%X, starts %s",
-           d->tpdo_count, (unsigned)(urrt_co_tpdo_cob_default(&run->co, status) & 0x7FFu),
+           "%sstatus TPDO%zu at 0x%X (off until enabled), heartbeat %u ms at 0x%X, EMCY 0x%X, SDO 0x%X/0x%X, starts %s",
+           status > 0 ? ", " : "", d->tpdo_count, (unsigned)(urrt_co_tpdo_cob_default(&run->co, status) & 0x7FFu),
            (unsigned)d->heartbeat_ms, 0x700u + d->node_id, 0x080u + d->node_id, SDO_RX_BASE + d->node_id,
            0x580u + d->node_id, canopen_nmt_start_name(d->nmt_start));
     for (size_t n = 0; n < d->rpdo_count; n++) {

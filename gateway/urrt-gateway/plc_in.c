@@ -229,6 +229,9 @@ static const char *node_state(const plc_in *in, const struct plc_group *g, uint6
 {
     switch (urrt_co_rpdo_status(co_run_node(in->node), g->input, now_us)) {
     case URRT_CO_RPDO_NOT_OPERATIONAL: return "the CANopen node is not OPERATIONAL";
+    /* Before "heartbeat lost" in lib's order, which it would hide: a manager
+     * that switched the RPDO off has said its registers are not written. */
+    case URRT_CO_RPDO_NOT_VALID: return "the manager switched the RPDO off (0x1400+n sub 1, bit 31)";
     case URRT_CO_RPDO_HEARTBEAT_LOST: return "the manager's heartbeat is lost (0x1016)";
     default: return NULL;
     }

@@ -217,6 +217,7 @@ static int dbc_writer(FILE *out, gw_config *cfg, const char *path)
 
 static int c_tables_writer(FILE *out, gw_config *cfg, const char *path)
 {
+
     struct can_ctables_robot robots[GW_MAX_ROBOTS];
     (void)path;
     for (unsigned i = 0; i < cfg->robot_count && i < GW_MAX_ROBOTS; i++) {
@@ -238,6 +239,12 @@ static int write_output(gw_config *cfg, const char *path, writer_fn write, const
     bool ok;
     if (!can_map_enabled(&cfg->can)) {
         fprintf(stderr, "urrt-gateway: %s has no [can] section or [frame NAME]: no %s to write\n", cfg->path, what);
+        return CLI_EXIT_USAGE;
+    }
+    if (write == c_tables_writer && cfg->co_run != NULL && cfg->can.input_count > 0) {
+        /* Its node would start without the RPDOs its objects need. */
+        fprintf(stderr, "urrt-gateway: %s: --print-c-tables does not write a CANopen node's RPDOs yet ([input]s "
+                "with [canopen]): generate the tables from the configuration without its [input]s\n", cfg->path);
         return CLI_EXIT_USAGE;
     }
     if (write == eds_writer && cfg->co_run == NULL) {
