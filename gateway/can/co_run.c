@@ -184,7 +184,8 @@ static void input_range(const urrt_can_signal *sig, const struct can_map_signal 
         lo = lo > type_lo && accepted(sig, lo - 1) ? lo - 1 : lo;
         hi = hi < type_hi && accepted(sig, hi + 1) ? hi + 1 : hi;
     }
-    if (!meta->bitmask && meta->var >= URRT_RTDE_V_INPUT_BIT_REGISTER && meta->var < URRT_RTDE_V_INPUT_BIT_REGISTER + 64) {
+    if (!meta->bitmask && meta->var >= URRT_RTDE_V_INPUT_BIT_REGISTER &&
+        meta->var < URRT_RTDE_V_INPUT_BIT_REGISTER + 64) {
         lo = lo > 0 ? lo : 0;
         hi = hi < 1 ? hi : 1;
     }

@@ -32,14 +32,12 @@ struct plc_group {
 };
 
 struct plc_in {
-    gateway *gw;
     const struct can_map *map;
     struct co_run *node;      /* with [canopen]: the [input]s are its RPDOs; NULL: plain frames */
     struct plc_group *groups;
     size_t count;
     uint64_t period_us;       /* 1 / inputs_min_rate */
     uint64_t bus_off_seen;
-    bool link_up;
     uint64_t due_us;          /* the earliest timeout or refresh */
 };
 
@@ -162,7 +160,8 @@ static void fall_silent(struct plc_group *g, const char *why)
 
 /* ---- receiving --------------------------------------------------------------------- */
 
-static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
 static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, ...)
 {
     char text[400];
@@ -293,9 +292,10 @@ bool plc_in_on_frame(void *ctx, const urrt_can_frame *frame, uint64_t rx_us)
 void plc_in_link(void *ctx, bool up, uint64_t bus_off, uint64_t now_us)
 {
     plc_in *in = ctx;
-    const char *why = !up ? "the CAN interface is down" : bus_off != in->bus_off_seen ? "the CAN controller went bus-off" : NULL;
+    const char *why = !up                          ? "the CAN interface is down"
+                      : bus_off != in->bus_off_seen ? "the CAN controller went bus-off"
+                                                    : NULL;
     (void)now_us;
-    in->link_up = up;
     in->bus_off_seen = bus_off;
     for (size_t i = 0; why != NULL && i < in->count; i++) {
         if (in->groups[i].fresh) {
@@ -403,12 +403,10 @@ plc_in *plc_in_new(gateway *gw, const struct can_map *map, struct co_run *node)
         free(in);
         return NULL;
     }
-    in->gw = gw;
     in->map = map;
     in->node = node;
     in->count = map->input_count;
     in->period_us = (uint64_t)(1e6 / map->inputs_min_rate_hz);
-    in->link_up = true;
     in->due_us = UINT64_MAX;
     for (size_t i = 0; i < in->count; i++) {
         struct plc_group *g = &in->groups[i];
