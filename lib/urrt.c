@@ -1113,6 +1113,20 @@ int urrt_framer_feed(urrt_framer *fr, const uint8_t *data, size_t len, size_t *u
     if (fr == NULL || used_out == NULL || (data == NULL && len != 0)) {
         return URRT_E_ARG;
     }
+    if (len >= URRT_HEADER_SIZE && (fr->need | fr->have) == 0) {
+        /* The usual read first: it starts with a whole packet of the last
+         * accepted size, taken where it lies (what the loop below does for
+         * it, without the loop). */
+        uint32_t size = load_be32(data);
+        if (size == fr->last_length && size != 0 && len >= size) {
+            fr->packet = data;
+            fr->packet_length = size;
+            fr->stats.bytes += size;
+            fr->stats.packets++;
+            *used_out = size;
+            return 1;
+        }
+    }
     fr->packet = NULL;
     fr->packet_length = 0;
     while (used < len) {

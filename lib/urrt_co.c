@@ -16,14 +16,6 @@
 #define SDO_RX_BASE 0x600u
 #define SDO_TX_BASE 0x580u
 #define NMT_EC_BASE URRT_CO_NMT_EC_BASE
-#define TPDO_COMM 0x1800u
-#define TPDO_MAP 0x1A00u
-#define TPDO_COMM_SUBS 5u              /* 0x1800+n sub 0: highest sub-index (4 is reserved, 6 unsupported) */
-#define RPDO_COMM 0x1400u
-#define RPDO_MAP 0x1600u
-#define RPDO_COMM_SUBS 5u              /* 0x1400+n sub 0: highest sub-index (3 and 4 are not an RPDO's) */
-#define CONSUMER_HB 0x1016u
-#define IDENTITY_SUBS 4u
 #define MFR_FIRST 0x2000u
 #define MFR_LAST 0x5FFFu
 #define SYNC_MAX_N URRT_CO_SYNC_MAX_N
@@ -42,13 +34,8 @@
 #define SDO_TOGGLE 0x10u
 #define SDO_LAST 0x01u
 
-/* Conditions: bit i of urrt_co.active, with its EMCY code and error register
- * bits; the receiving side's after the five of urrt_co.h, one per 0x1016
- * entry or RPDO. */
-enum {
-    COND_LINK, COND_STALE, COND_OVERRUN, COND_PASSIVE, COND_BUS_OFF,
-    COND_ALL = URRT_CO_COND_ALL /* the receiving side's: urrt_co_internal.h */
-};
+/* Conditions: bit i of urrt_co.active, with its EMCY code and error register bits. */
+enum { COND_LINK, COND_STALE, COND_OVERRUN, COND_PASSIVE, COND_BUS_OFF };
 #define ERR_GENERIC 0x01u
 #define ERR_COMMUNICATION 0x10u
 #define ERR_MANUFACTURER 0x80u
@@ -64,9 +51,7 @@ const char *urrt_co_strerror(int result)
     case URRT_CO_E_NODE_ID: return "the node id is outside 1..127, or nmt_start is unknown";
     case URRT_CO_E_TPDO: return "a TPDO's frame, transmission type, period, mapping or COB-ID is not usable";
     case URRT_CO_E_OBJECT: return "a manufacturer object's index, type, access, source or range is not usable";
-    case URRT_CO_E_STORAGE: return "the CANopen node lacks its urrt_cantx, TPDO states, variables or RPDO storage";
-    case URRT_CO_E_RPDO: return "an RPDO's transmission type, mapping or COB-ID is not usable";
-    case URRT_CO_E_CONSUMER: return "a consumer heartbeat (0x1016) entry is not usable, or RPDOs have none";
+    case URRT_CO_E_STORAGE: return "the CANopen node lacks its urrt_cantx, TPDO states or variables";
     default: return urrt_cantx_strerror(result);
     }
 }
@@ -95,6 +80,25 @@ static uint32_t text_len(const char *s)
     return n;
 }
 
+static uint32_t type_size(uint8_t type)
+{
+    switch (type) {
+    case URRT_CO_INTEGER8:
+    case URRT_CO_UNSIGNED8: return 1;
+    case URRT_CO_INTEGER16:
+    case URRT_CO_UNSIGNED16: return 2;
+    case URRT_CO_INTEGER32:
+    case URRT_CO_UNSIGNED32:
+    case URRT_CO_REAL32: return 4;
+    default: return 0;
+    }
+}
+
+uint32_t urrt_co_type_size(uint8_t type)
+{
+    return type_size(type);
+}
+
 static bool type_signed(uint8_t type)
 {
     return type == URRT_CO_INTEGER8 || type == URRT_CO_INTEGER16 || type == URRT_CO_INTEGER32;
@@ -110,7 +114,7 @@ static uint32_t size_mask(uint32_t bytes)
  * conversion to int32_t). */
 static uint32_t order_key(uint32_t raw, uint8_t type)
 {
-    uint32_t bytes = urrt_co_type_size(type);
+    uint32_t bytes = type_size(type);
     uint32_t sign = UINT32_C(1) << (8u * bytes - 1u);
     if (!type_signed(type)) {
         return raw;
@@ -122,6 +126,16 @@ static uint32_t order_key(uint32_t raw, uint8_t type)
     return raw ^ UINT32_C(0x80000000);
 }
 
+static uint64_t min64(uint64_t a, uint64_t b)
+{
+    return a < b ? a : b;
+}
+
+static bool cob_valid(uint32_t cob)
+{
+    return (cob & URRT_CO_COB_INVALID) == 0u;
+}
+
 /* CiA 301's restricted CAN-IDs: NMT, SYNC/EMCY of others, SDO, NMT error
  * control and the LSS range; no PDO, EMCY or SYNC may use them. */
 static bool id_restricted(uint32_t id)
@@ -130,7 +144,7 @@ static bool id_restricted(uint32_t id)
            (id >= 0x601u && id <= 0x67Fu) || (id >= 0x6E0u && id <= 0x6FFu) || id >= 0x701u;
 }
 
-/* A COB-ID with a "not valid" bit 31 (EMCY, TPDO): 11-bit ids only, and a
+/* A COB-ID with a "not valid" bit 31 (EMCY, TPDO, RPDO): 11-bit ids only, and a
  * valid one not restricted. The id may change in a write that leaves or
  * makes the object invalid (CiA 301; python-canopen's PdoMap.save disables
  * and moves a PDO in one write): only a new id while staying valid is
@@ -140,10 +154,10 @@ uint32_t urrt_co_cob_check(uint32_t old, uint32_t value, uint32_t also_allowed)
     if ((value & ~(URRT_CO_COB_INVALID | also_allowed | ID_MASK)) != 0u) {
         return URRT_CO_ABORT_VALUE;
     }
-    if (!urrt_co_cob_valid(value)) {
+    if (!cob_valid(value)) {
         return 0;
     }
-    if (urrt_co_cob_valid(old) && ((old ^ value) & ID_MASK) != 0u) {
+    if (cob_valid(old) && ((old ^ value) & ID_MASK) != 0u) {
         return URRT_CO_ABORT_VALUE;
     }
     return id_restricted(value & ID_MASK) ? URRT_CO_ABORT_VALUE : 0u;
@@ -153,7 +167,7 @@ uint32_t urrt_co_cob_check(uint32_t old, uint32_t value, uint32_t also_allowed)
 
 static bool type_supported(uint8_t type)
 {
-    return urrt_co_type_size(type) != 0u;
+    return type_size(type) != 0u;
 }
 
 static int check_tpdo(const urrt_co_desc *d, const urrt_cantx *tx, size_t n)
@@ -200,13 +214,13 @@ static bool signal_fits(const urrt_co_object *o, const urrt_cantx *tx)
     if ((o->type == URRT_CO_REAL32) != (sig->type == (uint8_t)URRT_CAN_FLOAT32)) {
         return false;
     }
-    return sig->length <= 8u * urrt_co_type_size(o->type);
+    return sig->length <= 8u * type_size(o->type);
 }
 
 static bool var_fits(const urrt_co_object *o, const uint32_t *vars, size_t var_count)
 {
     uint32_t def = order_key(o->def, o->type);
-    return vars != NULL && o->item < var_count && (o->def & ~size_mask(urrt_co_type_size(o->type))) == 0u &&
+    return vars != NULL && o->item < var_count && (o->def & ~size_mask(type_size(o->type))) == 0u &&
            def >= order_key(o->min, o->type) && def <= order_key(o->max, o->type);
 }
 
@@ -249,18 +263,18 @@ static int check_desc(const urrt_co_desc *d, const urrt_cantx *tx, const uint32_
     return rc;
 }
 
-int urrt_co_init(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urrt_co_tpdo_state *tpdo_states,
-                 uint32_t *vars, size_t var_count, size_t *bad_item)
-{
-    return urrt_co_init_with(co, desc, tx, tpdo_states, vars, var_count, NULL, NULL, bad_item);
-}
-
-/* Without ops, a description with RPDOs or 0x1016 entries lacks their
- * storage; with them, the receiving side checks its storage and its part of
- * the description after the node's, and binds it (urrt_co_rx.c). */
-int urrt_co_init_with(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urrt_co_tpdo_state *tpdo_states,
-                      uint32_t *vars, size_t var_count, const struct urrt_co_rx_ops *ops,
-                      const urrt_co_rx_storage *rx, size_t *bad_item)
+/* urrt_co_init (ops NULL) and urrt_co_init_with: without ops, a
+ * description with RPDOs or 0x1016 entries lacks their storage; with them
+ * (urrt_co_init_rx, which saw that rx holds what the description needs),
+ * the receiving side checks its part of the description after the node's,
+ * and binds its storage. Inline in both, so that urrt_co_init holds none of
+ * the receiving side's calls. */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline int init_node(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urrt_co_tpdo_state *tpdo_states,
+                            uint32_t *vars, size_t var_count, const struct urrt_co_rx_ops *ops,
+                            urrt_co_rx_storage *rx, size_t *bad_item)
 {
     size_t bad = NONE;
     int rc = 0;
@@ -269,7 +283,7 @@ int urrt_co_init_with(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urr
     } else if (tx == NULL || tx->tables == NULL ||
                (desc->tpdo_count > 0u && (tpdo_states == NULL || desc->tpdos == NULL)) ||
                (desc->object_count > 0u && desc->objects == NULL) ||
-               (ops != NULL ? ops->missing(desc, rx) : desc->rpdo_count > 0u || desc->consumer_count > 0u)) {
+               (ops == NULL && (desc->rpdo_count > 0u || desc->consumer_count > 0u))) {
         rc = URRT_CO_E_STORAGE;
     } else {
         rc = check_desc(desc, tx, vars, var_count, &bad);
@@ -285,20 +299,33 @@ int urrt_co_init_with(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urr
     co->tx = tx;
     co->tpdos = tpdo_states;
     co->vars = vars;
-    co->rx = ops;
-    co->written_us = NULL;
-    co->var_writes = 0;
-    co->values_refused = 0;
     co->state = (uint8_t)URRT_CO_INITIALISING;
     co->heartbeat_due_us = URRT_CANTX_NEVER;
     co->sdo_busy = false;
     co->error_passive = false;
     co->sync_cob_id = SYNC_DEFAULT; /* urrt_co_rx_ids holds before urrt_co_start */
+    co->rx = ops;
+    co->rx_storage = rx;
+    co->var_writes = 0;
+    co->values_refused = 0;
     if (ops != NULL) {
-        ops->bind(co, rx, var_count);
+        ops->bind(co, var_count);
     }
     co->rx_changes = 0;
     return 0;
+}
+
+int urrt_co_init(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urrt_co_tpdo_state *tpdo_states,
+                 uint32_t *vars, size_t var_count, size_t *bad_item)
+{
+    return init_node(co, desc, tx, tpdo_states, vars, var_count, NULL, NULL, bad_item);
+}
+
+int urrt_co_init_with(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urrt_co_tpdo_state *tpdo_states,
+                      uint32_t *vars, size_t var_count, const struct urrt_co_rx_ops *ops, urrt_co_rx_storage *rx,
+                      size_t *bad_item)
+{
+    return init_node(co, desc, tx, tpdo_states, vars, var_count, ops, rx, bad_item);
 }
 
 /* The SYNC id becomes id: a change of the received set when it is new. */
@@ -312,14 +339,13 @@ static void sync_id_set(urrt_co *co, uint32_t cob_id)
 
 size_t urrt_co_rx_ids(const urrt_co *co, uint32_t ids[URRT_CO_RX_IDS_MAX])
 {
-    size_t count = 3;
     if (co == NULL || co->desc == NULL) {
         return 0;
     }
     ids[0] = 0x000u; /* NMT */
     ids[1] = co->sync_cob_id & ID_MASK;
     ids[2] = SDO_RX_BASE + co->desc->node_id;
-    return co->rx != NULL ? count + co->rx->ids(co, ids + count) : count;
+    return co->rx != NULL ? 3u + co->rx->ids(co, ids + 3) : 3u;
 }
 
 /* ---- frames out ------------------------------------------------------------------- */
@@ -369,7 +395,7 @@ static bool tpdo_on_packets(const urrt_co *co, size_t n)
 /* Whether the node may send TPDO n at all now. */
 static bool tpdo_live(const urrt_co *co, size_t n)
 {
-    return co->state == (uint8_t)URRT_CO_OPERATIONAL && urrt_co_cob_valid(co->tpdos[n].cob_id);
+    return co->state == (uint8_t)URRT_CO_OPERATIONAL && cob_valid(co->tpdos[n].cob_id);
 }
 
 static void gates_apply(urrt_co *co)
@@ -495,7 +521,7 @@ static uint64_t tpdo_deadline(const urrt_co *co)
     size_t n;
     for (n = 0; n < co->desc->tpdo_count; n++) {
         const urrt_co_tpdo_state *t = &co->tpdos[n];
-        next = t->held && t->inhibited ? urrt_co_min64(next, t->inhibit_end_us) : next;
+        next = t->held && t->inhibited ? min64(next, t->inhibit_end_us) : next;
     }
     return next;
 }
@@ -505,7 +531,7 @@ static bool tpdo_id_taken(const urrt_co *co, size_t n, uint32_t id)
 {
     size_t i;
     for (i = 0; i < co->desc->tpdo_count; i++) {
-        if (i != n && urrt_co_cob_valid(co->tpdos[i].cob_id) && (co->tpdos[i].cob_id & ID_MASK) == id) {
+        if (i != n && cob_valid(co->tpdos[i].cob_id) && (co->tpdos[i].cob_id & ID_MASK) == id) {
             return true;
         }
     }
@@ -519,7 +545,7 @@ static uint32_t tpdo_write(urrt_co *co, size_t n, uint8_t sub, uint32_t value, u
     switch (sub) {
     case 1:
         if (urrt_co_cob_check(t->cob_id, value, COB_NO_RTR) != 0u ||
-            (urrt_co_cob_valid(value) && tpdo_id_taken(co, n, value & ID_MASK))) {
+            (cob_valid(value) && tpdo_id_taken(co, n, value & ID_MASK))) {
             return URRT_CO_ABORT_VALUE;
         }
         t->cob_id = value;
@@ -536,7 +562,7 @@ static uint32_t tpdo_write(urrt_co *co, size_t n, uint8_t sub, uint32_t value, u
         break;
     case 3:
         /* CiA 301: the inhibit time changes only while the PDO is not valid. */
-        if (urrt_co_cob_valid(t->cob_id)) {
+        if (cob_valid(t->cob_id)) {
             return URRT_CO_ABORT_VALUE;
         }
         t->inhibit_100us = (uint16_t)value;
@@ -596,31 +622,12 @@ static uint8_t robot_conditions(const urrt_co *co, uint64_t now_us)
     return found;
 }
 
-/* Condition i's EMCY code, and in bits 16..23 its manufacturer byte 5: the
- * 0x1016 sub-index or the RPDO number of one of the receiving side's (set
- * only by it), 0 for the others. */
-static uint32_t condition_emcy(const urrt_co *co, unsigned i)
-{
-    return i < URRT_CO_CONDITIONS ? condition_codes[i] : co->rx->emcy(i);
-}
-
-/* The conditions now: each that started goes into 0x1003. */
-static void conditions_commit(urrt_co *co, uint32_t active)
-{
-    uint32_t started = active & ~co->active;
-    unsigned i;
-    for (i = 0; i < COND_ALL; i++) {
-        if ((started >> i & 1u) != 0u) {
-            history_push(co, (uint16_t)condition_emcy(co, i));
-        }
-    }
-    co->active = active;
-}
-
 static void conditions_update(urrt_co *co, uint64_t now_us)
 {
     const urrt_cantx_link *link = &co->tx->link;
-    uint32_t active = robot_conditions(co, now_us);
+    uint8_t active = robot_conditions(co, now_us);
+    uint8_t started;
+    unsigned i;
     if (link->dropped != co->seen_dropped) {
         co->seen_dropped = link->dropped;
         co->overrun_until_us = now_us + URRT_CO_EVENT_HOLD_US;
@@ -629,10 +636,19 @@ static void conditions_update(urrt_co *co, uint64_t now_us)
         co->seen_bus_off = link->bus_off;
         co->bus_off_until_us = now_us + URRT_CO_EVENT_HOLD_US;
     }
-    active |= (now_us < co->overrun_until_us ? 1u << COND_OVERRUN : 0u) |
-              (co->error_passive ? 1u << COND_PASSIVE : 0u) |
-              (now_us < co->bus_off_until_us ? 1u << COND_BUS_OFF : 0u);
-    conditions_commit(co, co->rx != NULL ? active | co->rx->conditions(co, now_us) : active);
+    active = (uint8_t)(active | (now_us < co->overrun_until_us ? 1u << COND_OVERRUN : 0u) |
+                       (co->error_passive ? 1u << COND_PASSIVE : 0u) |
+                       (now_us < co->bus_off_until_us ? 1u << COND_BUS_OFF : 0u));
+    started = (uint8_t)(active & ~co->active);
+    for (i = 0; i < URRT_CO_CONDITIONS; i++) {
+        if (((unsigned)started >> i & 1u) != 0u) {
+            history_push(co, condition_codes[i]);
+        }
+    }
+    co->active = active;
+    if (co->rx != NULL) {
+        co->rx->conditions(co, now_us); /* its own after the node's, and bit URRT_CO_CONDITIONS */
+    }
 }
 
 static bool emcy_may_send(const urrt_co *co)
@@ -646,10 +662,14 @@ static uint64_t emcy_due(const urrt_co *co)
     return co->emcy_sent ? co->emcy_last_us + (uint64_t)co->emcy_inhibit_100us * 100u : 0u;
 }
 
+uint64_t urrt_co_emcy_due(const urrt_co *co)
+{
+    return emcy_due(co);
+}
+
 /* One EMCY per condition that started or ended since the last, in order,
  * as the inhibit time (0x1015) allows. A reset EMCY names the code it
- * clears in its manufacturer bytes 3-4; byte 5 is the RPDO or 0x1016 entry
- * of a condition of the receiving side. */
+ * clears in its manufacturer bytes 3-4. */
 static size_t emcy_send(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
 {
     size_t sent = 0;
@@ -657,28 +677,41 @@ static size_t emcy_send(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, v
     if (!emcy_may_send(co)) {
         return 0;
     }
-    if (!urrt_co_cob_valid(co->emcy_cob_id)) {
+    if (!cob_valid(co->emcy_cob_id)) {
         co->reported = co->active; /* no EMCY object: nothing to tell later */
         return 0;
     }
-    for (i = 0; i < COND_ALL && now_us >= emcy_due(co); i++) {
-        uint32_t bit = UINT32_C(1) << i;
-        uint32_t emcy;
+    for (i = 0; i < URRT_CO_CONDITIONS && now_us >= emcy_due(co); i++) {
+        uint8_t bit = (uint8_t)(1u << i);
         uint8_t *data;
         if (((co->active ^ co->reported) & bit) == 0u) {
             continue;
         }
         data = frame_begin(co, co->emcy_cob_id & ID_MASK, 8);
-        emcy = condition_emcy(co, i);
-        put_le(data + ((co->active & bit) != 0u ? 0u : 3u), emcy & 0xFFFFu, 2);
+        if ((co->active & bit) != 0u) {
+            put_le(data, condition_codes[i], 2);
+        } else {
+            put_le(data + 3, condition_codes[i], 2);
+        }
         data[2] = urrt_co_error_register(co);
-        data[5] = (uint8_t)(emcy >> 16);
         co->reported ^= bit;
         co->emcy_last_us = now_us;
         co->emcy_sent = true;
         sent += frame_send(co, now_us, emit, ctx);
     }
     return sent;
+}
+
+size_t urrt_co_emcy_send(urrt_co *co, uint32_t emcy, bool started, uint64_t now_us, urrt_cantx_emit_fn emit,
+                         void *ctx)
+{
+    uint8_t *data = frame_begin(co, co->emcy_cob_id & ID_MASK, 8);
+    put_le(data + (started ? 0u : 3u), emcy, 2);
+    data[2] = urrt_co_error_register(co);
+    data[5] = (uint8_t)(emcy >> 16);
+    co->emcy_last_us = now_us;
+    co->emcy_sent = true;
+    return frame_send(co, now_us, emit, ctx);
 }
 
 void urrt_co_set_error_passive(urrt_co *co, bool passive)
@@ -724,6 +757,9 @@ static size_t heartbeat(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, v
 static void nmt_enter(urrt_co *co, urrt_co_nmt state)
 {
     size_t n;
+    if (co->rx != NULL) {
+        co->rx->nmt(co, state);
+    }
     if (state == URRT_CO_OPERATIONAL && co->state != (uint8_t)URRT_CO_OPERATIONAL) {
         for (n = 0; n < co->desc->tpdo_count; n++) {
             co->tpdos[n].syncs = 0;
@@ -731,9 +767,6 @@ static void nmt_enter(urrt_co *co, urrt_co_nmt state)
     }
     if (state == URRT_CO_STOPPED) {
         co->sdo_busy = false; /* no SDO while stopped: the client times out */
-    }
-    if (co->rx != NULL) {
-        co->rx->nmt(co, state);
     }
     co->state = (uint8_t)state;
     gates_apply(co);
@@ -778,7 +811,7 @@ static size_t boot(urrt_co *co, uint64_t now_us, bool whole_node, urrt_cantx_emi
     co->heartbeat_ms = d->heartbeat_ms;
     sync_id_set(co, SYNC_DEFAULT);
     if (co->rx != NULL) {
-        co->rx->reset(co, true, whole_node);
+        co->rx->reset(co, whole_node);
     }
     co->emcy_cob_id = EMCY_BASE + d->node_id;
     co->emcy_inhibit_100us = 0;
@@ -812,8 +845,7 @@ static size_t nmt_command(urrt_co *co, const uint8_t *data, uint64_t now_us, urr
     }
 }
 
-/* Every nth SYNC, in OPERATIONAL, a valid TPDO of type n goes out; the
- * synchronous RPDOs received since the last are acted on before. */
+/* Every nth SYNC, in OPERATIONAL, a valid TPDO of type n goes out. */
 static size_t sync_received(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *ctx)
 {
     size_t sent = 0;
@@ -821,16 +853,13 @@ static size_t sync_received(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emi
     if (co->state != (uint8_t)URRT_CO_OPERATIONAL) {
         return 0;
     }
-    if (co->rx != NULL) {
-        co->rx->sync(co, now_us); /* the synchronous RPDOs' values first, as they stand at the SYNC */
-    }
     for (n = 0; n < co->desc->tpdo_count; n++) {
         urrt_co_tpdo_state *t = &co->tpdos[n];
         if (t->type > SYNC_MAX_N || ++t->syncs < t->type) {
             continue;
         }
         t->syncs = 0;
-        if (urrt_co_cob_valid(t->cob_id)) {
+        if (cob_valid(t->cob_id)) {
             sent += urrt_cantx_trigger(co->tx, tpdo_desc(co, n)->frame, now_us, emit, ctx);
         }
     }
@@ -838,6 +867,14 @@ static size_t sync_received(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emi
 }
 
 /* ---- the object dictionary: the communication objects ---------------------------------- */
+
+/* A number: its size is its row's type's (urrt_co_comm_read). */
+static uint32_t value_of(urrt_co_value *v, uint32_t value)
+{
+    v->value = value;
+    v->text = NULL;
+    return 0;
+}
 
 static uint32_t text_of(urrt_co_value *v, const char *text)
 {
@@ -851,14 +888,14 @@ static uint32_t read_error_register(const urrt_co *co, size_t n, uint8_t sub, ur
 {
     (void)n;
     (void)sub;
-    return urrt_co_value_of(v, urrt_co_error_register(co));
+    return value_of(v, urrt_co_error_register(co));
 }
 
 /* 0x1003 sub 1..: the codes, newest first. */
 static uint32_t read_errors(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
 {
     (void)n;
-    return sub > co->error_count ? URRT_CO_ABORT_NO_DATA : urrt_co_value_of(v, co->errors[sub - 1u]);
+    return sub > co->error_count ? URRT_CO_ABORT_NO_DATA : value_of(v, co->errors[sub - 1u]);
 }
 
 /* 0x1003 sub 0: only 0 clears the history (CiA 301). */
@@ -922,89 +959,51 @@ static uint32_t read_tpdo_map(const urrt_co *co, size_t n, uint8_t sub, urrt_co_
 {
     const urrt_co_tpdo *p = tpdo_desc(co, n);
     if (sub == 0u) {
-        return urrt_co_value_of(v, p->mapping_count);
+        return value_of(v, p->mapping_count);
     }
-    return sub > p->mapping_count ? URRT_CO_ABORT_NO_SUB : urrt_co_value_of(v, p->mapping[sub - 1u]);
+    return sub > p->mapping_count ? URRT_CO_ABORT_NO_SUB : value_of(v, p->mapping[sub - 1u]);
 }
 
-/* The receiving side's rows (instances only with it: urrt_co_comm_instances). */
-static uint32_t read_rpdo_map(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
-{
-    return co->rx->read_rpdo_map(co, n, sub, v);
-}
-
-static uint32_t read_consumer(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
+/* The receiving side's rows as urrt_co_comm_table has them: through its
+ * functions (urrt_co_internal.h). Instances only with it (the counts are the
+ * description's, which urrt_co_init holds at 0 without it), so these are
+ * called only with urrt_co.rx set. */
+static uint32_t via_read_consumer(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
 {
     return co->rx->read_consumer(co, n, sub, v);
 }
 
-static uint32_t write_rpdo(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
-{
-    return co->rx->write_rpdo(co, n, sub, value, now_us);
-}
-
-static uint32_t write_consumer(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
+static uint32_t via_write_consumer(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
 {
     return co->rx->write_consumer(co, n, sub, value, now_us);
 }
 
-/*
- * The communication objects, one line each, written once and expanded three
- * times (nanopb's X-macros): into urrt_co_comm_table, the node's; into
- * comm_names, which only urrt_co_comm_name reads (an array of its own, so that
- * a firmware that writes no EDS links no names: --gc-sections drops it); and
- * into comm_limits, for the rows with limits.
- *   HEAD(index, object, flags, name)  an ARRAY or RECORD; the rows of its index follow
- *   ROW(index, sub, subs, object, type, in, what, write, flags, name)
- *       in FN: `what` is the read function; NODE, DESC, TPDO, RPDO: `what` is
- *       the member of urrt_co, urrt_co_desc, TPDO n's urrt_co_tpdo_state or
- *       RPDO n's urrt_co_rpdo_state that holds the value (read as the type);
- *       CONST: `what` is the value
- *   LIMITED(the ROW's columns, low, high)  a ROW whose writes outside low..high are refused
- */
-#define COMM_LIST(HEAD, ROW, LIMITED)                                                                         \
-    ROW(0x1000, 0, 1, VAR, U32, DESC, device_type, NULL, 0, "Device type")                                    \
-    ROW(0x1001, 0, 1, VAR, U8, FN, read_error_register, NULL, 0, "Error register")                            \
-    HEAD(0x1003, ARRAY, 0, "Pre-defined error field")                                                         \
-    ROW(0x1003, 0, 1, SUB, U8, NODE, error_count, write_errors, 0, "Number of errors")                        \
-    ROW(0x1003, 1, URRT_CO_HISTORY, SUB, U32, FN, read_errors, NULL, 0, "Standard error field")               \
-    ROW(0x1005, 0, 1, VAR, U32, NODE, sync_cob_id, write_sync, 0, "COB-ID SYNC")                              \
-    ROW(0x1008, 0, 1, VAR, TEXT, DESC, device_name, NULL, 0, "Manufacturer device name")                      \
-    ROW(0x1009, 0, 1, VAR, TEXT, DESC, hardware_version, NULL, 0, "Manufacturer hardware version")            \
-    ROW(0x100A, 0, 1, VAR, TEXT, DESC, software_version, NULL, 0, "Manufacturer software version")            \
-    ROW(0x1014, 0, 1, VAR, U32, NODE, emcy_cob_id, write_emcy, NODE_ID, "COB-ID EMCY")                        \
-    ROW(0x1015, 0, 1, VAR, U16, NODE, emcy_inhibit_100us, write_emcy_inhibit, 0, "Inhibit time EMCY")         \
-    HEAD(CONSUMER_HB, ARRAY, IF_CONSUMERS, "Consumer heartbeat time")                                         \
-    ROW(CONSUMER_HB, 0, 1, SUB, U8, DESC, consumer_count, NULL, IF_CONSUMERS, "Highest sub-index supported")  \
-    ROW(CONSUMER_HB, 1, URRT_CO_MAX_CONSUMERS, SUB, U32, FN, read_consumer, write_consumer, IF_CONSUMERS,     \
-        "Consumer heartbeat time")                                                                            \
-    ROW(0x1017, 0, 1, VAR, U16, NODE, heartbeat_ms, write_heartbeat, 0, "Producer heartbeat time")            \
-    HEAD(0x1018, RECORD, 0, "Identity object")                                                                \
-    ROW(0x1018, 0, 1, SUB, U8, CONST, IDENTITY_SUBS, NULL, 0, "Highest sub-index supported")                  \
-    ROW(0x1018, 1, 1, SUB, U32, DESC, vendor_id, NULL, 0, "Vendor-ID")                                        \
-    ROW(0x1018, 2, 1, SUB, U32, DESC, product_code, NULL, 0, "Product code")                                  \
-    ROW(0x1018, 3, 1, SUB, U32, DESC, revision, NULL, 0, "Revision number")                                   \
-    ROW(0x1018, 4, 1, SUB, U32, DESC, serial, NULL, 0, "Serial number")                                       \
-    HEAD(RPDO_COMM, RECORD, PER_RPDO, "RPDO communication parameter")                                         \
-    ROW(RPDO_COMM, 0, 1, SUB, U8, CONST, RPDO_COMM_SUBS, NULL, PER_RPDO, "Highest sub-index supported")       \
-    ROW(RPDO_COMM, 1, 1, SUB, U32, RPDO, cob_id, write_rpdo, PER_RPDO | NODE_ID, "COB-ID used by RPDO")       \
-    /* 0..240 (at the next SYNC), 254, 255; 241..253 are refused by its write */                             \
-    ROW(RPDO_COMM, 2, 1, SUB, U8, RPDO, type, write_rpdo, PER_RPDO, "Transmission type")                      \
-    ROW(RPDO_COMM, 5, 1, SUB, U16, RPDO, event_ms, write_rpdo, PER_RPDO, "Event timer")                       \
-    HEAD(RPDO_MAP, RECORD, PER_RPDO, "RPDO mapping parameter")                                                \
-    ROW(RPDO_MAP, 0, 1, SUB, U8, FN, read_rpdo_map, NULL, PER_RPDO, "Number of mapped objects")               \
-    ROW(RPDO_MAP, 1, URRT_CO_RPDO_MAX_MAPPED, SUB, U32, FN, read_rpdo_map, NULL, PER_RPDO, "Mapped object")   \
-    HEAD(TPDO_COMM, RECORD, PER_TPDO, "TPDO communication parameter")                                         \
-    ROW(TPDO_COMM, 0, 1, SUB, U8, CONST, TPDO_COMM_SUBS, NULL, PER_TPDO, "Highest sub-index supported")       \
-    ROW(TPDO_COMM, 1, 1, SUB, U32, TPDO, cob_id, tpdo_write, PER_TPDO | NODE_ID, "COB-ID used by TPDO")       \
-    /* 1..240 (every nth SYNC), 254, 255; 241..253 are refused by tpdo_write */                               \
-    LIMITED(TPDO_COMM, 2, 1, SUB, U8, TPDO, type, tpdo_write, PER_TPDO, "Transmission type", 1, 0xFF)         \
-    ROW(TPDO_COMM, 3, 1, SUB, U16, TPDO, inhibit_100us, tpdo_write, PER_TPDO, "Inhibit time")                 \
-    ROW(TPDO_COMM, 5, 1, SUB, U16, TPDO, event_ms, tpdo_write, PER_TPDO, "Event timer")                       \
-    HEAD(TPDO_MAP, RECORD, PER_TPDO, "TPDO mapping parameter")                                                \
-    ROW(TPDO_MAP, 0, 1, SUB, U8, FN, read_tpdo_map, NULL, PER_TPDO, "Number of mapped objects")               \
-    ROW(TPDO_MAP, 1, URRT_CO_MAX_MAPPED, SUB, U32, FN, read_tpdo_map, NULL, PER_TPDO, "Mapped object")
+static uint32_t via_read_rpdo(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    return co->rx->read_rpdo(co, n, sub, v);
+}
 
+static uint32_t via_write_rpdo(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
+{
+    return co->rx->write_rpdo(co, n, sub, value, now_us);
+}
+
+static uint32_t via_read_rpdo_map(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    return co->rx->read_rpdo_map(co, n, sub, v);
+}
+
+/*
+ * The communication objects: URRT_CO_COMM_LIST (urrt_co_internal.h),
+ * expanded here four times: into comm_rows, the node's rows, which the SDO
+ * server looks requests up in (the receiving side's are urrt_co_rx.c's);
+ * into urrt_co_comm_table, every row in index order, for readers of the
+ * dictionary (an EDS writer), the receiving side's rows through the via_
+ * functions above; into comm_names, which only urrt_co_comm_name reads; and
+ * into comm_limits, for the rows with limits. The last three are arrays of
+ * their own, so that a firmware that reads no dictionary links none of them
+ * (--gc-sections drops them).
+ */
 #define U8 URRT_CO_UNSIGNED8
 #define U16 URRT_CO_UNSIGNED16
 #define U32 URRT_CO_UNSIGNED32
@@ -1025,13 +1024,11 @@ static uint32_t write_consumer(urrt_co *co, size_t n, uint8_t sub, uint32_t valu
 #define READ_NODE(m) NULL
 #define READ_DESC(m) NULL
 #define READ_TPDO(m) NULL
-#define READ_RPDO(m) NULL
 #define READ_CONST(value) NULL
 #define IN_FN 0u
 #define IN_NODE URRT_CO_IN_NODE
 #define IN_DESC URRT_CO_IN_DESC
 #define IN_TPDO URRT_CO_IN_TPDO
-#define IN_RPDO URRT_CO_IN_RPDO
 #define IN_CONST URRT_CO_IN_CONST
 #define TYPE_BYTES(type_) ((type_) == TEXT ? sizeof(const char *) : (type_) == U32 ? 4u : (type_) == U16 ? 2u : 1u)
 #define MEMBER_AT(struct_, m, type_) \
@@ -1040,24 +1037,39 @@ static uint32_t write_consumer(urrt_co *co, size_t n, uint8_t sub, uint32_t valu
 #define AT_NODE(m, type_) MEMBER_AT(urrt_co, m, type_)
 #define AT_DESC(m, type_) MEMBER_AT(urrt_co_desc, m, type_)
 #define AT_TPDO(m, type_) MEMBER_AT(urrt_co_tpdo_state, m, type_)
-#define AT_RPDO(m, type_) MEMBER_AT(urrt_co_rpdo_state, m, type_)
 #define AT_CONST(value, type_) (value)
+/* The receiving side's functions, as urrt_co_comm_table reaches them. */
+#define VIA_FN(f) via_##f
+#define VIA_DESC(m) NULL
+#define VIA_CONST(value) NULL
+#define via_NULL NULL
 
+#define NO_HEAD(index_, object_, flags_, name_)
+#define NO_ROW(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_)
+#define NO_LIMITED(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_, low_, high_)
 #define TABLE_HEAD(index_, object_, flags_, name_) {NULL, NULL, (index_), 0, 0, (object_), 0, (flags_), 0},
 #define TABLE_ROW(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_)                     \
     {READ_##in_(what_), (write_), (index_), (sub_), (subs_), (object_), (type_), (flags_) | IN_##in_,     \
      AT_##in_(what_, type_)},
 #define TABLE_LIMITED(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_, low_, high_) \
     TABLE_ROW(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_)
+#define VIA_ROW(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_)                       \
+    {VIA_##in_(what_), via_##write_, (index_), (sub_), (subs_), (object_), (type_), (flags_) | IN_##in_,  \
+     AT_##in_(what_, type_)},
 
-const urrt_co_comm urrt_co_comm_table[] = {COMM_LIST(TABLE_HEAD, TABLE_ROW, TABLE_LIMITED)};
+static const urrt_co_comm comm_rows[] = {
+    URRT_CO_COMM_LIST(TABLE_HEAD, TABLE_ROW, TABLE_LIMITED, NO_HEAD, NO_ROW)};
+#define COMM_ROWS (sizeof comm_rows / sizeof comm_rows[0])
+
+const urrt_co_comm urrt_co_comm_table[] = {
+    URRT_CO_COMM_LIST(TABLE_HEAD, TABLE_ROW, TABLE_LIMITED, TABLE_HEAD, VIA_ROW)};
 const size_t urrt_co_comm_count = sizeof urrt_co_comm_table / sizeof urrt_co_comm_table[0];
 
-/* The names, each ended by its NUL, in the table's order. */
+/* The names, each ended by its NUL, in urrt_co_comm_table's order. */
 #define NAME_HEAD(index_, object_, flags_, name_) name_ "\0"
 #define NAME_ROW(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_) name_ "\0"
 #define NAME_LIMITED(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_, low_, high_) name_ "\0"
-static const char comm_names[] = COMM_LIST(NAME_HEAD, NAME_ROW, NAME_LIMITED);
+static const char comm_names[] = URRT_CO_COMM_LIST(NAME_HEAD, NAME_ROW, NAME_LIMITED, NAME_HEAD, NAME_ROW);
 
 const char *urrt_co_comm_name(const urrt_co_comm *row)
 {
@@ -1074,10 +1086,9 @@ typedef struct comm_limit {
     uint16_t index;
     uint8_t sub;
 } comm_limit;
-#define NO_LIMITS(...)
 #define LIMITS_OF(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_, low_, high_) \
     {(low_), (high_), (index_), (sub_)},
-static const comm_limit comm_limits[] = {COMM_LIST(NO_LIMITS, NO_LIMITS, LIMITS_OF)};
+static const comm_limit comm_limits[] = {URRT_CO_COMM_LIST(NO_HEAD, NO_ROW, LIMITS_OF, NO_HEAD, NO_ROW)};
 
 /* Where in comm_limits a row that holds sub-indices has its limits, or NONE. */
 static size_t limits_at(const urrt_co_comm *row)
@@ -1101,19 +1112,25 @@ bool urrt_co_comm_limits(const urrt_co_comm *row, uint32_t *low, uint32_t *high)
     return i != NONE;
 }
 
+/* The instances of one of the node's rows (comm_rows). */
+static size_t row_instances(const urrt_co *co, const urrt_co_comm *row)
+{
+    return (row->flags & URRT_CO_PER_TPDO) != 0u ? co->desc->tpdo_count : 1u;
+}
+
 size_t urrt_co_comm_instances(const urrt_co *co, const urrt_co_comm *row)
 {
-    if ((row->flags & URRT_CO_PER_TPDO) != 0u) {
-        return co->desc->tpdo_count;
-    }
     if ((row->flags & URRT_CO_PER_RPDO) != 0u) {
         return co->desc->rpdo_count;
     }
-    return (row->flags & URRT_CO_IF_CONSUMERS) != 0u ? (co->desc->consumer_count > 0u ? 1u : 0u) : 1u;
+    if ((row->flags & URRT_CO_IF_CONSUMERS) != 0u) {
+        return co->desc->consumer_count > 0u ? 1u : 0u;
+    }
+    return row_instances(co, row);
 }
 
 /* A row without a read function: the member `at` bytes into the node, its
- * description or PDO n's state, read as the row's type; or `at` itself. */
+ * description or TPDO n's state, read as the row's type; or `at` itself. */
 static uint32_t read_plain(const urrt_co *co, const urrt_co_comm *row, size_t n, urrt_co_value *v)
 {
     const unsigned char *base;
@@ -1121,27 +1138,35 @@ static uint32_t read_plain(const urrt_co *co, const urrt_co_comm *row, size_t n,
     case URRT_CO_IN_NODE: base = (const unsigned char *)co; break;
     case URRT_CO_IN_DESC: base = (const unsigned char *)co->desc; break;
     case URRT_CO_IN_TPDO: base = (const unsigned char *)&co->tpdos[n]; break;
-    case URRT_CO_IN_RPDO: base = (const unsigned char *)&co->rpdos[n]; break;
-    default: return urrt_co_value_of(v, row->at);
+    default: return value_of(v, row->at);
     }
     base += row->at;
     switch (row->type) {
     case TEXT: return text_of(v, *(const char *const *)(const void *)base);
-    case U8: return urrt_co_value_of(v, *base);
-    case U16: return urrt_co_value_of(v, *(const uint16_t *)(const void *)base);
-    default: return urrt_co_value_of(v, *(const uint32_t *)(const void *)base);
+    case U8: return value_of(v, *base);
+    case U16: return value_of(v, *(const uint16_t *)(const void *)base);
+    default: return value_of(v, *(const uint32_t *)(const void *)base);
     }
+}
+
+/* Sub-index `sub` of instance n of a row that has both (the caller saw to it). */
+static uint32_t row_read(const urrt_co *co, const urrt_co_comm *row, size_t n, uint8_t sub, urrt_co_value *v)
+{
+    uint32_t abort_code;
+    v->text = NULL;
+    abort_code = row->read != NULL ? row->read(co, n, sub, v) : read_plain(co, row, n, v);
+    v->size = v->text != NULL ? v->size : type_size(row->type);
+    return abort_code;
 }
 
 uint32_t urrt_co_comm_read(const urrt_co *co, const urrt_co_comm *row, size_t n, uint8_t sub, urrt_co_value *v)
 {
-    uint32_t abort_code;
+    uint32_t abort_code = URRT_CO_ABORT_NO_SUB; /* a header row holds no sub-index */
     v->text = NULL;
-    if (sub < row->sub || sub - row->sub >= row->subs || n >= urrt_co_comm_instances(co, row)) {
-        return URRT_CO_ABORT_NO_SUB; /* a header row holds no sub-index */
+    if (sub >= row->sub && sub - row->sub < row->subs && n < urrt_co_comm_instances(co, row)) {
+        abort_code = row_read(co, row, n, sub, v);
     }
-    abort_code = row->read != NULL ? row->read(co, n, sub, v) : read_plain(co, row, n, v);
-    v->size = v->text != NULL ? v->size : urrt_co_type_size(row->type);
+    v->text = abort_code == 0u ? v->text : NULL; /* a read that failed leaves no text behind */
     return abort_code;
 }
 
@@ -1154,26 +1179,33 @@ typedef struct od_entry {
     uint8_t access;
 } od_entry;
 
-/* The row holding (index, sub), or NULL with the abort code. */
+/* The row holding (index, sub), the node's or the receiving side's, or
+ * NULL with the abort code. */
 static uint32_t comm_find(const urrt_co *co, uint16_t index, uint8_t sub, od_entry *e)
 {
     bool known = false;
     size_t i;
-    for (i = 0; i < urrt_co_comm_count; i++) {
-        const urrt_co_comm *row = &urrt_co_comm_table[i];
+    for (i = 0; i < COMM_ROWS; i++) {
+        const urrt_co_comm *row = &comm_rows[i];
         size_t n = (size_t)(index - row->index);
-        if (index < row->index || n >= urrt_co_comm_instances(co, row)) {
+        if (index < row->index || n >= row_instances(co, row)) {
             continue;
         }
         known = true;
         if (row->subs != 0u && sub >= row->sub && sub - row->sub < row->subs) {
             e->row = row;
             e->n = n;
-            e->access = row->write != NULL ? URRT_CO_RW : URRT_CO_RO;
-            return urrt_co_comm_read(co, row, n, sub, &e->v);
+            break;
         }
     }
-    return known ? URRT_CO_ABORT_NO_SUB : URRT_CO_ABORT_NO_OBJECT;
+    if (e->row == NULL) {
+        uint32_t abort_code = known ? URRT_CO_ABORT_NO_SUB : URRT_CO_ABORT_NO_OBJECT;
+        if (known || co->rx == NULL || (abort_code = co->rx->find(co, index, sub, &e->row, &e->n)) != 0u) {
+            return abort_code;
+        }
+    }
+    e->access = e->row->write != NULL ? URRT_CO_RW : URRT_CO_RO;
+    return row_read(co, e->row, e->n, sub, &e->v);
 }
 
 /* A signal's raw bits as its frame would go out now, sign-extended for INTEGERn. */
@@ -1188,7 +1220,7 @@ static uint32_t signal_value(urrt_co *co, const urrt_co_object *o, uint64_t now_
     if (type_signed(o->type) && sig->length < 32u && (value >> (sig->length - 1u) & 1u) != 0u) {
         value |= UINT32_MAX << sig->length;
     }
-    return value & size_mask(urrt_co_type_size(o->type));
+    return value & size_mask(type_size(o->type));
 }
 
 /* 0x2000-0x5FFF: the description's objects; a record's sub 0 is its highest sub. */
@@ -1208,14 +1240,14 @@ static uint32_t od_mfr(urrt_co *co, uint16_t index, uint8_t sub, uint64_t now_us
         if (o->sub == sub) {
             e->object = o;
             e->access = o->access;
-            e->v.size = urrt_co_type_size(o->type);
-            return urrt_co_value_of(&e->v, o->kind == URRT_CO_VAR ? co->vars[o->item] : signal_value(co, o, now_us));
+            e->v.size = type_size(o->type);
+            return value_of(&e->v, o->kind == URRT_CO_VAR ? co->vars[o->item] : signal_value(co, o, now_us));
         }
     }
     if (known && sub == 0u) {
         e->access = URRT_CO_RO;
         e->v.size = 1;
-        return urrt_co_value_of(&e->v, highest);
+        return value_of(&e->v, highest);
     }
     return known ? URRT_CO_ABORT_NO_SUB : URRT_CO_ABORT_NO_OBJECT;
 }
@@ -1263,8 +1295,11 @@ static uint32_t od_write(urrt_co *co, uint8_t sub, const od_entry *e, uint32_t v
     if (e->object != NULL) {
         abort_code = urrt_co_range_check(value, e->object->type, e->object->min, e->object->max);
         if (abort_code == 0u) {
-            urrt_co_var_store(co, e->object->item, value, now_us);
+            co->vars[e->object->item] = value;
             co->var_writes++;
+            if (co->rx != NULL) {
+                co->rx->written(co, e->object->item, now_us); /* when, for the caller (written_us) */
+            }
         }
         return abort_code;
     }
@@ -1440,14 +1475,14 @@ size_t urrt_co_on_frame(urrt_co *co, uint32_t id, unsigned flags, const uint8_t 
     if (state == (uint8_t)URRT_CO_STOPPED) {
         return 0; /* only NMT */
     }
+    if (co->rx != NULL) {
+        co->rx->frame(co, id, data, len, now_us); /* RPDOs, heartbeats, a SYNC's kept RPDOs: no answer */
+    }
     if (id == (co->sync_cob_id & ID_MASK)) {
         return len <= 1u ? sync_received(co, now_us, emit, ctx) : 0u;
     }
     if (id == SDO_RX_BASE + co->desc->node_id) {
         return sdo_request(co, data, len, now_us, emit, ctx);
-    }
-    if (co->rx != NULL) {
-        co->rx->frame(co, id, data, len, now_us); /* RPDOs, heartbeats: they answer nothing */
     }
     return 0;
 }
@@ -1464,6 +1499,9 @@ size_t urrt_co_run(urrt_co *co, uint64_t now_us, urrt_cantx_emit_fn emit, void *
     }
     conditions_update(co, now_us);
     sent += emcy_send(co, now_us, emit, ctx);
+    if (co->rx != NULL) {
+        sent += co->rx->emcy(co, emit, ctx, now_us); /* the receiving side's, after the node's */
+    }
     sent += tpdo_events(co, now_us, emit, ctx);
     sent += urrt_cantx_run(co->tx, now_us, emit, ctx);
     tpdo_sent(co, now_us);
@@ -1481,11 +1519,11 @@ static uint64_t conditions_deadline(const urrt_co *co)
     for (i = 0; i < tx->tables->robot_count; i++) {
         const urrt_cantx_robot *r = &tx->robots[i];
         uint64_t stale_us = r->data_us + co->desc->stale_after_us + 1u;
-        next = r->has_data && r->up && stale_us > after ? urrt_co_min64(next, stale_us) : next;
+        next = r->has_data && r->up && stale_us > after ? min64(next, stale_us) : next;
     }
-    next = tx->start_us + tx->tables->startup_us > after ? urrt_co_min64(next, tx->start_us + tx->tables->startup_us) : next;
-    next = co->overrun_until_us > after ? urrt_co_min64(next, co->overrun_until_us) : next;
-    return co->bus_off_until_us > after ? urrt_co_min64(next, co->bus_off_until_us) : next;
+    next = tx->start_us + tx->tables->startup_us > after ? min64(next, tx->start_us + tx->tables->startup_us) : next;
+    next = co->overrun_until_us > after ? min64(next, co->overrun_until_us) : next;
+    return co->bus_off_until_us > after ? min64(next, co->bus_off_until_us) : next;
 }
 
 uint64_t urrt_co_deadline(const urrt_co *co)
@@ -1494,10 +1532,10 @@ uint64_t urrt_co_deadline(const urrt_co *co)
     if (co == NULL || co->state == (uint8_t)URRT_CO_INITIALISING) {
         return URRT_CANTX_NEVER;
     }
-    next = urrt_co_min64(urrt_cantx_deadline(co->tx), co->heartbeat_due_us);
-    next = co->sdo_busy ? urrt_co_min64(next, co->sdo_deadline_us) : next;
-    next = emcy_may_send(co) ? urrt_co_min64(next, emcy_due(co)) : next;
-    next = urrt_co_min64(next, tpdo_deadline(co));
-    next = co->rx != NULL ? urrt_co_min64(next, co->rx->deadline(co)) : next;
-    return urrt_co_min64(next, conditions_deadline(co));
+    next = min64(urrt_cantx_deadline(co->tx), co->heartbeat_due_us);
+    next = co->sdo_busy ? min64(next, co->sdo_deadline_us) : next;
+    next = emcy_may_send(co) ? min64(next, emcy_due(co)) : next;
+    next = min64(next, tpdo_deadline(co));
+    next = co->rx != NULL ? min64(next, co->rx->deadline(co)) : next;
+    return min64(next, conditions_deadline(co));
 }

@@ -103,7 +103,11 @@ enum urrt_co_result {
                                  with bits 24..31 set, a node id over 127, or a node id twice with a time */
 };
 
-/* A short English text for any urrt_co, urrt_cantx, urrt_can or urrt result. */
+/* A short English text for any result of urrt_co_init, urrt_cantx, urrt_can
+ * or urrt. urrt_co_init_rx's own two (URRT_CO_E_RPDO, _CONSUMER), unknown
+ * here, have theirs in urrt_co_rx_strerror, the receiving side's, which
+ * gives every other result as this does: a firmware without RPDOs links none
+ * of their texts. */
 const char *urrt_co_strerror(int result);
 
 /* NMT states, valued as the heartbeat carries them. */
@@ -305,12 +309,21 @@ typedef struct urrt_co_consumer {
     bool lost;                /* URRT_CO_EMCY_HEARTBEAT's condition */
 } urrt_co_consumer;
 
-/* The receiving side's storage (urrt_co_init_rx), the caller's like the rest. */
+/* The receiving side's storage (urrt_co_init_rx), the caller's like the
+ * rest and kept as long as the node (static, or beside the node): the node
+ * keeps a pointer to it, and its own run-time state in it, so that a node
+ * without RPDOs and 0x1016 has none of it. The caller sets the first three
+ * members, by name (urrt_co_init_rx sets the others). */
 typedef struct urrt_co_rx_storage {
     urrt_co_rpdo_state *rpdos;    /* desc->rpdo_count entries */
     urrt_co_consumer *consumers;  /* desc->consumer_count entries */
     uint64_t *written_us;         /* var_count entries, or NULL: when an RPDO or SDO write last stored
                                      vars[i], URRT_CANTX_NEVER before the first (and after reset node) */
+    /* The node's. */
+    size_t var_count;
+    uint16_t active;              /* its conditions now: bit i = a heartbeat lost (0x1016 entry i, 0..3),
+                                     a short RPDO (4 + n), a deadline missed (8 + n) */
+    uint16_t reported;            /* those conditions as its EMCYs told them so far */
 } urrt_co_rx_storage;
 
 /* Why an RPDO's data is not fresh (urrt_co_rpdo_status). */
@@ -336,6 +349,12 @@ typedef struct urrt_co {
     urrt_cantx *tx;
     urrt_co_tpdo_state *tpdos;
     uint32_t *vars;
+    /* The receiving side (urrt_co_init_rx, lib/urrt_co_rx.c): urrt_co.c reaches
+     * it only through `rx`; both NULL after urrt_co_init. */
+    const struct urrt_co_rx_ops *rx;
+    urrt_co_rx_storage *rx_storage;
+    uint32_t var_writes;          /* RPDOs acted on and SDO writes that stored a variable, since init */
+    uint32_t values_refused;      /* RPDO values outside their object's range, not stored, since init */
     urrt_can_frame out;           /* the frame being emitted: copy it to keep it */
     uint64_t heartbeat_due_us;    /* URRT_CANTX_NEVER while off */
     uint64_t sdo_deadline_us;     /* of the segmented upload in progress */
@@ -347,7 +366,7 @@ typedef struct urrt_co {
     uint32_t sync_cob_id;         /* 0x1005 */
     uint32_t rx_changes;          /* changes of urrt_co_rx_ids' set since urrt_co_init (see there) */
     uint32_t emcy_cob_id;         /* 0x1014 */
-    uint32_t errors[URRT_CO_HISTORY]; /* 0x1003 sub 1..: newest first */
+    uint16_t errors[URRT_CO_HISTORY]; /* 0x1003 sub 1..: newest first (the codes: bits 16..31 are 0) */
     uint32_t sdo_size;            /* segmented upload: the string, its length, bytes sent */
     uint32_t sdo_offset;
     const char *sdo_text;
@@ -358,35 +377,35 @@ typedef struct urrt_co {
     uint8_t sdo_toggle;
     uint8_t state;                /* urrt_co_nmt */
     uint8_t error_count;          /* 0x1003 sub 0 */
+    uint8_t active;               /* conditions now, bit i = condition i; bit URRT_CO_CONDITIONS: one of
+                                     the receiving side's (urrt_co_rx_storage.active) */
+    uint8_t reported;             /* conditions as the EMCYs sent so far told them (bit 5: as active's) */
     bool sdo_busy;                /* a segmented upload is in progress */
     bool error_passive;
     bool emcy_sent;               /* emcy_last_us holds a time */
-    uint32_t active;              /* conditions now, bit i = condition i (the five, then the receiving side's) */
-    uint32_t reported;            /* conditions as the EMCYs sent so far told them */
-    uint32_t var_writes;          /* RPDOs acted on and SDO writes that stored a variable, since init */
-    uint32_t values_refused;      /* RPDO values outside their object's range, not stored, since init */
-    /* The receiving side (urrt_co_init_rx, lib/urrt_co_rx.c): urrt_co.c reaches
-     * it only through `rx`, NULL after urrt_co_init. */
-    const struct urrt_co_rx_ops *rx;
-    urrt_co_rpdo_state *rpdos;    /* urrt_co_rx_storage's, NULL without */
-    urrt_co_consumer *consumers;
-    uint64_t *written_us;
-    size_t var_count;
 } urrt_co;
 
 /* ---- the communication objects (0x1000-0x1FFF) ------------------------------
- * One const table describes them: the SDO server looks every request up in
- * it, and `urrt-gateway --print-eds` writes the EDS's communication objects
- * from it, so that the two cannot disagree. A row is an object (a lone
- * variable, or the header of an ARRAY or RECORD) or a run of its
- * sub-indices; per-TPDO rows stand for index + n, n < tpdo_count. A row's
- * default is the value it reads right after urrt_co_start (or a reset).
- * A write is checked in one order for every object (CiA 301): exists, access,
- * size, then value (the row's limits, then its write hook's own rules).
- * The rows, their names and their limits are written once in urrt_co.c, as
- * one list; the names are an array of their own, which only
- * urrt_co_comm_name reads: a firmware that writes no EDS links none of them
- * (with -fdata-sections and --gc-sections). */
+ * One list describes them (lib/urrt_co_internal.h), written once and
+ * expanded into the rows the SDO server looks requests up in and into
+ * urrt_co_comm_table, every row in index order, from which `urrt-gateway
+ * --print-eds` writes the EDS's communication objects, so that the two
+ * cannot disagree. A row is an object (a lone variable, or the header of
+ * an ARRAY or RECORD) or a run of its sub-indices; per-TPDO rows stand for
+ * index + n, n < tpdo_count (per-RPDO rows likewise). A row's default is
+ * the value it reads right after urrt_co_start (or a reset). A write is
+ * checked in one order for every object (CiA 301): exists, access, size,
+ * then value (the row's limits, then its write hook's own rules).
+ *
+ * The SDO server reads its own expansions, not urrt_co_comm_table: the
+ * node's rows in urrt_co.c, and the receiving side's (0x1016, 0x1400+n,
+ * 0x1600+n) in lib/urrt_co_rx.c, through the node's `rx`, so that a node
+ * set up with urrt_co_init links none of those. The functions
+ * below are a reader's (an EDS writer's): urrt_co_comm_table, its names
+ * (an array of their own, which only urrt_co_comm_name reads) and these
+ * functions are linked only where they are called (with -ffunction-sections,
+ * -fdata-sections and --gc-sections): a firmware that writes no EDS links
+ * none of them. */
 
 #define URRT_CO_OBJ_SUB 0x0u      /* a sub-index of the ARRAY or RECORD a header row opened */
 #define URRT_CO_OBJ_VAR 0x7u      /* object codes as CiA 306 numbers them */
@@ -398,16 +417,15 @@ typedef struct urrt_co {
 #define URRT_CO_NODE_ID 0x02u     /* a COB-ID counted from the node id (an EDS's $NODEID) */
 #define URRT_CO_PER_RPDO 0x04u    /* one object per RPDO: index + n */
 #define URRT_CO_IF_CONSUMERS 0x08u /* one object if the description has 0x1016 entries, else none */
-/* A row without a read function (bits 4-6 of flags): its value is the
- * member `at` bytes into the urrt_co, its urrt_co_desc, TPDO n's
- * urrt_co_tpdo_state or RPDO n's urrt_co_rpdo_state, read as the row's
- * type; or `at` itself. */
+/* A row without a read function (bits 4-5 of flags): its value is the
+ * member `at` bytes into the urrt_co, its urrt_co_desc or TPDO n's
+ * urrt_co_tpdo_state, read as the row's type; or `at` itself. (The
+ * receiving side's rows read through functions.) */
 #define URRT_CO_IN_CONST 0x00u
 #define URRT_CO_IN_NODE 0x10u
 #define URRT_CO_IN_DESC 0x20u
 #define URRT_CO_IN_TPDO 0x30u
-#define URRT_CO_IN_RPDO 0x40u
-#define URRT_CO_IN_MASK 0x70u
+#define URRT_CO_IN_MASK 0x30u
 
 /* A value as the SDO server sends it. */
 typedef struct urrt_co_value {
@@ -434,6 +452,8 @@ typedef struct urrt_co_comm {
     uint8_t at;               /* read NULL: a member's offset, or the value (URRT_CO_IN_CONST) */
 } urrt_co_comm;
 
+/* Every row, in index order (the receiving side's among them: they have
+ * instances only on a node set up with urrt_co_init_rx). */
 extern const urrt_co_comm urrt_co_comm_table[];
 extern const size_t urrt_co_comm_count;
 
@@ -449,7 +469,8 @@ bool urrt_co_comm_limits(const urrt_co_comm *row, uint32_t *low, uint32_t *high)
 size_t urrt_co_comm_instances(const struct urrt_co *co, const urrt_co_comm *row);
 
 /* Reads sub-index `sub` of the row's instance n as the SDO server would
- * (a row's sub-indices past what the node has: URRT_CO_ABORT_NO_SUB). */
+ * (a row's sub-indices past what the node has: URRT_CO_ABORT_NO_SUB). The
+ * row is one of urrt_co_comm_table's. */
 uint32_t urrt_co_comm_read(const struct urrt_co *co, const urrt_co_comm *row, size_t n, uint8_t sub,
                            urrt_co_value *v);
 
@@ -465,14 +486,21 @@ int urrt_co_init(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urrt_co_
                  uint32_t *vars, size_t var_count, size_t *bad_item);
 
 /* urrt_co_init for a description with RPDOs or heartbeat consumers: rx
- * holds their storage (and, optionally, written_us), whose pointers it
- * copies. It, urrt_co_rpdo_cob_default and urrt_co_rpdo_status are
- * lib/urrt_co_rx.c, which urrt_co.c reaches only through the node (`rx`): a
- * firmware that calls none of them links none of it. urrt_co_init is this
- * with rx NULL, and refuses such a description (URRT_CO_E_STORAGE). bad_item
- * is the RPDO (URRT_CO_E_RPDO) or the 0x1016 entry, from 0 (_CONSUMER). */
+ * holds their storage (and, optionally, written_us) and, from this call on,
+ * the receiving side's run-time state: the caller keeps it as long as the
+ * node. It, urrt_co_rpdo_cob_default, urrt_co_rpdo_status and
+ * urrt_co_rx_strerror are lib/urrt_co_rx.c, which urrt_co.c reaches only
+ * through the node (`rx`): a firmware that calls none of them links none of
+ * it. urrt_co_init is this with rx NULL, and refuses such a description
+ * (URRT_CO_E_STORAGE). bad_item is the RPDO (URRT_CO_E_RPDO) or the 0x1016
+ * entry, from 0 (_CONSUMER). */
 int urrt_co_init_rx(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urrt_co_tpdo_state *tpdo_states,
-                    uint32_t *vars, size_t var_count, const urrt_co_rx_storage *rx, size_t *bad_item);
+                    uint32_t *vars, size_t var_count, urrt_co_rx_storage *rx, size_t *bad_item);
+
+/* urrt_co_strerror's texts, and those of urrt_co_init_rx's own results
+ * (URRT_CO_E_RPDO, URRT_CO_E_CONSUMER, and a URRT_CO_E_STORAGE that names
+ * the receiving side's storage too). */
+const char *urrt_co_rx_strerror(int result);
 
 /* RPDO n's COB-ID after a reset (0x1400+n sub 1's default): the
  * description's, or CiA 301's pre-defined one. After urrt_co_init_rx. */

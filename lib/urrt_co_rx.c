@@ -3,13 +3,16 @@
  * heartbeat 0x1016 (see urrt_co.h, "RPDOs", and docs/canopen.md). A unit of
  * its own, as urrt_rtde_in.c is for RTDE: urrt_co.c calls it only through
  * the table urrt_co_init_rx installs (urrt_co_internal.h), so a node set up
- * with urrt_co_init links none of this file. Freestanding C99. */
+ * with urrt_co_init links none of this file: its error texts, its
+ * conditions (their EMCYs, their entries in 0x1003) and its rows of the
+ * communication objects are here. Freestanding C99. */
 #include "urrt_co.h"
 
 #include <stdint.h>
 
 #include "urrt_co_internal.h"
 
+#define type_size urrt_co_type_size
 #define NONE URRT_CO_NONE
 #define MAX_NODE_ID URRT_CO_MAX_NODE_ID
 #define ID_MASK URRT_CO_ID_MASK
@@ -20,10 +23,40 @@
 #define RPDO_BASE 0x200u               /* RPDO1..4: 0x200, 0x300, 0x400, 0x500 + node id */
 #define DUMMY_FIRST 0x0002u            /* dummy mapping entries: the data type indices INTEGER8.. */
 #define DUMMY_LAST 0x0007u             /* .. UNSIGNED32 */
-#define COND_HEARTBEAT URRT_CO_COND_HEARTBEAT
-#define COND_LENGTH URRT_CO_COND_LENGTH
-#define COND_TIMEOUT URRT_CO_COND_TIMEOUT
-#define BASE_CONDITIONS URRT_CO_BASE_CONDITIONS
+/* Its conditions: bit i of urrt_co_rx_storage.active, in the order of their EMCYs. */
+#define COND_HEARTBEAT 0u                                      /* + 0x1016 entry */
+#define COND_LENGTH (COND_HEARTBEAT + URRT_CO_MAX_CONSUMERS)   /* + RPDO */
+#define COND_TIMEOUT (COND_LENGTH + URRT_CO_MAX_RPDOS)         /* + RPDO */
+
+const char *urrt_co_rx_strerror(int result)
+{
+    switch (result) {
+    case URRT_CO_E_STORAGE: return "the CANopen node lacks its urrt_cantx, TPDO states, variables or RPDO storage";
+    case URRT_CO_E_RPDO: return "an RPDO's transmission type, mapping or COB-ID is not usable";
+    case URRT_CO_E_CONSUMER: return "a consumer heartbeat (0x1016) entry is not usable, or RPDOs have none";
+    default: return urrt_co_strerror(result);
+    }
+}
+
+/* ---- small helpers ------------------------------------------------------------ */
+
+static uint64_t min64(uint64_t a, uint64_t b)
+{
+    return a < b ? a : b;
+}
+
+static bool cob_valid(uint32_t cob)
+{
+    return (cob & URRT_CO_COB_INVALID) == 0u;
+}
+
+/* A number: its size is its row's type's (urrt_co.c's row_read). */
+static uint32_t value_of(urrt_co_value *v, uint32_t value)
+{
+    v->value = value;
+    v->text = NULL;
+    return 0;
+}
 
 /* ---- checks, once --------------------------------------------------------------- */
 
@@ -52,10 +85,10 @@ static bool rpdo_entry_fits(const urrt_co_desc *d, uint32_t entry)
     size_t i = object_of(d, entry);
     uint32_t bits = entry & 0xFFu;
     if (dummy_entry(entry)) {
-        return (entry >> 8 & 0xFFu) == 0u && bits == 8u * urrt_co_type_size((uint8_t)(entry >> 16));
+        return (entry >> 8 & 0xFFu) == 0u && bits == 8u * type_size((uint8_t)(entry >> 16));
     }
     return i != NONE && d->objects[i].kind == URRT_CO_VAR && (d->objects[i].access & URRT_CO_WO) != 0u &&
-           d->objects[i].type != URRT_CO_REAL32 && bits == 8u * urrt_co_type_size(d->objects[i].type);
+           d->objects[i].type != URRT_CO_REAL32 && bits == 8u * type_size(d->objects[i].type);
 }
 
 static uint32_t rpdo_bytes(const urrt_co_rpdo *p)
@@ -93,8 +126,8 @@ static int check_rpdo(const urrt_co_desc *d, size_t n)
     if (bits > 8u * URRT_CAN_CLASSIC_MAX_LEN) {
         return URRT_CO_E_RPDO;
     }
-    for (i = 0; urrt_co_cob_valid(rpdo_cob(d, n)) && i < n; i++) {
-        if (urrt_co_cob_valid(rpdo_cob(d, i)) && ((rpdo_cob(d, i) ^ rpdo_cob(d, n)) & ID_MASK) == 0u) {
+    for (i = 0; cob_valid(rpdo_cob(d, n)) && i < n; i++) {
+        if (cob_valid(rpdo_cob(d, i)) && ((rpdo_cob(d, i) ^ rpdo_cob(d, n)) & ID_MASK) == 0u) {
             return URRT_CO_E_RPDO; /* two valid RPDOs on one id */
         }
     }
@@ -164,7 +197,7 @@ static bool rx_storage_missing(const urrt_co_desc *d, const urrt_co_rx_storage *
 /* The id an RPDO's COB-ID or a 0x1016 entry makes the node receive, or NONE. */
 static uint32_t rpdo_rx_id(uint32_t cob_id)
 {
-    return urrt_co_cob_valid(cob_id) ? cob_id & ID_MASK : UINT32_MAX;
+    return cob_valid(cob_id) ? cob_id & ID_MASK : UINT32_MAX;
 }
 
 static uint32_t consumer_rx_id(uint32_t value)
@@ -195,13 +228,14 @@ static void rpdo_forget(urrt_co_rpdo_state *t)
 static void rx_defaults(urrt_co *co, bool boot, bool whole_node)
 {
     const urrt_co_desc *d = co->desc;
+    urrt_co_rx_storage *rx = co->rx_storage;
     bool changed = false;
     size_t i;
-    for (i = 0; whole_node && co->written_us != NULL && i < co->var_count; i++) {
-        co->written_us[i] = URRT_CANTX_NEVER;
+    for (i = 0; whole_node && rx->written_us != NULL && i < rx->var_count; i++) {
+        rx->written_us[i] = URRT_CANTX_NEVER;
     }
     for (i = 0; i < d->rpdo_count; i++) {
-        urrt_co_rpdo_state *t = &co->rpdos[i];
+        urrt_co_rpdo_state *t = &co->rx_storage->rpdos[i];
         uint32_t cob = rpdo_cob(d, i);
         changed = changed || (boot && rpdo_rx_id(t->cob_id) != rpdo_rx_id(cob));
         t->cob_id = cob;
@@ -210,7 +244,7 @@ static void rx_defaults(urrt_co *co, bool boot, bool whole_node)
         rpdo_forget(t);
     }
     for (i = 0; i < d->consumer_count; i++) {
-        urrt_co_consumer *c = &co->consumers[i];
+        urrt_co_consumer *c = &co->rx_storage->consumers[i];
         uint32_t value = d->consumers != NULL ? d->consumers[i] : 0u;
         changed = changed || (boot && consumer_rx_id(c->value) != consumer_rx_id(value));
         c->value = value;
@@ -229,7 +263,7 @@ static uint64_t rpdo_due(const urrt_co_rpdo_state *t)
 /* Whether RPDO n's deadline is watched now: a late one raises its EMCY. */
 static bool rpdo_watched(const urrt_co *co, const urrt_co_rpdo_state *t)
 {
-    return co->state == (uint8_t)URRT_CO_OPERATIONAL && urrt_co_cob_valid(t->cob_id) && t->event_ms != 0u && t->armed &&
+    return co->state == (uint8_t)URRT_CO_OPERATIONAL && cob_valid(t->cob_id) && t->event_ms != 0u && t->armed &&
            !t->late;
 }
 
@@ -250,30 +284,40 @@ static uint32_t rx_conditions(urrt_co *co, uint64_t now_us)
     uint32_t found = 0;
     size_t i;
     for (i = 0; i < co->desc->rpdo_count; i++) {
-        urrt_co_rpdo_state *t = &co->rpdos[i];
+        urrt_co_rpdo_state *t = &co->rx_storage->rpdos[i];
         t->late = t->late || (rpdo_watched(co, t) && now_us > rpdo_due(t));
         found |= (uint32_t)t->short_seen << (COND_LENGTH + i) | (uint32_t)t->late << (COND_TIMEOUT + i);
     }
     for (i = 0; i < co->desc->consumer_count; i++) {
-        urrt_co_consumer *c = &co->consumers[i];
+        urrt_co_consumer *c = &co->rx_storage->consumers[i];
         c->lost = c->lost || (consumer_watched(co, c) && now_us > consumer_due(c));
         found |= (uint32_t)c->lost << (COND_HEARTBEAT + i);
     }
     return found;
 }
 
-/* After a frame or a write changed them: the EMCY follows from urrt_co_run. */
-static uint32_t rx_emcy(unsigned i);
+/* Condition i of the receiving side: its EMCY code, and byte 5 (the 0x1016
+ * sub-index or the RPDO number) in bits 16..23. */
+static uint32_t rx_emcy(unsigned i)
+{
+    if (i < COND_LENGTH) {
+        return URRT_CO_EMCY_HEARTBEAT | (uint32_t)(i - COND_HEARTBEAT + 1u) << 16;
+    }
+    return i < COND_TIMEOUT ? URRT_CO_EMCY_PDO_LENGTH | (uint32_t)(i - COND_LENGTH + 1u) << 16
+                            : URRT_CO_EMCY_RPDO_TIMEOUT | (uint32_t)(i - COND_TIMEOUT + 1u) << 16;
+}
 
-/* urrt_co.c's conditions_commit for the receiving side's bits: each that
- * started goes into 0x1003 (newest first), as urrt_co.c's history_push,
- * which stays static there so that a node without RPDOs keeps it inline. */
+/* The conditions now (after a frame or a write changed them, or at
+ * urrt_co_run, after the node's own): each that started goes into 0x1003
+ * (newest first), as urrt_co.c's history_push, which stays static there so
+ * that a node without RPDOs keeps it inline; urrt_co.active's bit for the
+ * error register. Their EMCYs follow from urrt_co_run. */
 static void rx_refresh(urrt_co *co, uint64_t now_us)
 {
     uint32_t active = rx_conditions(co, now_us);
-    uint32_t started = active & ~co->active;
+    uint32_t started = active & ~(uint32_t)co->rx_storage->active;
     unsigned i, k;
-    for (i = URRT_CO_CONDITIONS; i < URRT_CO_COND_ALL; i++) {
+    for (i = 0; i < URRT_CO_RX_CONDITIONS; i++) {
         if ((started >> i & 1u) == 0u) {
             continue;
         }
@@ -283,19 +327,52 @@ static void rx_refresh(urrt_co *co, uint64_t now_us)
         co->errors[0] = rx_emcy(i) & 0xFFFFu;
         co->error_count = (uint8_t)(co->error_count < URRT_CO_HISTORY ? co->error_count + 1u : URRT_CO_HISTORY);
     }
-    co->active = (co->active & BASE_CONDITIONS) | active;
+    co->rx_storage->active = (uint16_t)active;
+    co->active = (uint8_t)((co->active & ~URRT_CO_RX_ACTIVE) | (active != 0u ? URRT_CO_RX_ACTIVE : 0u));
+    co->reported = (uint8_t)((co->reported & ~URRT_CO_RX_ACTIVE) | (co->active & URRT_CO_RX_ACTIVE));
 }
 
-/* When a deadline of the receiving side passes. */
+static bool rx_emcy_may_send(const urrt_co *co)
+{
+    return (co->state == (uint8_t)URRT_CO_PRE_OPERATIONAL || co->state == (uint8_t)URRT_CO_OPERATIONAL) &&
+           co->rx_storage->active != co->rx_storage->reported;
+}
+
+/* After the node's own EMCYs (urrt_co_run): one per condition of the
+ * receiving side that started or ended since the last, in order, as the
+ * inhibit time (0x1015) allows, byte 5 its 0x1016 entry or RPDO. */
+static size_t rx_emcy_send(urrt_co *co, urrt_cantx_emit_fn emit, void *ctx, uint64_t now_us)
+{
+    size_t sent = 0;
+    unsigned i;
+    if (!rx_emcy_may_send(co)) {
+        return 0;
+    }
+    if (!cob_valid(co->emcy_cob_id)) {
+        co->rx_storage->reported = co->rx_storage->active; /* no EMCY object: nothing to tell later */
+        return 0;
+    }
+    for (i = 0; i < URRT_CO_RX_CONDITIONS && now_us >= urrt_co_emcy_due(co); i++) {
+        uint32_t bit = UINT32_C(1) << i;
+        if (((uint32_t)(co->rx_storage->active ^ co->rx_storage->reported) & bit) == 0u) {
+            continue;
+        }
+        co->rx_storage->reported = (uint16_t)(co->rx_storage->reported ^ bit);
+        sent += urrt_co_emcy_send(co, rx_emcy(i), (co->rx_storage->active & bit) != 0u, now_us, emit, ctx);
+    }
+    return sent;
+}
+
+/* When a deadline of the receiving side passes, or its EMCYs may go. */
 static uint64_t rx_deadline(const urrt_co *co)
 {
-    uint64_t next = URRT_CANTX_NEVER;
+    uint64_t next = rx_emcy_may_send(co) ? urrt_co_emcy_due(co) : URRT_CANTX_NEVER;
     size_t i;
     for (i = 0; i < co->desc->rpdo_count; i++) {
-        next = rpdo_watched(co, &co->rpdos[i]) ? urrt_co_min64(next, rpdo_due(&co->rpdos[i]) + 1u) : next;
+        next = rpdo_watched(co, &co->rx_storage->rpdos[i]) ? min64(next, rpdo_due(&co->rx_storage->rpdos[i]) + 1u) : next;
     }
     for (i = 0; i < co->desc->consumer_count; i++) {
-        next = consumer_watched(co, &co->consumers[i]) ? urrt_co_min64(next, consumer_due(&co->consumers[i]) + 1u) : next;
+        next = consumer_watched(co, &co->rx_storage->consumers[i]) ? min64(next, consumer_due(&co->rx_storage->consumers[i]) + 1u) : next;
     }
     return next;
 }
@@ -307,15 +384,15 @@ urrt_co_rx_status urrt_co_rpdo_status(const urrt_co *co, size_t n, uint64_t now_
     if (co == NULL || co->desc == NULL || n >= co->desc->rpdo_count) {
         return URRT_CO_RPDO_NONE;
     }
-    t = &co->rpdos[n];
+    t = &co->rx_storage->rpdos[n];
     if (co->state != (uint8_t)URRT_CO_OPERATIONAL) {
         return URRT_CO_RPDO_NOT_OPERATIONAL;
     }
-    if (!urrt_co_cob_valid(t->cob_id)) {
+    if (!cob_valid(t->cob_id)) {
         return URRT_CO_RPDO_NOT_VALID;
     }
     for (i = 0; i < co->desc->consumer_count; i++) {
-        const urrt_co_consumer *c = &co->consumers[i];
+        const urrt_co_consumer *c = &co->rx_storage->consumers[i];
         if (c->lost || (consumer_watched(co, c) && now_us > consumer_due(c))) {
             return URRT_CO_RPDO_HEARTBEAT_LOST;
         }
@@ -347,7 +424,10 @@ static void rpdo_act(urrt_co *co, size_t n, const uint8_t *data, uint64_t now_us
             if (urrt_co_range_check(value, o->type, o->min, o->max) != 0u) {
                 co->values_refused++;
             } else {
-                urrt_co_var_store(co, o->item, value, now_us);
+                co->vars[o->item] = value;
+                if (co->rx_storage->written_us != NULL) {
+                    co->rx_storage->written_us[o->item] = now_us;
+                }
                 wrote = true;
             }
         }
@@ -360,7 +440,7 @@ static void rpdo_act(urrt_co *co, size_t n, const uint8_t *data, uint64_t now_us
  * (254, 255) or kept for the next SYNC (0..240). */
 static void rpdo_received(urrt_co *co, size_t n, const uint8_t *data, size_t len, uint64_t now_us)
 {
-    urrt_co_rpdo_state *t = &co->rpdos[n];
+    urrt_co_rpdo_state *t = &co->rx_storage->rpdos[n];
     size_t i;
     t->short_seen = len < rpdo_bytes(&co->desc->rpdos[n]);
     if (!t->short_seen) {
@@ -386,7 +466,7 @@ static void consumer_heard(urrt_co *co, uint32_t id, uint8_t state, uint64_t now
     bool heard = false;
     size_t i;
     for (i = 0; i < co->desc->consumer_count; i++) {
-        urrt_co_consumer *c = &co->consumers[i];
+        urrt_co_consumer *c = &co->rx_storage->consumers[i];
         if (consumer_rx_id(c->value) != id) {
             continue;
         }
@@ -401,30 +481,40 @@ static void consumer_heard(urrt_co *co, uint32_t id, uint8_t state, uint64_t now
     }
 }
 
-/* Frames of the receiving side: RPDOs (in OPERATIONAL), heartbeats (1 byte). */
-static void rx_frame(urrt_co *co, uint32_t id, const uint8_t *data, size_t len, uint64_t now_us)
-{
-    size_t n;
-    if (id > NMT_EC_BASE && len == 1u) {
-        consumer_heard(co, id, data[0], now_us);
-        return;
-    }
-    for (n = 0; co->state == (uint8_t)URRT_CO_OPERATIONAL && n < co->desc->rpdo_count; n++) {
-        if (rpdo_rx_id(co->rpdos[n].cob_id) == id) {
-            rpdo_received(co, n, data, len, now_us);
-            return;
-        }
-    }
-}
-
 /* At a SYNC in OPERATIONAL: the synchronous RPDOs kept since the last. */
 static void rpdo_sync(urrt_co *co, uint64_t now_us)
 {
     size_t n;
     for (n = 0; n < co->desc->rpdo_count; n++) {
-        if (co->rpdos[n].pending) {
-            co->rpdos[n].pending = false;
-            rpdo_act(co, n, co->rpdos[n].data, now_us);
+        if (co->rx_storage->rpdos[n].pending) {
+            co->rx_storage->rpdos[n].pending = false;
+            rpdo_act(co, n, co->rx_storage->rpdos[n].data, now_us);
+        }
+    }
+}
+
+/* Every frame but NMT's, in PRE-OPERATIONAL and OPERATIONAL, before the
+ * node's own: a SYNC (0 or 1 byte; only that: no RPDO on its id is acted
+ * on) acts on the kept RPDOs in OPERATIONAL, before the node's TPDOs go;
+ * then heartbeats (1 byte) and RPDOs (in OPERATIONAL). No SDO request
+ * reaches here as anything else: no RPDO or heartbeat may use its id. */
+static void rx_frame(urrt_co *co, uint32_t id, const uint8_t *data, size_t len, uint64_t now_us)
+{
+    size_t n;
+    if (id == (co->sync_cob_id & ID_MASK)) {
+        if (len <= 1u && co->state == (uint8_t)URRT_CO_OPERATIONAL) {
+            rpdo_sync(co, now_us); /* the synchronous RPDOs' values first, as they stand at the SYNC */
+        }
+        return;
+    }
+    if (id > NMT_EC_BASE && len == 1u) {
+        consumer_heard(co, id, data[0], now_us);
+        return;
+    }
+    for (n = 0; co->state == (uint8_t)URRT_CO_OPERATIONAL && n < co->desc->rpdo_count; n++) {
+        if (rpdo_rx_id(co->rx_storage->rpdos[n].cob_id) == id) {
+            rpdo_received(co, n, data, len, now_us);
+            return;
         }
     }
 }
@@ -435,14 +525,14 @@ static void rx_nmt(urrt_co *co, urrt_co_nmt state)
 {
     size_t i;
     for (i = 0; i < co->desc->rpdo_count; i++) {
-        urrt_co_rpdo_state *t = &co->rpdos[i];
+        urrt_co_rpdo_state *t = &co->rx_storage->rpdos[i];
         bool again = state == URRT_CO_OPERATIONAL && co->state != (uint8_t)URRT_CO_OPERATIONAL;
         t->pending = t->pending && state == URRT_CO_OPERATIONAL;
         t->received = t->received && !again;
         t->armed = t->armed && !again;
     }
     for (i = 0; i < co->desc->consumer_count; i++) {
-        co->consumers[i].started = co->consumers[i].started && state != URRT_CO_STOPPED;
+        co->rx_storage->consumers[i].started = co->rx_storage->consumers[i].started && state != URRT_CO_STOPPED;
     }
 }
 
@@ -451,7 +541,7 @@ static bool rpdo_id_taken(const urrt_co *co, size_t n, uint32_t id)
 {
     size_t i;
     for (i = 0; i < co->desc->rpdo_count; i++) {
-        if (i != n && rpdo_rx_id(co->rpdos[i].cob_id) == id) {
+        if (i != n && rpdo_rx_id(co->rx_storage->rpdos[i].cob_id) == id) {
             return true;
         }
     }
@@ -461,12 +551,12 @@ static bool rpdo_id_taken(const urrt_co *co, size_t n, uint32_t id)
 /* 0x1400+n sub 1, 2, 5 (urrt_co_comm_table): as a TPDO's, the COB-ID's id
  * changes only while or into invalid; a new id or validity starts the RPDO
  * over (its conditions end), a new event timer its monitoring. */
-static uint32_t rpdo_write(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
+static uint32_t write_rpdo(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
 {
-    urrt_co_rpdo_state *t = &co->rpdos[n];
+    urrt_co_rpdo_state *t = &co->rx_storage->rpdos[n];
     switch (sub) {
     case 1:
-        if (urrt_co_cob_check(t->cob_id, value, COB_NO_RTR) != 0u || (urrt_co_cob_valid(value) && rpdo_id_taken(co, n, value & ID_MASK))) {
+        if (urrt_co_cob_check(t->cob_id, value, COB_NO_RTR) != 0u || (cob_valid(value) && rpdo_id_taken(co, n, value & ID_MASK))) {
             return URRT_CO_ABORT_VALUE;
         }
         if (rpdo_rx_id(t->cob_id) != rpdo_rx_id(value)) {
@@ -494,16 +584,16 @@ static uint32_t rpdo_write(urrt_co *co, size_t n, uint8_t sub, uint32_t value, u
 
 /* 0x1016 sub 1..: node ids up to 127, bits 24..31 0, no node twice;
  * monitoring starts again with the producer's next heartbeat. */
-static uint32_t consumer_write(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
+static uint32_t write_consumer(urrt_co *co, size_t n, uint8_t sub, uint32_t value, uint64_t now_us)
 {
-    urrt_co_consumer *c = &co->consumers[sub - 1u];
+    urrt_co_consumer *c = &co->rx_storage->consumers[sub - 1u];
     size_t i;
     (void)n;
     if (!consumer_value_ok(value)) {
         return URRT_CO_ABORT_VALUE;
     }
     for (i = 0; i < co->desc->consumer_count; i++) {
-        if (i != sub - 1u && consumer_twice(co->consumers[i].value, value)) {
+        if (i != sub - 1u && consumer_twice(co->rx_storage->consumers[i].value, value)) {
             return URRT_CO_ABORT_INCOMPATIBLE;
         }
     }
@@ -520,16 +610,16 @@ static uint32_t read_rpdo_map(const urrt_co *co, size_t n, uint8_t sub, urrt_co_
 {
     const urrt_co_rpdo *p = &co->desc->rpdos[n];
     if (sub == 0u) {
-        return urrt_co_value_of(v, p->mapping_count);
+        return value_of(v, p->mapping_count);
     }
-    return sub > p->mapping_count ? URRT_CO_ABORT_NO_SUB : urrt_co_value_of(v, p->mapping[sub - 1u]);
+    return sub > p->mapping_count ? URRT_CO_ABORT_NO_SUB : value_of(v, p->mapping[sub - 1u]);
 }
 
 /* 0x1016 sub 1..: the description's count of them. */
 static uint32_t read_consumer(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
 {
     (void)n;
-    return sub > co->desc->consumer_count ? URRT_CO_ABORT_NO_SUB : urrt_co_value_of(v, co->consumers[sub - 1u].value);
+    return sub > co->desc->consumer_count ? URRT_CO_ABORT_NO_SUB : value_of(v, co->rx_storage->consumers[sub - 1u].value);
 }
 
 /* The ids after NMT, SYNC and SDO: the valid RPDOs', the watched producers'. */
@@ -538,43 +628,127 @@ static size_t rx_ids(const urrt_co *co, uint32_t *ids)
     size_t count = 0;
     size_t i;
     for (i = 0; i < co->desc->rpdo_count; i++) {
-        ids[count] = rpdo_rx_id(co->rpdos[i].cob_id);
+        ids[count] = rpdo_rx_id(co->rx_storage->rpdos[i].cob_id);
         count += ids[count] != UINT32_MAX;
     }
     for (i = 0; i < co->desc->consumer_count; i++) {
-        ids[count] = consumer_rx_id(co->consumers[i].value);
+        ids[count] = consumer_rx_id(co->rx_storage->consumers[i].value);
         count += ids[count] != UINT32_MAX;
     }
     return count;
 }
 
-/* Condition i of the receiving side: its EMCY code, and byte 5 (the 0x1016
- * sub-index or the RPDO number) in bits 16..23. */
-static uint32_t rx_emcy(unsigned i)
+/* 0x1400+n sub 1, 2, 5. */
+static uint32_t read_rpdo(const urrt_co *co, size_t n, uint8_t sub, urrt_co_value *v)
 {
-    if (i < COND_LENGTH) {
-        return URRT_CO_EMCY_HEARTBEAT | (uint32_t)(i - COND_HEARTBEAT + 1u) << 16;
-    }
-    return i < COND_TIMEOUT ? URRT_CO_EMCY_PDO_LENGTH | (uint32_t)(i - COND_LENGTH + 1u) << 16
-                            : URRT_CO_EMCY_RPDO_TIMEOUT | (uint32_t)(i - COND_TIMEOUT + 1u) << 16;
+    const urrt_co_rpdo_state *t = &co->rx_storage->rpdos[n];
+    return value_of(v, sub == 1u ? t->cob_id : sub == 2u ? t->type : t->event_ms);
 }
 
-static void rx_bind(urrt_co *co, const urrt_co_rx_storage *rx, size_t var_count)
+/* The receiving side's rows of the communication objects, for the SDO
+ * server (urrt_co_internal.h's list; the headers are urrt_co_comm_table's
+ * alone: each row of an index knows it as well). */
+#define U8 URRT_CO_UNSIGNED8
+#define U16 URRT_CO_UNSIGNED16
+#define U32 URRT_CO_UNSIGNED32
+#define SUB URRT_CO_OBJ_SUB
+#define PER_RPDO URRT_CO_PER_RPDO
+#define IF_CONSUMERS URRT_CO_IF_CONSUMERS
+#define NODE_ID URRT_CO_NODE_ID
+#define READ_FN(f) (f)
+#define READ_DESC(m) NULL
+#define READ_CONST(value) NULL
+#define IN_FN 0u
+#define IN_DESC URRT_CO_IN_DESC
+#define IN_CONST URRT_CO_IN_CONST
+#define AT_FN(f, type_) 0u
+#define TYPE_BYTES(type_) ((type_) == U32 ? 4u : (type_) == U16 ? 2u : 1u)
+#define AT_DESC(m, type_) \
+    (offsetof(urrt_co_desc, m) + 0u * sizeof(char[sizeof(((urrt_co_desc *)0)->m) == TYPE_BYTES(type_) ? 1 : -1]))
+#define AT_CONST(value, type_) (value)
+#define NO_HEAD(index_, object_, flags_, name_)
+#define NO_ROW(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_)
+#define NO_LIMITED(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_, low_, high_)
+#define RX_ROW(index_, sub_, subs_, object_, type_, in_, what_, write_, flags_, name_)                        \
+    {READ_##in_(what_), (write_), (index_), (sub_), (subs_), (object_), (type_), (flags_) | IN_##in_,     \
+     AT_##in_(what_, type_)},
+static const urrt_co_comm rx_rows[] = {URRT_CO_COMM_LIST(NO_HEAD, NO_ROW, NO_LIMITED, NO_HEAD, RX_ROW)};
+
+/* One of rx_rows' objects on this node: the RPDOs', 0x1016 if it has entries. */
+static size_t rx_instances(const urrt_co *co, const urrt_co_comm *row)
 {
-    co->rpdos = co->desc->rpdo_count > 0u ? rx->rpdos : NULL;
-    co->consumers = co->desc->consumer_count > 0u ? rx->consumers : NULL;
-    co->written_us = rx != NULL ? rx->written_us : NULL;
-    co->var_count = var_count;
+    return (row->flags & URRT_CO_PER_RPDO) != 0u ? co->desc->rpdo_count : co->desc->consumer_count > 0u ? 1u : 0u;
+}
+
+static uint32_t rx_find(const urrt_co *co, uint16_t index, uint8_t sub, const urrt_co_comm **found, size_t *n)
+{
+    uint32_t abort_code = URRT_CO_ABORT_NO_OBJECT;
+    size_t i;
+    for (i = 0; i < sizeof rx_rows / sizeof rx_rows[0]; i++) {
+        const urrt_co_comm *row = &rx_rows[i];
+        if (index < row->index || (size_t)(index - row->index) >= rx_instances(co, row)) {
+            continue;
+        }
+        abort_code = URRT_CO_ABORT_NO_SUB;
+        if (sub >= row->sub && sub - row->sub < row->subs) {
+            *found = row;
+            *n = (size_t)(index - row->index);
+            return 0;
+        }
+    }
+    return abort_code;
+}
+
+/* An SDO write stored vars[item]: when, for the caller. */
+static void rx_written(urrt_co *co, uint16_t item, uint64_t now_us)
+{
+    if (co->rx_storage->written_us != NULL) {
+        co->rx_storage->written_us[item] = now_us;
+    }
+}
+
+/* Its storage, once every check passed: the defaults, nothing active. */
+static void rx_bind(urrt_co *co, size_t var_count)
+{
+    co->rx_storage->var_count = var_count;
+    co->rx_storage->active = 0;
+    co->rx_storage->reported = 0;
     rx_defaults(co, false, false);
 }
 
+/* A reset: the parameters back, the ids received with them; nothing active. */
+static void rx_reset(urrt_co *co, bool whole_node)
+{
+    co->rx_storage->active = 0;
+    co->rx_storage->reported = 0;
+    rx_defaults(co, true, whole_node);
+}
+
 static const struct urrt_co_rx_ops rx_ops = {
-    rx_storage_missing, check_rx, rx_bind, rx_defaults, rx_nmt, rx_frame, rpdo_sync, rx_conditions, rx_emcy, rx_deadline,
-    rx_ids, read_rpdo_map, read_consumer, rpdo_write, consumer_write,
+    .check = check_rx,
+    .bind = rx_bind,
+    .reset = rx_reset,
+    .nmt = rx_nmt,
+    .frame = rx_frame,
+    .conditions = rx_refresh,
+    .emcy = rx_emcy_send,
+    .deadline = rx_deadline,
+    .ids = rx_ids,
+    .find = rx_find,
+    .written = rx_written,
+    .read_consumer = read_consumer,
+    .write_consumer = write_consumer,
+    .read_rpdo = read_rpdo,
+    .write_rpdo = write_rpdo,
+    .read_rpdo_map = read_rpdo_map,
 };
 
 int urrt_co_init_rx(urrt_co *co, const urrt_co_desc *desc, urrt_cantx *tx, urrt_co_tpdo_state *tpdo_states,
-                    uint32_t *vars, size_t var_count, const urrt_co_rx_storage *rx, size_t *bad_item)
+                    uint32_t *vars, size_t var_count, urrt_co_rx_storage *rx, size_t *bad_item)
 {
-    return urrt_co_init_with(co, desc, tx, tpdo_states, vars, var_count, &rx_ops, rx, bad_item);
+    /* Storage the description needs and lacks: urrt_co_init's refusal (URRT_CO_E_STORAGE).
+     * Without any (no RPDOs, no 0x1016), the node is urrt_co_init's. */
+    bool missing = desc != NULL && rx_storage_missing(desc, rx);
+    return urrt_co_init_with(co, desc, tx, tpdo_states, vars, var_count, missing || rx == NULL ? NULL : &rx_ops, rx,
+                             bad_item);
 }

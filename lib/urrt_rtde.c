@@ -94,18 +94,14 @@ static const only_row only_table[] = {
 #undef X_ONLY
 };
 
-/* Where each urrt_state field sits, for the decode's NaN fill of the fields
- * a recipe does not have. */
-typedef struct state_field {
-    uint16_t offset;
-    uint8_t count;
-} state_field;
-
-static const state_field state_fields[URRT_FIELD_COUNT] = {
-#define X_STATE(ID, name, count, c1, c3, unit, since, desc) {(uint16_t)offsetof(urrt_state, name), count},
-    URRT_FIELDS(X_STATE)
-#undef X_STATE
-};
+/* urrt_state's fields are doubles back to back from its start up to
+ * present: the clear at URRT_RTDE_EV_RECIPE writes NaN over all of them. */
+#define X_STATE_DOUBLES(ID, name, count, c1, c3, unit, since, desc) +(count)
+enum { STATE_DOUBLES = 0 URRT_FIELDS(X_STATE_DOUBLES) };
+#undef X_STATE_DOUBLES
+RTDE_STATIC_ASSERT(state_doubles_first, offsetof(urrt_state, present) == 8u * STATE_DOUBLES);
+RTDE_STATIC_ASSERT(present_words, URRT_RTDE_PRESENT_WORDS * 32 >= URRT_RTDE_ONLY_COUNT &&
+                                       URRT_RTDE_PRESENT_WORDS % 4 == 0);
 
 /* ---- bytes ----------------------------------------------------------------- */
 
@@ -162,6 +158,37 @@ static inline double load_double(const uint8_t *p)
     rtde_bits b;
     b.u = load_be64(p);
     return b.d;
+}
+
+/* n bytes from src to dst (distinct buffers): 8 at a time where loads may
+ * be unaligned (a fixed-size __builtin_memcpy is then one load and one
+ * store, never a call), then single bytes. Its own pointers and count: no
+ * store through a byte pointer makes it reload a session's counters. */
+static void copy_bytes(uint8_t *dst, const uint8_t *src, size_t n)
+{
+    size_t i = 0;
+#ifdef RTDE_LOAD_UNALIGNED
+    for (; i + 8u <= n; i += 8u) {
+        __builtin_memcpy(dst + i, src + i, 8u);
+    }
+#endif
+    for (; i < n; i++) {
+        dst[i] = src[i];
+    }
+}
+
+/* A data package's first four bytes as one word, in the host's order where
+ * loads may be unaligned, else assembled (either way as compile_recipe
+ * computes the expected one). */
+static uint32_t load_head(const uint8_t *p)
+{
+#ifdef RTDE_LOAD_UNALIGNED
+    uint32_t v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return v;
+#else
+    return load_be32(p);
+#endif
 }
 
 static void store_be16(uint8_t *p, unsigned v)
@@ -454,25 +481,72 @@ int urrt_rtde_var_available(int var, uint32_t major, uint32_t minor, uint32_t bu
     return have >= need ? 1 : 0;
 }
 
-void urrt_rtde_values_clear(urrt_rtde_values *v)
+/* count doubles at d set to NaN, four at a time (GCC and clang join the
+ * stores into the widest the build has). */
+static void fill_nan(double *d, size_t count)
 {
     rtde_bits nan;
-    size_t i;
+    size_t k;
+    nan.u = RTDE_NAN_BITS;
+    for (k = 0; k + 4 <= count; k += 4) {
+        d[k] = nan.d;
+        d[k + 1] = nan.d;
+        d[k + 2] = nan.d;
+        d[k + 3] = nan.d;
+    }
+    for (; k < count; k++) {
+        d[k] = nan.d;
+    }
+}
+
+/* Every member of *v by its row: the doubles NaN, the integers 0, in their
+ * own types (a byte loop of unknown length would be a call to memset). */
+void urrt_rtde_values_clear(urrt_rtde_values *v)
+{
+    size_t i, k;
     if (v == 0) {
         return;
     }
-    nan.u = RTDE_NAN_BITS;
-#define X_CLEAR(ID, member, name, TYPE, first, names, split, since, since_hi) \
-    for (i = 0; i < sizeof v->member / sizeof v->member[0]; i++) {           \
-        v->member[i] = (URRT_RTDE_CTYPE_##TYPE)(URRT_RTDE_T_##TYPE == URRT_RTDE_T_DOUBLE || \
-                       URRT_RTDE_T_##TYPE == URRT_RTDE_T_VECTOR3D ||          \
-                       URRT_RTDE_T_##TYPE == URRT_RTDE_T_VECTOR6D ? nan.d : 0.0); \
+    for (i = 0; i < ONLY_ROWS; i++) {
+        const only_row *r = &only_table[i];
+        unsigned char *d = (unsigned char *)v + r->offset;
+        size_t n = (size_t)r->names * type_table[r->type].count;
+        switch (type_table[r->type].size / type_table[r->type].count) {
+        case 8:
+            if (r->type == URRT_RTDE_T_UINT64) {
+                for (k = 0; k < n; k++) {
+                    ((uint64_t *)(void *)d)[k] = 0;
+                }
+            } else {
+                fill_nan((double *)(void *)d, n);
+            }
+            break;
+        case 4:
+            for (k = 0; k < n; k++) {
+                ((uint32_t *)(void *)d)[k] = 0;
+            }
+            break;
+        default:
+            for (k = 0; k < n; k++) {
+                d[k] = 0;
+            }
+            break;
+        }
     }
-    URRT_RTDE_ONLY(X_CLEAR)
-#undef X_CLEAR
-    for (i = 0; i < sizeof v->present; i++) {
+    for (i = 0; i < URRT_RTDE_PRESENT_WORDS; i++) {
         v->present[i] = 0;
     }
+}
+
+/* *st as urrt_state_clear leaves it (without linking urrt.c's table). */
+static void state_clear(urrt_state *st)
+{
+    fill_nan((double *)(void *)st, STATE_DOUBLES);
+    st->present = 0;
+    st->length = 0;
+    st->doubles = 0;
+    st->extra_columns = 0;
+    st->generation = URRT_GEN_UNKNOWN;
 }
 
 /* Where an RTDE-only variable sits in urrt_rtde_values: a family's values
@@ -625,6 +699,7 @@ static int check_vars(urrt_rtde *s, const uint16_t *vars, size_t count)
     }
     s->state_present = 0;
     s->has_values = 0;
+    s->has_state = 0;
     for (i = 0; i < count; i++) {
         for (j = 0; j < i; j++) {
             if (vars[j] == vars[i]) {
@@ -633,32 +708,12 @@ static int check_vars(urrt_rtde *s, const uint16_t *vars, size_t count)
         }
         if (vars[i] < URRT_RTDE_MAPPED_COUNT) {
             s->state_present |= UINT64_C(1) << mapped_table[vars[i]].field;
+            s->has_state = 1;
         } else {
             s->has_values = 1;
         }
     }
     return URRT_OK; /* its data package fits URRT_RTDE_PACKAGE_MAX: any recipe's does */
-}
-
-/* The spans of urrt_state fields no variable of the recipe fills, each
- * field joined to the one before it where they touch. */
-static void find_absent(urrt_rtde *s)
-{
-    unsigned id, n = 0;
-    for (id = 0; id < (unsigned)URRT_FIELD_COUNT; id++) {
-        const state_field *f = &state_fields[id];
-        if (((s->state_present >> id) & 1u) != 0) {
-            continue;
-        }
-        if (n > 0 && s->absent[n - 1].offset + 8u * s->absent[n - 1].count == f->offset) {
-            s->absent[n - 1].count = (uint16_t)(s->absent[n - 1].count + f->count);
-        } else {
-            s->absent[n].offset = f->offset;
-            s->absent[n].count = f->count;
-            n++;
-        }
-    }
-    s->absent_count = (uint16_t)n;
 }
 
 int urrt_rtde_begin(urrt_rtde *s, const uint16_t *vars, size_t count, double frequency)
@@ -682,7 +737,6 @@ int urrt_rtde_begin(urrt_rtde *s, const uint16_t *vars, size_t count, double fre
     if (r < 0) {
         return r;
     }
-    find_absent(s);
     for (i = 0; i < count; i++) {
         s->vars[i] = vars[i];
     }
@@ -692,6 +746,8 @@ int urrt_rtde_begin(urrt_rtde *s, const uint16_t *vars, size_t count, double fre
     s->var_count = (uint16_t)count;
     s->frequency = frequency;
     s->data_size = 0;
+    s->head = 1; /* no data package matches before a recipe is compiled */
+    s->head_mask = 0;
     s->have = 0;
     s->need = 0;
     s->error = 0;
@@ -710,7 +766,7 @@ int urrt_rtde_begin(urrt_rtde *s, const uint16_t *vars, size_t count, double fre
 int urrt_rtde_set_recipe(urrt_rtde *s, const uint16_t *vars, size_t count)
 {
     uint64_t state_present;
-    uint8_t has_values;
+    uint8_t has_values, has_state;
     size_t i;
     int r;
     if (s == 0 || s->phase != PH_SETUP || s->pending != REQ_SETUP || vars == 0 || count == 0 ||
@@ -724,13 +780,14 @@ int urrt_rtde_set_recipe(urrt_rtde *s, const uint16_t *vars, size_t count)
     }
     state_present = s->state_present;
     has_values = s->has_values;
+    has_state = s->has_state;
     r = check_vars(s, vars, count);
     if (r < 0) {
         s->state_present = state_present;
         s->has_values = has_values;
+        s->has_state = has_state;
         return r;
     }
-    find_absent(s);
     for (i = 0; i < count; i++) {
         s->vars[i] = vars[i];
     }
@@ -862,118 +919,207 @@ size_t urrt_rtde_finish(urrt_rtde *s)
 
 /* ---- data packages ---------------------------------------------------------- */
 
+/* How an entry's elements are converted (urrt_rtde_entry.op). */
+enum rtde_op {
+    OP_F64 = 0, /* a double into a double (urrt_state or urrt_rtde_values) */
+    OP_X32,     /* 32 bits into an int32_t or uint32_t of urrt_rtde_values */
+    OP_I32_F64, /* an int32 into a double of urrt_state */
+    OP_U32_F64, /* a uint32 into a double of urrt_state */
+    OP_U64_F64, /* a uint64 into a double of urrt_state */
+    OP_U64,     /* 64 bits into a uint64_t of urrt_rtde_values */
+    OP_U8,      /* a byte into urrt_rtde_values */
+    OP_BOOL     /* a byte into urrt_rtde_values as 0 or 1 */
+};
+
 static int32_t to_int32(uint32_t u)
 {
     return u >= UINT32_C(0x80000000) ? -(int32_t)(~u) - 1 : (int32_t)u;
 }
 
-/* count doubles from the wire at p into d: four at a time, so that the
- * loads, swaps and stores of a run overlap. */
-static inline void state_doubles(double *d, const uint8_t *p, unsigned count)
+/* n doubles from the wire at p into d: eight at a time, then the last
+ * ones (a variable's 1, 3 or 6 where it is not a run) by four, two and one,
+ * without a loop or a jump table. */
+static inline void swap_doubles(double *d, const uint8_t *p, size_t n)
 {
-    unsigned k;
-    for (k = 0; k + 4 <= count; k += 4) {
-        d[k] = load_double(p + 8u * k);
-        d[k + 1] = load_double(p + 8u * k + 8u);
-        d[k + 2] = load_double(p + 8u * k + 16u);
-        d[k + 3] = load_double(p + 8u * k + 24u);
+    if (n == 1) { /* a DOUBLE: the usual case by itself */
+        d[0] = load_double(p);
+        return;
     }
-    for (; k < count; k++) {
-        d[k] = load_double(p + 8u * k);
+    for (; n >= 8; n -= 8, d += 8, p += 64) {
+        d[0] = load_double(p);
+        d[1] = load_double(p + 8);
+        d[2] = load_double(p + 16);
+        d[3] = load_double(p + 24);
+        d[4] = load_double(p + 32);
+        d[5] = load_double(p + 40);
+        d[6] = load_double(p + 48);
+        d[7] = load_double(p + 56);
+    }
+    if ((n & 4u) != 0) {
+        d[0] = load_double(p);
+        d[1] = load_double(p + 8);
+        d[2] = load_double(p + 16);
+        d[3] = load_double(p + 24);
+        d += 4;
+        p += 32;
+    }
+    if ((n & 2u) != 0) {
+        d[0] = load_double(p);
+        d[1] = load_double(p + 8);
+        d += 2;
+        p += 16;
+    }
+    if ((n & 1u) != 0) {
+        d[0] = load_double(p);
     }
 }
 
-/* One entry into urrt_state: every element as a double. */
-static void decode_to_state(const urrt_rtde_entry *e, const uint8_t *p, urrt_state *st)
+/* The same for 32-bit values (an int32_t written through its unsigned type,
+ * C99 6.5p7). */
+static inline void swap_words(uint32_t *d, const uint8_t *p, size_t n)
 {
-    double *d = (double *)(void *)((unsigned char *)st + e->dest_offset);
-    unsigned k, count = e->count;
-    switch (e->type) {
-    case URRT_RTDE_T_DOUBLE:
-    case URRT_RTDE_T_VECTOR3D:
-    case URRT_RTDE_T_VECTOR6D: state_doubles(d, p, count); break;
-    case URRT_RTDE_T_INT32:
-    case URRT_RTDE_T_VECTOR6INT32:
-        for (k = 0; k < count; k++) {
-            d[k] = (double)to_int32(load_be32(p + 4u * k));
-        }
-        break;
-    case URRT_RTDE_T_UINT32:
-    case URRT_RTDE_T_VECTOR6UINT32:
-        for (k = 0; k < count; k++) {
-            d[k] = (double)load_be32(p + 4u * k);
-        }
-        break;
-    case URRT_RTDE_T_UINT64: d[0] = (double)load_be64(p); break;
-    default: d[0] = (double)p[0]; break; /* BOOL, UINT8: no mapped variable has them */
+    if (n == 1) { /* an INT32 or UINT32: the usual case by itself */
+        d[0] = load_be32(p);
+        return;
+    }
+    for (; n >= 4; n -= 4, d += 4, p += 16) {
+        d[0] = load_be32(p);
+        d[1] = load_be32(p + 4);
+        d[2] = load_be32(p + 8);
+        d[3] = load_be32(p + 12);
+    }
+    if ((n & 2u) != 0) {
+        d[0] = load_be32(p);
+        d[1] = load_be32(p + 4);
+        d += 2;
+        p += 8;
+    }
+    if ((n & 1u) != 0) {
+        d[0] = load_be32(p);
     }
 }
 
-/* One entry into urrt_rtde_values, in its own C type. */
-static void decode_to_values(const urrt_rtde_entry *e, const uint8_t *p, urrt_rtde_values *v)
+/* One entry's values of the ops other than OP_F64 and OP_X32, once (p: its
+ * first byte on the wire, d: its destination, n its elements). */
+static void decode_other(unsigned op, const uint8_t *p, unsigned char *d, size_t n)
 {
-    unsigned char *d = (unsigned char *)v + e->dest_offset;
-    unsigned k, count = e->count;
-    switch (e->type) {
-    case URRT_RTDE_T_BOOL: *d = (unsigned char)(p[0] != 0); break;
-    case URRT_RTDE_T_UINT8: *d = p[0]; break;
-    case URRT_RTDE_T_UINT64: *(uint64_t *)(void *)d = load_be64(p); break;
-    case URRT_RTDE_T_INT32:
-    case URRT_RTDE_T_VECTOR6INT32:
-        for (k = 0; k < count; k++) {
-            ((int32_t *)(void *)d)[k] = to_int32(load_be32(p + 4u * k));
+    size_t k;
+    switch (op) {
+    case OP_I32_F64:
+        for (k = 0; k < n; k++) {
+            ((double *)(void *)d)[k] = (double)to_int32(load_be32(p + 4u * k));
         }
         break;
-    case URRT_RTDE_T_UINT32:
-    case URRT_RTDE_T_VECTOR6UINT32:
-        for (k = 0; k < count; k++) {
-            ((uint32_t *)(void *)d)[k] = load_be32(p + 4u * k);
+    case OP_U32_F64:
+        for (k = 0; k < n; k++) {
+            ((double *)(void *)d)[k] = (double)load_be32(p + 4u * k);
         }
         break;
-    default: /* DOUBLE, VECTOR3D, VECTOR6D */
-        for (k = 0; k < count; k++) {
-            ((double *)(void *)d)[k] = load_double(p + 8u * k);
+    case OP_U64_F64:
+        for (k = 0; k < n; k++) {
+            ((double *)(void *)d)[k] = (double)load_be64(p + 8u * k);
+        }
+        break;
+    case OP_U64:
+        for (k = 0; k < n; k++) {
+            ((uint64_t *)(void *)d)[k] = load_be64(p + 8u * k);
+        }
+        break;
+    case OP_U8:
+        for (k = 0; k < n; k++) {
+            d[k] = p[k];
+        }
+        break;
+    default: /* OP_BOOL */
+        for (k = 0; k < n; k++) {
+            d[k] = (unsigned char)(p[k] != 0);
         }
         break;
     }
-    v->present[e->present_bit / 8u] = (uint8_t)(v->present[e->present_bit / 8u] | 1u << (e->present_bit % 8u));
 }
 
-/* Everything of *st but the recipe's fields, which the walk writes: NaN in
- * the spans of fields the recipe does not have, on every decode (the caller
- * may have written anything there since: nothing stale survives). Four
- * stores at a time, which GCC and clang join into the widest vector stores
- * the build has (at -O2 they leave a loop of unknown count scalar). */
-static void state_begin(const urrt_rtde *s, urrt_state *st, size_t size)
+/* The present bits of the recipe's RTDE-only variables into *vals, whole,
+ * sixteen bytes at a time (URRT_RTDE_PRESENT_WORDS is whole groups of four
+ * words): as structs of four words where GCC copies those inline (LDM/STM
+ * on ARM, vector moves on x86-64 and AArch64; an uint32_t is accessed
+ * through an aggregate that holds it, C99 6.5p7), else word by word. */
+typedef struct rtde_quad {
+    uint32_t w[4];
+} rtde_quad;
+
+RTDE_STATIC_ASSERT(present_three_quads, URRT_RTDE_PRESENT_WORDS == 12); /* else one more line below */
+
+static void copy_present(uint32_t *d, const uint32_t *p)
 {
-    rtde_bits nan;
-    unsigned i, k;
-    nan.u = RTDE_NAN_BITS;
-    for (i = 0; i < s->absent_count; i++) {
-        double *d = (double *)(void *)((unsigned char *)st + s->absent[i].offset);
-        unsigned n = s->absent[i].count;
-        for (k = 0; k + 4 <= n; k += 4) {
-            d[k] = nan.d;
-            d[k + 1] = nan.d;
-            d[k + 2] = nan.d;
-            d[k + 3] = nan.d;
-        }
-        for (; k < n; k++) {
-            d[k] = nan.d;
-        }
+#if defined(__GNUC__) && (defined(__arm__) || defined(__x86_64__) || defined(__aarch64__))
+    rtde_quad *dq = (rtde_quad *)(void *)d;
+    const rtde_quad *pq = (const rtde_quad *)(const void *)p;
+    dq[0] = pq[0];
+    dq[1] = pq[1];
+    dq[2] = pq[2];
+#else
+    size_t i;
+    for (i = 0; i < URRT_RTDE_PRESENT_WORDS; i += 4) {
+        d[i] = p[i];
+        d[i + 1] = p[i + 1];
+        d[i + 2] = p[i + 2];
+        d[i + 3] = p[i + 3];
     }
-    st->present = s->state_present;
-    st->length = (uint32_t)size;
-    st->doubles = 0;
-    st->extra_columns = 0;
-    st->generation = URRT_GEN_3X;
+#endif
+}
+
+/* The decode proper, of a package whose size (the recipe's), type and
+ * recipe id are checked: the present bits whole, every time (nothing of
+ * another recipe reads as present), then each value of the recipe, once;
+ * nothing else. */
+static void decode_package(const urrt_rtde *s, const uint8_t *pkg, urrt_state *st, urrt_rtde_values *vals)
+{
+    const urrt_rtde_entry *e = s->recipe;
+    size_t k;
+    if (st != 0) {
+        st->present = s->state_present;
+        st->length = s->data_size;
+        st->doubles = 0;
+        st->extra_columns = 0;
+        st->generation = URRT_GEN_3X;
+    }
+    if (vals != 0) {
+        copy_present(vals->present, s->values_present);
+    }
+    /* the entries into urrt_state, then those into urrt_rtde_values; the
+     * two usual ops by a test each */
+#define RTDE_ENTRY(base)                                                                    \
+    do {                                                                                    \
+        const uint8_t *p = pkg + e->wire_offset;                                            \
+        unsigned char *d = (unsigned char *)(base) + e->dest_offset;                        \
+        if (e->op == OP_F64) {                                                              \
+            swap_doubles((double *)(void *)d, p, e->count);                                 \
+        } else if (e->op == OP_X32) {                                                       \
+            swap_words((uint32_t *)(void *)d, p, e->count);                                 \
+        } else {                                                                            \
+            decode_other(e->op, p, d, e->count);                                            \
+        }                                                                                   \
+    } while (0)
+    for (k = s->state_entries; k > 0; k--, e++) {
+        RTDE_ENTRY(st);
+    }
+    for (k = (size_t)(s->entry_count - s->state_entries); k > 0; k--, e++) {
+        RTDE_ENTRY(vals);
+    }
+#undef RTDE_ENTRY
+}
+
+/* Whether a data package of the recipe's size and type has its recipe id
+ * (protocol 2; protocol 1 has none). */
+static bool recipe_id_ok(const urrt_rtde *s, const uint8_t *pkg)
+{
+    return s->protocol_accepted != 2 || pkg[3] == s->recipe_id;
 }
 
 int urrt_rtde_decode(const urrt_rtde *s, const uint8_t *pkg, size_t size, urrt_state *st,
                      urrt_rtde_values *vals)
 {
-    const urrt_rtde_entry *e, *end;
-    if (s == 0 || pkg == 0 || (s->state_present != 0 && st == 0) || (s->has_values && vals == 0)) {
+    if (s == 0 || pkg == 0 || (s->has_state && st == 0) || (s->has_values && vals == 0)) {
         return URRT_E_ARG;
     }
     if (s->data_size == 0) {
@@ -982,27 +1128,10 @@ int urrt_rtde_decode(const urrt_rtde *s, const uint8_t *pkg, size_t size, urrt_s
     if (size != s->data_size || load_be16(pkg) != size || pkg[2] != URRT_RTDE_TYPE_DATA) {
         return URRT_RTDE_E_DATA_SIZE;
     }
-    if (s->protocol_accepted == 2 && pkg[3] != s->recipe_id) {
+    if (!recipe_id_ok(s, pkg)) {
         return URRT_RTDE_E_RECIPE_ID;
     }
-    if (st != 0) {
-        state_begin(s, st, size);
-    }
-    if (vals != 0) {
-        urrt_rtde_values_clear(vals);
-    }
-    /* The doubles first (compile_recipe puts them there): no switch per entry. */
-    for (e = s->recipe, end = s->recipe + s->entry_count; e < end && e->type == URRT_RTDE_T_DOUBLE && e->to_state;
-         e++) {
-        state_doubles((double *)(void *)((unsigned char *)st + e->dest_offset), pkg + e->wire_offset, e->count);
-    }
-    for (; e < end; e++) {
-        if (e->to_state) {
-            decode_to_state(e, pkg + e->wire_offset, st);
-        } else {
-            decode_to_values(e, pkg + e->wire_offset, vals);
-        }
-    }
+    decode_package(s, pkg, st, vals);
     return (int)size;
 }
 
@@ -1093,66 +1222,74 @@ static int type_of_word(const uint8_t *w, size_t n)
     return -1;
 }
 
-/* The types the decode converts alike, element by element: doubles, int32s
- * or uint32s (1, 2, 3; 0 for the others, which never join a run). */
-static unsigned run_kind(unsigned type)
+/* How a variable of a wire type is converted: into urrt_state every element
+ * becomes a double, into urrt_rtde_values it keeps its C type. */
+static unsigned op_of(unsigned type, bool to_state)
 {
     switch (type) {
     case URRT_RTDE_T_DOUBLE:
     case URRT_RTDE_T_VECTOR3D:
-    case URRT_RTDE_T_VECTOR6D: return 1;
+    case URRT_RTDE_T_VECTOR6D: return OP_F64;
+    case URRT_RTDE_T_UINT64: return to_state ? OP_U64_F64 : OP_U64;
     case URRT_RTDE_T_INT32:
-    case URRT_RTDE_T_VECTOR6INT32: return 2;
+    case URRT_RTDE_T_VECTOR6INT32: return to_state ? OP_I32_F64 : OP_X32;
     case URRT_RTDE_T_UINT32:
-    case URRT_RTDE_T_VECTOR6UINT32: return 3;
-    default: return 0;
+    case URRT_RTDE_T_VECTOR6UINT32: return to_state ? OP_U32_F64 : OP_X32;
+    case URRT_RTDE_T_BOOL: return OP_BOOL;
+    default: return OP_U8; /* no mapped variable is a BOOL or a UINT8 */
     }
 }
 
-/* Whether entry e continues the run of the entry before it, on the wire and
- * in urrt_state, elements of one kind (robot_mode then joint_mode): then the
- * walk converts both in one loop. */
-static bool continues_run(const urrt_rtde_entry *prev, const urrt_rtde_entry *e)
+/* Bytes of one element of an op's entries on the wire and in the struct. */
+static unsigned op_wire_size(unsigned op)
 {
-    unsigned kind = run_kind(prev->type), element_size;
-    if (!prev->to_state || !e->to_state || kind == 0 || kind != run_kind(e->type)) {
-        return false;
+    switch (op) {
+    case OP_X32:
+    case OP_I32_F64:
+    case OP_U32_F64: return 4u;
+    case OP_U8:
+    case OP_BOOL: return 1u;
+    default: return 8u;
     }
-    element_size = type_table[prev->type].size / type_table[prev->type].count; /* on the wire */
-    return prev->wire_offset + element_size * prev->count == e->wire_offset &&
-           prev->dest_offset + 8u * prev->count == e->dest_offset;
 }
 
-/* One pass of compile_recipe over the recipe: the entries of the urrt_state
- * doubles (doubles set) or of every other variable, appended from entry n,
- * adjacent ones joined into runs; returns the entries then in use. */
-static unsigned compile_pass(urrt_rtde *s, unsigned n, bool doubles)
+static unsigned op_dest_size(unsigned op)
+{
+    return op == OP_X32 ? 4u : op == OP_U8 || op == OP_BOOL ? 1u : 8u;
+}
+
+/* One pass of compile_recipe over the recipe: the entries of the variables
+ * into urrt_state (to_state set) or into urrt_rtde_values, appended from
+ * entry n in wire order, each joined to the one before it where both follow
+ * each other on the wire and in the struct and convert alike (a run, which
+ * the decode converts in one go); returns the entries then in use. */
+static unsigned compile_pass(urrt_rtde *s, unsigned n, bool to_state)
 {
     unsigned offset = URRT_RTDE_HEADER_SIZE + (s->protocol_accepted == 2 ? 1u : 0u), first = n;
     size_t i;
     for (i = 0; i < s->var_count; i++) {
-        urrt_rtde_entry *e = &s->recipe[n];
+        urrt_rtde_entry *e = &s->recipe[n], *prev = n > first ? &s->recipe[n - 1] : 0;
         int var = s->vars[i];
         const only_row *r = only_row_of(var);
-        unsigned type = (unsigned)urrt_rtde_var_type(var);
-        unsigned at = offset;
+        unsigned type = (unsigned)urrt_rtde_var_type(var), op = op_of(type, r == 0), at = offset;
         offset += type_table[type].size;
-        if ((r == 0 && run_kind(type) == 1) != doubles) {
+        if ((r == 0) != to_state) {
             continue;
         }
         e->wire_offset = (uint16_t)at;
-        e->type = (uint8_t)(doubles ? URRT_RTDE_T_DOUBLE : type);
         e->count = type_table[type].count;
-        e->to_state = (uint8_t)(r == 0);
+        e->op = (uint8_t)op;
+        e->to_state = (uint8_t)to_state;
         if (r == 0) {
             e->dest_offset = mapped_table[var].offset;
-            e->present_bit = 0;
         } else {
+            unsigned bit = (unsigned)(var - URRT_RTDE_MAPPED_COUNT);
             e->dest_offset = (uint16_t)value_offset(r, var);
-            e->present_bit = (uint16_t)(var - URRT_RTDE_MAPPED_COUNT);
+            s->values_present[bit / 32u] |= UINT32_C(1) << (bit % 32u);
         }
-        if (n > first && continues_run(&s->recipe[n - 1], e)) {
-            s->recipe[n - 1].count = (uint16_t)(s->recipe[n - 1].count + e->count); /* its type converts alike */
+        if (prev != 0 && prev->op == e->op && prev->wire_offset + op_wire_size(op) * prev->count == e->wire_offset &&
+            prev->dest_offset + op_dest_size(op) * prev->count == e->dest_offset) {
+            prev->count = (uint16_t)(prev->count + e->count);
         } else {
             n++;
         }
@@ -1161,12 +1298,30 @@ static unsigned compile_pass(urrt_rtde *s, unsigned n, bool doubles)
     return n;
 }
 
-/* Compiles the accepted recipe into the entry table: the urrt_state doubles
- * first (type DOUBLE), which the decode copies in a loop without a switch,
- * then the rest; each part in wire order. */
+/* Compiles the accepted recipe into the entry table: the entries into
+ * urrt_state first, then those into urrt_rtde_values (the decode walks each
+ * part with its struct's address, no choice per entry); and the present
+ * bits of its RTDE-only variables, which every decode writes whole. */
 static void compile_recipe(urrt_rtde *s)
 {
-    s->entry_count = (uint16_t)compile_pass(s, compile_pass(s, 0, true), false);
+    size_t i;
+    uint8_t head[4];
+    for (i = 0; i < URRT_RTDE_PRESENT_WORDS; i++) {
+        s->values_present[i] = 0;
+    }
+    s->state_entries = (uint16_t)compile_pass(s, 0, true);
+    s->entry_count = (uint16_t)compile_pass(s, s->state_entries, false);
+    /* A data package begins size, 'U', recipe id (protocol 2): the feed
+     * compares those four bytes (three in protocol 1) at once. */
+    store_be16(head, s->data_size);
+    head[2] = URRT_RTDE_TYPE_DATA;
+    head[3] = s->recipe_id;
+    s->head = load_head(head);
+    store_be16(head, 0xFFFFu);
+    head[2] = 0xFFu;
+    head[3] = s->protocol_accepted == 2 ? 0xFFu : 0u;
+    s->head_mask = load_head(head);
+    s->head &= s->head_mask;
 }
 
 /* Checks each word of a setup reply against its name: a word that is no
@@ -1210,7 +1365,10 @@ static int check_types(urrt_rtde *s, urrt_rtde_event *ev, size_t at)
     return URRT_OK;
 }
 
-static int on_setup(urrt_rtde *s, urrt_rtde_event *ev)
+/* The recipe is fixed for the session: what it lacks is set absent here,
+ * once, in the structs the caller decodes into (a decode writes only the
+ * recipe's members). */
+static int on_setup(urrt_rtde *s, urrt_rtde_event *ev, urrt_state *st, urrt_rtde_values *vals)
 {
     size_t at = URRT_RTDE_HEADER_SIZE + (s->protocol_accepted == 2 ? 1u : 0u);
     int r;
@@ -1223,6 +1381,10 @@ static int on_setup(urrt_rtde *s, urrt_rtde_event *ev)
     }
     s->recipe_id = s->protocol_accepted == 2 ? s->buf[URRT_RTDE_HEADER_SIZE] : 0;
     compile_recipe(s);
+    if (st != 0) {
+        state_clear(st);
+    }
+    urrt_rtde_values_clear(vals);
     s->phase = PH_START;
     s->pending = REQ_START;
     ev->kind = URRT_RTDE_EV_RECIPE;
@@ -1298,20 +1460,28 @@ static int on_text(urrt_rtde *s, urrt_rtde_event *ev)
     return (int)ev->kind;
 }
 
-static int on_data(urrt_rtde *s, urrt_rtde_event *ev, urrt_state *st, urrt_rtde_values *vals)
+/* A data package's event (at pkg: in s->buf, or in the caller's read), its
+ * size, type and recipe id checked. */
+static int data_event(urrt_rtde *s, const uint8_t *pkg, urrt_rtde_event *ev, urrt_state *st, urrt_rtde_values *vals)
 {
-    int r = urrt_rtde_decode(s, s->buf, s->need, st, vals);
-    if (r < 0) {
-        return end_session(s, ev, r);
-    }
+    decode_package(s, pkg, st, vals);
     if (s->phase == PH_START) {
         s->phase = PH_STREAMING; /* data before the S reply: start succeeded */
     }
     s->stats.data++;
     ev->kind = URRT_RTDE_EV_DATA;
-    ev->first = s->up == 0;
+    ev->first = !s->up;
     s->up = 1;
     return (int)ev->kind;
+}
+
+/* A data package check_header has let through (its size and type). */
+static int on_data(urrt_rtde *s, const uint8_t *pkg, urrt_rtde_event *ev, urrt_state *st, urrt_rtde_values *vals)
+{
+    if (!recipe_id_ok(s, pkg)) {
+        return end_session(s, ev, URRT_RTDE_E_RECIPE_ID);
+    }
+    return data_event(s, pkg, ev, st, vals);
 }
 
 /* Whether a reply of this type answers the request of the phase. (Not
@@ -1329,15 +1499,24 @@ static int awaited(const urrt_rtde *s, uint8_t type)
     }
 }
 
-static int on_package(urrt_rtde *s, urrt_rtde_event *ev, urrt_state *st, urrt_rtde_values *vals)
+/* A whole package of size bytes at pkg (in s->buf, or in the caller's
+ * read). A data package is decoded where it lies; any other is read from
+ * s->buf, its size in s->need (where the replies and urrt_rtde_in_feed look),
+ * copied there first if it lies in the read. */
+static int on_package(urrt_rtde *s, const uint8_t *pkg, size_t size, urrt_rtde_event *ev, urrt_state *st,
+                      urrt_rtde_values *vals)
 {
-    uint8_t type = s->buf[2];
+    uint8_t type = pkg[2];
     s->stats.packages++;
+    if (type == URRT_RTDE_TYPE_DATA) {
+        return on_data(s, pkg, ev, st, vals);
+    }
+    if (pkg != s->buf) {
+        copy_bytes(s->buf, pkg, size);
+    }
+    s->need = (uint16_t)size;
     if (type == URRT_RTDE_TYPE_TEXT_MESSAGE) {
         return on_text(s, ev);
-    }
-    if (type == URRT_RTDE_TYPE_DATA) {
-        return on_data(s, ev, st, vals);
     }
     if (!awaited(s, type)) {
         s->stats.ignored++;
@@ -1346,24 +1525,24 @@ static int on_package(urrt_rtde *s, urrt_rtde_event *ev, urrt_state *st, urrt_rt
     switch (type) {
     case URRT_RTDE_TYPE_PROTOCOL_VERSION: return on_protocol(s, ev);
     case URRT_RTDE_TYPE_CONTROLLER_VERSION: return on_controller(s, ev);
-    case URRT_RTDE_TYPE_SETUP_OUTPUTS: return on_setup(s, ev);
+    case URRT_RTDE_TYPE_SETUP_OUTPUTS: return on_setup(s, ev, st, vals);
     case URRT_RTDE_TYPE_START: return on_start(s, ev);
     default: return on_pause(s, ev);
     }
 }
 
-/* A complete header: the size bounds, and a data package's size against the
- * recipe, before any of its body is taken. */
-static int check_header(const urrt_rtde *s)
+/* A complete header at p: the size bounds, and a data package's size
+ * against the recipe, before any of its body is taken. */
+static int check_header(const urrt_rtde *s, const uint8_t *p)
 {
-    unsigned size = load_be16(s->buf);
+    unsigned size = load_be16(p);
     if (size < URRT_RTDE_HEADER_SIZE) {
         return URRT_RTDE_E_SIZE_SMALL;
     }
     if (size > URRT_RTDE_PACKAGE_MAX) {
         return URRT_RTDE_E_SIZE_LARGE;
     }
-    if (s->buf[2] == URRT_RTDE_TYPE_DATA) {
+    if (p[2] == URRT_RTDE_TYPE_DATA) {
         if (s->data_size == 0) {
             return URRT_RTDE_E_DATA_EARLY;
         }
@@ -1399,43 +1578,87 @@ int urrt_rtde_feed(urrt_rtde *s, const uint8_t *data, size_t len, size_t *used, 
         *used = 0;
     }
     if (s == 0 || used == 0 || ev == 0 || (data == 0 && len > 0) || (s->has_values && vals == 0) ||
-        (s->state_present != 0 && st == 0)) {
+        (s->has_state && st == 0)) {
         return URRT_E_ARG;
     }
     clear_event(ev);
     if (s->phase == PH_IDLE || s->phase == PH_ENDED) {
         return URRT_RTDE_E_ENDED;
     }
+    if (s->have == 0 && len >= s->data_size && len >= 4 && (load_head(data) & s->head_mask) == s->head) {
+        /* The usual read first: one that starts with a whole data package
+         * of the recipe (its size, type and recipe id are its first four
+         * bytes, compared at once), decoded where it lies: what the loop
+         * below does, without it. */
+        int k;
+        s->stats.packages++;
+        k = data_event(s, data, ev, st, vals);
+        *used = s->data_size;
+        s->stats.bytes += s->data_size;
+        return k;
+    }
     while (i < len) {
-        if (s->need == 0) {
-            s->buf[s->have++] = data[i++];
-            if (s->have == URRT_RTDE_HEADER_SIZE) {
-                int r = check_header(s);
-                if (r < 0) {
+        const uint8_t *pkg;
+        size_t size, left = len - i, take;
+        int k;
+        if (s->have == 0 && left >= URRT_RTDE_HEADER_SIZE) {
+            /* A header in the read: a package it holds whole is taken
+             * where it lies; the start of a longer one is kept. */
+            pkg = data + i;
+            k = check_header(s, pkg);
+            if (k < 0) {
+                i += URRT_RTDE_HEADER_SIZE;
+                *used = i;
+                s->stats.bytes += i;
+                return end_session(s, ev, k);
+            }
+            size = load_be16(pkg);
+            if (left < size) {
+                copy_bytes(s->buf, pkg, left);
+                s->have = (uint16_t)left;
+                s->need = (uint16_t)size;
+                break;
+            }
+            i += size;
+        } else {
+            /* A package split across reads, gathered in s->buf: the rest of
+             * its header, then of its body. */
+            if (s->need == 0) {
+                take = (size_t)(URRT_RTDE_HEADER_SIZE - s->have);
+                take = take < left ? take : left;
+                copy_bytes(s->buf + s->have, data + i, take);
+                s->have = (uint16_t)(s->have + take);
+                i += take;
+                left -= take;
+                if (s->have < URRT_RTDE_HEADER_SIZE) {
+                    break;
+                }
+                k = check_header(s, s->buf);
+                if (k < 0) {
                     *used = i;
                     s->stats.bytes += i;
-                    return end_session(s, ev, r);
+                    return end_session(s, ev, k);
                 }
                 s->need = load_be16(s->buf);
             }
-        } else {
-            size_t n = len - i < (size_t)(s->need - s->have) ? len - i : (size_t)(s->need - s->have);
-            size_t k;
-            for (k = 0; k < n; k++) {
-                s->buf[s->have + k] = data[i + k];
+            take = (size_t)(s->need - s->have);
+            take = take < left ? take : left;
+            copy_bytes(s->buf + s->have, data + i, take);
+            s->have = (uint16_t)(s->have + take);
+            i += take;
+            if (s->have < s->need) {
+                break;
             }
-            s->have = (uint16_t)(s->have + n);
-            i += n;
+            pkg = s->buf;
+            size = s->need;
         }
-        if (s->need != 0 && s->have == s->need) {
-            int k = on_package(s, ev, st, vals);
-            s->have = 0;
-            s->need = 0;
-            if (k != URRT_RTDE_EV_NONE) {
-                *used = i;
-                s->stats.bytes += i;
-                return k;
-            }
+        k = on_package(s, pkg, size, ev, st, vals);
+        s->have = 0;
+        s->need = 0;
+        if (k != URRT_RTDE_EV_NONE) {
+            *used = i;
+            s->stats.bytes += i;
+            return k;
         }
     }
     *used = len;

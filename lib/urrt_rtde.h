@@ -32,9 +32,31 @@
  * It never writes setup-inputs or data packages: no function here can. Data
  * packages are decoded through the accepted recipe, compiled once into a
  * table (wire offset, wire type, destination), into the urrt_state members
- * the RealTime decode fills (actual_q into q_actual, ...; absent members hold
- * NaN and present says which are there) and, for the values RealTime does not
- * have (registers, status bits, ...), into a urrt_rtde_values.
+ * the RealTime decode fills (actual_q into q_actual, ...; present says which
+ * are there) and, for the values RealTime does not have (registers, status
+ * bits, ...), into a urrt_rtde_values.
+ *
+ * What a decode writes:
+ *   - every value of the recipe, once, and the present bits, whole: st->present
+ *     is exactly the recipe's fields and vals' present bits exactly its
+ *     RTDE-only variables (urrt_rtde_has), whatever the struct held before,
+ *     so no value of another recipe or session is ever read as present;
+ *     st->length, doubles, extra_columns and generation as urrt_decode's;
+ *   - nothing else: a member the recipe lacks keeps what it held.
+ * What a recipe lacks cannot change within a session, so it is set absent
+ * once: the feed that accepts the recipe (URRT_RTDE_EV_RECIPE) clears the
+ * urrt_state and the urrt_rtde_values passed to it (urrt_state_clear's NaN,
+ * urrt_rtde_values_clear's NaN and 0, present none). A caller that decodes
+ * into those structs only, and does not write the absent members itself,
+ * sees NaN (and 0) there for the whole session, as before. A caller that
+ * decodes into other structs as well (double buffers) clears each of them
+ * once (urrt_state_clear, urrt_rtde_values_clear) if it reads absent members
+ * at all; a caller that reads only what present says needs nothing.
+ *
+ * The receive path: a read that holds a whole data package is decoded where
+ * it lies, in the caller's bytes; only what a split leaves (a package's
+ * first part, and every other package: replies, text messages) is copied
+ * into s->buf, in words where the target loads them unaligned.
  */
 #ifndef URRT_RTDE_H
 #define URRT_RTDE_H
@@ -346,26 +368,32 @@ typedef enum urrt_rtde_var {
 } urrt_rtde_var;
 
 #define URRT_RTDE_ONLY_COUNT (URRT_RTDE_VAR_COUNT - URRT_RTDE_MAPPED_COUNT)
+/* Words of urrt_rtde_values' present bits: one bit per RTDE-only variable,
+ * in whole groups of four words (the decode writes them four at a time). */
+#define URRT_RTDE_PRESENT_WORDS (4 * ((URRT_RTDE_ONLY_COUNT + 127) / 128))
 /* The longest variable name, for buffers of urrt_rtde_var_name(). */
 #define URRT_RTDE_NAME_MAX 40
 
 /*
  * The RTDE-only values of a data package. Members hold a value only where
- * urrt_rtde_has() says so; absent doubles hold NaN and absent integers 0.
+ * urrt_rtde_has() says so, and every decode writes the present bits whole.
+ * Absent doubles hold NaN and absent integers 0 from the last clear on
+ * (urrt_rtde_values_clear, or the feed of URRT_RTDE_EV_RECIPE): a decode
+ * writes only its recipe's members (see the top of this file).
  */
 typedef struct urrt_rtde_values {
 #define URRT_RTDE_X_MEMBER(ID, member, name, TYPE, first, names, split, since, since_hi) \
     URRT_RTDE_CTYPE_##TYPE member[(names) * URRT_RTDE_COUNT_##TYPE];
     URRT_RTDE_ONLY(URRT_RTDE_X_MEMBER)
 #undef URRT_RTDE_X_MEMBER
-    uint8_t present[(URRT_RTDE_ONLY_COUNT + 7) / 8]; /* bit (var - URRT_RTDE_MAPPED_COUNT) */
+    uint32_t present[URRT_RTDE_PRESENT_WORDS]; /* bit (var - URRT_RTDE_MAPPED_COUNT) % 32 of word / 32 */
 } urrt_rtde_values;
 
 /* 1 if variable var (an RTDE-only one) is in *v. */
 #define urrt_rtde_has(v, var)                                                                  \
     ((unsigned)(var) >= (unsigned)URRT_RTDE_MAPPED_COUNT && (unsigned)(var) < (unsigned)URRT_RTDE_VAR_COUNT && \
-     (((v)->present[((unsigned)(var) - (unsigned)URRT_RTDE_MAPPED_COUNT) / 8u] >>               \
-       (((unsigned)(var) - (unsigned)URRT_RTDE_MAPPED_COUNT) % 8u)) & 1u))
+     (((v)->present[((unsigned)(var) - (unsigned)URRT_RTDE_MAPPED_COUNT) / 32u] >>              \
+       (((unsigned)(var) - (unsigned)URRT_RTDE_MAPPED_COUNT) % 32u)) & 1u))
 
 /* Set every double of *v to NaN, every integer to 0, present to none. */
 void urrt_rtde_values_clear(urrt_rtde_values *v);
@@ -462,37 +490,31 @@ typedef struct urrt_rtde_stats {
     uint64_t errors;    /* sessions ended by an error */
 } urrt_rtde_stats;
 
-/* One compiled recipe entry: where a variable sits in a data package and
- * where it goes. Variables that follow each other both on the wire and in
- * urrt_state, of types converted alike (target_q, target_qd, ...: doubles;
- * robot_mode, joint_mode, safety_mode: int32s) are one entry, a run; the
- * entries of urrt_state doubles come first. */
+/* One compiled recipe entry: where a variable sits in a data package, where
+ * it goes and how it is converted. Variables that follow each other both on
+ * the wire and in their struct, converted alike (target_q, target_qd, ...:
+ * doubles; robot_mode, joint_mode, safety_mode: int32s into doubles;
+ * robot_status_bits, safety_status_bits: 32 bits) are one entry, a run.
+ * The entries into urrt_state come first, each part in wire order. */
 typedef struct urrt_rtde_entry {
     uint16_t wire_offset; /* from the package's first byte */
     uint16_t dest_offset; /* bytes into urrt_state or urrt_rtde_values */
-    uint16_t present_bit; /* RTDE-only variable index (urrt_state's come from the recipe's mask) */
     uint16_t count;       /* elements */
-    uint8_t type;         /* urrt_rtde_type (urrt_state doubles: DOUBLE; a run: its first variable's) */
+    uint8_t op;           /* how each element is converted, internal */
     uint8_t to_state;     /* 1: urrt_state (as doubles), 0: urrt_rtde_values */
 } urrt_rtde_entry;
-
-/* Doubles of urrt_state a recipe does not fill, back to back: the decode
- * writes NaN there. */
-typedef struct urrt_rtde_span {
-    uint16_t offset; /* bytes into urrt_state */
-    uint16_t count;  /* doubles */
-} urrt_rtde_span;
 
 typedef struct urrt_rtde {
     uint8_t buf[URRT_RTDE_PACKAGE_MAX];       /* the package being received */
     urrt_rtde_entry recipe[URRT_RTDE_MAX_VARS]; /* compiled from the setup reply */
     uint16_t vars[URRT_RTDE_MAX_VARS];        /* the variables asked for, in order */
-    urrt_rtde_span absent[URRT_FIELD_COUNT];  /* the fields the recipe has not */
-    uint16_t absent_count;
+    uint32_t values_present[URRT_RTDE_PRESENT_WORDS]; /* urrt_rtde_values present bits of the recipe */
     uint8_t not_found[URRT_RTDE_MAX_VARS / 8]; /* bit i: vars[i] was NOT_FOUND */
     uint16_t var_count;
     uint16_t entry_count;  /* entries of recipe[] in use */
+    uint16_t state_entries; /* of those, the first ones, into urrt_state */
     uint16_t data_size;    /* size of a data package of the accepted recipe, 0 before */
+    uint32_t head, head_mask; /* a data package's first bytes, internal */
     uint16_t have;         /* bytes of buf filled */
     uint16_t need;         /* size of the package being received, 0 in its header */
     double frequency;      /* asked for; 0: the controller's maximum */
@@ -505,6 +527,7 @@ typedef struct urrt_rtde {
     uint8_t protocol_accepted;
     uint8_t recipe_id;
     uint8_t has_values;    /* the recipe has RTDE-only variables */
+    uint8_t has_state;     /* the recipe has variables of urrt_state */
     uint8_t up;            /* a data package was decoded in this session */
     urrt_rtde_stats stats;
 } urrt_rtde;
@@ -542,10 +565,15 @@ int urrt_rtde_output(urrt_rtde *s, uint8_t *out, size_t cap);
  * kind, > 0, *used says how many bytes) or all are consumed (returns
  * URRT_RTDE_EV_NONE). Any chunking of the same bytes gives the same events.
  * On URRT_RTDE_EV_DATA, *st (and *vals if the recipe has RTDE-only
- * variables) hold the package; either may be NULL if the recipe has no
- * variable for it. On EV_DROP or EV_CONFIG the session has ended: later
- * feeds return URRT_RTDE_E_ENDED until the next begin. URRT_E_ARG for null
- * pointers, URRT_RTDE_E_ENDED also before the first begin.
+ * variables) hold the package as urrt_rtde_decode writes it; either may be
+ * NULL if the recipe has no variable for it. On URRT_RTDE_EV_RECIPE, *st and
+ * *vals (those not NULL) are cleared: every member absent (NaN, 0), present
+ * none, so that what the recipe lacks stays absent for the session. A data
+ * package a read holds whole is decoded in place, in data; the bytes of a
+ * package split across reads are gathered in s->buf. On EV_DROP or EV_CONFIG
+ * the session has ended: later feeds return URRT_RTDE_E_ENDED until the next
+ * begin. URRT_E_ARG for null pointers, URRT_RTDE_E_ENDED also before the
+ * first begin.
  */
 int urrt_rtde_feed(urrt_rtde *s, const uint8_t *data, size_t len, size_t *used, urrt_rtde_event *ev,
                    urrt_state *st, urrt_rtde_values *vals);
@@ -585,12 +613,15 @@ int urrt_rtde_end(urrt_rtde *s, urrt_rtde_event *ev, int error);
 int urrt_rtde_not_found(const urrt_rtde *s, size_t i);
 
 /*
- * Decode one data package (size bytes, header included) through the
- * session's accepted recipe: what feed does for each. *st gets the mapped
- * variables (others NaN, present their mask, length the package size,
- * generation URRT_GEN_3X: RTDE's robot mode numbering is 3.x/5.x's); *vals
- * the RTDE-only ones. Returns the size, or URRT_RTDE_E_DATA_EARLY,
- * _DATA_SIZE, _RECIPE_ID, URRT_E_ARG.
+ * Decode one data package (size bytes, header included, anywhere in memory)
+ * through the session's accepted recipe: what feed does for each. *st gets
+ * the mapped variables (present their mask, length the package size,
+ * doubles and extra_columns 0, generation URRT_GEN_3X: RTDE's robot mode
+ * numbering is 3.x/5.x's); *vals the RTDE-only ones and its present bits,
+ * whole. Nothing else of either is written: the members the recipe lacks
+ * keep what they held (NaN and 0 after a clear; see the top of this file).
+ * Returns the size, or URRT_RTDE_E_DATA_EARLY, _DATA_SIZE, _RECIPE_ID,
+ * URRT_E_ARG.
  */
 int urrt_rtde_decode(const urrt_rtde *s, const uint8_t *pkg, size_t size, urrt_state *st,
                      urrt_rtde_values *vals);

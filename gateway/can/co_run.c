@@ -278,7 +278,9 @@ static int node_init(struct co_run *r, struct can_run *run, size_t vars, char *e
              : urrt_co_init(&r->co, &r->desc, can_run_tx(run), r->states, r->vars, 1, &bad);
     if (rc < 0) {
         snprintf(err, errlen, "the CANopen node (lib/urrt_co) refuses the configuration (%s %zu): %s",
-                 rc == URRT_CO_E_OBJECT ? "object" : "TPDO", bad == SIZE_MAX ? 0 : bad + 1, urrt_co_strerror(rc));
+                 rc == URRT_CO_E_OBJECT ? "object" : r->desc.rpdo_count > 0 ? "PDO" : "TPDO",
+                 bad == SIZE_MAX ? 0 : bad + 1,
+                 r->desc.rpdo_count > 0 ? urrt_co_rx_strerror(rc) : urrt_co_strerror(rc));
     }
     return rc;
 }

@@ -92,8 +92,9 @@ bool rtde_source_attach(rtde_source *src, urrt_link *link);
 
 /* During the packet function of a package from this source (and until the
  * next byte is fed): the decoded values. The state is urrt_rtde_decode's:
- * present holds the recipe's fields, others NaN, time the controller's
- * timestamp when the recipe has it. */
+ * present holds the recipe's fields, the others NaN (set once, when the
+ * session's recipe was accepted: nothing else writes these structs), time
+ * the controller's timestamp when the recipe has it. */
 const urrt_state *rtde_source_state(const rtde_source *src);
 const urrt_rtde_values *rtde_source_values(const rtde_source *src);
 

@@ -171,23 +171,35 @@ check "image (framer + decode + random access) links with -nostdlib" \
 roots=$(${CROSS}nm -g --defined-only $objs | awk 'NF == 3 && $2 ~ /[TDRB]/ { printf " -Wl,-u,%s", $3 }')
 check "image (every lib/ function) links with -nostdlib -lgcc" \
   ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $roots -lgcc -o "$out/image-all.elf"
-# The CANopen node as a firmware links it: every urrt_co_ function but
-# urrt_co_comm_name, which only an EDS writer calls; and with it. The object
-# names are an array of their own that --gc-sections must drop without it.
-co_roots=$(${CROSS}nm -g --defined-only "$out/urrt_co.o" |
-  awk 'NF == 3 && $2 ~ /[TDR]/ && $3 != "urrt_co_comm_name" { printf " -Wl,-u,%s", $3 }')
+# The CANopen node as a firmware links it: every function of lib/urrt_co.h
+# that urrt_co.o defines but the dictionary's readers (urrt_co_comm_*: the
+# table of every row, its names, limits, instances and reads), which only an
+# EDS writer calls; and with them. The SDO server reads rows of its own, so
+# the table and the names are arrays that --gc-sections must drop without
+# them. Functions lib/urrt_co_internal.h declares (the seam to urrt_co_rx.c)
+# are no roots: a firmware links them only where something calls them.
+sed -n 's/^[a-z].*[ *]\(urrt_co_[a-z0-9_]*\)(.*/\1/p' lib/urrt_co.h | sort -u > "$out/co-api"
+${CROSS}nm -g --defined-only "$out/urrt_co.o" | awk 'NF == 3 && $2 ~ /[TDR]/ { print $3 }' | sort -u > "$out/co-defined"
+co_roots=$(comm -12 "$out/co-api" "$out/co-defined" | awk '!/^urrt_co_comm_/ { printf " -Wl,-u,%s", $1 }')
+eds_roots=$(awk '/^urrt_co_comm_/ { printf " -Wl,-u,%s", $1 }' "$out/co-defined")
+if [ -z "$co_roots" ] || ! echo "$co_roots" | grep -q 'urrt_co_on_frame' || ! echo "$eds_roots" | grep -q 'urrt_co_comm_table'; then
+  fail "the CANopen node's roots are not what lib/urrt_co.h declares (roots:$co_roots; readers:$eds_roots)"
+fi
 check "image (the CANopen node, no EDS writer) links with -nostdlib -lgcc" \
   ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $co_roots -lgcc -o "$out/image-co.elf"
-check "image (the CANopen node and urrt_co_comm_name) links with -nostdlib -lgcc" \
-  ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $co_roots -Wl,-u,urrt_co_comm_name -lgcc -o "$out/image-co-eds.elf"
+check "image (the CANopen node and the dictionary's readers) links with -nostdlib -lgcc" \
+  ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $co_roots $eds_roots -lgcc -o "$out/image-co-eds.elf"
 # With the receiving side (RPDOs, 0x1016): every urrt_co_ function of both
-# files. urrt_co.c reaches lib/urrt_co_rx.c only through the table
+# files (urrt_co_init_rx in place of urrt_co_init, which such a firmware does
+# not call). urrt_co.c reaches lib/urrt_co_rx.c only through the table
 # urrt_co_init_rx installs, so the node without it (image-co, a TPDO-only
 # node) holds no symbol of urrt_co_rx.o: not one of its functions, nor the
-# table (symbols urrt_co.o defines too, static inline copies, aside).
+# table, nor its rows of the communication objects (symbols urrt_co.o
+# defines too, static inline copies, aside); nor its error texts.
 rx_roots=$(${CROSS}nm -g --defined-only "$out/urrt_co_rx.o" | awk 'NF == 3 && $2 ~ /[TDR]/ { printf " -Wl,-u,%s", $3 }')
+rx_co_roots=$(echo "$co_roots " | sed 's/ -Wl,-u,urrt_co_init / /')
 check "image (the CANopen node with RPDOs and 0x1016, no EDS writer) links with -nostdlib -lgcc" \
-  ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $co_roots $rx_roots -lgcc -o "$out/image-co-rx.elf"
+  ${CROSS}gcc $LDFLAGS "$out/startup.o" $objs $rx_co_roots $rx_roots -lgcc -o "$out/image-co-rx.elf"
 if [ -f "$out/image-co.elf" ] && [ -f "$out/image-co-rx.elf" ]; then
   ${CROSS}nm --defined-only "$out/urrt_co.o" | awk 'NF == 3 { print $3 }' | sort -u > "$out/co-syms"
   ${CROSS}nm --defined-only "$out/urrt_co_rx.o" | awk 'NF == 3 && $2 ~ /[TtDdRrBb]/ { print $3 }' | sort -u |
@@ -203,20 +215,34 @@ if [ -f "$out/image-co.elf" ] && [ -f "$out/image-co-rx.elf" ]; then
   check "the image with the receiving side links urrt_co_init_rx and urrt_co_rpdo_status" \
     sh -c "${CROSS}nm '$out/image-co-rx.elf' | grep -q ' urrt_co_init_rx\$' &&
       ${CROSS}nm '$out/image-co-rx.elf' | grep -q ' urrt_co_rpdo_status\$'"
+  rx_text="consumer heartbeat (0x1016) entry" # URRT_CO_E_CONSUMER's text (urrt_co_rx_strerror)
+  if grep -q "$rx_text" "$out/image-co.elf"; then
+    fail "the CANopen node without urrt_co_init_rx holds the receiving side's error texts (\"$rx_text\")"
+  else
+    ok "the CANopen node without urrt_co_init_rx holds none of the receiving side's error texts"
+  fi
+  check "the image with the receiving side holds its error texts (\"$rx_text\")" grep -q "$rx_text" "$out/image-co-rx.elf"
 fi
-if ${CROSS}nm "$out/urrt_co.o" | grep -q ' U urrt_co_\(init_rx\|rpdo_\)'; then
-  fail "lib/urrt_co.o references the receiving side: $(${CROSS}nm "$out/urrt_co.o" | grep ' U urrt_co_' | head -n 3)"
+${CROSS}nm -g --defined-only "$out/urrt_co_rx.o" | awk 'NF == 3 { print $3 }' | sort -u > "$out/co-rx-globals"
+rx_used=$(${CROSS}nm -u "$out/urrt_co.o" | awk '{ print $NF }' | sort -u | comm -12 - "$out/co-rx-globals")
+if [ -n "$rx_used" ]; then
+  fail "lib/urrt_co.o references the receiving side: $(echo $rx_used)"
 else
-  ok "lib/urrt_co.o references no function of lib/urrt_co_rx.c"
+  ok "lib/urrt_co.o references no symbol of lib/urrt_co_rx.c"
 fi
 co_name="Producer heartbeat time" # 0x1017's name
 if [ -f "$out/image-co.elf" ] && [ -f "$out/image-co-eds.elf" ]; then
   if grep -q "$co_name" "$out/image-co.elf"; then
-    fail "the CANopen node's image without urrt_co_comm_name holds the object names (\"$co_name\"): keep them out of urrt_co_comm_table"
+    fail "the CANopen node's image without the dictionary's readers holds the object names (\"$co_name\"): keep them out of the SDO server's rows"
   else
-    ok "the CANopen node's image without urrt_co_comm_name holds no object names"
+    ok "the CANopen node's image without the dictionary's readers holds no object names"
   fi
-  check "the image with urrt_co_comm_name holds the object names (\"$co_name\")" grep -q "$co_name" "$out/image-co-eds.elf"
+  if ${CROSS}nm "$out/image-co.elf" | grep -q ' urrt_co_comm_table$'; then
+    fail "the CANopen node's image without the dictionary's readers holds urrt_co_comm_table: the SDO server must read rows of its own"
+  else
+    ok "the CANopen node's image without the dictionary's readers holds no urrt_co_comm_table"
+  fi
+  check "the image with the dictionary's readers holds the object names (\"$co_name\")" grep -q "$co_name" "$out/image-co-eds.elf"
 fi
 
 # The RTDE client as a read-only firmware links it (a session: begin, the
@@ -284,7 +310,7 @@ for img in min co co-rx co-eds rtde rtde-in all; do
     min) name="image: framer + decode + random access (tests/cross)" ;;
     co) name="image: the CANopen node, no EDS writer (tests/cross)" ;;
     co-rx) name="image: the CANopen node with RPDOs and 0x1016, no EDS writer (tests/cross)" ;;
-    co-eds) name="image: the CANopen node and urrt_co_comm_name (tests/cross)" ;;
+    co-eds) name="image: the CANopen node and the dictionary's readers, urrt_co_comm_* (tests/cross)" ;;
     rtde) name="image: the RTDE client, read-only (tests/cross)" ;;
     rtde-in) name="image: the RTDE client and its writing side (tests/cross)" ;;
     all) name="image: every lib/ function (tests/cross)" ;;
@@ -308,6 +334,8 @@ printf '| sizeof(urrt_co) | %s |\n| sizeof(urrt_co_tpdo_state) | %s |\n' \
   "$(symbol_size urrt_probe_co)" "$(symbol_size urrt_probe_co_tpdo)" >> "$measured"
 printf '| sizeof(urrt_co_rpdo_state) | %s |\n| sizeof(urrt_co_consumer) | %s |\n' \
   "$(symbol_size urrt_probe_co_rpdo)" "$(symbol_size urrt_probe_co_consumer)" >> "$measured"
+# The receiving side's storage, kept beside the node (its run-time state is there).
+printf '| sizeof(urrt_co_rx_storage) | %s |\n' "$(symbol_size urrt_probe_co_rx_storage)" >> "$measured"
 rm -f "$out"/*.O2.su
 echo "cross: largest stack frames of lib/ functions (-fstack-usage, bytes; lib/ has no recursion):"
 for obj in $objs; do cat "${obj%.o}.su"; done | sort -t "$(printf '\t')" -k2 -n -r | head -n 5 | sed 's/^/cross:   /'

@@ -11,8 +11,9 @@ char urrt_probe_framer[sizeof(urrt_framer)];
 char urrt_probe_rtde[sizeof(urrt_rtde)];
 char urrt_probe_rtde_values[sizeof(urrt_rtde_values)];
 char urrt_probe_rtde_in[sizeof(urrt_rtde_in)];
-/* The CANopen node and its per-PDO and per-0x1016-entry storage (lib/urrt_co.h). */
+/* The CANopen node, its per-PDO and per-0x1016-entry storage and its receiving side's (lib/urrt_co.h). */
 char urrt_probe_co[sizeof(urrt_co)];
 char urrt_probe_co_tpdo[sizeof(urrt_co_tpdo_state)];
 char urrt_probe_co_rpdo[sizeof(urrt_co_rpdo_state)];
 char urrt_probe_co_consumer[sizeof(urrt_co_consumer)];
+char urrt_probe_co_rx_storage[sizeof(urrt_co_rx_storage)];

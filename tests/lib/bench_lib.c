@@ -381,7 +381,7 @@ static size_t bench_decode(void *ctx, size_t n)
     return n;
 }
 
-/* ---- RTDE: one data package of the STATE recipe --------------------------- */
+/* ---- RTDE: data packages of two recipes ------------------------------------ */
 
 /* The recipe that mirrors what urrt publishes from RealTime (docs/rtde.md):
  * a 904-byte data package. */
@@ -393,12 +393,20 @@ static const char *const rtde_state_names[] = {
     "actual_tool_accelerometer", "speed_scaling", "actual_momentum", "actual_main_voltage",
     "actual_robot_voltage", "actual_robot_current", "actual_joint_voltage", "actual_digital_output_bits",
     "runtime_state"};
-#define RTDE_STATE_VARS (sizeof rtde_state_names / sizeof rtde_state_names[0])
+/* A small recipe, a PLC's: the clock, the joints, the status bits and one
+ * register a robot program writes: a 72-byte data package. */
+static const char *const rtde_small_names[] = {"timestamp", "actual_q", "robot_status_bits", "safety_status_bits",
+                                               "output_int_register_24"};
 
-static urrt_rtde rtde_session;
+typedef struct rtde_bench {
+    urrt_rtde session;
+    packets pkgs;
+} rtde_bench;
+
+static urrt_rtde_values rtde_vals __attribute__((aligned(64)));
 
 /* Feeds one package (size and letter in front of body) to the session. */
-static int rtde_reply(uint8_t type, const uint8_t *body, size_t n)
+static int rtde_reply(urrt_rtde *s, uint8_t type, const uint8_t *body, size_t n)
 {
     static uint8_t pkg[URRT_RTDE_PACKAGE_MAX];
     urrt_rtde_event ev;
@@ -408,71 +416,234 @@ static int rtde_reply(uint8_t type, const uint8_t *body, size_t n)
     pkg[1] = (uint8_t)(n + 3);
     pkg[2] = type;
     memcpy(pkg + 3, body, n);
-    while (urrt_rtde_output(&rtde_session, out, sizeof out) > 0) {
+    while (urrt_rtde_output(s, out, sizeof out) > 0) {
     }
-    return urrt_rtde_feed(&rtde_session, pkg, n + 3, &used, &ev, &state, NULL);
+    return urrt_rtde_feed(s, pkg, n + 3, &used, &ev, &state, &rtde_vals);
 }
 
 /* The session through the handshake (the bench's own replies: what is
- * measured is the decode, not the replies), and its data packages. */
-static void rtde_setup(packets *p)
+ * measured is the data, not the replies), and its data packages, each 64
+ * bytes aligned (its values then start 4 bytes past that, after the header
+ * and the recipe id), of `size` bytes. */
+static void rtde_setup(rtde_bench *b, const char *const *names, size_t count, size_t size)
 {
-    uint16_t vars[RTDE_STATE_VARS];
-    char types[RTDE_STATE_VARS * 14 + 1] = {1}; /* recipe id 1, then the types */
+    uint16_t vars[URRT_RTDE_MAX_VARS];
+    char types[URRT_RTDE_MAX_VARS * 14 + 1] = {1}; /* recipe id 1, then the types */
     size_t at = 1;
     static const uint8_t yes = 1, version[16] = {0, 0, 0, 5, 0, 0, 0, 12};
-    for (size_t i = 0; i < RTDE_STATE_VARS; i++) {
+    packets *p = &b->pkgs;
+    for (size_t i = 0; i < count; i++) {
         const char *t;
-        vars[i] = (uint16_t)urrt_rtde_var_find(rtde_state_names[i], strlen(rtde_state_names[i]));
+        vars[i] = (uint16_t)urrt_rtde_var_find(names[i], strlen(names[i]));
         t = urrt_rtde_type_name(urrt_rtde_var_type(vars[i]));
         at += (size_t)sprintf(types + at, "%s%s", i > 0 ? "," : "", t);
     }
-    urrt_rtde_init(&rtde_session);
-    if (urrt_rtde_begin(&rtde_session, vars, RTDE_STATE_VARS, 0.0) != URRT_OK ||
-        rtde_reply('V', &yes, 1) != URRT_RTDE_EV_PROTOCOL || rtde_reply('v', version, 16) != URRT_RTDE_EV_CONTROLLER ||
-        rtde_reply('O', (const uint8_t *)types, at) != URRT_RTDE_EV_RECIPE ||
-        rtde_reply('S', &yes, 1) != URRT_RTDE_EV_STARTED || rtde_session.data_size != 904) {
+    urrt_rtde_init(&b->session);
+    if (urrt_rtde_begin(&b->session, vars, count, 0.0) != URRT_OK ||
+        rtde_reply(&b->session, 'V', &yes, 1) != URRT_RTDE_EV_PROTOCOL ||
+        rtde_reply(&b->session, 'v', version, 16) != URRT_RTDE_EV_CONTROLLER ||
+        rtde_reply(&b->session, 'O', (const uint8_t *)types, at) != URRT_RTDE_EV_RECIPE ||
+        rtde_reply(&b->session, 'S', &yes, 1) != URRT_RTDE_EV_STARTED || b->session.data_size != size) {
         fprintf(stderr, "bench: the RTDE handshake failed\n");
         exit(1);
     }
-    p->length = rtde_session.data_size;
+    p->length = b->session.data_size;
     for (size_t v = 0; v < VARIANTS; v++) {
-        uint8_t *b = p->storage + v * STRIDE;
+        uint8_t *bytes = p->storage + v * STRIDE;
         for (size_t i = 0; i < p->length; i++) {
-            b[i] = (uint8_t)(i * 7 + v * 13 + 1);
+            bytes[i] = (uint8_t)(i * 7 + v * 13 + 1);
         }
-        b[0] = (uint8_t)(p->length >> 8);
-        b[1] = (uint8_t)p->length;
-        b[2] = 'U';
-        b[3] = 1;
-        p->bytes[v] = b;
+        bytes[0] = (uint8_t)(p->length >> 8);
+        bytes[1] = (uint8_t)p->length;
+        bytes[2] = 'U';
+        bytes[3] = 1;
+        p->bytes[v] = bytes;
     }
 }
 
+/* urrt_rtde_decode of the package, into a urrt_state and the RTDE-only
+ * values, as a caller that takes the packages out itself. */
 static size_t bench_rtde_decode(void *ctx, size_t n)
 {
-    const packets *p = ctx;
+    const rtde_bench *b = ctx;
     uint64_t sum = 0;
     for (size_t i = 0; i < n; i++) {
-        sum += (uint64_t)urrt_rtde_decode(&rtde_session, p->bytes[i % VARIANTS], p->length, &state, NULL);
+        sum += (uint64_t)urrt_rtde_decode(&b->session, b->pkgs.bytes[i % VARIANTS], b->pkgs.length, &state,
+                                          &rtde_vals);
         USE(&state);
+        USE(&rtde_vals);
         sum += state.present;
     }
     checksum += sum;
     return n;
 }
 
-/* The copy floor: the same package's bytes after the recipe id, byte-swapped
- * eight at a time into doubles (the plain loop). */
-static size_t bench_rtde_copy(void *ctx, size_t n)
+/* What the gateway and a firmware run: urrt_rtde_feed of the bytes a read
+ * returned, here one whole package, to its event. */
+static size_t bench_rtde_feed(void *ctx, size_t n)
 {
-    const packets *p = ctx;
+    rtde_bench *b = ctx;
+    uint64_t sum = 0;
     for (size_t i = 0; i < n; i++) {
-        plain_swap(plain_target, p->bytes[i % VARIANTS] + 4, (p->length - 4) / 8);
-        USE(plain_target);
+        urrt_rtde_event ev;
+        size_t used;
+        int k = urrt_rtde_feed(&b->session, b->pkgs.bytes[i % VARIANTS], b->pkgs.length, &used, &ev, &state,
+                               &rtde_vals);
+        USE(&state);
+        USE(&rtde_vals);
+        sum += (uint64_t)k + used + state.present;
     }
-    checksum += (uint64_t)plain_target[3];
+    if (sum != n * (URRT_RTDE_EV_DATA + b->pkgs.length + state.present)) {
+        fprintf(stderr, "bench: a feed of a whole data package did not give its data event\n");
+        exit(1);
+    }
+    checksum += sum;
     return n;
+}
+
+/* The copy floors: each recipe's values, byte-swapped into a struct of
+ * their own C types, field by field, as a C programmer writes it for one
+ * recipe (the bench's flags: -O2, or -O2 -march=native). */
+static inline double be_f64(const uint8_t *p)
+{
+    uint64_t v;
+    double d;
+    memcpy(&v, p, sizeof v);
+    v = __builtin_bswap64(v);
+    memcpy(&d, &v, sizeof d);
+    return d;
+}
+
+static inline uint64_t be_u64(const uint8_t *p)
+{
+    uint64_t v;
+    memcpy(&v, p, sizeof v);
+    return __builtin_bswap64(v);
+}
+
+static inline uint32_t be_u32(const uint8_t *p)
+{
+    uint32_t v;
+    memcpy(&v, p, sizeof v);
+    return __builtin_bswap32(v);
+}
+
+#define F64(m) (c->m = be_f64(p), p += 8)
+#define F64N(m, n) bench_f64n(c->m, &p, n)
+static inline void bench_f64n(double *d, const uint8_t **p, unsigned n)
+{
+    for (unsigned k = 0; k < n; k++) {
+        d[k] = be_f64(*p + 8 * k);
+    }
+    *p += 8 * n;
+}
+
+typedef struct state_copy {
+    double timestamp, target_q[6], target_qd[6], target_qdd[6], target_current[6], target_moment[6], actual_q[6],
+        actual_qd[6], actual_current[6], joint_control_output[6], actual_tcp_pose[6], actual_tcp_speed[6],
+        actual_tcp_force[6], target_tcp_pose[6], target_tcp_speed[6];
+    uint64_t actual_digital_input_bits;
+    double joint_temperatures[6], actual_execution_time;
+    int32_t robot_mode, joint_mode[6], safety_mode;
+    double actual_tool_accelerometer[3], speed_scaling, actual_momentum, actual_main_voltage, actual_robot_voltage,
+        actual_robot_current, actual_joint_voltage[6];
+    uint64_t actual_digital_output_bits;
+    uint32_t runtime_state;
+} state_copy;
+
+static state_copy state_copy_target __attribute__((aligned(64)));
+
+static __attribute__((noinline)) void copy_state_recipe(state_copy *c, const uint8_t *pkg)
+{
+    const uint8_t *p = pkg + 4;
+    F64(timestamp);
+    F64N(target_q, 6);
+    F64N(target_qd, 6);
+    F64N(target_qdd, 6);
+    F64N(target_current, 6);
+    F64N(target_moment, 6);
+    F64N(actual_q, 6);
+    F64N(actual_qd, 6);
+    F64N(actual_current, 6);
+    F64N(joint_control_output, 6);
+    F64N(actual_tcp_pose, 6);
+    F64N(actual_tcp_speed, 6);
+    F64N(actual_tcp_force, 6);
+    F64N(target_tcp_pose, 6);
+    F64N(target_tcp_speed, 6);
+    c->actual_digital_input_bits = be_u64(p);
+    p += 8;
+    F64N(joint_temperatures, 6);
+    F64(actual_execution_time);
+    c->robot_mode = (int32_t)be_u32(p);
+    p += 4;
+    for (unsigned k = 0; k < 6; k++, p += 4) {
+        c->joint_mode[k] = (int32_t)be_u32(p);
+    }
+    c->safety_mode = (int32_t)be_u32(p);
+    p += 4;
+    F64N(actual_tool_accelerometer, 3);
+    F64(speed_scaling);
+    F64(actual_momentum);
+    F64(actual_main_voltage);
+    F64(actual_robot_voltage);
+    F64(actual_robot_current);
+    F64N(actual_joint_voltage, 6);
+    c->actual_digital_output_bits = be_u64(p);
+    p += 8;
+    c->runtime_state = be_u32(p);
+}
+
+typedef struct small_copy {
+    double timestamp, actual_q[6];
+    uint32_t robot_status_bits, safety_status_bits;
+    int32_t output_int_register_24;
+} small_copy;
+
+static small_copy small_copy_target __attribute__((aligned(64)));
+
+static __attribute__((noinline)) void copy_small_recipe(small_copy *c, const uint8_t *pkg)
+{
+    const uint8_t *p = pkg + 4;
+    F64(timestamp);
+    F64N(actual_q, 6);
+    c->robot_status_bits = be_u32(p);
+    c->safety_status_bits = be_u32(p + 4);
+    c->output_int_register_24 = (int32_t)be_u32(p + 8);
+}
+
+static size_t bench_state_copy(void *ctx, size_t n)
+{
+    const rtde_bench *b = ctx;
+    for (size_t i = 0; i < n; i++) {
+        copy_state_recipe(&state_copy_target, b->pkgs.bytes[i % VARIANTS]);
+        USE(&state_copy_target);
+    }
+    checksum += (uint64_t)state_copy_target.runtime_state;
+    return n;
+}
+
+static size_t bench_small_copy(void *ctx, size_t n)
+{
+    const rtde_bench *b = ctx;
+    for (size_t i = 0; i < n; i++) {
+        copy_small_recipe(&small_copy_target, b->pkgs.bytes[i % VARIANTS]);
+        USE(&small_copy_target);
+    }
+    checksum += (uint64_t)small_copy_target.robot_status_bits;
+    return n;
+}
+
+/* The session's decode, feed and copy floor of one recipe, and `what`
+ * (urrt_rtde_decode or urrt_rtde_feed) against the floor. */
+static void rtde_versus(const char *name, const char *what, bench_fn subject, bench_fn floor_fn, rtde_bench *b)
+{
+    double s, f, r;
+    measure(subject, b, floor_fn, b, &s, &f, &r);
+    printf("%srtde_%s_%s_ns: %.1f\n", URRT_BENCH_PREFIX, what, name, s);
+    printf("%srtde_%s_%s_copy_floor_ns: %.1f\n", URRT_BENCH_PREFIX, what, name, f);
+    printf("%srtde_%s_%s_vs_copy_floor: %.2f\n", URRT_BENCH_PREFIX, what, name, r);
+    printf("%srtde_%s_%s_vs_copy_floor_of_best: %.2f\n", URRT_BENCH_PREFIX, what, name, s / f);
 }
 
 static const urrt_field_id read_fields[10] = {
@@ -532,6 +703,26 @@ static size_t bench_framer(void *ctx, size_t n)
     }
     checksum += sum;
     return rounds * s->packets;
+}
+
+/* The RealTime receive path as the RTDE one is measured: a read that holds
+ * one whole packet fed to the framer, and the packet it yields decoded. */
+static size_t bench_framer_whole(void *ctx, size_t n)
+{
+    const packets *p = ctx;
+    uint64_t sum = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t used, len;
+        const uint8_t *pkt;
+        if (urrt_framer_feed(&framer, p->bytes[i % VARIANTS], p->length, &used) > 0) {
+            pkt = urrt_framer_packet(&framer, &len);
+            sum += (uint64_t)urrt_decode(pkt, len, &state);
+            USE(&state);
+            sum += state.present;
+        }
+    }
+    checksum += sum;
+    return n;
 }
 
 /* The baseline: the same bytes, memcpy'd a packet at a time. */
@@ -662,7 +853,22 @@ static void bench_decode_at(uint32_t length)
     }
 }
 
-int main(void)
+/* The sections to run: all, or those named on the command line (decode,
+ * rtde, framer). */
+static int wanted(int argc, char **argv, const char *section)
+{
+    if (argc < 2) {
+        return 1;
+    }
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], section) == 0) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
 {
     static packets p1116;
     static stream streams[3];
@@ -679,7 +885,12 @@ int main(void)
            "bench: bswap, store per double; *_plain_ns); *_ratio: against memcpy of the packet's bytes\n"
            "bench: (*_memcpy_ns; context: it moves with the memory layout). A ratio is the median of the\n"
            "bench: per-batch ratios, *_of_best the ratio of the best figures (steadier on a busy machine);\n"
-           "bench: a64: packet 64-byte aligned, a64p4: 4 bytes past that\n",
+           "bench: a64: packet 64-byte aligned, a64p4: 4 bytes past that; rtde_feed_* and rtde_decode_*:\n"
+           "bench: urrt_rtde_feed of a read holding one whole data package (and urrt_rtde_decode of it) of the\n"
+           "bench: STATE recipe (904 bytes) and of a 5-value recipe (72 bytes) against each recipe's copy floor\n"
+           "bench: (its values byte-swapped into a struct of their own types, field by field);\n"
+           "bench: framer_decode_1116: urrt_framer_feed of a read holding one whole packet, and urrt_decode of it,\n"
+           "bench: against the decode's copy floor\n",
            BATCHES, sizeof(urrt_state));
 #ifdef URRT_BENCH_FLAGS
     printf("bench_flags: %s\n", URRT_BENCH_FLAGS);
@@ -706,30 +917,51 @@ int main(void)
         (void)copy_floor_widest(&bytes);
         printf("bench_copy_floor_vector_bytes: %u\n", bytes);
     }
-    { /* every length a controller sends, from lib's table */
+    if (wanted(argc, argv, "decode")) { /* every length a controller sends, from lib's table */
         size_t rows;
         const urrt_controller *c = urrt_controllers(&rows);
         for (size_t i = 0; i < rows; i++) {
             bench_decode_at(c[i].length);
         }
     }
-    measure(bench_read10, &p1116, bench_memcpy, &p1116, &s, &b, &r);
-    report("read10_1116", s, b, r);
+    if (wanted(argc, argv, "decode")) {
+        measure(bench_read10, &p1116, bench_memcpy, &p1116, &s, &b, &r);
+        report("read10_1116", s, b, r);
+    }
 
-    {
-        static packets rtde;
-        rtde_setup(&rtde);
-        measure(bench_rtde_decode, &rtde, bench_rtde_copy, &rtde, &s, &b, &r);
-        printf("%srtde_decode_state_ns: %.1f\n", URRT_BENCH_PREFIX, s);
-        printf("%srtde_decode_state_copy_floor_ns: %.1f\n", URRT_BENCH_PREFIX, b);
-        printf("%srtde_decode_state_vs_copy_floor: %.2f\n", URRT_BENCH_PREFIX, r);
+    if (wanted(argc, argv, "rtde")) {
+        static rtde_bench state_recipe, small_recipe;
+        rtde_setup(&state_recipe, rtde_state_names, sizeof rtde_state_names / sizeof rtde_state_names[0], 904);
+        rtde_setup(&small_recipe, rtde_small_names, sizeof rtde_small_names / sizeof rtde_small_names[0], 72);
+        rtde_versus("state", "feed", bench_rtde_feed, bench_state_copy, &state_recipe);
+        rtde_versus("small", "feed", bench_rtde_feed, bench_small_copy, &small_recipe);
+        rtde_versus("state", "decode", bench_rtde_decode, bench_state_copy, &state_recipe);
+        rtde_versus("small", "decode", bench_rtde_decode, bench_small_copy, &small_recipe);
         /* beside it, the RealTime decode of a 1116-byte packet (4 bytes past a 64-byte boundary) */
-        measure(bench_rtde_decode, &rtde, bench_decode, &p1116, &s, &b, &r);
+        measure(bench_rtde_decode, &state_recipe, bench_decode, &p1116, &s, &b, &r);
         printf("%srtde_decode_state_realtime_decode_1116_ns: %.1f\n", URRT_BENCH_PREFIX, b);
         printf("%srtde_decode_state_vs_realtime_decode_1116: %.2f\n", URRT_BENCH_PREFIX, r);
     }
 
-    for (int i = 0; i < 3; i++) {
+    if (wanted(argc, argv, "framer")) {
+        /* the framer fed one whole 1116-byte packet per read, and its decode, against the
+         * decode's copy floor of that packet */
+        static copy_floor_bench vector, plain;
+        double f[2];
+        unsigned bytes;
+        vector.p = plain.p = &p1116;
+        vector.fn = copy_floor_widest(&bytes);
+        plain.fn = copy_floor_plain;
+        urrt_framer_init(&framer);
+        measure_min(bench_framer_whole, &p1116, bench_copy_floor, &vector, bench_copy_floor, &plain, &s, f, &r);
+        printf("%sframer_decode_1116_ns: %.1f\n", URRT_BENCH_PREFIX, s);
+        printf("%sframer_decode_1116_copy_floor_ns: %.1f\n", URRT_BENCH_PREFIX, f[0] < f[1] ? f[0] : f[1]);
+        printf("%sframer_decode_1116_vs_copy_floor: %.2f\n", URRT_BENCH_PREFIX, r);
+        printf("%sframer_decode_1116_vs_copy_floor_of_best: %.2f\n", URRT_BENCH_PREFIX, s / (f[0] < f[1] ? f[0] : f[1]));
+        decode_versus_copy_floor("decode_1116_beside_framer", &p1116); /* the decode alone, for scale */
+    }
+
+    for (int i = 0; i < 3 && wanted(argc, argv, "framer"); i++) {
         stream *st = &streams[i];
         st->packets = STREAM_PACKETS;
         st->length = STREAM_PACKETS * p1116.length;

@@ -117,7 +117,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *in, size_t size)
     static urrt_co_rpdo_state rpdo_states[2];
     static urrt_co_consumer consumer_states[2];
     static uint64_t written[CO_FIXTURE_RX_VARS];
-    static const urrt_co_rx_storage rx = {rpdo_states, consumer_states, written};
+    static urrt_co_rx_storage rx = {.rpdos = rpdo_states, .consumers = consumer_states, .written_us = written};
     bool with_rx = size % 2u == 0u;
     uint64_t now = 0;
     size_t at = 0;

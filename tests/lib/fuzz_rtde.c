@@ -10,7 +10,10 @@
  *     no event; an ended session refuses input and writes nothing more;
  *   - every byte the client writes is a whole V, v, O, S or P request;
  *   - a text event points into the text message's package;
- *   - a data event holds exactly the recipe's variables, nothing stale;
+ *   - a data event's present bits are exactly the recipe's variables,
+ *     whatever the structs held (they are poisoned before every read), and
+ *     nothing else of them is written (what the recipe lacks keeps the
+ *     poison); the recipe's event clears them;
  *   - a NOT_FOUND error names as many variables as it counts.
  * The recipe is the reference's FUZZ_VARS: every wire type an output has.
  */
@@ -51,15 +54,45 @@ static void take_output(void)
     ASSERT(n == 0);
 }
 
+#define POISON 0x3F
+
+static int poisoned(const void *p, size_t n)
+{
+    const uint8_t *b = p;
+    for (size_t i = 0; i < n; i++) {
+        if (b[i] != POISON) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 static void check_data(void)
 {
     ASSERT(st.present == mask && st.length == s.data_size && st.generation == URRT_GEN_3X);
+    for (unsigned f = 0; f < URRT_FIELD_COUNT; f++) {
+        if (((mask >> f) & 1u) == 0) {
+            ASSERT(poisoned(urrt_field_values(&st, (urrt_field_id)f), 8u * urrt_field((urrt_field_id)f)->count));
+        }
+    }
     for (unsigned v = URRT_RTDE_MAPPED_COUNT; v < URRT_RTDE_VAR_COUNT; v++) {
         int want = 0;
         for (size_t i = 0; i < NVARS; i++) {
             want |= vars[i] == v;
         }
         ASSERT((int)urrt_rtde_has(&vals, v) == want);
+        if (!want) {
+            ASSERT(poisoned(urrt_rtde_value(&vals, (int)v), urrt_rtde_type_size(urrt_rtde_var_type((int)v))));
+        }
+    }
+}
+
+/* The recipe's event: both structs cleared, nothing present. */
+static void check_cleared(void)
+{
+    ASSERT(st.present == 0 && st.generation == URRT_GEN_UNKNOWN);
+    for (unsigned v = URRT_RTDE_MAPPED_COUNT; v < URRT_RTDE_VAR_COUNT; v++) {
+        ASSERT(!urrt_rtde_has(&vals, v));
     }
 }
 
@@ -73,6 +106,7 @@ static void check_event(int k, const urrt_rtde_event *ev)
         ASSERT(ev->source >= lo && ev->source + ev->source_len <= hi);
         break;
     case URRT_RTDE_EV_DATA: check_data(); break;
+    case URRT_RTDE_EV_RECIPE: check_cleared(); break;
     case URRT_RTDE_EV_DROP:
     case URRT_RTDE_EV_CONFIG:
         ASSERT(ev->error < 0 && urrt_rtde_is_config_error(ev->error) == (k == URRT_RTDE_EV_CONFIG));
@@ -112,6 +146,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     while (pos < size && !ended) {
         size_t n = size - pos < chunk ? size - pos : chunk, used = SIZE_MAX;
         urrt_rtde_event ev;
+        memset(&st, POISON, sizeof st); /* the caller may write its structs between reads */
+        memset(&vals, POISON, sizeof vals);
         int k = urrt_rtde_feed(&s, data + pos, n, &used, &ev, &st, &vals);
         ASSERT(used <= n && (k != URRT_RTDE_EV_NONE || used == n));
         pos += used;

@@ -15,8 +15,10 @@
 #   bench-lib       ns/packet at every length of lib's controller table against the copy
 #                   floor (the packet's doubles byte-swapped by the CPU's widest vectors into
 #                   a urrt_state-sized buffer, the rest set), the store floor (memset of a
-#                   urrt_state), the plain byte-swap loop and memcpy of the packet
-#                   (docs/performance.md)
+#                   urrt_state), the plain byte-swap loop and memcpy of the packet; the receive
+#                   paths: a read holding one whole package fed to the RTDE client (the STATE
+#                   recipe and a 5-value one, each beside its own copy floor) and to the framer
+#                   and decoded (docs/performance.md); `bench_lib decode|rtde|framer` runs parts
 # Every lib-level rule takes lib/*.c by wildcard (LIB_SRCS, or LIB_HOST_SRCS: the same with
 # lib/vector/urrt_vector.c in place of lib/urrt.c, lib/lib.mk), so new modules are covered.
 

@@ -918,10 +918,15 @@ static void test_comm_table(void)
     NAME(0x1003, 0, true, "Pre-defined error field");
     NAME(0x1003, 0, false, "Number of errors");
     NAME(0x1003, 8, false, "Standard error field");
+    NAME(0x1016, 0, true, "Consumer heartbeat time");
+    NAME(0x1016, 4, false, "Consumer heartbeat time");
     NAME(0x1017, 0, false, "Producer heartbeat time");
     NAME(0x1018, 0, true, "Identity object");
     NAME(0x1018, 1, false, "Vendor-ID");
     NAME(0x1018, 4, false, "Serial number");
+    NAME(0x1400, 1, false, "COB-ID used by RPDO");
+    NAME(0x1600, 0, true, "RPDO mapping parameter");
+    NAME(0x1600, 8, false, "Mapped object");
     NAME(0x1800, 2, false, "Transmission type");
     NAME(0x1A00, 0, true, "TPDO mapping parameter");
     NAME(0x1A00, 64, false, "Mapped object");
@@ -1027,10 +1032,15 @@ static urrt_co_rpdo_state rpdo_states[2];
 static urrt_co_consumer consumer_states[2];
 static uint32_t rx_vars[CO_FIXTURE_RX_VARS];
 static uint64_t written[CO_FIXTURE_RX_VARS];
+/* Kept as long as the node: the receiving side's state is in it. */
+static urrt_co_rx_storage storage;
 
 static int init_rx(size_t *bad)
 {
-    const urrt_co_rx_storage storage = {rpdo_states, consumer_states, written};
+    memset(&storage, 0xA5, sizeof storage); /* what the node keeps there, it sets */
+    storage.rpdos = rpdo_states;
+    storage.consumers = consumer_states;
+    storage.written_us = written;
     memset(frame_states, 0, sizeof frame_states);
     EQ(urrt_cantx_init(&tx, &tables, frame_states, robots, values, 8, NULL, NULL), 0);
     return urrt_co_init_rx(&co, &desc, &tx, tpdo_states, rx_vars, CO_FIXTURE_RX_VARS, &storage, bad);
@@ -1091,7 +1101,33 @@ static void expect_rx_init(int want, size_t want_item, const char *what)
     size_t bad = 0;
     int rc = init_rx(&bad);
     CHECK(rc == want && bad == want_item, "%s: got %d at %zu, want %d at %zu", what, rc, bad, want, want_item);
-    CHECK(urrt_co_strerror(rc)[0] != '\0', "a text for %d", rc);
+    CHECK(urrt_co_rx_strerror(rc)[0] != '\0' && !CHECK_SAME_TEXT(urrt_co_rx_strerror(rc), urrt_strerror(-1000)),
+          "a text of its own for %d", rc);
+}
+
+/* urrt_co_init_rx's own results have their texts in the receiving side's
+ * urrt_co_rx_strerror, which a node without RPDOs does not link (check-cross
+ * looks for them in its image); every other result it gives as
+ * urrt_co_strerror does. */
+static void test_rx_strerror(void)
+{
+    int rc;
+    CHECK(CHECK_SAME_TEXT(urrt_co_rx_strerror(URRT_CO_E_RPDO),
+                          "an RPDO's transmission type, mapping or COB-ID is not usable"),
+          "URRT_CO_E_RPDO: \"%s\"", urrt_co_rx_strerror(URRT_CO_E_RPDO));
+    CHECK(CHECK_SAME_TEXT(urrt_co_rx_strerror(URRT_CO_E_CONSUMER),
+                          "a consumer heartbeat (0x1016) entry is not usable, or RPDOs have none"),
+          "URRT_CO_E_CONSUMER: \"%s\"", urrt_co_rx_strerror(URRT_CO_E_CONSUMER));
+    CHECK(CHECK_SAME_TEXT(urrt_co_rx_strerror(URRT_CO_E_STORAGE),
+                          "the CANopen node lacks its urrt_cantx, TPDO states, variables or RPDO storage"),
+          "URRT_CO_E_STORAGE: \"%s\"", urrt_co_rx_strerror(URRT_CO_E_STORAGE));
+    CHECK(CHECK_SAME_TEXT(urrt_co_strerror(URRT_CO_E_RPDO), urrt_strerror(-1000)),
+          "urrt_co_strerror knows URRT_CO_E_RPDO: \"%s\"", urrt_co_strerror(URRT_CO_E_RPDO));
+    for (rc = -80; rc <= 1; rc++) {
+        if (rc != URRT_CO_E_RPDO && rc != URRT_CO_E_CONSUMER && rc != URRT_CO_E_STORAGE) {
+            CHECK(urrt_co_rx_strerror(rc) == urrt_co_strerror(rc), "%d: urrt_co_rx_strerror differs", rc);
+        }
+    }
 }
 
 /* Descriptions urrt_co_init_rx refuses, each naming the RPDO or 0x1016 entry. */
@@ -1217,6 +1253,90 @@ static void test_rx_sdo_reads(void)
     ABORT(0, 0x06020000, 0x40, 0x00, 0x16, 0x00, 0, 0, 0, 0);
     ABORT(0, 0x06020000, 0x40, 0x16, 0x10, 0x00, 0, 0, 0, 0);
     ABORT(0, 0x06020000, 0x23, 0x16, 0x10, 0x01, 0x64, 0x00, 0x01, 0x00);
+}
+
+/* An upload's answer (expedited, or the initiation of a segmented one,
+ * which the client's abort then ends): 0 with the value and its size, or
+ * the abort code. */
+static uint32_t sdo_read(uint16_t index, uint8_t sub, uint32_t *value, uint32_t *size)
+{
+    const uint8_t req[8] = {0x40, (uint8_t)index, (uint8_t)(index >> 8), sub, 0, 0, 0, 0};
+    const uint8_t client_abort[8] = {0x80, (uint8_t)index, (uint8_t)(index >> 8), sub, 0, 0, 0x04, 0x05};
+    uint32_t word;
+    EQ(rx(0x600 + NODE, req, 8, 0), 1);
+    word = (uint32_t)out[0].data[4] | (uint32_t)out[0].data[5] << 8 | (uint32_t)out[0].data[6] << 16 |
+           (uint32_t)out[0].data[7] << 24;
+    if (out[0].data[0] == 0x80) {
+        return word;
+    }
+    if ((out[0].data[0] & 0x02) == 0u) {
+        *size = word;
+        *value = 0;
+        EQ(rx(0x600 + NODE, client_abort, 8, 0), 0);
+        return 0;
+    }
+    *size = 4u - (uint32_t)(out[0].data[0] >> 2 & 3u);
+    *value = *size == 4u ? word : word & ((UINT32_C(1) << (8u * *size)) - 1u);
+    return 0;
+}
+
+/* The dictionary as its readers (an EDS writer) see it, urrt_co_comm_table:
+ * every row, in index order, the receiving side's among them, with its
+ * instances on this node; each of their sub-indices reads what the SDO
+ * server answers an upload of it (the value and its size, or the abort), and
+ * a row without a write function is the SDO server's read-only. The SDO
+ * server looks up rows of its own (urrt_co.c's and urrt_co_rx.c's), so this
+ * holds the two expansions of one list to each other. On the node with
+ * RPDOs, then the one without (where the receiving side's rows have none). */
+static void check_comm_readers(const char *node)
+{
+    size_t i;
+    for (i = 0; i < urrt_co_comm_count; i++) {
+        const urrt_co_comm *r = &urrt_co_comm_table[i];
+        size_t n;
+        unsigned s;
+        CHECK(i == 0 || r->index >= urrt_co_comm_table[i - 1u].index, "%s: row %zu (0x%04X) out of index order",
+              node, i, (unsigned)r->index);
+        for (n = 0; n < urrt_co_comm_instances(&co, r); n++) {
+            for (s = r->sub; s < (unsigned)r->sub + r->subs; s++) {
+                uint16_t index = (uint16_t)(r->index + n);
+                urrt_co_value v;
+                uint32_t value = 0, size = 0;
+                uint32_t abort_code = urrt_co_comm_read(&co, r, n, (uint8_t)s, &v);
+                uint32_t sdo = sdo_read(index, (uint8_t)s, &value, &size);
+                CHECK(abort_code == sdo, "%s: 0x%04X sub %u: read 0x%08X, the SDO server 0x%08X", node,
+                      (unsigned)index, s, (unsigned)abort_code, (unsigned)sdo);
+                if (abort_code == 0u && sdo == 0u) {
+                    CHECK(v.size == size && (v.text != NULL || v.value == value),
+                          "%s: 0x%04X sub %u: read 0x%X (%u bytes), the SDO server 0x%X (%u bytes)", node,
+                          (unsigned)index, s, (unsigned)v.value, (unsigned)v.size, (unsigned)value, (unsigned)size);
+                }
+                if (r->write == NULL && abort_code != URRT_CO_ABORT_NO_SUB) {
+                    const uint8_t req[8] = {0x23, (uint8_t)index, (uint8_t)(index >> 8), (uint8_t)s, 0, 0, 0, 0};
+                    EQ(rx(0x600 + NODE, req, 8, 0), 1);
+                    CHECK(out[0].data[0] == 0x80 && out[0].data[4] == 0x02 && out[0].data[5] == 0x00 &&
+                              out[0].data[6] == 0x01 && out[0].data[7] == 0x06,
+                          "%s: 0x%04X sub %u has no write, and the SDO server does not answer 0x06010002", node,
+                          (unsigned)index, s);
+                }
+            }
+        }
+        if (r->subs != 0u) {
+            urrt_co_value v;
+            EQ(urrt_co_comm_read(&co, r, urrt_co_comm_instances(&co, r), r->sub, &v), URRT_CO_ABORT_NO_SUB);
+        }
+    }
+}
+
+static void test_comm_readers(void)
+{
+    co_fixture_rx_desc(&desc);
+    setup_rx();
+    nmt(0x01, NODE, 0);
+    check_comm_readers("the node with RPDOs");
+    desc_defaults();
+    setup();
+    check_comm_readers("the node without");
 }
 
 /* urrt_co_rx_ids on the node with RPDOs: NMT, SYNC, SDO, RPDO1, RPDO2, node 1's heartbeat. */
@@ -1769,6 +1889,8 @@ int main(void)
     test_random();
     test_rx_init();
     test_rx_sdo_reads();
+    test_comm_readers();
+    test_rx_strerror();
     test_rx_sdo_writes();
     test_rpdo_processing();
     test_rpdo_deadline();

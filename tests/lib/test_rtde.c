@@ -60,8 +60,11 @@ static struct runner {
     size_t var_count;
     double freq;
     int begun;
-    char session[64];
+    int poison; /* the caller writes its structs before every read (see next_event) */
+    char session[96];
 } R;
+
+#define POISON 0x3F /* every byte: a double 0.36, an integer 0x3F3F... */
 
 /* Feeds pending input in chunks of R.chunk until an event. */
 static int next_event(void)
@@ -69,10 +72,15 @@ static int next_event(void)
     while (R.in_pos < R.in_len) {
         size_t n = R.in_len - R.in_pos < R.chunk ? R.in_len - R.in_pos : R.chunk;
         size_t used = 99999;
-        /* The caller may write its struct between packages: every double
-         * (not present, nor length) poisoned, so that a decode that keeps
-         * the NaN of the absent fields from its last call is caught. */
-        memset(&R.st, 0x3F, offsetof(urrt_state, present));
+        /* The caller may write its structs between packages: with R.poison
+         * every byte of both (present bits, length and generation too) is
+         * poisoned before every read, so that a decode that writes what its
+         * recipe lacks (or leaves a present bit it does not set) is caught:
+         * it writes its values and the present bits, nothing else. */
+        if (R.poison) {
+            memset(&R.st, POISON, sizeof R.st);
+            memset(&R.vals, POISON, sizeof R.vals);
+        }
         int k = urrt_rtde_feed(&R.s, R.in + R.in_pos, n, &used, &R.ev, &R.st, &R.vals);
         CHECK(used <= n, "%s: used %zu of %zu", R.session, used, n);
         R.in_pos += used;
@@ -160,9 +168,56 @@ static void check_text(const char *hex, const char *got, size_t len)
     CHECK(n == len && (n == 0 || memcmp(got, want, n) == 0), "%s: text of %zu bytes, expected %zu", R.session, len, n);
 }
 
+/* Whether the element bytes at p (n of them) are all the poison. */
+static int poisoned(const void *p, size_t n)
+{
+    const uint8_t *b = p;
+    for (size_t i = 0; i < n; i++) {
+        if (b[i] != POISON) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* An absent field of urrt_state as the contract says: the caller's poison,
+ * which no decode writes over; else NaN since the recipe's clear. */
+static void check_absent_field(int f)
+{
+    const double *d = urrt_field_values(&R.st, (urrt_field_id)f);
+    for (unsigned k = 0; k < urrt_field((urrt_field_id)f)->count; k++) {
+        CHECK(R.poison ? poisoned(d + k, 8) : isnan(d[k]), "%s: absent %s[%u] is %s", R.session,
+              urrt_field((urrt_field_id)f)->name, k, R.poison ? "written" : "not NaN");
+    }
+}
+
+/* An absent RTDE-only variable likewise: poison, or NaN (doubles) and 0. */
+static void check_absent_value(int var)
+{
+    const uint8_t *p = urrt_rtde_value(&R.vals, var);
+    urrt_rtde_type t = urrt_rtde_var_type(var);
+    unsigned n = urrt_rtde_type_size(t);
+    int is_double = t == URRT_RTDE_T_DOUBLE || t == URRT_RTDE_T_VECTOR3D || t == URRT_RTDE_T_VECTOR6D;
+    int ok = 1;
+    if (R.poison) {
+        ok = poisoned(p, n);
+    } else {
+        for (unsigned k = 0; k < n; k++) {
+            ok &= is_double ? 1 : p[k] == 0;
+        }
+        for (unsigned k = 0; is_double && k < n / 8; k++) {
+            double d;
+            memcpy(&d, p + 8 * k, 8);
+            ok &= isnan(d);
+        }
+    }
+    CHECK(ok, "%s: absent variable %d is %s", R.session, var, R.poison ? "written" : "not NaN (or 0)");
+}
+
 /* After a data package: exactly the recipe's fields present in urrt_state,
- * every element of every other field NaN (nothing stale), and the same for
- * the RTDE-only values' present bits. */
+ * exactly its RTDE-only variables present in urrt_rtde_values, whatever the
+ * structs held (nothing of another recipe or session reads as present), and
+ * every absent member as the contract says (check_absent_field). */
 static void check_state_fields(void)
 {
     for (int f = 0; f < URRT_FIELD_COUNT; f++) {
@@ -171,18 +226,53 @@ static void check_state_fields(void)
             in_recipe |= var >= 0 && R.vars[i] == var;
         }
         CHECK((int)urrt_has(&R.st, f) == in_recipe, "%s: field %d present %d", R.session, f, (int)urrt_has(&R.st, f));
-        const double *d = urrt_field_values(&R.st, (urrt_field_id)f);
-        for (unsigned k = 0; !in_recipe && k < urrt_field((urrt_field_id)f)->count; k++) {
-            CHECK(isnan(d[k]), "%s: absent %s[%u] is not NaN", R.session, urrt_field((urrt_field_id)f)->name, k);
+        if (!in_recipe) {
+            check_absent_field(f);
         }
     }
-    CHECK(R.st.length == R.s.data_size && R.st.generation == URRT_GEN_3X, "%s: length %u", R.session, R.st.length);
+    CHECK(R.st.length == R.s.data_size && R.st.generation == URRT_GEN_3X && R.st.doubles == 0 &&
+              R.st.extra_columns == 0, "%s: length %u", R.session, R.st.length);
     for (int var = URRT_RTDE_MAPPED_COUNT; var < URRT_RTDE_VAR_COUNT; var++) {
         int in_recipe = 0;
         for (size_t i = 0; i < R.var_count; i++) {
             in_recipe |= R.vars[i] == var;
         }
         CHECK((int)urrt_rtde_has(&R.vals, var) == in_recipe, "%s: var %d present", R.session, var);
+        if (!in_recipe) {
+            check_absent_value(var);
+        }
+    }
+    for (size_t w = (URRT_RTDE_ONLY_COUNT + 31) / 32; w < URRT_RTDE_PRESENT_WORDS; w++) {
+        CHECK(R.vals.present[w] == 0, "%s: present word %zu", R.session, w);
+    }
+    if (URRT_RTDE_ONLY_COUNT % 32 != 0) { /* the bits past the last variable */
+        CHECK(R.vals.present[URRT_RTDE_ONLY_COUNT / 32] >> (URRT_RTDE_ONLY_COUNT % 32) == 0,
+              "%s: present bits past the last variable", R.session);
+    }
+}
+
+/* After the recipe is accepted: the structs the feed was given are cleared,
+ * every member absent (NaN, 0), present none: what the recipe lacks stays
+ * so for the session (no decode writes it). */
+static void check_cleared(void)
+{
+    const double *d = (const double *)(const void *)&R.st;
+    int bad = 0;
+    for (size_t k = 0; k < offsetof(urrt_state, present) / 8; k++) {
+        bad += !isnan(d[k]);
+    }
+    CHECK(bad == 0 && R.st.present == 0 && R.st.length == 0 && R.st.generation == URRT_GEN_UNKNOWN,
+          "%s: after the recipe, %d doubles of the state are not NaN (present %llx)", R.session, bad,
+          (unsigned long long)R.st.present);
+    int saved = R.poison;
+    R.poison = 0;
+    for (int var = URRT_RTDE_MAPPED_COUNT; var < URRT_RTDE_VAR_COUNT; var++) {
+        CHECK(!urrt_rtde_has(&R.vals, var), "%s: var %d present after the recipe", R.session, var);
+        check_absent_value(var);
+    }
+    R.poison = saved;
+    for (size_t w = 0; w < URRT_RTDE_PRESENT_WORDS; w++) {
+        CHECK(R.vals.present[w] == 0, "%s: present word %zu after the recipe", R.session, w);
     }
 }
 
@@ -205,7 +295,10 @@ static void check_event(char *args)
               "%s: controller %u.%u.%u.%u", R.session, R.ev.version[0], R.ev.version[1], R.ev.version[2],
               R.ev.version[3]);
         break;
-    case URRT_RTDE_EV_RECIPE: CHECK_EQ_INT(R.ev.recipe_id, atoi(a1)); break;
+    case URRT_RTDE_EV_RECIPE:
+        CHECK_EQ_INT(R.ev.recipe_id, atoi(a1));
+        check_cleared();
+        break;
     case URRT_RTDE_EV_TEXT:
         CHECK_EQ_INT(R.ev.level, atoi(a1));
         check_text(a2, R.ev.text, R.ev.text_len);
@@ -283,14 +376,11 @@ static void check_absent(const char *name)
 {
     int var = urrt_rtde_var_find(name, strlen(name)), field = urrt_rtde_var_field(var);
     if (field >= 0) {
-        const urrt_field_info *f = urrt_field((urrt_field_id)field);
-        const double *d = urrt_field_values(&R.st, (urrt_field_id)field);
         CHECK(!urrt_has(&R.st, field), "%s: %s present", R.session, name);
-        for (unsigned i = 0; i < f->count; i++) {
-            CHECK(isnan(d[i]), "%s: absent %s[%u] is not NaN", R.session, name, i);
-        }
+        check_absent_field(field);
     } else {
         CHECK(!urrt_rtde_has(&R.vals, var), "%s: %s present", R.session, name);
+        check_absent_value(var);
     }
 }
 
@@ -302,8 +392,8 @@ static void directive(char *line)
         *sp = '\0';
     }
     if (strcmp(line, "session") == 0) {
-        snprintf(R.session, sizeof R.session, "%.40s/%s%u", arg, R.chunk == SIZE_MAX ? "whole" : "chunk ",
-                 R.chunk == SIZE_MAX ? 0u : (unsigned)R.chunk);
+        snprintf(R.session, sizeof R.session, "%.40s/%s%u%s", arg, R.chunk == SIZE_MAX ? "whole" : "chunk ",
+                 R.chunk == SIZE_MAX ? 0u : (unsigned)R.chunk, R.poison ? " poisoned" : "");
         urrt_rtde_init(&R.s);
         R.in_len = R.in_pos = 0;
         R.begun = 0;
@@ -358,7 +448,7 @@ static void directive(char *line)
     }
 }
 
-static int run_vectors(const char *path, size_t chunk)
+static int run_vectors(const char *path, size_t chunk, int poison)
 {
     static char line[LINE_MAX_CHARS];
     FILE *f = fopen(path, "r");
@@ -368,6 +458,7 @@ static int run_vectors(const char *path, size_t chunk)
         return 0;
     }
     R.chunk = chunk;
+    R.poison = poison;
     while (fgets(line, sizeof line, f) != NULL) {
         line[strcspn(line, "\n")] = '\0';
         sessions += strncmp(line, "session ", 8) == 0;
@@ -684,6 +775,86 @@ static void test_set_recipe_api(void)
     CHECK_EQ_INT(urrt_rtde_feed(&s, replies, 0, &used, &ev, &st, NULL), URRT_E_ARG); /* now they are */
 }
 
+/* The receive path: a data package a read holds whole is decoded where it
+ * lies (s.buf untouched), one split across reads is gathered in s.buf, and
+ * both decode alike; replies always land in s.buf (urrt_rtde_in_feed reads
+ * an input setup reply there). The decode writes the recipe's values and
+ * the present bits only: a struct written between packages keeps what the
+ * recipe lacks, and a present bit of another recipe is cleared. */
+static void test_in_place(void)
+{
+    static urrt_rtde s;
+    static urrt_state st;
+    static urrt_rtde_values vals;
+    static const uint8_t replies[] = {0, 4, 'V', 1, 0, 19, 'v', 0, 0, 0, 5, 0, 0, 0, 12, 0, 0, 0, 0, 0, 0, 0, 1,
+                                      0, 16, 'O', 9, 'D', 'O', 'U', 'B', 'L', 'E', ',', 'I', 'N', 'T', '3', '2',
+                                      0, 4, 'S', 1};
+    /* timestamp 1.5, output_int_register_24 -2 */
+    static const uint8_t data[] = {0, 16, 'U', 9, 0x3F, 0xF8, 0, 0, 0, 0, 0, 0, 0xFF, 0xFF, 0xFF, 0xFE};
+    uint16_t vars[] = {URRT_RTDE_V_TIMESTAMP, URRT_RTDE_V_OUTPUT_INT_REGISTER + 24};
+    uint8_t out[URRT_RTDE_REQUEST_MAX], marker[sizeof data];
+    urrt_rtde_event ev;
+    size_t used, pos = 0;
+    int k;
+    urrt_rtde_init(&s);
+    CHECK_EQ_INT(urrt_rtde_begin(&s, vars, 2, 0.0), URRT_OK);
+    memset(&st, 0x11, sizeof st);
+    memset(&vals, 0x11, sizeof vals);
+    while (pos < sizeof replies) {
+        while (urrt_rtde_output(&s, out, sizeof out) > 0) {
+        }
+        k = urrt_rtde_feed(&s, replies + pos, sizeof replies - pos, &used, &ev, &st, &vals);
+        CHECK(k > 0, "handshake event %d", k);
+        pos += used;
+        if (k == URRT_RTDE_EV_RECIPE) { /* the recipe's clear */
+            CHECK(st.present == 0 && isnan(st.q_actual[0]) && isnan(st.time[0]), "state not cleared");
+            CHECK(vals.present[0] == 0 && vals.output_int_register[3] == 0 && isnan(vals.output_double_register[0]),
+                  "values not cleared");
+            CHECK(s.buf[2] == 'O', "the setup reply is not in s.buf");
+        }
+        if (k <= 0) {
+            break;
+        }
+    }
+    CHECK(urrt_rtde_streaming(&s), "not streaming after the handshake");
+    /* whole in one read: decoded in place */
+    memset(s.buf, 0xA5, sizeof data);
+    memcpy(marker, s.buf, sizeof data);
+    st.q_actual[0] = 7.0;                   /* the caller's own writes to what the recipe lacks */
+    vals.output_int_register[3] = 33;
+    st.present |= UINT64_C(1) << URRT_F_Q_ACTUAL; /* and a present bit of another recipe */
+    vals.present[URRT_RTDE_PRESENT_WORDS - 1] = 0xFFFFFFFFu;
+    CHECK_EQ_INT(urrt_rtde_feed(&s, data, sizeof data, &used, &ev, &st, &vals), URRT_RTDE_EV_DATA);
+    CHECK(used == sizeof data && ev.first, "used %zu", used);
+    CHECK(memcmp(s.buf, marker, sizeof data) == 0, "a whole data package was copied into s.buf");
+    CHECK(st.time[0] == 1.5 && vals.output_int_register[24] == -2, "values %g %d", st.time[0],
+          (int)vals.output_int_register[24]);
+    CHECK(st.q_actual[0] == 7.0 && vals.output_int_register[3] == 33, "the decode wrote what the recipe lacks");
+    CHECK(st.present == UINT64_C(1) << URRT_F_TIME && st.length == 16 && st.generation == URRT_GEN_3X,
+          "present %llx", (unsigned long long)st.present);
+    for (int var = URRT_RTDE_MAPPED_COUNT; var < URRT_RTDE_VAR_COUNT; var++) {
+        CHECK((int)urrt_rtde_has(&vals, var) == (var == URRT_RTDE_V_OUTPUT_INT_REGISTER + 24), "var %d present", var);
+    }
+    /* behind another package in the same read, and split across reads: the same values */
+    for (size_t cut = 1; cut < sizeof data; cut++) {
+        st.time[0] = 0.0;
+        vals.output_int_register[24] = 0;
+        CHECK_EQ_INT(urrt_rtde_feed(&s, data, cut, &used, &ev, &st, &vals), URRT_RTDE_EV_NONE);
+        CHECK_EQ_INT(urrt_rtde_feed(&s, data + cut, sizeof data - cut, &used, &ev, &st, &vals), URRT_RTDE_EV_DATA);
+        CHECK(used == sizeof data - cut && !ev.first && st.time[0] == 1.5 && vals.output_int_register[24] == -2,
+              "split at %zu", cut);
+        CHECK(memcmp(s.buf, data, sizeof data) == 0, "split at %zu: not gathered in s.buf", cut);
+    }
+    /* a wrong recipe id in a whole package ends the session, as split */
+    {
+        uint8_t bad[sizeof data];
+        memcpy(bad, data, sizeof data);
+        bad[3] = 8;
+        CHECK_EQ_INT(urrt_rtde_feed(&s, bad, sizeof bad, &used, &ev, &st, &vals), URRT_RTDE_EV_DROP);
+        CHECK(ev.error == URRT_RTDE_E_RECIPE_ID && used == sizeof bad, "error %d, used %zu", ev.error, used);
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -695,11 +866,16 @@ int main(int argc, char **argv)
     test_largest_recipe();
     test_api_errors();
     test_set_recipe_api();
+    test_in_place();
     test_ports();
-    int sessions = run_vectors(argv[1], SIZE_MAX);
+    /* whole and in small reads; the caller's structs left alone (absent
+     * members NaN and 0 from the recipe's clear on) and poisoned before
+     * every read (the decode writes its values and present bits only) */
+    int sessions = run_vectors(argv[1], SIZE_MAX, 0);
     CHECK(sessions >= 40, "only %d sessions in %s", sessions, argv[1]);
-    run_vectors(argv[1], 1);
-    run_vectors(argv[1], 7);
+    run_vectors(argv[1], SIZE_MAX, 1);
+    run_vectors(argv[1], 1, 1);
+    run_vectors(argv[1], 7, 0);
     run_splits(argv[1]);
     return check_report();
 }

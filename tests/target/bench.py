@@ -15,10 +15,12 @@ P, the pipeline refill, is 1 to 3; divides 2-12. The estimate takes P = 2
 (range P = 1 to 3, IT folded or not, no load pipelining at the top) and no
 flash wait states: an estimate, not a measurement.
 
-Checks: the trace and SysTick agree on the instruction counts; decode of
+Checks: the trace and SysTick agree on the instruction counts (within 1 %,
+or 10 instructions on short operations); decode of
 1116 bytes at -O2 within 2x of a byte-swapping copy of the same bytes; the
 RTDE decode of one data package of the STATE recipe at -O2 within 1.5x of
-that RealTime decode of 1116 bytes; the
+that RealTime decode of 1116 bytes; the feed of a read holding one whole
+72-byte package of the 5-value recipe at -O2 within 300 instructions; the
 table between <!-- m4-bench:begin --> and <!-- m4-bench:end --> in
 docs/performance.md states these figures (within 5 %).
 
@@ -40,15 +42,22 @@ MHZ = 168
 OPS = [("decode_1116", "full decode, 1116 bytes"), ("decode_1220", "full decode, 1220 bytes"),
        ("swap_copy_1116", "byte-swapping copy of the same 1116 bytes (floor)"),
        ("framer_feed_1460", "framer feed, one 1460-byte segment of 1116-byte packets"),
+       ("framer_decode_1116", "framer feed of a read holding one whole 1116-byte packet, and its decode"),
        ("read10_1116", "10 fields by random access, 1116 bytes"),
        ("can_pack_tpdo1", "pack one CAN frame (canopen.ini TPDO1: 3 scaled joints, alive, valid)"),
        ("can_pack_frame_tpdo1", "the same frame by urrt_can_pack_frame (each signal checked, its scale prepared)"),
-       ("rtde_decode_state", "RTDE: decode of one data package of the STATE recipe (904 bytes)")]
+       ("rtde_decode_state", "RTDE: decode of one data package of the STATE recipe (904 bytes)"),
+       ("rtde_feed_state", "RTDE: feed of a read holding one whole data package of the STATE recipe, to its event"),
+       ("rtde_feed_small", "RTDE: the same for a 5-value recipe (72 bytes)")]
 # Trace segments, in the order bench_target.c times them.
 ORDER = ["overhead", "calibration", "decode_1116", "swap_copy_1116", "read10_1116", "decode_1220",
-         "swap_copy_1220", "framer_feed_1460", "can_pack_tpdo1", "can_pack_frame_tpdo1", "rtde_decode_state"]
+         "swap_copy_1220", "framer_feed_1460", "framer_decode_1116", "can_pack_tpdo1", "can_pack_frame_tpdo1",
+         "rtde_decode_state", "rtde_feed_state", "rtde_feed_small"]
 # The RTDE decode of the STATE recipe against the RealTime decode of 1116 bytes, at -O2: at most.
 RTDE_VS_REALTIME = 1.5
+# The feed of a read holding one whole data package of the 5-value recipe, at -O2: at most
+# (instructions; issue 38's goal).
+RTDE_FEED_SMALL_BUDGET = 300
 # --can: TPDO1's packing on each core, and the most its prepared packing may take (instructions).
 CAN_OPS = ["can_pack_tpdo1", "can_pack_frame_tpdo1"]
 CAN_BUDGET = {"M4 -O2": 2000, "M4 -Os": 2500}
@@ -142,7 +151,8 @@ def not_slower(qemu, specs):
                              timeout=60)
         figures = dict((m.group(1), int(m.group(2)))
                        for m in re.finditer(r"^bench: (\w+) (\d+)$", out.stdout + out.stderr, re.M))
-        for name in ("decode_1116", "decode_1220", "read10_1116", "swap_copy_1116", "rtde_decode_state"):
+        for name in ("decode_1116", "decode_1220", "read10_1116", "swap_copy_1116", "rtde_decode_state",
+                     "rtde_feed_state", "rtde_feed_small"):
             print("%s: %s %d instructions" % (label, name, figures.get(name, -1)))
         runs.append((label, figures.get("decode_1116", -1)))
     (a, x), (b, y) = runs
@@ -236,7 +246,12 @@ def main():
                 continue
             n, mid, lo, hi = (round(x / count) for x in (n, mid, lo, hi))
             icount = figures.get(name, -1)
-            result(abs(n - icount) <= max(2, icount // 100),
+            # The trace takes the overhead segment's length off every operation,
+            # SysTick the reads' own cost: the instructions the compiler places
+            # between bench_begin and the first read (or the second read and
+            # bench_end) differ with the call's context, by up to 7 so far
+            # (SysTick the higher); on the short operations 1 % is less than that.
+            result(abs(n - icount) <= max(10, icount // 100),
                    "%s %s: trace counts %d instructions, SysTick %d" % (label, name, n, icount))
             measured[(label, name)] = (icount, mid, lo, hi)
         print("%s: SysTick ticks per 1000 instructions %d (1600 expected: shift=6, 25 MHz)"
@@ -263,6 +278,12 @@ def main():
         if l == "-O2":
             result(0 < r <= RTDE_VS_REALTIME * d, "-O2: RTDE decode of the STATE recipe (%d) is past %.1fx the "
                    "RealTime decode of 1116 bytes (%d)" % (r, RTDE_VS_REALTIME, d))
+        f = measured.get((l, "rtde_feed_small"), (0,))[0]
+        print("%s: RTDE feed of a whole 72-byte package of the 5-value recipe: %d instructions%s"
+              % (l, f, " (at most %d)" % RTDE_FEED_SMALL_BUDGET if l == "-O2" else ""))
+        if l == "-O2":
+            result(0 < f <= RTDE_FEED_SMALL_BUDGET, "-O2: RTDE feed of the 5-value recipe's package takes %d "
+                   "instructions, past %d" % (f, RTDE_FEED_SMALL_BUDGET))
     # The page: the same rows, each number within TOLERANCE.
     ok = same_rows(stated_table(doc, "m4-bench"), rows)
     result(ok, "%s's m4-bench table differs from the figures above (by more than 5 %%): replace it" % doc)

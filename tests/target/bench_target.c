@@ -83,16 +83,22 @@ static __attribute__((noinline)) void swap_copy(uint64_t *dst, const uint8_t *sr
 }
 
 static urrt_state st;
-static urrt_framer framer;
 static uint64_t packet_words[1224 / 8 + 1];
 static uint64_t copy_words[1220 / 8];
 #define STREAM_PACKETS 4 /* 3 whole segments; small enough for 16 KiB of RAM */
-/* The framer's stream and the RTDE session are never in use at once: one
- * piece of RAM (the Cortex-M0 board has 16 KiB). */
+/* The framer and its stream, and the RTDE session and its values, are never
+ * in use at once: one piece of RAM (the Cortex-M0 board has 16 KiB). */
 static union {
-    uint8_t stream[STREAM_PACKETS * 1116];
-    urrt_rtde rtde;
+    struct {
+        uint8_t stream[STREAM_PACKETS * 1116];
+        urrt_framer framer;
+    } rt;
+    struct {
+        urrt_rtde rtde;
+        urrt_rtde_values vals;
+    } r;
 } ram;
+#define framer ram.rt.framer
 
 static const urrt_field_id read_fields[10] = {
     URRT_F_TIME, URRT_F_Q_ACTUAL, URRT_F_QD_ACTUAL, URRT_F_TOOL_VECTOR_ACTUAL, URRT_F_TCP_FORCE,
@@ -183,13 +189,13 @@ static int bench_framer(const tv_vector *v1116)
     uint32_t ticks, i;
     int sink = 0;
     uint32_t total = 0, segments = 0, pos;
-    for (i = 0; i < sizeof ram.stream; i++) {
-        ram.stream[i] = v1116->packet[i % 1116u];
+    for (i = 0; i < sizeof ram.rt.stream; i++) {
+        ram.rt.stream[i] = v1116->packet[i % 1116u];
     }
     urrt_framer_init(&framer);
-    for (pos = 0; pos + 1460u <= sizeof ram.stream; pos += 1460u) {
+    for (pos = 0; pos + 1460u <= sizeof ram.rt.stream; pos += 1460u) {
         TIMED(ticks, {
-            const uint8_t *p = ram.stream + pos;
+            const uint8_t *p = ram.rt.stream + pos;
             size_t n = 1460, used;
             while (n > 0) {
                 sink += urrt_framer_feed(&framer, p, n, &used);
@@ -201,6 +207,30 @@ static int bench_framer(const tv_vector *v1116)
         segments++;
     }
     report("framer_feed_1460", total / segments + overhead_ticks);
+    return sink;
+}
+
+/* The RealTime receive path as the RTDE one's is measured below: a read
+ * that holds one whole 1116-byte packet (4-byte aligned, as a TCP stack's
+ * buffer), fed to the framer, and the packet it yields decoded. */
+static int bench_framer_decode(const tv_vector *v1116)
+{
+    uint32_t ticks, i;
+    int sink = 0;
+    size_t used, len;
+    uint8_t *pkt = (uint8_t *)packet_words;
+    for (i = 0; i < v1116->length; i++) {
+        pkt[i] = v1116->packet[i];
+    }
+    urrt_framer_init(&framer);
+    sink += urrt_framer_feed(&framer, pkt, v1116->length, &used); /* the first: its size is learnt */
+    TIMED(ticks, {
+        if (urrt_framer_feed(&framer, pkt, v1116->length, &used) > 0) {
+            const uint8_t *p = urrt_framer_packet(&framer, &len);
+            sink += urrt_decode(p, len, &st);
+        }
+    });
+    report("framer_decode_1116", ticks);
     return sink;
 }
 
@@ -252,6 +282,12 @@ static size_t text_length(const char *s)
     return n;
 }
 
+/* A small recipe, a PLC's (tests/lib/bench_lib.c's too): a 72-byte package. */
+static const char *const rtde_small_names[] = {"timestamp", "actual_q", "robot_status_bits", "safety_status_bits",
+                                               "output_int_register_24"};
+#define RTDE_SMALL_VARS (sizeof rtde_small_names / sizeof rtde_small_names[0])
+#define RTDE_SMALL_SIZE 72u
+
 /* One controller package (type, n bytes of body at pkg + 3) fed to the
  * session after its due request is taken out: the event it gives. */
 static int rtde_reply(uint8_t *pkg, uint8_t type, size_t n)
@@ -261,19 +297,19 @@ static int rtde_reply(uint8_t *pkg, uint8_t type, size_t n)
     pkg[0] = (uint8_t)((n + 3u) >> 8);
     pkg[1] = (uint8_t)(n + 3u);
     pkg[2] = type;
-    while (urrt_rtde_output(&ram.rtde, (uint8_t *)copy_words, sizeof copy_words) > 0) {
+    while (urrt_rtde_output(&ram.r.rtde, (uint8_t *)copy_words, sizeof copy_words) > 0) {
     }
-    return urrt_rtde_feed(&ram.rtde, pkg, n + 3u, &used, &ev, &st, NULL);
+    return urrt_rtde_feed(&ram.r.rtde, pkg, n + 3u, &used, &ev, &st, &ram.r.vals);
 }
 
-/* A controller's type list for the STATE recipe at pkg + 4 (after the
- * recipe id): its length. */
-static size_t rtde_types(uint8_t *pkg, uint16_t *vars)
+/* A controller's type list for a recipe at pkg + 4 (after the recipe id):
+ * its length. */
+static size_t rtde_types(uint8_t *pkg, const char *const *names, size_t count, uint16_t *vars)
 {
     size_t at = 4, i, k;
-    for (i = 0; i < RTDE_STATE_VARS; i++) {
+    for (i = 0; i < count; i++) {
         const char *type;
-        vars[i] = (uint16_t)urrt_rtde_var_find(rtde_state_names[i], text_length(rtde_state_names[i]));
+        vars[i] = (uint16_t)urrt_rtde_var_find(names[i], text_length(names[i]));
         type = urrt_rtde_type_name(urrt_rtde_var_type(vars[i]));
         if (i > 0) {
             pkg[at++] = ',';
@@ -285,20 +321,19 @@ static size_t rtde_types(uint8_t *pkg, uint16_t *vars)
     return at - 3;
 }
 
-/* The session through the handshake (the bench's own replies: what is timed
- * is the decode), then one data package of the STATE recipe: the 1116-byte
- * packet's bytes as its body. */
-static int bench_rtde(const tv_vector *v1116)
+/* The session through the handshake of a recipe (the bench's own replies:
+ * what is timed is the data), then one data package of `size` bytes in
+ * pkg: the 1116-byte packet's bytes as its body. */
+static void rtde_session(const tv_vector *v1116, const char *const *names, size_t count, size_t size)
 {
     static const uint8_t version[16] = {0, 0, 0, 5, 0, 0, 0, 12, 0, 0, 0, 0, 0, 0, 0, 1};
     uint16_t vars[RTDE_STATE_VARS];
     uint8_t *pkg = (uint8_t *)packet_words;
-    uint32_t ticks;
     size_t k;
-    int sink = 0, ok;
-    urrt_rtde_init(&ram.rtde);
-    (void)rtde_types(pkg, vars);
-    ok = urrt_rtde_begin(&ram.rtde, vars, RTDE_STATE_VARS, 0.0) == URRT_OK;
+    int ok;
+    urrt_rtde_init(&ram.r.rtde);
+    (void)rtde_types(pkg, names, count, vars);
+    ok = urrt_rtde_begin(&ram.r.rtde, vars, count, 0.0) == URRT_OK;
     pkg[3] = 1;
     ok = ok && rtde_reply(pkg, 'V', 1) == URRT_RTDE_EV_PROTOCOL;
     for (k = 0; k < 16; k++) {
@@ -306,22 +341,56 @@ static int bench_rtde(const tv_vector *v1116)
     }
     ok = ok && rtde_reply(pkg, 'v', 16) == URRT_RTDE_EV_CONTROLLER;
     pkg[3] = 1;
-    ok = ok && rtde_reply(pkg, 'O', rtde_types(pkg, vars)) == URRT_RTDE_EV_RECIPE;
+    ok = ok && rtde_reply(pkg, 'O', rtde_types(pkg, names, count, vars)) == URRT_RTDE_EV_RECIPE;
     pkg[3] = 1;
-    ok = ok && rtde_reply(pkg, 'S', 1) == URRT_RTDE_EV_STARTED && ram.rtde.data_size == RTDE_STATE_SIZE;
+    ok = ok && rtde_reply(pkg, 'S', 1) == URRT_RTDE_EV_STARTED && ram.r.rtde.data_size == size;
     if (!ok) {
         target_puts("bench: the RTDE handshake failed\n");
         target_exit(2);
     }
-    for (k = 4; k < RTDE_STATE_SIZE; k++) {
+    for (k = 4; k < size; k++) {
         pkg[k] = v1116->packet[k];
     }
-    pkg[0] = (uint8_t)(RTDE_STATE_SIZE >> 8);
-    pkg[1] = (uint8_t)RTDE_STATE_SIZE;
+    pkg[0] = (uint8_t)(size >> 8);
+    pkg[1] = (uint8_t)size;
     pkg[2] = 'U';
     pkg[3] = 1;
-    TIMED(ticks, sink += urrt_rtde_decode(&ram.rtde, pkg, RTDE_STATE_SIZE, &st, NULL));
+}
+
+/* A read that holds one whole data package (4-byte aligned, as a TCP
+ * stack's buffer) fed to the session, to its data event: what a firmware
+ * runs per package, timed as one call (its arguments set up), as the other
+ * operations are. */
+static urrt_rtde_event feed_ev;
+static size_t feed_used;
+
+static int rtde_feed(const char *name, size_t size)
+{
+    uint32_t ticks;
+    int sink = 0;
+    TIMED(ticks, sink += urrt_rtde_feed(&ram.r.rtde, (const uint8_t *)packet_words, size, &feed_used, &feed_ev, &st,
+                                         &ram.r.vals));
+    if (sink != URRT_RTDE_EV_DATA || feed_used != size) {
+        target_puts("bench: the feed of a whole data package gave no data event\n");
+        target_exit(2);
+    }
+    report(name, ticks);
+    return sink;
+}
+
+/* The STATE recipe: the decode of its package (urrt_rtde_decode), and its
+ * feed; then the small recipe's feed. */
+static int bench_rtde(const tv_vector *v1116)
+{
+    uint32_t ticks;
+    int sink = 0;
+    rtde_session(v1116, rtde_state_names, RTDE_STATE_VARS, RTDE_STATE_SIZE);
+    TIMED(ticks, sink += urrt_rtde_decode(&ram.r.rtde, (const uint8_t *)packet_words, RTDE_STATE_SIZE, &st,
+                                          &ram.r.vals));
     report("rtde_decode_state", ticks);
+    sink += rtde_feed("rtde_feed_state", RTDE_STATE_SIZE);
+    rtde_session(v1116, rtde_small_names, RTDE_SMALL_VARS, RTDE_SMALL_SIZE);
+    sink += rtde_feed("rtde_feed_small", RTDE_SMALL_SIZE);
     return sink;
 }
 
@@ -335,6 +404,7 @@ int main(void)
     sink += bench_read10(v1116);
     sink += bench_decode(v1220, "decode_1220", "swap_copy_1220");
     sink += bench_framer(v1116);
+    sink += bench_framer_decode(v1116);
     sink += bench_can_pack(v1116);
     sink += bench_rtde(v1116);
     target_puts("bench: sink ");

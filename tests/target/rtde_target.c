@@ -138,8 +138,8 @@ static void run(const rtv_session *t, size_t chunk)
             if (e < t->event_count) {
                 check_event(t, e, k, &ev);
             }
-            if (k == URRT_RTDE_EV_DATA) { /* the package is still in the buffer */
-                MEASURED(r, urrt_rtde_decode, (&s, s.buf, s.data_size, &st, &vals));
+            if (k == URRT_RTDE_EV_DATA) { /* the package ends where the read was used up to */
+                MEASURED(r, urrt_rtde_decode, (&s, t->stream + pos - s.data_size, s.data_size, &st, &vals));
                 CHECK_EQ_INT(r, s.data_size);
             }
             e++;

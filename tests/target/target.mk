@@ -24,7 +24,8 @@
 #                  lib/vector/urrt_vector.c passes and the same with the old vector condition
 #                  (commit d7588d7) fails
 #   bench-lib-m4   instructions per operation on the emulated Cortex-M4 (qemu -icount),
-#                  a cycle estimate at 168 MHz, checked against docs/performance.md; packing
+#                  a cycle estimate at 168 MHz, checked against docs/performance.md (and the
+#                  RTDE feed of a read holding a 5-value recipe's package within 300); packing
 #                  a CAN frame also on the M4 with its single-precision FPU and the M0, its
 #                  instruction budget on the M4 (soft-float)
 

@@ -1214,7 +1214,7 @@ static const char *const rtde_config =
 static void set_var(urrt_rtde_values *v, int var)
 {
     unsigned bit = (unsigned)(var - URRT_RTDE_MAPPED_COUNT);
-    v->present[bit / 8u] |= (uint8_t)(1u << (bit % 8u));
+    v->present[bit / 32u] |= 1u << (bit % 32u);
 }
 
 /* Frame `frame` as it would go out now, after a package with these values. */

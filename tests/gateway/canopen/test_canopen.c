@@ -685,7 +685,7 @@ static void test_rtde_node(void)
         for (int k = 0; k < 2; k++) {
             unsigned bit = (unsigned)((k ? URRT_RTDE_V_SAFETY_STATUS_BITS : URRT_RTDE_V_OUTPUT_INT_REGISTER + 24) -
                                       URRT_RTDE_MAPPED_COUNT);
-            v.present[bit / 8u] |= (uint8_t)(1u << (bit % 8u));
+            v.present[bit / 32u] |= 1u << (bit % 32u);
         }
         urrt_state_clear(&st);
         st.time[0] = 1.0;
