@@ -751,6 +751,9 @@ static void read_available(urrt_link *link, bool wait)
  * function, where the connection must not end under it. */
 static void flush_queue(urrt_link *link)
 {
+    if (link->out_len == 0) {
+        return; /* a RealTime reader's every service: nothing to write, nothing to check */
+    }
     if (urrt_rtde_check_port(link->cfg.port) != URRT_OK) {
         link->out_head = link->out_len = 0; /* never reached through set_source: the last guard */
         return;

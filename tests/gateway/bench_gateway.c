@@ -1,8 +1,24 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * bench_gateway: urrt-gateway's latency and CPU cost beside a minimal relay
- * (bench_relay.c: the framer and one lcm_publish of the raw bytes per message,
- * nothing else), its scaling over many robots, and its highest packet rate.
+ * bench_gateway: urrt-gateway beside a minimal relay (bench_relay.c: the
+ * framer, or lib's RTDE client, and one lcm_publish of the raw bytes per
+ * message, nothing else): first what a packet costs in counts that do not
+ * depend on the machine's load (--counts: user-space instructions from
+ * valgrind's cachegrind, system calls from strace -c, RealTime and RTDE, at
+ * 1, 10 and 50 robots); then its latency and CPU time, its scaling over many
+ * robots, and its highest packet rate.
+ *
+ *   bench_gateway --counts --gateway PATH --relay PATH --sim URRT-SIM
+ *                 --count-robots N[,N...] [--count-packets P] [--keep DIR]
+ *                 [--top K]
+ *       For RealTime and then RTDE (urrt-sim --rtde doing the handshake),
+ *       at each robot count, relay and gateway: instructions and system
+ *       calls per packet (each system call by name), P packets (1000) in
+ *       all robots beyond a short session's (see "counts" below); the
+ *       gateway's K (8) costliest functions per packet; the goals (system
+ *       calls at most the relay's + 0.1; instructions at the most robots
+ *       within 1.1x of those at the fewest). --keep DIR keeps the tools'
+ *       files (cg_annotate, cg_diff read the cachegrind ones).
  *
  * This program is the robots and the subscriber at once: it serves 1220-byte
  * packets (lib's urrt_encode, the controller time carrying the packet's index)
@@ -42,7 +58,8 @@
  * subscriber, runs on another). Measured with 1 robot and with N, since a
  * wake-up serves more packets when more robots send.
  *
- * Prints "name: value" lines; asserts nothing about timings.
+ * Prints "name: value" lines; asserts nothing about timings (nor about
+ * counts: goals are printed met or NOT met).
  */
 #define _GNU_SOURCE
 #include <dirent.h>
@@ -63,6 +80,7 @@
 #include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -317,7 +335,8 @@ static uint16_t free_udp_port(void)
     return ntohs(a.sin_port);
 }
 
-static void make_packet(uint8_t *out, long index)
+/* A packet whose time column is t seconds (a 500 Hz controller's clock). */
+static void make_packet_at(uint8_t *out, double t)
 {
     static urrt_state st;
     static int ready;
@@ -333,10 +352,15 @@ static void make_packet(uint8_t *out, long index)
         st.digital_outputs[0] = 3;
         ready = 1;
     }
+    st.time[0] = t;
+    urrt_encode(&st, LENGTH, out, LENGTH);
+}
+
+static void make_packet(uint8_t *out, long index)
+{
     /* A 500 Hz controller's clock: the gateway holds it against its own to
      * tell a backlog from fresh packets, and it gives back the index. */
-    st.time[0] = (double)index / HZ;
-    urrt_encode(&st, LENGTH, out, LENGTH);
+    make_packet_at(out, (double)index / HZ);
 }
 
 /* Loopback TCP write-to-read with nothing in between. */
@@ -388,6 +412,9 @@ typedef struct {
     int robots;
     double seconds;
     const char *focused_hz; /* NULL: every message at every packet */
+    bool rtde;              /* source = rtde (the relay: --rtde) */
+    const char *gateway_rate; /* the gateway's GATEWAY reports; NULL: 1 Hz */
+    const char *const *tool; /* run under this tool's argv (counts); NULL: none */
 } subject;
 
 /* The cores: this program (robots, subscriber) on the first this process may
@@ -435,6 +462,26 @@ static void pin_subject(void)
     }
 }
 
+/* Starts argv under tool (the tool's own argv, NULL-terminated, before the
+ * subject's; NULL: none), pinned to the subject's core. */
+static pid_t spawn(const char *const *tool, char *const *argv)
+{
+    char *all[MAX_ROBOTS + 40];
+    int n = 0;
+    for (; tool != NULL && tool[n] != NULL; n++) all[n] = (char *)(uintptr_t)tool[n];
+    for (int i = 0; argv[i] != NULL; i++) all[n++] = argv[i];
+    all[n] = NULL;
+    pid_t pid = fork();
+    if (pid == 0) {
+        pin_subject();
+        prctl(PR_SET_PDEATHSIG, SIGTERM);
+        execvp(all[0], all);
+        dprintf(2, "bench_gateway: %s: %s\n", all[0], strerror(errno));
+        _exit(127);
+    }
+    return pid;
+}
+
 static pid_t start_gateway(const subject *sj, const char *url, const char *prefix, const uint16_t *ports, char *ini)
 {
     int ifd = mkstemp(ini);
@@ -445,38 +492,35 @@ static pid_t start_gateway(const subject *sj, const char *url, const char *prefi
         dprintf(ifd, "[lcm]\nurl = %s\nstate_rate = off\njoints_rate = %s Hz\ntool_rate = %s Hz\n"
                      "status_rate = %s Hz\n", url, sj->focused_hz, sj->focused_hz, sj->focused_hz);
     }
-    dprintf(ifd, "gateway_rate = 1 Hz\n");
+    dprintf(ifd, "gateway_rate = %s\n", sj->gateway_rate != NULL ? sj->gateway_rate : "1 Hz");
     for (int r = 0; r < sj->robots; r++) {
-        dprintf(ifd, "[robot %s_%d]\nhost = 127.0.0.1\nport = %u\nsilence_timeout = 2 s\n", prefix, r, ports[r]);
+        dprintf(ifd, "[robot %s_%d]\nhost = 127.0.0.1\nport = %u\nsilence_timeout = 2 s\n%s", prefix, r, ports[r],
+                sj->rtde ? "source = rtde\n" : "");
     }
     close(ifd);
-    pid_t pid = fork();
-    if (pid == 0) {
-        pin_subject();
-        execl(sj->path, sj->path, "--log-level", "warning", ini, (char *)NULL);
-        _exit(127);
-    }
-    return pid;
+    char *argv[] = {(char *)(uintptr_t)sj->path, "--log-level", "warning", ini, NULL};
+    return spawn(sj->tool, argv);
 }
 
-static pid_t start_relay(const subject *sj, const char *url, const char *prefix, uint16_t port)
+static pid_t start_relay(const subject *sj, const char *url, const char *prefix, const uint16_t *ports)
 {
-    char ports[8], every[16], chan[48];
-    snprintf(ports, sizeof ports, "%u", port);
+    char every[16], port_s[MAX_ROBOTS][8];
+    char *argv[MAX_ROBOTS + 10];
+    int a = 0;
     snprintf(every, sizeof every, "%d", sj->focused_hz == NULL ? 1 : HZ / atoi(sj->focused_hz));
-    snprintf(chan, sizeof chan, "%s_0", prefix);
-    pid_t pid = fork();
-    if (pid == 0) {
-        pin_subject();
-        if (sj->focused_hz == NULL) {
-            execl(sj->path, sj->path, "127.0.0.1", ports, url, chan, every, "STATE", "JOINTS", "TOOL", "STATUS",
-                  (char *)NULL);
-        } else {
-            execl(sj->path, sj->path, "127.0.0.1", ports, url, chan, every, "JOINTS", "TOOL", "STATUS", (char *)NULL);
-        }
-        _exit(127);
+    argv[a++] = (char *)(uintptr_t)sj->path;
+    if (sj->rtde) argv[a++] = "--rtde";
+    argv[a++] = "127.0.0.1";
+    argv[a++] = (char *)(uintptr_t)url;
+    argv[a++] = (char *)(uintptr_t)prefix;
+    argv[a++] = every;
+    argv[a++] = sj->focused_hz == NULL ? "STATE,JOINTS,TOOL,STATUS" : "JOINTS,TOOL,STATUS";
+    for (int r = 0; r < sj->robots; r++) {
+        snprintf(port_s[r], sizeof port_s[r], "%u", ports[r]);
+        argv[a++] = port_s[r];
     }
-    return pid;
+    argv[a] = NULL;
+    return spawn(sj->tool, argv);
 }
 
 static void summarize(session *s, result *res)
@@ -532,7 +576,7 @@ static bool subject_start(const subject *sj, const session *s, subject_run *sr)
     snprintf(url, sizeof url, "udpm://%s:%u?ttl=0", LCM_GROUP, udp_port);
     sr->sub_fd = subscribe_udp(LCM_GROUP, udp_port);
     for (int r = 0; r < n; r++) sr->lfd[r] = listen_any(&ports[r]);
-    sr->pid = sj->relay ? start_relay(sj, url, s->prefix, ports[0]) : start_gateway(sj, url, s->prefix, ports, sr->ini);
+    sr->pid = sj->relay ? start_relay(sj, url, s->prefix, ports) : start_gateway(sj, url, s->prefix, ports, sr->ini);
     for (int r = 0; r < n; r++) {
         struct pollfd pl = {.fd = sr->lfd[r], .events = POLLIN};
         sr->cfd[r] = poll(&pl, 1, 5000) == 1 ? accept(sr->lfd[r], NULL, NULL) : -1;
@@ -861,13 +905,578 @@ static void max_rate(const subject *sj)
     unlink(ini);
 }
 
+/* ---- counts: user-space instructions and system calls per packet ------------- */
+
+/*
+ * Figures that do not move with the machine's load: each subject runs under
+ * a tool that counts what it does, not how long it takes. valgrind's
+ * cachegrind (--cache-sim=no) counts the instructions the subject executes
+ * in user space (its own code, liblcm, the C library; not the kernel's);
+ * strace -f -c counts its system calls, by name. Two sessions per subject and
+ * tool, a short one (COUNT_WARMUP packets in all, at least two a robot) and
+ * one env->packets longer: the difference divided by those packets is what
+ * a packet costs, start-up, connections, the RTDE handshake and the exit
+ * taken out. Before the first packet the subject has settled (settle).
+ *
+ * Each packet is written only once every message of the one before has
+ * come in (lock-step), and not before its time at 500 Hz a robot (the
+ * robots spread over the period): however slow the tool makes the subject,
+ * every packet finds it waiting and is read on its own, so a packet costs
+ * one wake-up, as it does when the gateway keeps up. The time column (the
+ * RTDE timestamp) is this host's monotonic clock when the packet is written,
+ * so that a subject slowed by its tool still judges the data fresh.
+ * GATEWAY reports are off: they come with time, not packets (0.002 of a
+ * message a packet at 1 Hz and 500 Hz), and a run the tool slows has more
+ * time per packet.
+ *
+ * RTDE: urrt-sim --rtde (-c 5.12, every variable the gateway asks for) does
+ * the handshake with the subject, through this program, which passes every
+ * byte both ways until the simulator's first data package; that package is
+ * then the template of every package this program writes, its timestamp set
+ * at the write.
+ */
+typedef enum { TOOL_VALGRIND, TOOL_STRACE } tool_kind;
+
+#define COUNT_WARMUP 100              /* packets (all robots) of the shorter session */
+#define COUNT_TIMEOUT_NS 30000000000u /* a subject under valgrind starts slowly */
+#define COUNT_WAIT_NS 10000000000u    /* for one packet's messages */
+#define PKG_MAX 4096
+
+typedef struct {
+    char key[128];
+    double v;
+} tally_entry;
+
+/* What a tool counted: per name (a function, a system call) and in all. */
+typedef struct {
+    tally_entry *e;
+    size_t n, cap;
+    double total;
+} tally;
+
+static size_t tally_find(tally *t, const char *key)
+{
+    for (size_t i = 0; i < t->n; i++) {
+        if (strcmp(t->e[i].key, key) == 0) return i;
+    }
+    if (t->n == t->cap) {
+        t->cap = t->cap ? 2 * t->cap : 256;
+        t->e = realloc(t->e, t->cap * sizeof *t->e);
+    }
+    snprintf(t->e[t->n].key, sizeof t->e[t->n].key, "%s", key);
+    t->e[t->n].v = 0;
+    return t->n++;
+}
+
+static void tally_free(tally *t)
+{
+    free(t->e);
+    memset(t, 0, sizeof *t);
+}
+
+/* (b - a) / packets, by name and in all. */
+static tally tally_per_packet(const tally *a, tally *b, double packets)
+{
+    tally d = {0};
+    for (size_t i = 0; i < b->n; i++) {
+        size_t k = tally_find(&d, b->e[i].key);
+        d.e[k].v += b->e[i].v / packets;
+    }
+    for (size_t i = 0; i < a->n; i++) {
+        size_t k = tally_find(&d, a->e[i].key);
+        d.e[k].v -= a->e[i].v / packets;
+    }
+    d.total = (b->total - a->total) / packets;
+    return d;
+}
+
+static int cmp_entry_desc(const void *x, const void *y)
+{
+    const tally_entry *p = x, *q = y;
+    double a = round(p->v * 1000.0), b = round(q->v * 1000.0); /* as printed: equal figures by name */
+    return a != b ? (a < b) - (a > b) : strcmp(p->key, q->key);
+}
+
+/* cachegrind's file (--cache-sim=no: one event, Ir): "fn=NAME" starts a
+ * function's lines, "LINE COUNT" follow, "summary: TOTAL" ends it. */
+static bool read_cachegrind(const char *path, tally *t)
+{
+    FILE *f = fopen(path, "r");
+    char line[4096];
+    size_t cur = SIZE_MAX;
+    bool summary = false;
+    if (f == NULL) return false;
+    while (fgets(line, sizeof line, f) != NULL) {
+        if (strncmp(line, "fn=", 3) == 0) {
+            line[strcspn(line, "\n")] = 0;
+            cur = tally_find(t, line + 3);
+        } else if (strncmp(line, "summary:", 8) == 0) {
+            t->total = strtod(line + 8, NULL);
+            summary = true;
+        } else if (line[0] >= '0' && line[0] <= '9' && cur != SIZE_MAX) {
+            char *end;
+            strtoull(line, &end, 10);
+            t->e[cur].v += strtod(end, NULL);
+        }
+    }
+    fclose(f);
+    return summary;
+}
+
+/* strace -c -U name,calls: "NAME CALLS" lines, "total CALLS" last. */
+static bool read_strace(const char *path, tally *t)
+{
+    FILE *f = fopen(path, "r");
+    char line[512], name[128];
+    unsigned long long calls;
+    bool total = false;
+    if (f == NULL) return false;
+    while (fgets(line, sizeof line, f) != NULL) {
+        if (sscanf(line, "%127s %llu", name, &calls) != 2) continue;
+        if (strcmp(name, "total") == 0) {
+            t->total = (double)calls;
+            total = true;
+        } else {
+            size_t k = tally_find(t, name); /* may move t->e */
+            t->e[k].v += (double)calls;
+        }
+    }
+    fclose(f);
+    return total;
+}
+
+static void put_be_double(uint8_t *d, double v)
+{
+    uint64_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    for (int i = 7; i >= 0; i--, bits >>= 8) d[i] = (uint8_t)bits;
+}
+
+static bool write_all_fd(int fd, const uint8_t *p, size_t n)
+{
+    while (n > 0) {
+        ssize_t w = write(fd, p, n);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) return false;
+        p += w;
+        n -= (size_t)w;
+    }
+    return true;
+}
+
+/* A connection to urrt-sim's RTDE port for each of n robots, in sfd[],
+ * before the subject starts: eight at a time, so that the simulator's
+ * listen backlog (16) never overflows (a SYN dropped is sent again a second
+ * later, which the subject's silence timeout would see). */
+static bool sim_connect(int n, uint16_t sim_port, int *sfd)
+{
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons(sim_port),
+                            .sin_addr.s_addr = htonl(INADDR_LOOPBACK)};
+    for (int r = 0; r < n; r++) sfd[r] = -1;
+    for (int r = 0; r < n; r++) {
+        sfd[r] = socket(AF_INET, SOCK_STREAM, 0);
+        if (connect(sfd[r], (struct sockaddr *)&a, sizeof a) != 0) {
+            perror("bench_gateway: connect to urrt-sim's RTDE port");
+            return false;
+        }
+        if (r % 8 == 7) nanosleep(&(struct timespec){0, 20000000}, NULL);
+    }
+    return true;
+}
+
+/* Accepts each robot's connection from the subject (lfd[r] -> cfd[r],
+ * *accepted of them) and, with RTDE (sfd[r] urrt-sim's connection for
+ * robot r; NULL: RealTime), passes every byte both ways until the
+ * simulator's first data package, which becomes the robot's template (not
+ * passed on): each robot's handshake goes on while the subject connects
+ * the next. Closes sfd[]. */
+static bool accept_robots(int n, const int *lfd, int *cfd, int *accepted, int *sfd, uint8_t (*tmpl)[PKG_MAX],
+                          size_t *tmpl_len)
+{
+    static struct {
+        uint8_t b[2 * PKG_MAX];
+        size_t have;
+    } in[MAX_ROBOTS];
+    int left = n;
+    bool done[MAX_ROBOTS] = {false}, ok = true, rtde = sfd != NULL;
+    for (int r = 0; r < n; r++) cfd[r] = -1;
+    *accepted = 0;
+    uint64_t end = mono_ns() + COUNT_TIMEOUT_NS;
+    while (ok && left > 0 && mono_ns() < end) {
+        struct pollfd p[2 * MAX_ROBOTS];
+        for (int r = 0; r < n; r++) {
+            p[2 * r] = (struct pollfd){.fd = cfd[r] < 0 ? lfd[r] : cfd[r], .events = POLLIN};
+            p[2 * r + 1] = (struct pollfd){.fd = done[r] || cfd[r] < 0 ? -1 : sfd[r], .events = POLLIN};
+        }
+        if (poll(p, (nfds_t)(2 * n), 100) <= 0) continue;
+        for (int r = 0; ok && r < n; r++) {
+            uint8_t buf[PKG_MAX];
+            if (p[2 * r].revents != 0 && cfd[r] < 0) { /* the subject connects */
+                cfd[r] = accept(lfd[r], NULL, NULL);
+                ok = cfd[r] >= 0;
+                if (!ok) break;
+                (*accepted)++;
+                setsockopt(cfd[r], IPPROTO_TCP, TCP_NODELAY, &(int){1}, sizeof(int));
+                in[r].have = 0;
+                if (!rtde) {
+                    done[r] = true;
+                    left--;
+                    continue;
+                }
+            } else if (p[2 * r].revents != 0) { /* the subject's requests */
+                ssize_t k = read(cfd[r], buf, sizeof buf);
+                ok = k > 0 && (done[r] || write_all_fd(sfd[r], buf, (size_t)k));
+                if (!ok) fprintf(stderr, "bench_gateway: RTDE: robot %d: the subject closed its connection\n", r);
+            }
+            if (ok && p[2 * r + 1].revents != 0) { /* the simulator's replies */
+                ssize_t k = read(sfd[r], in[r].b + in[r].have, sizeof in[r].b - in[r].have);
+                ok = k > 0;
+                if (!ok) fprintf(stderr, "bench_gateway: RTDE: robot %d: urrt-sim closed its connection\n", r);
+                in[r].have += k > 0 ? (size_t)k : 0;
+                while (ok && !done[r] && in[r].have >= 3) {
+                    size_t size = (size_t)in[r].b[0] << 8 | in[r].b[1];
+                    ok = size >= 3 && size <= PKG_MAX;
+                    if (!ok || in[r].have < size) break;
+                    if (in[r].b[2] == 'U') {
+                        memcpy(tmpl[r], in[r].b, size);
+                        tmpl_len[r] = size;
+                        done[r] = true;
+                        left--;
+                    } else {
+                        ok = write_all_fd(cfd[r], in[r].b, size);
+                    }
+                    memmove(in[r].b, in[r].b + size, in[r].have - size);
+                    in[r].have -= size;
+                }
+            }
+        }
+    }
+    for (int r = 0; rtde && r < n; r++) close(sfd[r]);
+    /* The timestamp is the recipe's first variable, after the recipe id
+     * (protocol 2): urrt-sim's clock is this host's monotonic one. */
+    for (int r = 0; ok && left == 0 && rtde && r < n; r++) {
+        double t = be_double(tmpl[r] + 4), now = (double)mono_ns() / 1e9;
+        ok = tmpl_len[r] >= 12 && fabs(t - now) < 10.0;
+    }
+    if (!ok || left > 0) {
+        fprintf(stderr, "bench_gateway: %d of %d robots connected%s\n", rtde ? n - left : *accepted, n,
+                rtde ? " and streaming RTDE (through urrt-sim)" : "");
+    }
+    return ok && left == 0;
+}
+
+/* Reads the subscriber's socket until want messages of prefix's robots
+ * have come in all (*got counts them) or the time is up. */
+static bool await_count(int fd, const char *prefix, uint64_t *got, uint64_t want, uint64_t timeout_ns)
+{
+    enum { N = 16, SIZE = 2048 };
+    static uint8_t bufs[N][SIZE];
+    struct iovec iov[N];
+    struct mmsghdr msgs[N];
+    size_t pl = strlen(prefix);
+    uint64_t end = mono_ns() + timeout_ns;
+    while (*got < want) {
+        uint64_t now = mono_ns();
+        if (now >= end) return false;
+        struct pollfd p = {.fd = fd, .events = POLLIN};
+        if (poll(&p, 1, (int)((end - now) / 1000000u) + 1) != 1) continue;
+        for (int i = 0; i < N; i++) {
+            iov[i] = (struct iovec){.iov_base = bufs[i], .iov_len = SIZE};
+            msgs[i] = (struct mmsghdr){.msg_hdr = {.msg_iov = &iov[i], .msg_iovlen = 1}};
+        }
+        int n = recvmmsg(fd, msgs, N, MSG_DONTWAIT, NULL);
+        for (int i = 0; i < n; i++) {
+            const uint8_t *d = bufs[i];
+            if (msgs[i].msg_len > 8 + pl && memcmp(d, "LC02", 4) == 0 && memcmp(d + 8, prefix, pl) == 0 &&
+                d[8 + pl] == '_') {
+                (*got)++;
+            }
+        }
+    }
+    return true;
+}
+
+/* The pid of pid's child (the subject strace started). */
+static pid_t child_of(pid_t pid)
+{
+    char path[64];
+    long child = 0;
+    snprintf(path, sizeof path, "/proc/%d/task/%d/children", (int)pid, (int)pid);
+    for (int i = 0; i < 100 && child == 0; i++) {
+        FILE *f = fopen(path, "r");
+        if (f != NULL) {
+            if (fscanf(f, "%ld", &child) != 1) child = 0;
+            fclose(f);
+        }
+        if (child == 0) nanosleep(&(struct timespec){0, 10000000}, NULL);
+    }
+    return (pid_t)child;
+}
+
+/* Waits for pid to exit, SIGKILL after timeout; its exit status, or -1. */
+static int reap(pid_t pid, uint64_t timeout_ns)
+{
+    int status = 0;
+    uint64_t end = mono_ns() + timeout_ns;
+    while (waitpid(pid, &status, WNOHANG) == 0) {
+        if (mono_ns() > end) {
+            kill(pid, SIGKILL);
+            waitpid(pid, &status, 0);
+            return -1;
+        }
+        nanosleep(&(struct timespec){0, 5000000}, NULL);
+    }
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/* urrt-sim serving RTDE as a 5.12 controller on a port the system chose. */
+static pid_t start_sim(const char *path, const char *dir, uint16_t *port)
+{
+    char port_file[128];
+    snprintf(port_file, sizeof port_file, "%s/sim.port", dir);
+    unlink(port_file);
+    pid_t pid = fork();
+    if (pid == 0) {
+        int null = open("/dev/null", O_WRONLY);
+        dup2(null, 1);
+        prctl(PR_SET_PDEATHSIG, SIGTERM); /* not left behind if this program dies */
+        execl(path, path, "-q", "-l", "127.0.0.1:0", "--rtde", "127.0.0.1:0", "--rtde-port-file", port_file, "-c",
+              "5.12", "--clock", "monotonic", "--max-clients", "64", (char *)NULL);
+        _exit(127);
+    }
+    for (int i = 0; i < 500; i++) {
+        FILE *f = fopen(port_file, "r");
+        unsigned p = 0;
+        if (f != NULL) {
+            int got = fscanf(f, "%u", &p);
+            fclose(f);
+            if (got == 1 && p > 0 && p < 65536) {
+                *port = (uint16_t)p;
+                return pid;
+            }
+        }
+        nanosleep(&(struct timespec){0, 10000000}, NULL);
+    }
+    fprintf(stderr, "bench_gateway: urrt-sim did not start\n");
+    kill(pid, SIGTERM);
+    waitpid(pid, NULL, 0);
+    return -1;
+}
+
+/* Waits until pid (every thread) has used no CPU for 30 ms, 1.5 s at most:
+ * it has done what its connections started and waits (the gateway's ticks,
+ * every 100 ms, leave such gaps even under valgrind; its robots' silence
+ * timeout, 2 s, is not reached). */
+static void settle(pid_t pid)
+{
+    uint64_t last = task_times(pid).ns;
+    int quiet = 0;
+    for (int i = 0; i < 150 && quiet < 3; i++) {
+        nanosleep(&(struct timespec){0, 10000000}, NULL);
+        uint64_t now = task_times(pid).ns;
+        quiet = now == last ? quiet + 1 : 0;
+        last = now;
+    }
+}
+
+typedef struct {
+    const char *gateway, *relay, *sim;
+    char dir[64];   /* the tools' files */
+    long packets;   /* the longer session's packets beyond the shorter's (all robots) */
+} count_env;
+
+/* One session of a subject under a tool: per_robot packets to each of n
+ * robots in lock-step; t gets the tool's figures. Messages that never came
+ * (each waited for COUNT_WAIT_NS) are added to *missing. */
+static bool count_session(const count_env *env, bool relay, bool rtde, int n, long per_robot, tool_kind tool,
+                          const char *out, tally *t, uint64_t *missing)
+{
+    static unsigned serial;
+    static uint8_t tmpl[MAX_ROBOTS][PKG_MAX];
+    size_t tmpl_len[MAX_ROBOTS];
+    char prefix[32], url[96], file_opt[320], log_opt[320], ini[] = INI_TEMPLATE;
+    uint16_t ports[MAX_ROBOTS], udp_port = free_udp_port();
+    int lfd[MAX_ROBOTS], cfd[MAX_ROBOTS], sfd[MAX_ROBOTS], accepted = 0;
+    snprintf(prefix, sizeof prefix, "c%d_%u", (int)getpid(), serial++);
+    snprintf(url, sizeof url, "udpm://%s:%u?ttl=0", LCM_GROUP, udp_port);
+    snprintf(file_opt, sizeof file_opt, "--cachegrind-out-file=%s", out);
+    snprintf(log_opt, sizeof log_opt, "--log-file=%s.log", out); /* valgrind's own messages */
+    const char *valgrind[] = {"valgrind", "-q", "--tool=cachegrind", "--cache-sim=no", file_opt, log_opt, NULL};
+    const char *strace[] = {"strace", "-f", "-c", "-U", "name,calls", "-o", out, NULL};
+    subject sj = {.path = relay ? env->relay : env->gateway, .relay = relay, .robots = n, .rtde = rtde,
+                  .gateway_rate = "off", .tool = tool == TOOL_VALGRIND ? valgrind : strace};
+    int sub_fd = subscribe_udp(LCM_GROUP, udp_port);
+    for (int r = 0; r < n; r++) {
+        lfd[r] = listen_any(&ports[r]);
+        cfd[r] = sfd[r] = -1;
+    }
+    /* A simulator of its own for each session: one that still counts the
+     * last session's connections might refuse this one's. */
+    uint16_t sim_port = 0;
+    pid_t sim_pid = rtde ? start_sim(env->sim, env->dir, &sim_port) : -1;
+    pid_t pid = rtde && (sim_pid < 0 || !sim_connect(n, sim_port, sfd)) ? -1
+                : relay ? start_relay(&sj, url, prefix, ports)
+                        : start_gateway(&sj, url, prefix, ports, ini);
+    bool ok = pid > 0 && accept_robots(n, lfd, cfd, &accepted, rtde ? sfd : NULL, tmpl, tmpl_len);
+    for (int r = 0; pid <= 0 && rtde && r < n; r++) {
+        if (sfd[r] >= 0) close(sfd[r]);
+    }
+    if (sim_pid > 0) {
+        kill(sim_pid, SIGTERM);
+        waitpid(sim_pid, NULL, 0);
+    }
+    /* strace's subject is its child; valgrind's is the process it runs in. */
+    pid_t target = pid <= 0 ? -1 : tool == TOOL_STRACE ? child_of(pid) : pid;
+    /* Nothing of the start-up left to do when the first packet comes. */
+    if (ok && target > 0) settle(target);
+    uint64_t start = mono_ns(), got = 0, want = 0;
+    for (long i = 0; ok && i < per_robot; i++) {
+        for (int r = 0; ok && r < n; r++) {
+            uint8_t pkt[PKG_MAX];
+            size_t len = LENGTH;
+            uint64_t due = start + (uint64_t)i * PERIOD_NS + (uint64_t)r * PERIOD_NS / (uint64_t)n, now = mono_ns();
+            if (now < due) nanosleep(&(struct timespec){0, (long)(due - now)}, NULL);
+            double stamp = (double)mono_ns() / 1e9;
+            if (rtde) {
+                len = tmpl_len[r];
+                memcpy(pkt, tmpl[r], len);
+                put_be_double(pkt + 4, stamp);
+            } else {
+                make_packet_at(pkt, stamp);
+            }
+            ok = write_all_fd(cfd[r], pkt, len);
+            want += KINDS;
+            if (ok && !await_count(sub_fd, prefix, &got, want, COUNT_WAIT_NS)) {
+                fprintf(stderr, "bench_gateway: %s under %s: packet %ld of robot %d: %llu of %d messages came\n",
+                        sj.path, sj.tool[0], i + 1, r, (unsigned long long)(got + KINDS - want), KINDS);
+                *missing += want - got;
+                ok = false;
+            }
+        }
+    }
+    if (!ok) fprintf(stderr, "bench_gateway: a count session of %s failed\n", sj.path);
+    if (target > 0) kill(target, SIGTERM);
+    int status = pid > 0 ? reap(pid, COUNT_TIMEOUT_NS) : -1;
+    for (int r = 0; r < n; r++) {
+        if (cfd[r] >= 0) close(cfd[r]);
+    }
+    for (int r = 0; r < n; r++) close(lfd[r]);
+    close(sub_fd);
+    if (!relay) unlink(ini);
+    if (status != 0) {
+        fprintf(stderr, "bench_gateway: %s under %s exited with status %d\n", sj.path, sj.tool[0], status);
+        ok = false;
+    }
+    return ok && (tool == TOOL_VALGRIND ? read_cachegrind(out, t) : read_strace(out, t));
+}
+
+/* A subject's figures per packet under a tool: two sessions, the second
+ * env->packets longer. */
+static bool count_per_packet(const count_env *env, bool relay, bool rtde, int n, tool_kind tool, tally *per_packet,
+                             uint64_t *missing)
+{
+    long warm = (COUNT_WARMUP + n - 1) / n, more = (env->packets + n - 1) / n;
+    tally a = {0}, b = {0};
+    char out_a[160], out_b[160];
+    const char *what = tool == TOOL_VALGRIND ? "cachegrind" : "strace";
+    snprintf(out_a, sizeof out_a, "%s/%s-%s-%d-%s-short.out", env->dir, rtde ? "rtde" : "realtime",
+             relay ? "relay" : "gateway", n, what);
+    snprintf(out_b, sizeof out_b, "%s/%s-%s-%d-%s-long.out", env->dir, rtde ? "rtde" : "realtime",
+             relay ? "relay" : "gateway", n, what);
+    bool ok = count_session(env, relay, rtde, n, warm, tool, out_a, &a, missing) &&
+              count_session(env, relay, rtde, n, warm + more, tool, out_b, &b, missing);
+    if (ok) *per_packet = tally_per_packet(&a, &b, (double)(more * n));
+    tally_free(&a);
+    tally_free(&b);
+    return ok;
+}
+
+static void print_goal(const char *name, double value, const char *fmt_goal, bool met)
+{
+    printf("%s: %.3f (goal %s: %s)\n", name, value, fmt_goal, met ? "met" : "NOT met");
+}
+
+/* Prints the counts for both sources at each robot count of list. */
+static bool counts(const count_env *env, const int *list, int nlist, int top)
+{
+    bool all_ok = true;
+    char name[160];
+    if (system("valgrind --version >/dev/null 2>&1") != 0 || system("strace -V >/dev/null 2>&1") != 0) {
+        fprintf(stderr, "bench_gateway: the counts need valgrind and strace (Debian: apt-get install valgrind "
+                        "strace)\n");
+        return false;
+    }
+    printf("counts_packets_per_figure: %ld\n", env->packets);
+    for (int src = 0; src < 2; src++) {
+        const char *sname = src ? "rtde" : "realtime";
+        double gw_instr[MAX_ROBOTS + 1] = {0};
+        for (int li = 0; li < nlist; li++) {
+            int n = list[li];
+            tally instr[2] = {{0}}, sys[2] = {{0}};
+            uint64_t missing[2] = {0, 0};
+            bool ok[2];
+            for (int who = 0; who < 2; who++) { /* relay, gateway */
+                ok[who] = count_per_packet(env, who == 0, src, n, TOOL_VALGRIND, &instr[who], &missing[who]) &&
+                          count_per_packet(env, who == 0, src, n, TOOL_STRACE, &sys[who], &missing[who]);
+                all_ok = all_ok && ok[who];
+                const char *wname = who ? "gateway" : "relay";
+                if (!ok[who]) {
+                    printf("counts_%s_robots_%d_%s: failed\n", sname, n, wname);
+                    continue;
+                }
+                snprintf(name, sizeof name, "counts_%s_robots_%d_%s_", sname, n, wname);
+                printf("%sinstructions_per_packet: %.0f\n", name, instr[who].total);
+                printf("%ssyscalls_per_packet: %.3f\n", name, sys[who].total);
+                qsort(sys[who].e, sys[who].n, sizeof *sys[who].e, cmp_entry_desc);
+                for (size_t i = 0; i < sys[who].n; i++) {
+                    if (fabs(sys[who].e[i].v) >= 0.0005) {
+                        printf("%ssyscall_%s_per_packet: %.3f\n", name, sys[who].e[i].key, sys[who].e[i].v);
+                    }
+                }
+                qsort(instr[who].e, instr[who].n, sizeof *instr[who].e, cmp_entry_desc);
+                for (size_t i = 0; who == 1 && i < instr[who].n && (int)i < top; i++) {
+                    printf("%sinstructions_in_%s: %.0f\n", name, instr[who].e[i].key, instr[who].e[i].v);
+                }
+                if (missing[who] != 0) {
+                    printf("%smessages_missing: %llu\n", name, (unsigned long long)missing[who]);
+                }
+            }
+            if (ok[0] && ok[1]) {
+                snprintf(name, sizeof name, "counts_%s_robots_%d_gateway_syscalls_vs_relay", sname, n);
+                double d = sys[1].total - sys[0].total;
+                printf("%s: %+.3f (goal at most +0.100: %s)\n", name, d, d <= 0.1 ? "met" : "NOT met");
+                snprintf(name, sizeof name, "counts_%s_robots_%d_gateway_instructions_vs_relay", sname, n);
+                printf("%s: %.2f\n", name, instr[1].total / instr[0].total);
+            }
+            if (ok[1]) gw_instr[li] = instr[1].total;
+            for (int who = 0; who < 2; who++) {
+                tally_free(&instr[who]);
+                tally_free(&sys[who]);
+            }
+        }
+        /* The most robots against the fewest (50 against 1). */
+        int lo = 0, hi = 0;
+        for (int li = 0; li < nlist; li++) {
+            if (list[li] < list[lo]) lo = li;
+            if (list[li] > list[hi]) hi = li;
+        }
+        if (lo != hi && gw_instr[lo] > 0 && gw_instr[hi] > 0) {
+            snprintf(name, sizeof name, "counts_%s_gateway_instructions_%d_vs_%d_robots", sname, list[hi], list[lo]);
+            print_goal(name, gw_instr[hi] / gw_instr[lo], "at most 1.100", gw_instr[hi] / gw_instr[lo] <= 1.1);
+        }
+    }
+    return all_ok;
+}
+
 int main(int argc, char **argv)
 {
     /* Sleeps of tens of microseconds between robots' packets: no 50 us slack. */
     prctl(PR_SET_TIMERSLACK, 1000UL);
     subject gw = {.robots = 0, .seconds = 4}, relay = {.relay = true, .robots = 1};
-    int rounds = 3, versus_robots = 0;
-    bool max = false, pin = true;
+    int rounds = 3, versus_robots = 0, count_list[MAX_ROBOTS], count_n = 0, top = 8;
+    bool max = false, pin = true, count_mode = false;
+    const char *sim = NULL, *keep = NULL;
+    long count_packets = 1000;
     for (int i = 1; i < argc; i++) {
         const char *v = i + 1 < argc ? argv[i + 1] : "";
         if (strcmp(argv[i], "--gateway") == 0) gw.path = argv[++i];
@@ -879,6 +1488,53 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--versus") == 0) versus_robots = atoi(v), i++;
         else if (strcmp(argv[i], "--max-rate") == 0) max = true;
         else if (strcmp(argv[i], "--no-pin") == 0) pin = false;
+        else if (strcmp(argv[i], "--counts") == 0) count_mode = true;
+        else if (strcmp(argv[i], "--sim") == 0) sim = argv[++i];
+        else if (strcmp(argv[i], "--keep") == 0) keep = argv[++i];
+        else if (strcmp(argv[i], "--count-packets") == 0) count_packets = atol(v), i++;
+        else if (strcmp(argv[i], "--top") == 0) top = atoi(v), i++;
+        else if (strcmp(argv[i], "--count-robots") == 0) {
+            char list[256], *save = NULL;
+            snprintf(list, sizeof list, "%s", v);
+            for (char *t = strtok_r(list, ", ", &save); t != NULL && count_n < MAX_ROBOTS;
+                 t = strtok_r(NULL, ", ", &save)) {
+                count_list[count_n++] = atoi(t);
+            }
+            i++;
+        }
+    }
+    if (count_mode) {
+        bool bad = gw.path == NULL || relay.path == NULL || sim == NULL || count_packets < 10 || count_n == 0;
+        for (int k = 0; k < count_n; k++) bad = bad || count_list[k] < 1 || count_list[k] > MAX_ROBOTS;
+        if (bad) {
+            fprintf(stderr, "usage: bench_gateway --counts --gateway PATH --relay PATH --sim PATH --count-robots "
+                            "N[,N...] [--count-packets P] [--keep DIR] [--top K] [--no-pin]\n");
+            return 2;
+        }
+        signal(SIGPIPE, SIG_IGN);
+        if (pin) choose_cores();
+        count_env env = {.gateway = gw.path, .relay = relay.path, .sim = sim, .packets = count_packets};
+        if (keep != NULL) {
+            snprintf(env.dir, sizeof env.dir, "%s", keep);
+            mkdir(keep, 0777);
+        } else if (mkdtemp(strcpy(env.dir, "/tmp/bench-gateway-counts-XXXXXX")) == NULL) {
+            perror("bench_gateway: mkdtemp");
+            return 1;
+        }
+        printf("bench_core: %d\nsubject_core: %d\n", bench_core, subject_core);
+        fflush(stdout);
+        bool ok = counts(&env, count_list, count_n, top);
+        if (keep == NULL) {
+            DIR *d = opendir(env.dir);
+            for (struct dirent *e; d != NULL && (e = readdir(d)) != NULL;) {
+                char p[400];
+                snprintf(p, sizeof p, "%s/%s", env.dir, e->d_name);
+                if (e->d_name[0] != '.') unlink(p);
+            }
+            if (d != NULL) closedir(d);
+            rmdir(env.dir);
+        }
+        return ok ? 0 : 1;
     }
     bool scale = gw.robots > 0;
     if (gw.path == NULL || (!scale && relay.path == NULL) || gw.robots > MAX_ROBOTS || rounds < 1 ||

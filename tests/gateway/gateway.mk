@@ -9,19 +9,24 @@
 #                   STATUS, WATCHDOG at half the period and none while SIGSTOPped, STOPPING
 #   check-metrics   the Prometheus textfile: promtool accepts it, values against the
 #                   simulator and the CAN log, renamed whole, write errors counted
-#   bench-gateway   latency robot -> subscriber and CPU per packet beside a
-#                   minimal relay (bench_relay.c), 1/10/50 robots, the CPU per
-#                   packet at 50 robots against 10, highest rate, and the 500 Hz
-#                   robots one core serves; then bench-plc-io (the PLC's frames
-#                   written as input registers, in the VM)
+#   bench-gateway   first counts per packet beside a minimal relay
+#                   (bench_relay.c): user-space instructions (valgrind's
+#                   cachegrind) and system calls (strace -c), RealTime and RTDE
+#                   (urrt-sim --rtde), 1/10/50 robots; then latency robot ->
+#                   subscriber and CPU per packet beside the relay, 1/10/50
+#                   robots, the CPU per packet at 50 robots against 10, highest
+#                   rate, and the 500 Hz robots one core serves; then
+#                   bench-plc-io (the PLC's frames written as input registers,
+#                   in the VM)
 GWT := $(BUILD)/tests/gateway
 GWT_CFLAGS := $(PROG_WARN) $(OPT) $(CPPFLAGS) -I$(LCMGEN)
 
 CHECKS += check-freshness check-gateway check-notify check-metrics
 BENCHES += bench-gateway
 .PHONY: check-freshness check-gateway check-notify check-metrics bench-gateway
-# promtool, for check-metrics.
-DEB_DEPS += prometheus
+# promtool, for check-metrics; strace, for bench-gateway's system calls per
+# packet (valgrind, its instructions, is in the Makefile's list).
+DEB_DEPS += prometheus strace
 
 # The age estimator and the rate meter on a fake clock (gateway/urrt-gateway/freshness.h).
 $(GWT)/test_freshness: tests/gateway/test_freshness.c tests/check.h gateway/urrt-gateway/freshness.c gateway/urrt-gateway/freshness.h
@@ -56,7 +61,11 @@ check-notify: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim
 check-metrics: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim
 	$(call suite,$@,$(PYTHON) tests/gateway/test_metrics.py --build $(BUILD))
 
-# The gateway beside the relay, every message at every packet, then the
+# First the counts: gateway and relay under valgrind (instructions) and strace
+# (system calls), RealTime and RTDE, at each of BENCH_GATEWAY_ROBOTS, every
+# message at every packet, BENCH_GATEWAY_COUNT_PACKETS packets a figure
+# (BENCH_GATEWAY_KEEP=DIR keeps the tools' files). Then the times: the gateway
+# beside the relay, every message at every packet, then the
 # focused messages at 50 Hz and no state; then one gateway against 1, 10 and
 # 50 robots at 500 Hz each, every message at every packet, and again with the
 # focused messages; then the CPU per packet at 50 robots against 10, three
@@ -65,8 +74,18 @@ check-metrics: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim
 BENCH_GATEWAY_ROBOTS ?= 1 10 50
 # --no-pin: the bench and the subject wherever the scheduler puts them.
 BENCH_GATEWAY_FLAGS ?=
+BENCH_GATEWAY_COUNT_PACKETS ?= 1000
+BENCH_GATEWAY_KEEP ?=
 BENCH_GW = $(GWT)/bench_gateway $(BENCH_GATEWAY_FLAGS)
-bench-gateway: $(BUILD)/bin/urrt-gateway $(GWT)/bench_gateway $(GWT)/bench_relay
+bench-gateway: $(BUILD)/bin/urrt-gateway $(BUILD)/bin/urrt-sim $(GWT)/bench_gateway $(GWT)/bench_relay
+	@echo "bench-gateway: counts per packet, which do not move with the load: *instructions_per_packet, user space"
+	@echo "bench-gateway: (valgrind --tool=cachegrind), *syscalls_per_packet (strace -f -c), each the difference of a"
+	@echo "bench-gateway: long and a short session over the packets between; every message at every packet, each"
+	@echo "bench-gateway: packet written once the last one's messages are in; RTDE: urrt-sim --rtde's handshake"
+	@$(BENCH_GW) --counts --gateway $(BUILD)/bin/urrt-gateway --relay $(GWT)/bench_relay --sim $(BUILD)/bin/urrt-sim \
+	  --count-robots "$(BENCH_GATEWAY_ROBOTS)" --count-packets $(BENCH_GATEWAY_COUNT_PACKETS) \
+	  $(if $(BENCH_GATEWAY_KEEP),--keep $(BENCH_GATEWAY_KEEP))
+	@echo "bench-gateway: then the times, the second figure: latency, CPU per packet (wall clock, machine and load)"
 	@echo "bench-gateway: *robots_per_core = 1 / (cpu_per_packet_us * 1e-6 * 500): the 500 Hz robots one core"
 	@echo "bench-gateway: serves at the subject's CPU per packet (its threads, from schedstat) measured there"
 	@echo "bench-gateway: the subject on a core of its own, the bench on another (BENCH_GATEWAY_FLAGS=--no-pin:"
