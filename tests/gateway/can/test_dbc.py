@@ -288,16 +288,20 @@ def parse_config(path):
         if f['stale'] is None:
             f['stale'] = can['stale']
     if 'node_id' in can:
-        canopen_ids(can, [frames[n] for n in order if not frames[n]['input']])
+        canopen_ids(can, [frames[n] for n in order if not frames[n]['input']],
+                    [frames[n] for n in order if frames[n]['input']])
     return can, [frames[n] for n in order]
 
 
-def canopen_ids(can, frames):
+def canopen_ids(can, frames, inputs):
     """With [canopen] (docs/canopen.md): the nth frame is TPDO n, at CiA 301's pre-defined COB-ID
     0x180/0x280/0x380/0x480 + node id unless it gives its own; the status frame (the heartbeat's
-    layout) is the next TPDO, at its pre-defined id, else 0x680 + node id."""
+    layout) is the next TPDO, at its pre-defined id, else 0x680 + node id; the nth [input] is
+    RPDO n, at 0x200/0x300/0x400/0x500 + node id."""
     for n, f in enumerate(frames, 1):
         f.setdefault('id', 0x80 + 0x100 * n + can['node_id'])
+    for n, f in enumerate(inputs, 1):
+        f.setdefault('id', 0x100 + 0x100 * n + can['node_id'])
     status = len(frames) + 1
     can.setdefault('hb_id', 0x80 + 0x100 * status + can['node_id'] if status <= 4 else 0x680 + can['node_id'])
 
