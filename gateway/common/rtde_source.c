@@ -219,10 +219,13 @@ static void config_reason(const rtde_source *src, const urrt_rtde_event *ev, cha
                  "of %g Hz: lower it or use auto", src->session.frequency, src->session.controller[0],
                  src->session.controller[1], max);
     } else if (ev->error == URRT_RTDE_E_IN_USE) {
-        append_name(names, sizeof names, &len, ev->var);
+        char name[URRT_RTDE_NAME_MAX]; /* the first register refused: one name */
+        if (urrt_rtde_var_name(ev->var, name, sizeof name) <= 0) {
+            snprintf(name, sizeof name, "?");
+        }
         snprintf(why, size, "RTDE: controller version %s refuses to let this client write %s%s (IN_USE): another "
                  "RTDE client, or an enabled fieldbus adapter (EtherNet/IP, PROFINET, Modbus: registers 0..23), "
-                 "holds it; write registers 24..47 (bits 64..127), or free it on the controller", version, names,
+                 "holds it; write registers 24..47 (bits 64..127), or free it on the controller", version, name,
                  ev->not_found > 1 ? " and more" : "");
     } else if (ev->error == URRT_RTDE_E_INPUTS_PROTOCOL) {
         snprintf(why, size, "RTDE: controller version %s speaks RTDE protocol 1 only, and urrt writes input "
