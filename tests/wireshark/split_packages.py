@@ -8,7 +8,7 @@ urrt-sim's tiny-writes fault cut across segments. Which ones those are is
 the kernel's to decide, not the simulator's: a simulator that wakes late
 writes its due pieces back to back, and Linux coalesces small writes queued
 behind an unsent one (TCP autocorking), so a whole package may then travel
-in one segment. This counts, for one direction of one connection, the data
+in one segment. This finds, for one direction of one connection, the data
 packages whose bytes a segment boundary falls inside of.
 
 Input on stdin: `tshark -T fields -e tcp.seq -e tcp.len -e tcp.payload` of
@@ -16,7 +16,9 @@ that direction's segments (relative sequence numbers, payload in hex), in
 capture order. The stream is walked from its first byte: RTDE packages are
 uint16 size (header included) and a type byte; 'U' (0x55) is a data package.
 
-  split_packages.py < FIELDS      prints: SPLIT TOTAL (data packages)
+  split_packages.py < FIELDS      prints: SPLIT TOTAL (data packages), then
+                                  each split data package in hex, a line each,
+                                  in stream order
 """
 import sys
 
@@ -36,7 +38,7 @@ def main():
             sys.exit('split_packages.py: a gap in the stream at %d (segment at %d)' % (len(stream), start))
         boundaries.add(start)
         stream += payload
-    split = total = at = 0
+    split, total, at = [], 0, 0
     while at + 3 <= len(stream):
         size = stream[at] << 8 | stream[at + 1]
         if size < 3:
@@ -45,9 +47,12 @@ def main():
             break
         if stream[at + 2] == 0x55:
             total += 1
-            split += any(b in boundaries for b in range(at + 1, at + size))
+            if any(b in boundaries for b in range(at + 1, at + size)):
+                split.append(stream[at:at + size].hex())
         at += size
-    print(split, total)
+    print(len(split), total)
+    for package in split:
+        print(package)
 
 
 if __name__ == '__main__':
