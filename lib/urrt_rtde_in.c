@@ -518,6 +518,13 @@ void urrt_rtde_in_forget(urrt_rtde_in *in)
     }
 }
 
+void urrt_rtde_in_unset(urrt_rtde_in *in, size_t i)
+{
+    if (in != 0 && i < in->count) {
+        set_given(in, i, false);
+    }
+}
+
 bool urrt_rtde_in_complete(const urrt_rtde_in *in)
 {
     size_t i;

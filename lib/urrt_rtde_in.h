@@ -175,6 +175,10 @@ int urrt_rtde_in_set_double(urrt_rtde_in *in, size_t i, double value);
  * again (the caller's data went stale). */
 void urrt_rtde_in_forget(urrt_rtde_in *in);
 
+/* vars[i] without a value, not counted as refused: the caller has none
+ * for it now (its source went stale, or refused it before it came here). */
+void urrt_rtde_in_unset(urrt_rtde_in *in, size_t i);
+
 /* Every register of the recipe holds a value. */
 bool urrt_rtde_in_complete(const urrt_rtde_in *in);
 

@@ -372,50 +372,10 @@ static void put_storage(FILE *out, const urrt_cantx_tables *t)
 /* ---- [input]s: the frames the PLC sends, for a firmware that writes registers --------- */
 
 static const char *const silence_names[] = {
-    [CAN_MAP_SILENCE_STOP] = "URRT_GATEWAY_SILENCE_STOP",
-    [CAN_MAP_SILENCE_HOLD] = "URRT_GATEWAY_SILENCE_HOLD",
-    [CAN_MAP_SILENCE_VALUE] = "URRT_GATEWAY_SILENCE_VALUE",
+    [URRT_PLCIN_STOP] = "URRT_PLCIN_STOP",
+    [URRT_PLCIN_HOLD] = "URRT_PLCIN_HOLD",
+    [URRT_PLCIN_VALUE] = "URRT_PLCIN_VALUE",
 };
-
-/* The type of urrt_gateway_inputs: lib/ has none (a frame received and its
- * registers are the gateway's notion, not lib's), so the file defines it,
- * and a firmware that declares the table repeats it. */
-static void put_input_type(FILE *out)
-{
-    fputs("/*\n"
-          " * An [input NAME]: a frame the PLC sends, whose signals write input registers of\n"
-          " * robot `robot` over RTDE (lib/urrt_rtde_in.h: one urrt_rtde_in per [input],\n"
-          " * urrt_rtde_in_init(&in, regs, reg_count)). A frame of its id and kind of id\n"
-          " * (URRT_CANTX_EXTENDED) with another length, or another URRT_CANTX_FD, is not used.\n"
-          " * Register regs[k] from the signals i with vars[i] == regs[k]: a bit mask\n"
-          " * (URRT_CAN_SIG_MASK) bit for bit, urrt_can_get_raw's raw shifted up by\n"
-          " * URRT_CAN_SIG_MASK_FIRST and or-ed together, urrt_rtde_in_set_int; any other\n"
-          " * value by urrt_can_unpack (raw * factor + offset), refused outside min..max\n"
-          " * (never clamped), then urrt_rtde_in_set_double, which checks the register's type.\n"
-          " * No frame for timeout_ms: the PLC is silent, and its registers get `silence`.\n"
-          " */\n"
-          "enum urrt_gateway_silence {\n"
-          "    URRT_GATEWAY_SILENCE_STOP = 0, /* nothing more is sent (urrt_rtde_in_forget): the program's\n"
-          "                                      rtde_set_watchdog acts */\n"
-          "    URRT_GATEWAY_SILENCE_HOLD = 1, /* the last values go on being sent */\n"
-          "    URRT_GATEWAY_SILENCE_VALUE = 2 /* silence_value goes to every register of the frame */\n"
-          "};\n"
-          "typedef struct urrt_gateway_input {\n"
-          "    const urrt_can_signal *signals; /* place and scaling (urrt_can.h) */\n"
-          "    const uint16_t *vars;           /* per signal: the register it writes (urrt_rtde.h's id) */\n"
-          "    const uint16_t *regs;           /* the input recipe: each register once */\n"
-          "    uint16_t signal_count;\n"
-          "    uint16_t reg_count;\n"
-          "    uint8_t len;                    /* payload bytes */\n"
-          "    uint8_t flags;                  /* URRT_CANTX_EXTENDED, URRT_CANTX_FD */\n"
-          "    uint32_t id;\n"
-          "    uint32_t timeout_ms;            /* no frame for longer than this: the PLC is silent */\n"
-          "    uint8_t silence;                /* enum urrt_gateway_silence: on_silence */\n"
-          "    uint8_t robot;                  /* the robot whose registers it writes */\n"
-          "    double silence_value;           /* URRT_GATEWAY_SILENCE_VALUE's */\n"
-          "} urrt_gateway_input;\n\n",
-          out);
-}
 
 /* A register as lib/urrt_rtde.h's enum names it, and its RTDE name. */
 static void put_register(FILE *out, int var, const char *what)
@@ -451,12 +411,11 @@ static void put_input_tables(FILE *out, const struct can_map_frame *f)
 
 static void put_inputs(FILE *out, const struct can_map *map)
 {
-    fprintf(out, "\n/* The [input]s: what the PLC sends, and the registers it writes. */\n");
-    put_input_type(out);
+    fprintf(out, "\n/* The [input]s: what the PLC sends, and the registers it writes (lib/urrt_plcin.h). */\n");
     for (size_t i = 0; i < map->input_count; i++) {
         put_input_tables(out, &map->inputs[i]);
     }
-    fprintf(out, "const urrt_gateway_input urrt_gateway_inputs[%zu] = {\n", map->input_count);
+    fprintf(out, "const urrt_plcin_desc urrt_gateway_inputs[%zu] = {\n", map->input_count);
     for (size_t i = 0; i < map->input_count; i++) {
         const struct can_map_frame *f = &map->inputs[i];
         uint8_t flags = (uint8_t)((f->extended ? URRT_CANTX_EXTENDED : 0u) | (f->fd ? URRT_CANTX_FD : 0u));
@@ -464,10 +423,13 @@ static void put_inputs(FILE *out, const struct can_map *map)
                      ", %s, %zu, ",
                 f->name, f->name, f->name, f->count, f->reg_count, (unsigned)f->len, flag_names(flags), f->id,
                 f->timeout_ms, silence_names[f->silence], f->robot_index);
-        put_double(out, f->silence == CAN_MAP_SILENCE_VALUE ? f->silence_value : 0.0);
+        put_double(out, f->silence == URRT_PLCIN_VALUE ? f->silence_value : 0.0);
         fprintf(out, "}, /* %s */\n", f->name);
     }
     fprintf(out, "};\nconst size_t urrt_gateway_input_count = %zu;\n", map->input_count);
+    fprintf(out, "/* [can] inputs_min_rate: a fresh input's package at least this often. */\n"
+                 "const uint64_t urrt_gateway_inputs_period_us = %" PRIu64 "u;\n",
+            (uint64_t)(1e6 / map->inputs_min_rate_hz));
 }
 
 /* ---- the CANopen node: its urrt_co_desc, from co_run's ---------------------------- */
@@ -486,16 +448,21 @@ static void put_string(FILE *out, const char *s)
     fprintf(out, "\"%s\"", s != NULL ? s : "");
 }
 
+/* A PDO's mapping entries: urrt_gateway_{tpdo,rpdo}N_mapping. */
+static void put_mapping(FILE *out, const char *kind, size_t n, const uint32_t *mapping, unsigned count)
+{
+    fprintf(out, "static const uint32_t urrt_gateway_%s%zu_mapping[%u] = {", kind, n + 1u, count);
+    for (unsigned k = 0; k < count; k++) {
+        fprintf(out, "%sUINT32_C(0x%08" PRIX32 ")", k % 4u == 0u ? "\n    " : " ", mapping[k]);
+        fputc(k + 1u < count ? ',' : '\n', out);
+    }
+    fprintf(out, "};\n");
+}
+
 static void put_tpdos(FILE *out, const urrt_co_desc *d)
 {
     for (size_t n = 0; n < d->tpdo_count; n++) {
-        const urrt_co_tpdo *p = &d->tpdos[n];
-        fprintf(out, "static const uint32_t urrt_gateway_tpdo%zu_mapping[%u] = {", n + 1u, p->mapping_count);
-        for (unsigned k = 0; k < p->mapping_count; k++) {
-            fprintf(out, "%sUINT32_C(0x%08" PRIX32 ")", k % 4u == 0u ? "\n    " : " ", p->mapping[k]);
-            fputc(k + 1u < p->mapping_count ? ',' : '\n', out);
-        }
-        fprintf(out, "};\n");
+        put_mapping(out, "tpdo", n, d->tpdos[n].mapping, d->tpdos[n].mapping_count);
     }
     fprintf(out, "static const urrt_co_tpdo urrt_gateway_tpdos[%zu] = {\n", d->tpdo_count);
     for (size_t n = 0; n < d->tpdo_count; n++) {
@@ -520,14 +487,38 @@ static void put_objects(FILE *out, const urrt_co_desc *d)
     fprintf(out, "};\n");
 }
 
-static void put_node(FILE *out, struct co_run *node)
+/* The node's RPDOs (the [input]s, RPDO n = [input] n) and 0x1016's entry. */
+static void put_rpdos(FILE *out, const urrt_co_desc *d)
+{
+    for (size_t n = 0; n < d->rpdo_count; n++) {
+        put_mapping(out, "rpdo", n, d->rpdos[n].mapping, d->rpdos[n].mapping_count);
+    }
+    fprintf(out, "static const urrt_co_rpdo urrt_gateway_rpdos[%zu] = {\n", d->rpdo_count);
+    for (size_t n = 0; n < d->rpdo_count; n++) {
+        const urrt_co_rpdo *p = &d->rpdos[n];
+        fprintf(out, "    {urrt_gateway_rpdo%zu_mapping, UINT32_C(0x%08" PRIX32 "), %u, %u, %u}, /* RPDO%zu */\n",
+                n + 1u, p->cob_id, p->event_ms, p->transmission_type, p->mapping_count, n + 1u);
+    }
+    fprintf(out, "};\nstatic const uint32_t urrt_gateway_consumers[%u] = {", d->consumer_count);
+    for (unsigned k = 0; k < d->consumer_count; k++) {
+        fprintf(out, "%sUINT32_C(0x%08" PRIX32 ")", k ? ", " : "", d->consumers != NULL ? d->consumers[k] : 0u);
+    }
+    fprintf(out, "};\n");
+}
+
+static void put_node(FILE *out, struct co_run *node, const struct can_map *map)
 {
     const urrt_co_desc *d = co_run_desc(node);
     size_t rx_count;
     const uint32_t *rx = co_run_rx_ids(node, &rx_count);
+    size_t vars = co_run_input_first_var(node, map->input_count);
+    bool rpdos = d->rpdo_count > 0;
     fprintf(out, "\n/* The CANopen node over these tables (lib/urrt_co.h, docs/canopen.md). */\n");
     put_tpdos(out, d);
     put_objects(out, d);
+    if (rpdos) {
+        put_rpdos(out, d);
+    }
     fprintf(out, "const urrt_co_desc urrt_gateway_node = {\n    %u, %s, %u, %u, %" PRIu32 ",\n"
                  "    UINT32_C(0x%08" PRIX32 "), UINT32_C(0x%08" PRIX32 "), UINT32_C(0x%08" PRIX32 "), "
                  "UINT32_C(0x%08" PRIX32 "), UINT32_C(0x%08" PRIX32 "),\n    ",
@@ -540,18 +531,42 @@ static void put_node(FILE *out, struct co_run *node)
     put_string(out, d->hardware_version);
     fputs(", ", out);
     put_string(out, d->software_version);
-    fprintf(out, ",\n    urrt_gateway_tpdos, %zu, urrt_gateway_objects, %zu, NULL, 0, NULL, 0};\n", d->tpdo_count,
-            d->object_count); /* no RPDOs, no 0x1016 (the configuration has none yet) */
+    fprintf(out, ",\n    urrt_gateway_tpdos, %zu, urrt_gateway_objects, %zu, ", d->tpdo_count, d->object_count);
+    if (rpdos) {
+        fprintf(out, "urrt_gateway_rpdos, %zu, urrt_gateway_consumers, %u};\n", d->rpdo_count, d->consumer_count);
+    } else {
+        fprintf(out, "NULL, 0, NULL, 0};\n"); /* no [input]s: no RPDOs, no 0x1016 */
+    }
     fprintf(out, "const uint32_t urrt_gateway_rx_ids[%zu] = {", rx_count);
     for (size_t i = 0; i < rx_count; i++) {
         fprintf(out, "%s0x%03" PRIX32, i ? ", " : "", rx[i]);
     }
-    fprintf(out, "};\nstatic urrt_co_tpdo_state urrt_gateway_tpdo_states[%zu];\n"
-                 "static uint32_t urrt_gateway_vars[1];\n\n"
+    fprintf(out, "};\nstatic urrt_co_tpdo_state urrt_gateway_tpdo_states[%zu];\n", d->tpdo_count);
+    if (!rpdos) {
+        fprintf(out, "static uint32_t urrt_gateway_vars[1];\n\n"
+                     "int urrt_gateway_co_init(urrt_co *co, urrt_cantx *tx, size_t *bad_item)\n{\n"
+                     "    return urrt_co_init(co, &urrt_gateway_node, tx, urrt_gateway_tpdo_states, urrt_gateway_vars, 1,\n"
+                     "                        bad_item);\n}\n");
+        return;
+    }
+    /* With RPDOs: the variables they write, when each was written, and the
+     * first of each [input]'s, for the firmware to take them from. */
+    fprintf(out, "uint32_t urrt_gateway_vars[%zu];\nuint64_t urrt_gateway_written_us[%zu];\n"
+                 "const uint16_t urrt_gateway_input_first_var[%zu] = {",
+            vars, vars, map->input_count);
+    for (size_t i = 0; i < map->input_count; i++) {
+        fprintf(out, "%s%zu", i ? ", " : "", co_run_input_first_var(node, i));
+    }
+    fprintf(out, "};\nstatic urrt_co_rpdo_state urrt_gateway_rpdo_states[%zu];\n"
+                 "static urrt_co_consumer urrt_gateway_consumer_states[%u];\n"
+                 "static urrt_co_rx_storage urrt_gateway_rx;\n\n"
                  "int urrt_gateway_co_init(urrt_co *co, urrt_cantx *tx, size_t *bad_item)\n{\n"
-                 "    return urrt_co_init(co, &urrt_gateway_node, tx, urrt_gateway_tpdo_states, urrt_gateway_vars, 1,\n"
-                 "                        bad_item);\n}\n",
-            d->tpdo_count);
+                 "    urrt_gateway_rx.rpdos = urrt_gateway_rpdo_states;\n"
+                 "    urrt_gateway_rx.consumers = urrt_gateway_consumer_states;\n"
+                 "    urrt_gateway_rx.written_us = urrt_gateway_written_us;\n"
+                 "    return urrt_co_init_rx(co, &urrt_gateway_node, tx, urrt_gateway_tpdo_states, urrt_gateway_vars, %zu,\n"
+                 "                           &urrt_gateway_rx, bad_item);\n}\n",
+            d->rpdo_count, d->consumer_count, vars);
 }
 
 /* Whether frame i gets a fill function of put_rtde_fill's. */
@@ -602,23 +617,32 @@ int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run,
     }
     if (map->input_count > 0) {
         fprintf(out, ".\n * The [input]s, the frames the PLC sends, whose signals write robots' input\n"
-                     " * registers over RTDE (lib/urrt_rtde_in.h, which a firmware that writes links):\n"
-                     " *     extern const urrt_gateway_input urrt_gateway_inputs[%zu];\n"
+                     " * registers over RTDE (lib/urrt_plcin.h and lib/urrt_rtde_in.h, which a firmware\n"
+                     " * that writes links; one urrt_plcin and one urrt_rtde_in per [input]):\n"
+                     " *     extern const urrt_plcin_desc urrt_gateway_inputs[%zu];\n"
                      " *     extern const size_t urrt_gateway_input_count;\n"
-                     " * lib/ has no type for them: urrt_gateway_input's typedef is below, and a\n"
-                     " * firmware that declares the table repeats it",
+                     " *     extern const uint64_t urrt_gateway_inputs_period_us;   [can] inputs_min_rate's period\n"
+                     " * (urrt_plcin_due's period_us)",
                 map->input_count);
     }
     if (node != NULL) {
         fprintf(out, ".\n * The CANopen node ([canopen]), over urrt_cantx_init's tx:\n"
                      " *     extern const urrt_co_desc urrt_gateway_node;\n"
                      " *     extern const uint32_t urrt_gateway_rx_ids[%d];   the ids it receives\n"
-                     " *     int urrt_gateway_co_init(urrt_co *co, urrt_cantx *tx, size_t *bad_item)",
-                (int)CO_RUN_RX_IDS);
+                     " *     int urrt_gateway_co_init(urrt_co *co, urrt_cantx *tx, size_t *bad_item)%s",
+                (int)CO_RUN_RX_IDS,
+                map->input_count > 0
+                    ? "\n * and its RPDOs ([input] i is RPDO i + 1), whose signal k the node stores in\n"
+                      " * variable urrt_gateway_input_first_var[i] + k, raw as its object's type:\n"
+                      " *     extern uint32_t urrt_gateway_vars[];          the variables\n"
+                      " *     extern uint64_t urrt_gateway_written_us[];    when an RPDO or SDO write stored each\n"
+                      " *     extern const uint16_t urrt_gateway_input_first_var[]\n"
+                      " * (with written_us older than timeout_ms: absent, in urrt_plcin_take)"
+                    : "");
     }
     fprintf(out, ".\n */\n#include <stdbool.h>\n#include <stddef.h>\n#include <stdint.h>\n\n#include \"%s\"\n%s\n",
             node != NULL ? "urrt_co.h" : "urrt_cantx.h",
-            rtde || map->input_count > 0 ? "#include \"urrt_rtde.h\"\n" : "");
+            map->input_count > 0 ? "#include \"urrt_plcin.h\"\n" : rtde ? "#include \"urrt_rtde.h\"\n" : "");
     put_rtde_refusal(out, map, robots);
     if (rtde) {
         put_rtde_reading(out, map, robots, t->robot_count);
@@ -644,7 +668,7 @@ int can_ctables_write(FILE *out, const struct can_map *map, struct can_run *run,
         put_inputs(out, map);
     }
     if (node != NULL) {
-        put_node(out, node);
+        put_node(out, node, map);
     }
     return ferror(out) ? -1 : 0;
 }

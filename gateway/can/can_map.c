@@ -1072,9 +1072,9 @@ static bool input_silence(void *obj, const struct conf_key *key, const char *val
     char reason[CONF_WHY_MAX];
     (void)key, (void)at;
     if (strcmp(value, "stop") == 0) {
-        f->silence = CAN_MAP_SILENCE_STOP;
+        f->silence = URRT_PLCIN_STOP;
     } else if (strcmp(value, "hold") == 0) {
-        f->silence = CAN_MAP_SILENCE_HOLD;
+        f->silence = URRT_PLCIN_HOLD;
     } else if (strncmp(value, "value", 5) == 0 && isspace((unsigned char)value[5])) {
         const char *v = value + 5;
         while (isspace((unsigned char)*v)) {
@@ -1083,7 +1083,7 @@ static bool input_silence(void *obj, const struct conf_key *key, const char *val
         if (!conf_number(v, -DBL_MAX, DBL_MAX, &f->silence_value, reason, sizeof reason)) {
             return conf_fail(why, n, "on_silence = '%s': value takes a finite number (value 0): %s", value, reason);
         }
-        f->silence = CAN_MAP_SILENCE_VALUE;
+        f->silence = URRT_PLCIN_VALUE;
     } else {
         return conf_fail(why, n, "on_silence = '%s': use stop (the program's RTDE watchdog acts), hold (the last "
                          "values go on) or value V (V goes to every register of the frame)", value);
@@ -1413,7 +1413,7 @@ static void input_registers(struct finish *fin, struct can_map_frame *f, const c
 static void check_silence_value(struct finish *fin, const struct can_map_frame *f, const char *what)
 {
     urrt_rtde_in in;
-    if (f->silence != CAN_MAP_SILENCE_VALUE || f->reg_count == 0 ||
+    if (f->silence != URRT_PLCIN_VALUE || f->reg_count == 0 ||
         urrt_rtde_in_init(&in, f->regs, f->reg_count) != URRT_OK) {
         return;
     }

@@ -32,6 +32,7 @@
 #include "urrt.h"
 #include "urrt_can.h"
 #include "urrt_cantx.h"
+#include "urrt_plcin.h"
 #include "urrt_rtde_in.h"
 
 #define CAN_MAP_NAME_MAX 32           /* DBC names: C identifiers of at most 32 characters */
@@ -73,14 +74,6 @@ struct can_map_signal {
 enum can_map_stale_policy {
     CAN_MAP_STALE_STOP = 0,  /* the frame stops: the receiver's own timeout fires */
     CAN_MAP_STALE_INVALID    /* the frame goes on with the validity bit cleared */
-};
-
-/* What an [input NAME] frame's registers get when the PLC falls silent
- * (the frame's timeout, the CAN interface down or bus-off). */
-enum can_map_silence {
-    CAN_MAP_SILENCE_STOP = 0, /* nothing more is sent: the robot program's own rtde_set_watchdog acts */
-    CAN_MAP_SILENCE_HOLD,     /* the last values go on being sent (the watchdog sees a living PLC) */
-    CAN_MAP_SILENCE_VALUE     /* silence_value goes to every register of the frame */
 };
 
 /* Keys of a [frame NAME] section, for duplicate detection and messages. */
@@ -126,8 +119,8 @@ struct can_map_frame {
     double load;                            /* worst-case share of the bus (0.027 = 2.7 %) */
     /* An [input]'s: */
     uint32_t timeout_ms;                    /* silent longer than this: on_silence */
-    enum can_map_silence silence;
-    double silence_value;                   /* CAN_MAP_SILENCE_VALUE's */
+    urrt_plcin_silence silence;             /* when the PLC falls silent (lib/urrt_plcin.h) */
+    double silence_value;                   /* URRT_PLCIN_VALUE's */
     /* Its input recipe, set by can_map_finish: the registers its signals
      * write, each once, in the order of their first signal. */
     uint16_t regs[URRT_RTDE_IN_MAX_VARS];

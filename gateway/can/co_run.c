@@ -355,6 +355,11 @@ const uint32_t *co_run_rx_ids(const struct co_run *run, size_t *count)
     return run->rx_ids;
 }
 
+size_t co_run_input_first_var(const struct co_run *run, size_t input)
+{
+    return run->first_var[input < URRT_CO_MAX_RPDOS ? input : URRT_CO_MAX_RPDOS];
+}
+
 uint32_t co_run_input_raw(const struct co_run *run, size_t input, size_t signal)
 {
     return run->vars[run->first_var[input] + signal];

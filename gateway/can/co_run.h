@@ -57,6 +57,11 @@ const urrt_co_desc *co_run_desc(const struct co_run *run);
  * running node (urrt_co.rx_changes), which can_out follows. */
 const uint32_t *co_run_rx_ids(const struct co_run *run, size_t *count);
 
+/* The node variable (urrt_co_init's vars) of [input] i's first signal; its
+ * signal k's is that + k. i = the [input]s' count: how many variables the
+ * [input]s have in all. */
+size_t co_run_input_first_var(const struct co_run *run, size_t input);
+
 /* [input] i's signal k as the node holds it: raw, as its object's type
  * (INTEGERn not sign-extended). */
 uint32_t co_run_input_raw(const struct co_run *run, size_t input, size_t signal);

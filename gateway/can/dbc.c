@@ -312,10 +312,10 @@ static void put_silence(FILE *out, const struct can_map_frame *f, bool why)
 {
     char value[40];
     switch (f->silence) {
-    case CAN_MAP_SILENCE_HOLD:
+    case URRT_PLCIN_HOLD:
         fprintf(out, "on_silence = hold%s", why ? " (the last values go on being written)" : "");
         break;
-    case CAN_MAP_SILENCE_VALUE:
+    case URRT_PLCIN_VALUE:
         fprintf(out, "on_silence = value %s%s", dbc_number(f->silence_value, value, sizeof value),
                 why ? " (written to every register of the frame)" : "");
         break;

@@ -14,20 +14,18 @@
 /* A frame's log lines (refused values, wrong lengths) at most this often. */
 #define PLC_IN_LOG_US (10u * 1000000u)
 
-/* One [input]: its frame, its robot's session, and what the PLC last said. */
+/* One [input]: its frame, its robot's session, and what the PLC last said
+ * (lib's state of it: when it is fresh and its package due is lib's rule). */
 struct plc_group {
     const struct can_map_frame *f;
+    urrt_plcin_desc desc;     /* f as lib describes an input */
+    uint16_t *vars;           /* desc's: the register of each signal */
+    urrt_plcin st;
     gw_robot *robot;
     size_t recipe;            /* its input recipe's index in the robot's source */
     size_t input;             /* its index among the [input]s: with [canopen], RPDO input + 1 */
     uint64_t written_seen;    /* with [canopen]: the node's newest write taken */
-    uint64_t rx_us;           /* the last good frame's receipt */
-    uint64_t sent_us;         /* the last package sent */
-    uint64_t sessions;        /* rtde_source_input_sessions at that send */
     uint64_t logged_us;       /* the last refused value or bad frame logged */
-    bool ever;                /* the PLC wrote since start: before, nothing is sent */
-    bool fresh;
-    bool changed;             /* a value changed since the last package */
     plc_in_counts counts;
 };
 
@@ -73,13 +71,6 @@ static void names_of(const struct can_map_frame *f, char *out, size_t size)
 
 /* ---- sending ---------------------------------------------------------------------- */
 
-/* Whether the group's registers are written now: the PLC wrote them, and
- * its data is fresh or its on_silence sends something. */
-static bool writing(const struct plc_group *g)
-{
-    return g->ever && (g->fresh || g->f->silence != CAN_MAP_SILENCE_STOP);
-}
-
 /* Whether the group's package can go now: its robot's session streams with
  * the recipe accepted. */
 static bool ready(const struct plc_group *g)
@@ -87,43 +78,37 @@ static bool ready(const struct plc_group *g)
     return g->robot->rtde != NULL && rtde_source_input_ready(g->robot->rtde, g->recipe);
 }
 
-/* The package, if a value changed, the session is new, or the minimum rate
- * asks for it. One that cannot go now (a register without a value, the
- * robot link's queue full) is tried again a period later; a session that is
- * not ready is waited for: its start is news, which ticks every output. */
-static void send_due(plc_in *in, struct plc_group *g, uint64_t now_us)
+/* The session's number: the current values go at once to a new one. */
+static uint32_t session_of(const struct plc_group *g)
 {
-    uint64_t sessions;
-    if (!writing(g) || !ready(g)) {
-        return;
-    }
-    sessions = rtde_source_input_sessions(g->robot->rtde);
-    if (!g->changed && sessions == g->sessions && now_us - g->sent_us < in->period_us) {
-        return;
-    }
-    g->sent_us = now_us;
-    if (rtde_source_send_input(g->robot->rtde, g->recipe) == 1) {
-        g->counts.written++;
-        g->sessions = sessions;
-        g->changed = false;
-    }
+    return g->robot->rtde != NULL ? (uint32_t)rtde_source_input_sessions(g->robot->rtde) : 0;
 }
 
-/* The earliest of the fresh groups' timeouts and the writable groups'
- * refreshes: the output's deadline, kept here so that asking costs nothing. */
+/* The package, when lib says it is due. One that cannot go now (a register
+ * without a value, the robot link's queue full) is tried again a period
+ * later; a session that is not ready is waited for: its start is news,
+ * which ticks every output. */
+static void send_due(plc_in *in, struct plc_group *g, uint64_t now_us)
+{
+    uint32_t session = session_of(g);
+    bool sent;
+    if (!urrt_plcin_due(&g->desc, &g->st, ready(g), session, now_us, in->period_us)) {
+        return;
+    }
+    sent = rtde_source_send_input(g->robot->rtde, g->recipe) == 1;
+    urrt_plcin_sent(&g->st, sent, session, now_us);
+    g->counts.written += sent;
+}
+
+/* The earliest of the groups' deadlines: the output's, kept here so that
+ * asking costs nothing. */
 static void plan(plc_in *in)
 {
     uint64_t due = UINT64_MAX;
     for (size_t i = 0; i < in->count; i++) {
         const struct plc_group *g = &in->groups[i];
-        uint64_t timeout = g->rx_us + (uint64_t)g->f->timeout_ms * 1000u;
-        uint64_t refresh = g->sent_us + in->period_us;
-        if (g->fresh && timeout < due) {
-            due = timeout;
-        }
-        if (writing(g) && ready(g) && refresh < due) {
-            due = refresh;
-        }
+        uint64_t d = urrt_plcin_deadline(&g->desc, &g->st, ready(g), in->period_us);
+        due = d < due ? d : due;
     }
     in->due_us = due;
 }
@@ -133,29 +118,18 @@ static void plan(plc_in *in)
 static void fall_silent(struct plc_group *g, const char *why)
 {
     static const char *const does[] = {
-        [CAN_MAP_SILENCE_STOP] = "nothing more is written (on_silence = stop): the robot program's "
+        [URRT_PLCIN_STOP] = "nothing more is written (on_silence = stop): the robot program's "
                                  "rtde_set_watchdog acts",
-        [CAN_MAP_SILENCE_HOLD] = "their last values go on being written (on_silence = hold)",
-        [CAN_MAP_SILENCE_VALUE] = "the on_silence value goes to them",
+        [URRT_PLCIN_HOLD] = "their last values go on being written (on_silence = hold)",
+        [URRT_PLCIN_VALUE] = "the on_silence value goes to them",
     };
-    urrt_rtde_in *recipe = recipe_of(g);
     char names[512];
-    g->fresh = false;
     g->counts.silences++;
     names_of(g->f, names, sizeof names);
     urrt_log(URRT_LOG_WARNING, "[input %s]: the PLC is silent (%s): %s: %s", g->f->name, why, names,
              does[g->f->silence]);
-    if (recipe == NULL) {
-        return;
-    }
-    if (g->f->silence == CAN_MAP_SILENCE_STOP) {
-        urrt_rtde_in_forget(recipe);
-    } else if (g->f->silence == CAN_MAP_SILENCE_VALUE) {
-        for (size_t k = 0; k < g->f->reg_count; k++) {
-            (void)urrt_rtde_in_set_double(recipe, k, g->f->silence_value); /* checked by can_map_finish */
-        }
-        g->changed = true;
-    }
+    /* on_silence value: one every register takes (can_map_finish checked it). */
+    urrt_plcin_silent(&g->desc, &g->st, recipe_of(g));
 }
 
 /* ---- receiving --------------------------------------------------------------------- */
@@ -177,40 +151,34 @@ static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, .
 }
 
 /* What the PLC wrote, at at_us: each register taken from raws (see
- * can_in_take), the package sent if a value changed. */
+ * urrt_plcin_take), the package sent if a value changed. */
 static void take_values(plc_in *in, struct plc_group *g, const uint64_t *raws, uint64_t absent, uint64_t at_us)
 {
     urrt_rtde_in *recipe = recipe_of(g);
     uint64_t now = urrt_port_monotonic_us();
-    uint8_t before[URRT_RTDE_IN_DATA_MAX], given[sizeof recipe->given];
+    bool was_silent = g->st.ever && !g->st.fresh;
     size_t refused = 0;
     if (recipe == NULL) {
         return;
     }
-    memcpy(before, recipe->data, recipe->data_size);
-    memcpy(given, recipe->given, sizeof given);
-    refused = can_in_take(g->f, recipe, raws, absent);
+    refused = urrt_plcin_take(&g->desc, &g->st, recipe, raws, absent, at_us < now ? at_us : now);
     if (refused > 0) {
         g->counts.refused += refused;
         log_limited(g, now, "%zu value%s refused (outside min..max, or not one the register takes): nothing is "
                     "written for %s until a good one comes (%" PRIu64 " refused so far)", refused,
                     refused == 1 ? "" : "s", refused == 1 ? "it" : "them", g->counts.refused);
     }
-    if (!g->fresh && g->ever) {
+    if (was_silent) {
         urrt_log(URRT_LOG_NOTICE, "[input %s]: the PLC writes again", g->f->name);
     }
-    g->changed = g->changed || memcmp(before, recipe->data, recipe->data_size) != 0 ||
-                 memcmp(given, recipe->given, sizeof given) != 0 || !g->fresh;
-    g->ever = g->fresh = true;
-    g->rx_us = at_us < now ? at_us : now;
     send_due(in, g, now);
 }
 
 static void take_frame(plc_in *in, struct plc_group *g, const urrt_can_frame *frame, uint64_t rx_us)
 {
-    uint64_t raws[CAN_IN_MAX_SIGNALS];
+    uint64_t raws[URRT_PLCIN_MAX_SIGNALS];
     g->counts.frames++;
-    if (!can_in_raws(g->f, frame, raws)) {
+    if (!urrt_plcin_raws(&g->desc, frame->data, frame->len, frame->fd, raws)) {
         g->counts.bad_frames++;
         log_limited(g, urrt_port_monotonic_us(), "a %s frame of %u bytes on 0x%X, configured %s of %u: not used (%"
                     PRIu64 " so far)", frame->fd ? "CAN FD" : "classic", (unsigned)frame->len, (unsigned)frame->id,
@@ -259,11 +227,11 @@ static void node_group(plc_in *in, struct plc_group *g, uint64_t now_us)
         take_values(in, g, raws, absent, written);
     }
     g->written_seen = written;
-    if (why == NULL && now_us - g->rx_us > timeout_us) {
+    if (why == NULL && urrt_plcin_timed_out(&g->desc, &g->st, now_us)) {
         snprintf(buf, sizeof buf, "no RPDO%zu or SDO write for %u ms", g->input + 1u, (unsigned)g->f->timeout_ms);
         why = buf;
     }
-    if (g->fresh && why != NULL) {
+    if (g->st.fresh && why != NULL) {
         fall_silent(g, why);
     }
 }
@@ -298,7 +266,7 @@ void plc_in_link(void *ctx, bool up, uint64_t bus_off, uint64_t now_us)
     (void)now_us;
     in->bus_off_seen = bus_off;
     for (size_t i = 0; why != NULL && i < in->count; i++) {
-        if (in->groups[i].fresh) {
+        if (in->groups[i].st.fresh) {
             fall_silent(&in->groups[i], why);
         }
     }
@@ -314,7 +282,7 @@ static void on_tick(void *ctx, uint64_t now_us)
         struct plc_group *g = &in->groups[i];
         if (in->node != NULL) {
             node_group(in, g, now_us);
-        } else if (g->fresh && now_us - g->rx_us > (uint64_t)g->f->timeout_ms * 1000u) {
+        } else if (urrt_plcin_timed_out(&g->desc, &g->st, now_us)) {
             char why[64];
             snprintf(why, sizeof why, "no frame for %u ms", (unsigned)g->f->timeout_ms);
             fall_silent(g, why);
@@ -377,7 +345,7 @@ static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *b
     for (size_t i = 0; i < in->count; i++) {
         if (in->groups[i].robot == robot) {
             total++;
-            fresh += in->groups[i].fresh;
+            fresh += in->groups[i].st.fresh;
             written += in->groups[i].counts.written;
             refused += in->groups[i].counts.refused;
         }
@@ -390,6 +358,9 @@ static int on_summary(void *ctx, const gw_robot *robot, uint64_t now_us, char *b
 static void on_close(void *ctx)
 {
     plc_in *in = ctx;
+    for (size_t i = 0; i < in->count; i++) {
+        free(in->groups[i].vars);
+    }
     free(in->groups);
     free(in);
 }
@@ -412,6 +383,15 @@ plc_in *plc_in_new(gateway *gw, const struct can_map *map, struct co_run *node)
         struct plc_group *g = &in->groups[i];
         size_t r = map->inputs[i].robot_index;
         g->f = &map->inputs[i];
+        g->vars = malloc((g->f->count ? g->f->count : 1) * sizeof *g->vars);
+        if (g->vars == NULL) {
+            urrt_log(URRT_LOG_ERR, "PLC inputs: out of memory");
+            in->count = i;
+            on_close(in);
+            return NULL;
+        }
+        can_in_desc(g->f, g->vars, &g->desc);
+        urrt_plcin_init(&g->st);
         g->robot = &gw->robots[r];
         g->recipe = per_robot[r]++;
         g->input = i;
@@ -450,6 +430,6 @@ void plc_in_get_counts(const plc_in *in, size_t i, plc_in_counts *out)
     memset(out, 0, sizeof *out);
     if (i < in->count) {
         *out = in->groups[i].counts;
-        out->fresh = in->groups[i].fresh;
+        out->fresh = in->groups[i].st.fresh;
     }
 }

@@ -131,9 +131,9 @@ static void describe_input(const gw_config *cfg, size_t input, char *buf, size_t
     const struct can_map *map = &cfg->can;
     const struct can_map_frame *f = &map->inputs[input];
     static const char *const policy[] = {
-        [CAN_MAP_SILENCE_STOP] = "stop (nothing written: the program's rtde_set_watchdog acts)",
-        [CAN_MAP_SILENCE_HOLD] = "hold (the last values go on: the program's watchdog does not see the silence)",
-        [CAN_MAP_SILENCE_VALUE] = "value",
+        [URRT_PLCIN_STOP] = "stop (nothing written: the program's rtde_set_watchdog acts)",
+        [URRT_PLCIN_HOLD] = "hold (the last values go on: the program's watchdog does not see the silence)",
+        [URRT_PLCIN_VALUE] = "value",
     };
     size_t used = 0;
     int w = cfg->co_run != NULL ? snprintf(buf, size, "input %s (RPDO%zu, 0x%03X): robot %s:", f->name, input + 1u,
@@ -152,7 +152,7 @@ static void describe_input(const gw_config *cfg, size_t input, char *buf, size_t
                      "on_silence = %s", map->inputs_min_rate_hz, (unsigned)f->timeout_ms, policy[f->silence]);
         used += w > 0 ? (size_t)w : 0;
     }
-    if (used < size && f->silence == CAN_MAP_SILENCE_VALUE) {
+    if (used < size && f->silence == URRT_PLCIN_VALUE) {
         snprintf(buf + used, size - used, " %.17g", f->silence_value);
     }
 }
@@ -239,12 +239,6 @@ static int write_output(gw_config *cfg, const char *path, writer_fn write, const
     bool ok;
     if (!can_map_enabled(&cfg->can)) {
         fprintf(stderr, "urrt-gateway: %s has no [can] section or [frame NAME]: no %s to write\n", cfg->path, what);
-        return CLI_EXIT_USAGE;
-    }
-    if (write == c_tables_writer && cfg->co_run != NULL && cfg->can.input_count > 0) {
-        /* Its node would start without the RPDOs its objects need. */
-        fprintf(stderr, "urrt-gateway: %s: --print-c-tables does not write a CANopen node's RPDOs yet ([input]s "
-                "with [canopen]): generate the tables from the configuration without its [input]s\n", cfg->path);
         return CLI_EXIT_USAGE;
     }
     if (write == eds_writer && cfg->co_run == NULL) {

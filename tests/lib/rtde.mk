@@ -15,15 +15,19 @@
 #   check-rtde-in-san     the same under ASan + UBSan
 #   check-fuzz-rtde-in    the libFuzzer harness tests/lib/fuzz_rtde_in.c, briefly (FUZZ_RTDE_SECONDS)
 #   fuzz-rtde-in     the same for FUZZ_SECONDS; the corpus grows in $(RTT)/fuzz-in
+# The PLC's answers (lib/urrt_plcin) over it:
+#   check-plcin      tests/lib/test_plcin.c: values taken from a frame (scaling, min..max, masks),
+#                    refused and absent ones, when a package is due, the timeout and each
+#                    on_silence policy, against values worked out by hand; and under ASan + UBSan
 
 RTT := $(BUILD)/tests/rtde
 RTDE_VECTORS := $(RTT)/vectors.txt
 RTDE_CORPUS := $(RTT)/seeds
 FUZZ_RTDE_SECONDS ?= 20
 
-CHECKS += check-rtde check-rtde-san check-fuzz-rtde check-rtde-in check-rtde-in-san check-fuzz-rtde-in
+CHECKS += check-rtde check-rtde-san check-fuzz-rtde check-rtde-in check-rtde-in-san check-fuzz-rtde-in check-plcin
 .PHONY: check-rtde check-rtde-san check-fuzz-rtde fuzz-rtde check-rtde-in check-rtde-in-san check-fuzz-rtde-in \
-        fuzz-rtde-in
+        fuzz-rtde-in check-plcin
 
 $(RTDE_VECTORS): tests/ref/rtde_ref.py
 	@mkdir -p $(@D)
@@ -98,3 +102,16 @@ fuzz-rtde-in: $(RTT)/fuzz_rtde_in $(RTDE_IN_VECTORS)
 	sh tests/lib/fuzz.sh $(RTT)/fuzz_rtde_in $(RTDE_IN_CORPUS) $(RTT)/fuzz-in $(FUZZ_SECONDS)
 
 fuzz: fuzz-rtde-in
+
+# ---- the PLC's answers: lib/urrt_plcin --------------------------------------------------
+
+$(RTT)/test_plcin: tests/lib/test_plcin.c tests/check.h $(LIBURRT) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LIB_TEST_CFLAGS) $(OPT) $< $(LIBURRT) -lm -o $@
+
+$(RTT)/test_plcin_san: tests/lib/test_plcin.c tests/check.h $(LIB_SRCS) $(LIB_HDRS)
+	@mkdir -p $(@D)
+	$(CC) $(LIB_TEST_CFLAGS) -O1 -g $(SAN_FLAGS) -fsanitize=float-cast-overflow $< $(LIB_SRCS) -lm -o $@
+
+check-plcin: $(RTT)/test_plcin $(RTT)/test_plcin_san
+	$(call suite,check-plcin,$(RTT)/test_plcin && UBSAN_OPTIONS=print_stacktrace=1 $(RTT)/test_plcin_san)

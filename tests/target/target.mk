@@ -14,10 +14,11 @@
 #                  stack of the urrt_rtde functions (its log joins stack_target.h's for stack.py);
 #                  the RTDE client's writing side (tests/lib/test_rtde_in.c, which reads
 #                  tests/ref/rtde_ref.py --inputs's sessions through semihosting) on the same three,
-#                  with the stack of the urrt_rtde_in functions
+#                  with the stack of the urrt_rtde_in functions; the PLC's answers (tests/lib/test_plcin.c)
+#                  on the same three, with the stack of the urrt_plcin functions
 #   check-lib-be   tests/lib/test_lib.c on big-endian s390x, powerpc and mips (with the lib/urrt_can,
-#                  urrt_cantx, urrt_co, urrt_rtde and urrt_rtde_in tests of tests/lib/test_can.c,
-#                  test_cantx.c, test_co.c, test_rtde.c, test_rtde_in.c),
+#                  urrt_cantx, urrt_co, urrt_rtde, urrt_rtde_in and urrt_plcin tests of tests/lib/test_can.c,
+#                  test_cantx.c, test_co.c, test_rtde.c, test_rtde_in.c, test_plcin.c),
 #                  lib/*.c alone, and on little-endian NEON
 #                  (aarch64, armhf; lib/vector/urrt_vector.c, and aarch64 also lib/*.c alone)
 #                  under qemu-user; on big-endian NEON (aarch64_be, armeb; freestanding)
@@ -79,7 +80,7 @@ TGT_BOARDS := m4-os:mps2-an386 m4f-o2:mps2-an386 m4na-os:mps2-an386 f405-os:netd
 # The CAN core's and the CANopen node's tests (tests/lib/test_cantx.c, test_co.c) as images
 # of their own, NAME/cantx.elf and NAME/co.elf, on the lib/ objects of an image above:
 # $(call tgt_unit,NAME,CPU FLAGS,OPT,LINKER SCRIPT).
-TGT_UNITS := cantx co
+TGT_UNITS := cantx co plcin
 TGT_UNIT_DEPS := tests/target/cm.c tests/target/target.h tests/target/target_check.h tests/testutil.h \
                  tests/lib/co_fixture.h
 define tgt_unit
@@ -138,6 +139,7 @@ check-lib-m4: $(foreach b,$(TGT_BOARDS),$(TGT)/$(firstword $(subst :, ,$(b)))/te
 	  $(foreach u,$(TGT_UNITS),$(foreach b,$(TGT_UNIT_BOARDS),$(u)-$(firstword $(subst :, ,$(b)))="$(TGT_QEMU_M) \
 	    -M $(lastword $(subst :, ,$(b))) -kernel $(TGT)/$(firstword $(subst :, ,$(b)))/$(u).elf")) \
 	  stack-m4-os="cat $(TGT)/logs/m4-os.log $(TGT)/logs/rtde-m4-os.log $(TGT)/logs/rtde-in-m4-os.log \
+	    $(TGT)/logs/plcin-m4-os.log \
 	    > $(TGT)/logs/stack-m4-os.marks && \
 	    $(PYTHON) tests/target/stack.py $(TGT)/logs/stack-m4-os.marks docs/footprint.md $(TGT)/m4-os/lib/*.ci")
 
@@ -205,16 +207,19 @@ $(TGT)/%/neon_be_old: $(TGT_DRIVER) tests/target/linux_start.c $(TGT)/vectors_na
 	$(if $(filter armeb,$*),$(TGT_ARMEB),$(TGT_A64BE)) $(TGT_BE_FREE) -Ilib/vector $(TGT_OLD_NEON) -o $@
 TGT_BE_BINS += $(foreach a,armeb aarch64_be,$(TGT)/$(a)/neon_be $(TGT)/$(a)/neon_be_old)
 
-# The RTDE client's tests (tests/lib/test_rtde.c, tests/lib/rtde.mk) on the big-endian CPUs,
+# The RTDE client's tests (tests/lib/test_rtde.c, test_rtde_in.c, test_plcin.c) on the big-endian CPUs,
 # on the reference's sessions: $(call tgt_rtde,NAME,CC,QEMU), on the lib/ objects of tgt_linux.
 define tgt_rtde
 $(TGT)/$(1)/test_rtde: tests/lib/test_rtde.c tests/check.h tests/lib/rtde_names.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
 	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
 $(TGT)/$(1)/test_rtde_in: tests/lib/test_rtde_in.c tests/check.h tests/target/stack_marks.h tests/lib/rtde_names.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
 	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
-TGT_BE_BINS += $(TGT)/$(1)/test_rtde $(TGT)/$(1)/test_rtde_in
+$(TGT)/$(1)/test_plcin: tests/lib/test_plcin.c tests/check.h tests/target/stack_marks.h $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o)
+	$(2) -static $(LIB_TEST_CFLAGS) -O2 $$< $(LIB_SRCS:lib/%.c=$(TGT)/$(1)/lib/%.o) -lm -o $$@
+TGT_BE_BINS += $(TGT)/$(1)/test_rtde $(TGT)/$(1)/test_rtde_in $(TGT)/$(1)/test_plcin
 TGT_BE_RUNS += $(1)-rtde="$(3) $(TGT)/$(1)/test_rtde $(RTDE_VECTORS)" \
-               $(1)-rtde-in="$(3) $(TGT)/$(1)/test_rtde_in $(RTDE_IN_VECTORS)"
+               $(1)-rtde-in="$(3) $(TGT)/$(1)/test_rtde_in $(RTDE_IN_VECTORS)" \
+               $(1)-plcin="$(3) $(TGT)/$(1)/test_plcin"
 endef
 $(eval $(call tgt_rtde,s390x,s390x-linux-gnu-gcc,qemu-s390x))
 $(eval $(call tgt_rtde,powerpc,powerpc-linux-gnu-gcc,qemu-ppc))

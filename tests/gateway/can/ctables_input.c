@@ -3,7 +3,7 @@
  * ctables_input: a firmware's receiving side over the [input] tables that
  * urrt-gateway --print-c-tables wrote, for tests/gateway/can/check_dbc_input.py.
  * The tables are included (TABLES, a path), so that this file is compiled
- * with them under lib/'s warnings and sees their urrt_gateway_input type;
+ * with them under lib/'s warnings and sees lib's urrt_plcin_desc type;
  * it uses lib/ alone (urrt_can, urrt_rtde's names), as the tables' comment
  * says a firmware does:
  *
@@ -36,7 +36,7 @@ static void put_name(unsigned var)
 static void describe(void)
 {
     for (size_t i = 0; i < urrt_gateway_input_count; i++) {
-        const urrt_gateway_input *in = &urrt_gateway_inputs[i];
+        const urrt_plcin_desc *in = &urrt_gateway_inputs[i];
         printf("INPUT id=0x%lX flags=%u len=%u timeout_ms=%lu silence=%u value=%.17g robot=%u regs=",
                (unsigned long)in->id, (unsigned)in->flags, (unsigned)in->len, (unsigned long)in->timeout_ms,
                (unsigned)in->silence, in->silence_value, (unsigned)in->robot);
@@ -56,7 +56,7 @@ static void describe(void)
 }
 
 /* Register k of input in from payload data, printed as NAME=VALUE. */
-static void put_register(const urrt_gateway_input *in, size_t k, const uint8_t *data)
+static void put_register(const urrt_plcin_desc *in, size_t k, const uint8_t *data)
 {
     uint64_t word = 0;
     double value = 0;
@@ -97,7 +97,7 @@ static int decode(void)
         unsigned long index = strtoul(line, &end, 10);
         uint8_t data[64];
         size_t len = 0;
-        const urrt_gateway_input *in;
+        const urrt_plcin_desc *in;
         if (end == line || index >= urrt_gateway_input_count) {
             fprintf(stderr, "ctables_input: bad line %s", line);
             return 1;

@@ -2,7 +2,8 @@
 /*
  * fuzz_can_in: the gateway's inputs from a PLC as untrusted input (libFuzzer,
  * ASan + UBSan): received [input] frames of any id, length and kind through
- * gateway/can/can_in.c into their input recipes, and, through the CANopen
+ * lib/urrt_plcin (as gateway/can/can_in.c describes them) into their input
+ * recipes, and, through the CANopen
  * node of the configuration's twin (gateway/can/co_run.c over lib/urrt_co),
  * any NMT command, RPDO and SDO request (the new objects 0x2200.., 0x1400..,
  * 0x1600.., 0x1016 among them), the node's variables then taken as
@@ -13,11 +14,12 @@
  * the rules, independently of the code under test's own arithmetic where
  * the rule allows:
  *   - each register holds a value, was refused, or is absent: the three
- *     counts add up to the recipe's registers, refused as can_in_take says;
+ *     counts add up to the recipe's registers, refused as urrt_plcin_take says;
  *   - a register's value is one its type takes (INT32 in range, BOOL 0/1,
  *     a DOUBLE finite) and, from a quantity, within each of its signals'
  *     min..max; a mask holds no bit its signals do not carry;
- *   - a register whose signal was absent holds no value.
+ *   - a register whose signal was absent holds no value;
+ *   - the input is fresh after it, and its package due to a new session.
  */
 #include <math.h>
 #include <stdio.h>
@@ -61,7 +63,14 @@ static const char canopen_ini[] =
     "signal = input_int_register_28 @16|8 intel signed min=-5 max=5 name=small\n";
 
 static gw_config plain, canopen;
-static urrt_rtde_in plain_in[8], canopen_in[URRT_CO_MAX_RPDOS];
+/* Per [input]: lib's description of it, its state, its recipe. */
+struct input {
+    urrt_plcin_desc d;
+    uint16_t vars[URRT_PLCIN_MAX_SIGNALS];
+    urrt_plcin st;
+    urrt_rtde_in in;
+};
+static struct input plain_in[8], canopen_in[URRT_CO_MAX_RPDOS];
 
 static void die(const char *what)
 {
@@ -69,7 +78,7 @@ static void die(const char *what)
     abort();
 }
 
-static void load(gw_config *cfg, const char *text, const char *name, urrt_rtde_in *in)
+static void load(gw_config *cfg, const char *text, const char *name, struct input *in)
 {
     FILE *f = fmemopen((void *)text, strlen(text), "r");
     if (f == NULL || gw_config_load_stream(cfg, f, name, stderr) != 0) {
@@ -77,9 +86,10 @@ static void load(gw_config *cfg, const char *text, const char *name, urrt_rtde_i
     }
     fclose(f);
     for (size_t i = 0; i < cfg->can.input_count; i++) {
-        if (urrt_rtde_in_init(&in[i], cfg->can.inputs[i].regs, cfg->can.inputs[i].reg_count) != URRT_OK) {
+        if (urrt_rtde_in_init(&in[i].in, cfg->can.inputs[i].regs, cfg->can.inputs[i].reg_count) != URRT_OK) {
             die("an [input]'s recipe is refused by lib");
         }
+        can_in_desc(&cfg->can.inputs[i], in[i].vars, &in[i].d);
     }
 }
 
@@ -160,9 +170,14 @@ static void check_value(const struct can_map_frame *f, const urrt_rtde_in *in, s
 }
 
 /* The take of f's registers from raws, then every rule of the header. */
-static void take_and_check(const struct can_map_frame *f, urrt_rtde_in *in, const uint64_t *raws, uint64_t absent)
+static void take_and_check(const struct can_map_frame *f, struct input *input, const uint64_t *raws,
+                           uint64_t absent, uint64_t now)
 {
-    size_t refused = can_in_take(f, in, raws, absent), held = 0, missing = 0;
+    urrt_rtde_in *in = &input->in;
+    size_t refused = urrt_plcin_take(&input->d, &input->st, in, raws, absent, now), held = 0, missing = 0;
+    if (!input->st.fresh || !urrt_plcin_due(&input->d, &input->st, true, input->st.session + 1u, now, UINT64_MAX)) {
+        die("an input just taken is not fresh, or its package not due to a new session");
+    }
     for (size_t k = 0; k < f->reg_count; k++) {
         bool gone = false;
         for (size_t i = 0; i < f->count && i < 64; i++) {
@@ -192,7 +207,7 @@ static void emit(void *ctx, const urrt_can_frame *frame, uint64_t now_us)
 static size_t plain_frame(const uint8_t *p, size_t n)
 {
     urrt_can_frame frame;
-    uint64_t raws[CAN_IN_MAX_SIGNALS];
+    uint64_t raws[URRT_PLCIN_MAX_SIGNALS];
     const struct can_map_frame *f;
     size_t used;
     if (n < 3) {
@@ -206,8 +221,9 @@ static size_t plain_frame(const uint8_t *p, size_t n)
     frame.len = (uint8_t)(p[1] & 0x7Fu) <= URRT_CAN_MAX_LEN ? (uint8_t)(p[1] & 0x7Fu) : URRT_CAN_MAX_LEN;
     used = 2u + (frame.len < n - 2u ? frame.len : n - 2u);
     memcpy(frame.data, p + 2, used - 2u);
-    if (can_in_raws(f, &frame, raws)) {
-        take_and_check(f, &plain_in[f - plain.can.inputs], raws, 0);
+    struct input *input = &plain_in[f - plain.can.inputs];
+    if (urrt_plcin_raws(&input->d, frame.data, frame.len, frame.fd, raws)) {
+        take_and_check(f, input, raws, 0, 1000000);
     } else if (frame.len == f->len && frame.fd == f->fd) {
         die("a frame of the configured length and kind is not used");
     }
@@ -240,7 +256,7 @@ static size_t node_frame(const uint8_t *p, size_t n, uint64_t *now)
             raws[k] = co_run_input_raw(canopen.co_run, i, k);
             absent |= (uint64_t)((p[0] >> k & 1u) && (p[2] & 1u)) << k;
         }
-        take_and_check(f, &canopen_in[i], raws, absent);
+        take_and_check(f, &canopen_in[i], raws, absent, *now);
     }
     return used;
 }
@@ -252,10 +268,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     urrt_co *co = co_run_node(canopen.co_run);
     (void)urrt_co_start(co, now, emit, NULL); /* power-on: every object to its default */
     for (size_t i = 0; i < plain.can.input_count; i++) {
-        urrt_rtde_in_forget(&plain_in[i]);
+        urrt_rtde_in_forget(&plain_in[i].in);
+        urrt_plcin_init(&plain_in[i].st);
     }
     for (size_t i = 0; i < canopen.can.input_count; i++) {
-        urrt_rtde_in_forget(&canopen_in[i]);
+        urrt_rtde_in_forget(&canopen_in[i].in);
+        urrt_plcin_init(&canopen_in[i].st);
     }
     while (size > 1) {
         size_t used = (data[0] & 1u) == 0 ? plain_frame(data + 1, size - 1) : node_frame(data + 1, size - 1, &now);

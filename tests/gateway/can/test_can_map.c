@@ -1423,7 +1423,7 @@ static void inputs_accepted(void)
         CHECK_EQ_STR(f->name, "cmd");
         CHECK(f->input && f->id == 0x18FF1234 && f->extended && f->fd && f->len == 16, "cmd: id, kind, length");
         CHECK_EQ_INT(f->timeout_ms, 250);
-        CHECK(f->silence == CAN_MAP_SILENCE_VALUE && f->silence_value == 1.0, "cmd: on_silence = value 1");
+        CHECK(f->silence == URRT_PLCIN_VALUE && f->silence_value == 1.0, "cmd: on_silence = value 1");
         CHECK_EQ_STR(f->comment, "Cell PLC setpoints");
         CHECK_EQ_INT(f->robot_index, 0);
         CHECK_EQ_INT(f->loc.line, 7);
@@ -1457,7 +1457,7 @@ static void inputs_accepted(void)
         const struct can_map_frame *f = &map->inputs[1];
         CHECK_EQ_STR(f->name, "stop");
         CHECK(f->id == 0x210 && !f->extended && !f->fd && f->len == 8, "stop: defaults 11-bit, classic, 8 bytes");
-        CHECK(f->timeout_ms == 50 && f->silence == CAN_MAP_SILENCE_HOLD, "stop: 50 ms, hold");
+        CHECK(f->timeout_ms == 50 && f->silence == URRT_PLCIN_HOLD, "stop: 50 ms, hold");
         CHECK(f->reg_count == 1 && f->regs[0] == URRT_RTDE_V_INPUT_INT_REGISTER + 26, "stop: its one register");
         CHECK_EQ_STR(f->comment, "");
     }
@@ -1530,7 +1530,7 @@ static void inputs_example(void)
         CHECK(cfg.can.input_count == 1 && cfg.can.frame_count == 1, "one [input], one [frame]");
         CHECK_EQ_STR(f->name, "plc_command");
         CHECK(f->id == 0x200 && !f->extended && !f->fd && f->len == 8, "plc_command: 0x200, classic, 8 bytes");
-        CHECK(f->timeout_ms == 100 && f->silence == CAN_MAP_SILENCE_STOP, "plc_command: 100 ms, stop");
+        CHECK(f->timeout_ms == 100 && f->silence == URRT_PLCIN_STOP, "plc_command: 100 ms, stop");
         CHECK(f->reg_count == 3 && f->regs[0] == URRT_RTDE_V_INPUT_INT_REGISTER + 24 &&
                   f->regs[1] == URRT_RTDE_V_INPUT_BIT_REGISTER + 0 && f->regs[2] == URRT_RTDE_V_INPUT_BIT_REGISTER + 1,
               "plc_command's recipe: input_int_register_24, input_bit_register_64, input_bit_register_65");

@@ -1,0 +1,287 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * test_plcin: lib/urrt_plcin.h's rules on one input of four registers, every
+ * expected value worked out by hand in the comments (the payload's fields,
+ * the registers' big-endian bytes), not by lib's own arithmetic:
+ *   - a payload of another length or kind is not used; the raws of one that is;
+ *   - the values taken (scaling, min..max, masks gathered from two signals),
+ *     a value refused or absent leaving its register without one;
+ *   - when a package is due: nothing before the first write, at once on a
+ *     change or a new session, then every period while fresh; the deadline;
+ *   - the timeout, and each on_silence policy: stop, hold, value.
+ * It runs on the host and, as NAME/plcin.elf, on the Cortex-M boards of
+ * make check-lib-m4, where it paints the stack of each urrt_plcin function
+ * (tests/target/stack_marks.h).
+ */
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "check.h"
+#include "urrt_plcin.h"
+#define STACK_MARKS_MAX 12
+#include "target/stack_marks.h"
+
+enum { PERIOD_US = 100000, TIMEOUT_MS = 250 };
+
+static const urrt_can_signal signals[] = {
+    /* job: bytes 0-1, Intel, unsigned, 0..9999 */
+    {.factor = 1, .offset = 0, .min = 0, .max = 9999, .start = 0, .length = 16, .type = URRT_CAN_UNSIGNED},
+    /* start: bit 16 */
+    {.factor = 1, .offset = 0, .min = 0, .max = 1, .start = 16, .length = 1, .type = URRT_CAN_UNSIGNED},
+    /* mask_lo: byte 3's low nibble, the mask's bits 0-3 */
+    {.factor = 1, .offset = 0, .min = 0, .max = 15, .start = 24, .length = 4, .type = URRT_CAN_UNSIGNED,
+     .flags = URRT_CAN_SIG_MASK(0)},
+    /* mask_hi: byte 4, the mask's bits 8-15 */
+    {.factor = 1, .offset = 0, .min = 0, .max = 255, .start = 32, .length = 8, .type = URRT_CAN_UNSIGNED,
+     .flags = URRT_CAN_SIG_MASK(8)},
+    /* speed: bytes 5-6, signed, x 0.01 + 0.5, -100..200 */
+    {.factor = 0.01, .offset = 0.5, .min = -100, .max = 200, .start = 40, .length = 16, .type = URRT_CAN_SIGNED},
+};
+static const uint16_t vars[] = {
+    URRT_RTDE_V_INPUT_INT_REGISTER + 24, URRT_RTDE_V_INPUT_BIT_REGISTER + 0,
+    URRT_RTDE_V_INPUT_BIT_REGISTERS32_TO_63, URRT_RTDE_V_INPUT_BIT_REGISTERS32_TO_63,
+    URRT_RTDE_V_INPUT_DOUBLE_REGISTER + 30,
+};
+/* INT32, BOOL, UINT32, DOUBLE: 4 + 1 + 4 + 8 = 17 bytes in a package. */
+static const uint16_t regs[] = {
+    URRT_RTDE_V_INPUT_INT_REGISTER + 24, URRT_RTDE_V_INPUT_BIT_REGISTER + 0,
+    URRT_RTDE_V_INPUT_BIT_REGISTERS32_TO_63, URRT_RTDE_V_INPUT_DOUBLE_REGISTER + 30,
+};
+
+/* lib's calls, each through its stack mark on the target. */
+static bool raws_of(const urrt_plcin_desc *d, const uint8_t *data, unsigned len, bool fd, uint64_t *raws)
+{
+    bool r;
+    MEASURED(r, urrt_plcin_raws, (d, data, len, fd, raws));
+    return r;
+}
+static size_t take(const urrt_plcin_desc *d, urrt_plcin *p, urrt_rtde_in *in, const uint64_t *raws,
+                   uint64_t absent, uint64_t at_us)
+{
+    size_t r;
+    MEASURED(r, urrt_plcin_take, (d, p, in, raws, absent, at_us));
+    return r;
+}
+static bool timed_out(const urrt_plcin_desc *d, const urrt_plcin *p, uint64_t now_us)
+{
+    bool r;
+    MEASURED(r, urrt_plcin_timed_out, (d, p, now_us));
+    return r;
+}
+static void silent(const urrt_plcin_desc *d, urrt_plcin *p, urrt_rtde_in *in)
+{
+    MEASURED_VOID(urrt_plcin_silent, (d, p, in));
+}
+static bool writing(const urrt_plcin_desc *d, const urrt_plcin *p)
+{
+    bool r;
+    MEASURED(r, urrt_plcin_writing, (d, p));
+    return r;
+}
+static bool due(const urrt_plcin_desc *d, const urrt_plcin *p, bool ready, uint32_t session, uint64_t now_us,
+                uint64_t period_us)
+{
+    bool r;
+    MEASURED(r, urrt_plcin_due, (d, p, ready, session, now_us, period_us));
+    return r;
+}
+static void sent(urrt_plcin *p, bool ok, uint32_t session, uint64_t now_us)
+{
+    MEASURED_VOID(urrt_plcin_sent, (p, ok, session, now_us));
+}
+static uint64_t deadline(const urrt_plcin_desc *d, const urrt_plcin *p, bool ready, uint64_t period_us)
+{
+    uint64_t r;
+    MEASURED(r, urrt_plcin_deadline, (d, p, ready, period_us));
+    return r;
+}
+
+static urrt_plcin_desc desc(urrt_plcin_silence silence, double value)
+{
+    urrt_plcin_desc d = {signals, vars, regs, 5, 4, 8, 0, 0x201, TIMEOUT_MS, (uint8_t)silence, 0, value};
+    return d;
+}
+
+/* job 0x1234 = 4660, start 1, mask_lo 0xA, mask_hi 0xF5, speed raw 0x2710 = 10000 (100.5). */
+static const uint8_t payload[8] = {0x34, 0x12, 0x01, 0x0A, 0xF5, 0x10, 0x27, 0x00};
+/* 4660; 1; 0xF5 << 8 | 0xA = 0xF50A; 100.5 = 0x4059200000000000. */
+static const uint8_t registers[17] = {0x00, 0x00, 0x12, 0x34, 0x01, 0x00, 0x00, 0xF5, 0x0A,
+                                      0x40, 0x59, 0x20, 0x00, 0x00, 0x00, 0x00, 0x00};
+
+static bool given(const urrt_rtde_in *in, unsigned k)
+{
+    return ((unsigned)in->given[k / 8u] >> (k % 8u) & 1u) != 0;
+}
+
+static bool same(const uint8_t *a, const uint8_t *b, unsigned n)
+{
+    for (unsigned i = 0; i < n; i++) {
+        if (a[i] != b[i]) {
+            return false;
+        }
+    }
+    return true;
+}
+
+static void setup(urrt_rtde_in *in, urrt_plcin *p)
+{
+    CHECK_EQ_INT(urrt_rtde_in_init(in, regs, 4), URRT_OK);
+    MEASURED_VOID(urrt_plcin_init, (p));
+}
+
+static void test_raws(void)
+{
+    urrt_plcin_desc d = desc(URRT_PLCIN_STOP, 0);
+    uint64_t raws[5] = {7, 7, 7, 7, 7};
+    CHECK(!raws_of(&d, payload, 7, false, raws), "7 bytes for 8: not used");
+    CHECK(!raws_of(&d, payload, 8, true, raws), "CAN FD for classic: not used");
+    CHECK(raws[0] == 7 && raws[4] == 7, "raws untouched by a payload not used");
+    CHECK(raws_of(&d, payload, 8, false, raws), "the configured length and kind");
+    CHECK(raws[0] == 4660 && raws[1] == 1 && raws[2] == 0xA && raws[3] == 0xF5 && raws[4] == 10000,
+          "raws %llu %llu %llu %llu %llu", (unsigned long long)raws[0], (unsigned long long)raws[1],
+          (unsigned long long)raws[2], (unsigned long long)raws[3], (unsigned long long)raws[4]);
+}
+
+static void test_values(void)
+{
+    urrt_plcin_desc d = desc(URRT_PLCIN_STOP, 0);
+    urrt_rtde_in in;
+    urrt_plcin p;
+    uint64_t raws[5];
+    setup(&in, &p);
+    (void)raws_of(&d, payload, 8, false, raws);
+    CHECK_EQ_INT(take(&d, &p, &in, raws, 0, 1000), 0);
+    CHECK_EQ_INT(in.data_size, 17);
+    CHECK(same(in.data, registers, 17) && urrt_rtde_in_complete(&in), "the four registers as worked out");
+
+    raws[0] = 10000; /* job past max=9999: refused, never clamped */
+    raws[4] = (uint64_t)(uint16_t)-30000; /* -300 + 0.5: below min=-100 */
+    CHECK_EQ_INT(take(&d, &p, &in, raws, 0, 2000), 2);
+    CHECK(!given(&in, 0) && given(&in, 1) && given(&in, 2) && !given(&in, 3), "the refused ones hold no value");
+    CHECK(!urrt_rtde_in_complete(&in), "so no package can go");
+
+    raws[0] = 9999;
+    raws[4] = (uint64_t)(uint16_t)-10050; /* -100.5 + 0.5 = -100.0: the min itself */
+    CHECK_EQ_INT(take(&d, &p, &in, raws, 1u << 1, 3000), 0); /* start absent: not counted */
+    CHECK(given(&in, 0) && !given(&in, 1) && given(&in, 3), "an absent signal's register holds no value");
+    CHECK(in.data[2] == 0x27 && in.data[3] == 0x0F, "job 9999 = 0x270F");
+    CHECK(in.data[9] == 0xC0 && in.data[10] == 0x59 && in.data[11] == 0x00, "-100.0 = 0xC059000000000000");
+
+    /* A mask bit past 31 (first 28, 8 bits): the UINT32 word refuses it. */
+    {
+        urrt_can_signal wide[5];
+        for (unsigned i = 0; i < 5; i++) {
+            wide[i] = signals[i];
+        }
+        wide[3].flags = (uint8_t)URRT_CAN_SIG_MASK(28);
+        d.signals = wide;
+        raws[3] = 0x10; /* bit 4 of the signal: the mask's bit 32 */
+        CHECK_EQ_INT(take(&d, &p, &in, raws, 0, 4000), 1);
+        CHECK(!given(&in, 2), "a mask past bit 31 is refused");
+        raws[3] = 0x08; /* the mask's bit 31: 0x8000000A */
+        CHECK_EQ_INT(take(&d, &p, &in, raws, 0, 5000), 0);
+        CHECK(given(&in, 2) && in.data[5] == 0x80 && in.data[8] == 0x0A, "bit 31 and the low nibble");
+    }
+}
+
+static void test_schedule(void)
+{
+    urrt_plcin_desc d = desc(URRT_PLCIN_STOP, 0);
+    urrt_rtde_in in;
+    urrt_plcin p;
+    uint64_t raws[5];
+    const uint64_t t = 1000000;
+    setup(&in, &p);
+    (void)raws_of(&d, payload, 8, false, raws);
+    CHECK(!writing(&d, &p) && !due(&d, &p, true, 1, t, PERIOD_US),
+          "nothing before the PLC first wrote");
+    CHECK(deadline(&d, &p, true, PERIOD_US) == URRT_CANTX_NEVER, "and no deadline");
+
+    (void)take(&d, &p, &in, raws, 0, t);
+    CHECK(due(&d, &p, true, 1, t, PERIOD_US), "the first write: due at once");
+    CHECK(!due(&d, &p, false, 1, t, PERIOD_US), "but not to a session that is not ready");
+    sent(&p, true, 1, t);
+    CHECK(!due(&d, &p, true, 1, t + PERIOD_US - 1, PERIOD_US), "not again within the period");
+    CHECK(due(&d, &p, true, 1, t + PERIOD_US, PERIOD_US), "again after the period");
+    CHECK(due(&d, &p, true, 2, t + 1, PERIOD_US), "at once to a new session");
+    CHECK(deadline(&d, &p, true, PERIOD_US) == t + PERIOD_US, "deadline: the period (before the timeout)");
+    CHECK(deadline(&d, &p, false, PERIOD_US) == t + TIMEOUT_MS * 1000u,
+          "deadline with no session ready: the timeout");
+
+    (void)take(&d, &p, &in, raws, 0, t + 10);
+    CHECK(!due(&d, &p, true, 1, t + 10, PERIOD_US), "the same values: not due within the period");
+    raws[4] = 10001;
+    (void)take(&d, &p, &in, raws, 0, t + 20);
+    CHECK(due(&d, &p, true, 1, t + 20, PERIOD_US), "a changed value: due at once");
+    sent(&p, false, 1, t + 20);
+    CHECK(due(&d, &p, true, 1, t + 21, PERIOD_US), "one that could not go: still due");
+    CHECK(deadline(&d, &p, true, PERIOD_US) == t + 20 + PERIOD_US, "with its deadline a period later");
+    sent(&p, true, 1, t + 30);
+    CHECK(!due(&d, &p, true, 1, t + 31, PERIOD_US), "sent: no longer due");
+
+    CHECK(!timed_out(&d, &p, t + 20 + TIMEOUT_MS * 1000u), "not timed out at exactly timeout_ms");
+    CHECK(timed_out(&d, &p, t + 21 + TIMEOUT_MS * 1000u), "timed out past it");
+    silent(&d, &p, &in);
+    CHECK(!p.fresh && !given(&in, 0) && !given(&in, 3), "stop: not fresh, the values forgotten");
+    CHECK(!writing(&d, &p) && !due(&d, &p, true, 3, t + 10000000, PERIOD_US),
+          "stop: nothing is sent, even to a new session");
+    CHECK(deadline(&d, &p, true, PERIOD_US) == URRT_CANTX_NEVER, "stop: no deadline");
+
+    raws[4] = 10000;
+    (void)take(&d, &p, &in, raws, 0, t + 20000000);
+    CHECK(p.fresh && due(&d, &p, true, 1, t + 20000000, PERIOD_US), "the PLC writes again: due at once");
+}
+
+static void test_hold_and_value(void)
+{
+    urrt_plcin_desc hold = desc(URRT_PLCIN_HOLD, 0), value = desc(URRT_PLCIN_VALUE, 0);
+    urrt_rtde_in in;
+    urrt_plcin p;
+    uint64_t raws[5];
+    const uint64_t t = 5000000;
+    setup(&in, &p);
+    (void)raws_of(&hold, payload, 8, false, raws);
+    (void)take(&hold, &p, &in, raws, 0, t);
+    sent(&p, true, 1, t);
+    silent(&hold, &p, &in);
+    CHECK(!p.fresh && same(in.data, registers, 17) && urrt_rtde_in_complete(&in), "hold: the last values kept");
+    CHECK(!due(&hold, &p, true, 1, t + 1, PERIOD_US) &&
+              due(&hold, &p, true, 1, t + PERIOD_US, PERIOD_US),
+          "hold: sent on at the period");
+    CHECK(deadline(&hold, &p, true, PERIOD_US) == t + PERIOD_US, "hold: the period is the deadline");
+
+    setup(&in, &p);
+    (void)take(&value, &p, &in, raws, 0, t);
+    sent(&p, true, 1, t);
+    silent(&value, &p, &in);
+    {
+        static const uint8_t zeros[17] = {0};
+        CHECK(same(in.data, zeros, 17) && urrt_rtde_in_complete(&in), "value 0: every register 0");
+    }
+    CHECK(due(&value, &p, true, 1, t + 1, PERIOD_US), "value: the new values due at once");
+    silent(&value, &p, &in);
+    CHECK(!p.fresh, "silent twice: nothing more");
+}
+
+int main(void)
+{
+#ifdef URRT_TARGET_CORTEX_M
+    measuring = true;
+#endif
+    test_raws();
+    test_values();
+    test_schedule();
+    test_hold_and_value();
+    {
+        urrt_rtde_in in;
+        CHECK_EQ_INT(urrt_rtde_in_init(&in, regs, 4), URRT_OK);
+        in.given[0] = 0x0F;
+        MEASURED_VOID(urrt_rtde_in_unset, (&in, 2));
+        MEASURED_VOID(urrt_rtde_in_unset, (&in, 4)); /* past the recipe: nothing */
+        CHECK(in.given[0] == 0x0B, "urrt_rtde_in_unset: register 2 alone");
+    }
+#ifdef URRT_TARGET_CORTEX_M
+    stack_marks_print();
+#endif
+    return check_report();
+}
