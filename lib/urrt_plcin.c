@@ -2,10 +2,13 @@
 /* urrt_plcin.c: see urrt_plcin.h. */
 #include "urrt_plcin.h"
 
+#include "urrt_double_internal.h"
+
 void urrt_plcin_init(urrt_plcin *p)
 {
     if (p != 0) {
         p->rx_us = 0;
+        p->seen_us = URRT_CANTX_NEVER;
         p->sent_us = 0;
         p->session = 0;
         p->ever = false;
@@ -39,6 +42,54 @@ bool urrt_plcin_raws(const urrt_plcin_desc *d, const uint8_t *data, unsigned len
 
 enum take { TAKEN, REFUSED, ABSENT };
 
+/* A double's bits: compared as integers, a Cortex-M4 does no floating-point
+ * arithmetic in software for it. */
+typedef union {
+    double d;
+    uint64_t u;
+} bits_of;
+
+/* The integer a signal's raw value stands for when its scaling is the
+ * identity (factor 1, offset 0, an integer raw type): the physical value is
+ * the raw integer itself (sign-extended), with no scaling to compute; false
+ * for any other signal, and for an unsigned 64-bit raw past INT64_MAX. */
+static bool identity_value(const urrt_can_signal *sig, uint64_t raw, int64_t *v)
+{
+    bits_of factor, offset;
+    uint64_t sign;
+    factor.d = sig->factor;
+    offset.d = sig->offset;
+    if (factor.u != UINT64_C(0x3FF0000000000000) || (offset.u << 1) != 0u || sig->length == 0u ||
+        sig->length > 64u || (sig->type != URRT_CAN_UNSIGNED && sig->type != URRT_CAN_SIGNED)) {
+        return false;
+    }
+    if (sig->length < 64u) {
+        raw &= (UINT64_C(1) << sig->length) - 1u;
+        sign = UINT64_C(1) << (sig->length - 1u);
+        if (sig->type == URRT_CAN_SIGNED && (raw & sign) != 0u) {
+            raw |= ~((UINT64_C(1) << sig->length) - 1u);
+        }
+    } else if (sig->type == URRT_CAN_UNSIGNED && raw > (uint64_t)INT64_MAX) {
+        return false;
+    }
+    *v = (int64_t)raw;
+    return true;
+}
+
+/* v within the signal's min..max: compared as integers where a limit is an
+ * integer (the usual case), as doubles where it is not. */
+static bool within(const urrt_can_signal *sig, int64_t v)
+{
+    bits_of lo, hi;
+    int64_t l, h;
+    bool above, below;
+    lo.d = sig->min;
+    hi.d = sig->max;
+    above = urrt_int_of_double_bits(lo.u, &l) ? v >= l : (double)v >= sig->min;
+    below = urrt_int_of_double_bits(hi.u, &h) ? v <= h : (double)v <= sig->max;
+    return above && below;
+}
+
 static enum take none(urrt_rtde_in *in, size_t k, enum take why)
 {
     urrt_rtde_in_unset(in, k);
@@ -51,7 +102,8 @@ static enum take take_register(const urrt_plcin_desc *d, urrt_rtde_in *in, size_
 {
     uint64_t word = 0;
     double value = 0;
-    bool mask = false;
+    int64_t whole = 0;
+    bool mask = false, integer = false;
     size_t i;
     for (i = 0; i < d->signal_count; i++) {
         const urrt_can_signal *sig = &d->signals[i];
@@ -68,10 +120,20 @@ static enum take take_register(const urrt_plcin_desc *d, urrt_rtde_in *in, size_
             word |= first < 64u ? bits << first : 0u;
             continue;
         }
+        if (identity_value(sig, raws[i], &whole)) {
+            integer = true;
+            if (!within(sig, whole)) {
+                return none(in, k, REFUSED);
+            }
+            continue;
+        }
         value = urrt_can_from_raw(sig, raws[i]);
         if (!(value >= sig->min) || !(value <= sig->max)) {
             return none(in, k, REFUSED);
         }
+    }
+    if (integer) {
+        return urrt_rtde_in_set_int(in, k, whole) == URRT_OK ? TAKEN : REFUSED;
     }
     if (mask) {
         /* The bit-register words are UINT32: a mask past bit 31 is refused there. */
@@ -184,7 +246,8 @@ uint64_t urrt_plcin_deadline(const urrt_plcin_desc *d, const urrt_plcin *p, bool
         return due;
     }
     if (p->fresh) {
-        uint64_t timeout = p->rx_us + (uint64_t)d->timeout_ms * 1000u;
+        /* The first instant it is timed out: older than timeout_ms, not as old. */
+        uint64_t timeout = p->rx_us + (uint64_t)d->timeout_ms * 1000u + 1u;
         due = timeout < due ? timeout : due;
     }
     if (ready && urrt_plcin_writing(d, p)) {
@@ -192,4 +255,66 @@ uint64_t urrt_plcin_deadline(const urrt_plcin_desc *d, const urrt_plcin *p, bool
         due = refresh < due ? refresh : due;
     }
     return due;
+}
+
+/* ---- through a CANopen node ------------------------------------------------------ */
+
+/* The node's own reason for the input to be silent, in urrt_co_rpdo_status's
+ * order but for the RPDO's deadline and for no data yet, which are not. */
+static urrt_plcin_why node_why(const urrt_plcin_rpdo *r, uint64_t now_us)
+{
+    switch (urrt_co_rpdo_status(r->co, r->rpdo, now_us)) {
+    case URRT_CO_RPDO_NOT_OPERATIONAL: return URRT_PLCIN_NOT_OPERATIONAL;
+    /* Before "heartbeat lost", which it would hide: a manager that switched the
+     * RPDO off has said its registers are not written. */
+    case URRT_CO_RPDO_NOT_VALID: return URRT_PLCIN_RPDO_OFF;
+    case URRT_CO_RPDO_HEARTBEAT_LOST: return URRT_PLCIN_HEARTBEAT_LOST;
+    default: return URRT_PLCIN_STILL;
+    }
+}
+
+void urrt_plcin_node(const urrt_plcin_desc *d, const urrt_plcin_rpdo *r, urrt_plcin *p, urrt_rtde_in *in,
+                     uint64_t now_us, urrt_plcin_look *look)
+{
+    uint64_t timeout_us, newest = URRT_CANTX_NEVER;
+    const uint64_t *written;
+    urrt_plcin_why why;
+    size_t i;
+    if (look == 0) {
+        return;
+    }
+    look->took = false;
+    look->refused = 0;
+    look->why = URRT_PLCIN_STILL;
+    if (d == 0 || r == 0 || p == 0 || in == 0 || r->co == 0 || r->co->rx_storage == 0 ||
+        r->co->rx_storage->written_us == 0 || d->signal_count > URRT_CO_RPDO_MAX_MAPPED ||
+        (size_t)r->first_var + d->signal_count > r->co->rx_storage->var_count) {
+        return;
+    }
+    timeout_us = (uint64_t)d->timeout_ms * 1000u;
+    written = r->co->rx_storage->written_us + r->first_var;
+    for (i = 0; i < d->signal_count; i++) {
+        uint64_t w = written[i];
+        newest = w == URRT_CANTX_NEVER ? newest : newest == URRT_CANTX_NEVER || w > newest ? w : newest;
+    }
+    why = node_why(r, now_us);
+    if (why == URRT_PLCIN_STILL && newest != URRT_CANTX_NEVER && newest != p->seen_us &&
+        since(now_us, newest) <= timeout_us) {
+        uint64_t raws[URRT_CO_RPDO_MAX_MAPPED];
+        uint64_t absent = 0;
+        for (i = 0; i < d->signal_count; i++) {
+            raws[i] = r->co->vars[r->first_var + i];
+            absent |= (uint64_t)(written[i] == URRT_CANTX_NEVER || since(now_us, written[i]) > timeout_us) << i;
+        }
+        look->refused = urrt_plcin_take(d, p, in, raws, absent, newest);
+        look->took = true;
+    }
+    p->seen_us = newest;
+    if (why == URRT_PLCIN_STILL && urrt_plcin_timed_out(d, p, now_us)) {
+        why = URRT_PLCIN_NO_WRITE;
+    }
+    if (p->fresh && why != URRT_PLCIN_STILL) {
+        urrt_plcin_silent(d, p, in);
+        look->why = why;
+    }
 }

@@ -15,9 +15,10 @@
  *
  *   a frame of the input's id:  if (urrt_plcin_raws(&d, data, len, fd, raws))
  *                                   urrt_plcin_take(&d, &p, &in, raws, 0, now);
- *   an RPDO or SDO write stored: raws[i] = the node's variable of signal i,
- *                               bit i of absent when it is older than the
- *                               timeout; urrt_plcin_take(&d, &p, &in, raws, absent, at)
+ *   with a CANopen node:        after each frame to it and each urrt_co_run,
+ *                               urrt_plcin_node(&d, &rpdo, &p, &in, now, &look)
+ *                               takes what an RPDO or SDO write stored, and
+ *                               judges the node's state (below)
  *   at every loop:              if (urrt_plcin_timed_out(&d, &p, now))
  *                                   urrt_plcin_silent(&d, &p, &in);
  *                               (and on the caller's own reasons: the CAN
@@ -59,6 +60,7 @@
 
 #include "urrt_can.h"
 #include "urrt_cantx.h"
+#include "urrt_co.h"
 #include "urrt_rtde_in.h"
 
 #ifdef __cplusplus
@@ -95,6 +97,7 @@ typedef struct urrt_plcin_desc {
 /* One input's state: the caller's, zeroed or urrt_plcin_init'ed. */
 typedef struct urrt_plcin {
     uint64_t rx_us;     /* the PLC's last write taken */
+    uint64_t seen_us;   /* with a node: its newest write to the input's variables at the last look */
     uint64_t sent_us;   /* the last package sent or tried */
     uint32_t session;   /* the session the last package went to */
     bool ever;          /* the PLC wrote since start: before, nothing is sent */
@@ -148,10 +151,51 @@ bool urrt_plcin_due(const urrt_plcin_desc *d, const urrt_plcin *p, bool ready, u
  * urrt_plcin_deadline does not spin on it. */
 void urrt_plcin_sent(urrt_plcin *p, bool ok, uint32_t session, uint64_t now_us);
 
-/* The earliest time something is due: the timeout of fresh data, or the
- * next package of one written to a ready session; URRT_CANTX_NEVER when
+/* The earliest time something is due: the timeout of fresh data (the first
+ * microsecond urrt_plcin_timed_out holds), or the next package of one
+ * written to a ready session; URRT_CANTX_NEVER when
  * neither. A session that becomes ready, and a write, are the caller's news. */
 uint64_t urrt_plcin_deadline(const urrt_plcin_desc *d, const urrt_plcin *p, bool ready, uint64_t period_us);
+
+/* ---- through a CANopen node: RPDOs and SDO writes (lib/urrt_co.h) --------------
+ * Input n is the node's RPDO n (urrt_co_init_rx), its signal i the node's
+ * variable first_var + i, written by RPDO n or by an SDO download; each
+ * variable is as old as its own last write (co->rx_storage->written_us). */
+typedef struct urrt_plcin_rpdo {
+    const urrt_co *co;
+    uint16_t first_var;
+    uint8_t rpdo;       /* n: 0 for RPDO1 */
+} urrt_plcin_rpdo;
+
+/* Why the input fell silent at a look through the node. */
+typedef enum urrt_plcin_why {
+    URRT_PLCIN_STILL = 0,            /* it did not fall silent at this look */
+    URRT_PLCIN_NOT_OPERATIONAL,      /* the node is not OPERATIONAL */
+    URRT_PLCIN_RPDO_OFF,             /* the manager switched the RPDO off (0x1400+n sub 1, bit 31) */
+    URRT_PLCIN_HEARTBEAT_LOST,       /* the manager's heartbeat is lost (0x1016) */
+    URRT_PLCIN_NO_WRITE              /* no RPDO or SDO write for timeout_ms */
+} urrt_plcin_why;
+
+/* What a look through the node did. */
+typedef struct urrt_plcin_look {
+    bool took;          /* it took a write (as urrt_plcin_take) */
+    size_t refused;     /* of its values, refused */
+    urrt_plcin_why why; /* it fell silent (urrt_plcin_silent done), and why */
+} urrt_plcin_look;
+
+/*
+ * One look at input d through the node at now_us: what was written since
+ * the last look is taken, while the node may act on it (OPERATIONAL, the RPDO
+ * valid, the manager's heartbeat there) and its newest write is at most
+ * timeout_ms old, each variable whose own write is older absent (a manager
+ * may write by SDO alone, and a value the node refused keeps an older one);
+ * then a fresh input falls silent on the node's reason or with no write for
+ * timeout_ms. The RPDO's own event timer (urrt_co_rpdo_status's DEADLINE) is
+ * the node's EMCY, not a reason: d's timeout_ms is. At most URRT_CO_RPDO_MAX_MAPPED
+ * signals (an RPDO maps no more). *look says what happened.
+ */
+void urrt_plcin_node(const urrt_plcin_desc *d, const urrt_plcin_rpdo *r, urrt_plcin *p, urrt_rtde_in *in,
+                     uint64_t now_us, urrt_plcin_look *look);
 
 #ifdef __cplusplus
 }

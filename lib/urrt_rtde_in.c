@@ -5,6 +5,8 @@
  * are checked and packed as bits. */
 #include "urrt_rtde_in.h"
 
+#include "urrt_double_internal.h"
+
 #define IN_STATIC_ASSERT(name, cond) typedef char urrt_rtde_in_assert_##name[(cond) ? 1 : -1]
 
 IN_STATIC_ASSERT(double_is_binary64, sizeof(double) == 8);
@@ -91,8 +93,9 @@ int urrt_rtde_in_init(urrt_rtde_in *in, const uint16_t *vars, size_t count)
     }
     for (i = 0; i < count; i++) {
         in->vars[i] = vars[i];
+        in->types[i] = (uint8_t)urrt_rtde_var_type(vars[i]);
         in->offset[i] = (uint16_t)offset;
-        offset += urrt_rtde_type_size(urrt_rtde_var_type(vars[i]));
+        offset += urrt_rtde_type_size((urrt_rtde_type)in->types[i]);
     }
     in->count = (uint16_t)count;
     in->data_size = (uint16_t)offset;
@@ -388,69 +391,11 @@ static int given(urrt_rtde_in *in, size_t i, bool ok)
     return URRT_OK;
 }
 
-/* An integer as the bits of the double of the same value, if it has one
- * exactly (every integer up to 2^53 in magnitude, larger ones with enough
- * trailing zero bits); false otherwise. */
-static bool double_of_int(int64_t v, uint64_t *bits)
-{
-    uint64_t sign = v < 0 ? UINT64_C(1) << 63 : 0u;
-    uint64_t m = v < 0 ? (uint64_t)0 - (uint64_t)v : (uint64_t)v;
-    unsigned top = 0;
-    if (m == 0) {
-        *bits = 0; /* +0.0 */
-        return true;
-    }
-    while ((m >> top) > 1u) {
-        top++;
-    }
-    if (top > 52u) {
-        if ((m & ((UINT64_C(1) << (top - 52u)) - 1u)) != 0) {
-            return false;
-        }
-        m >>= top - 52u;
-    } else {
-        m <<= 52u - top;
-    }
-    *bits = sign | (uint64_t)(1023u + top) << 52 | (m & ((UINT64_C(1) << 52) - 1u));
-    return true;
-}
-
-/* A double's bits as an integer, if it is one exactly and its magnitude is
- * below 2^40 (past every integer register's range); false otherwise. -0.0
- * is 0. */
-static bool int_of_double(uint64_t bits, int64_t *v)
-{
-    unsigned exponent = (unsigned)(bits >> 52) & 0x7FFu;
-    uint64_t m = bits & ((UINT64_C(1) << 52) - 1u);
-    int shift;
-    if (exponent == 0) {
-        *v = 0;
-        return m == 0; /* a zero, or a denormal (no integer) */
-    }
-    if (exponent == 0x7FFu) {
-        return false; /* infinite, NaN */
-    }
-    shift = (int)exponent - 1075; /* value = (m | 2^52) * 2^shift */
-    m |= UINT64_C(1) << 52;
-    if (shift >= -52 + 40) {
-        return false; /* 2^40 or more */
-    }
-    if (shift < -52) {
-        return false; /* below 1 in magnitude, not zero */
-    }
-    if ((m & ((UINT64_C(1) << (unsigned)-shift) - 1u)) != 0) {
-        return false; /* a fraction (shift is -52..-13 here) */
-    }
-    m >>= (unsigned)-shift;
-    *v = (bits >> 63) != 0 ? -(int64_t)m : (int64_t)m;
-    return true;
-}
-
 /* An integer into an integer register if its type holds it; false if not. */
 static bool put_int(urrt_rtde_in *in, size_t i, int64_t v)
 {
     uint8_t *p = in->data + in->offset[i];
-    switch (urrt_rtde_var_type(in->vars[i])) {
+    switch ((urrt_rtde_type)in->types[i]) {
     case URRT_RTDE_T_BOOL:
         if (v != 0 && v != 1) {
             return false;
@@ -480,10 +425,10 @@ int urrt_rtde_in_set_int(urrt_rtde_in *in, size_t i, int64_t value)
     if (in == 0 || !usable(in) || i >= in->count) {
         return URRT_E_ARG;
     }
-    if (urrt_rtde_var_type(in->vars[i]) != URRT_RTDE_T_DOUBLE) {
+    if (in->types[i] != (uint8_t)URRT_RTDE_T_DOUBLE) {
         ok = put_int(in, i, value);
     } else {
-        ok = double_of_int(value, &bits); /* no double holds it exactly: refused */
+        ok = urrt_double_bits_of_int(value, &bits); /* no double holds it exactly: refused */
         if (ok) {
             store_be64(in->data + in->offset[i], bits);
         }
@@ -500,8 +445,8 @@ int urrt_rtde_in_set_double(urrt_rtde_in *in, size_t i, double value)
         return URRT_E_ARG;
     }
     b.d = value;
-    if (urrt_rtde_var_type(in->vars[i]) != URRT_RTDE_T_DOUBLE) {
-        ok = int_of_double(b.u, &v) && put_int(in, i, v);
+    if (in->types[i] != (uint8_t)URRT_RTDE_T_DOUBLE) {
+        ok = urrt_int_of_double_bits(b.u, &v) && put_int(in, i, v);
     } else {
         ok = ((unsigned)(b.u >> 52) & 0x7FFu) != 0x7FFu; /* infinite or NaN: refused */
         if (ok) {

@@ -93,6 +93,7 @@ typedef struct urrt_rtde_in_stats {
 typedef struct urrt_rtde_in {
     uint16_t vars[URRT_RTDE_IN_MAX_VARS];    /* the registers, in recipe order */
     uint16_t offset[URRT_RTDE_IN_MAX_VARS];  /* each value's place in data */
+    uint8_t types[URRT_RTDE_IN_MAX_VARS];    /* each register's urrt_rtde_type, looked up once at init */
     uint8_t data[URRT_RTDE_IN_DATA_MAX];     /* the values, big-endian, packed in recipe order */
     uint8_t given[URRT_RTDE_IN_MAX_VARS / 8]; /* bit i: vars[i] holds a value */
     uint16_t count;

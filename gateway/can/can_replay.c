@@ -8,10 +8,20 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "can_in.h"
 #include "cli.h"
 #include "rtde_only.h"
 #include "port.h"
 #include "rtde_capture.h"
+
+/* An [input] of the first robot: lib's description, state and recipe. */
+struct replay_input {
+    urrt_plcin_desc d;
+    uint16_t *vars;
+    urrt_plcin st;
+    urrt_rtde_in in;
+    size_t index;          /* among the map's [input]s: with [canopen], its RPDO */
+};
 
 /* A received frame of the rx log, on the capture's clock. */
 struct rx_frame {
@@ -38,6 +48,18 @@ struct replay {
     uint64_t ended;        /* RTDE sessions the capture's client ended on an error */
     uint64_t frames;
     uint64_t refused;
+    /* The [input]s (with --replay-inputs): the input packages the gateway
+     * would write, one line each, on the capture's clock. */
+    struct co_run *co_run;
+    struct replay_input *inputs;
+    size_t input_count;
+    uint64_t period_us;    /* [can] inputs_min_rate's */
+    FILE *inputs_out;
+    const urrt_rtde *session; /* the capture's session, while an RTDE capture is replayed */
+    bool recipe_in;        /* this session's recipe is in: the input recipes are taken as accepted */
+    uint8_t recipe_id;     /* its id: input recipe k's is recipe_id + 1 + k */
+    uint64_t inputs_us;    /* the latest look: its time never goes back */
+    uint64_t packages;     /* input packages written */
 };
 
 static void emit(void *ctx, const urrt_can_frame *frame, uint64_t now_us)
@@ -50,21 +72,108 @@ static void emit(void *ctx, const urrt_can_frame *frame, uint64_t now_us)
     }
 }
 
-/* The node at each of its deadlines before until_us: heartbeats, EMCYs,
- * TPDOs, as a loop waking at each would have sent them. */
-static void node_catch_up(struct replay *r, uint64_t until_us)
+/* ---- the [input]s: what the gateway would write to the robot ---------------- */
+
+/* The session streams, its recipe in: the capture's controller is taken as
+ * having accepted every input recipe, after the output recipe, in order. */
+static bool inputs_ready(const struct replay *r, const struct replay_input *x)
+{
+    (void)x;
+    return r->session != NULL && r->recipe_in && urrt_rtde_streaming(r->session);
+}
+
+/* The input data package of x, as the gateway writes it (docs/rtde.md: size,
+ * 'U', the input recipe's id, its values big-endian in recipe order): its
+ * size, or 0 while a register holds no value. */
+static size_t input_package(const struct replay *r, const struct replay_input *x, uint8_t *pkg)
+{
+    size_t size = URRT_RTDE_HEADER_SIZE + 1u + x->in.data_size;
+    if (!urrt_rtde_in_complete(&x->in)) {
+        return 0;
+    }
+    pkg[0] = (uint8_t)(size >> 8);
+    pkg[1] = (uint8_t)size;
+    pkg[2] = URRT_RTDE_TYPE_DATA;
+    pkg[3] = (uint8_t)(r->recipe_id + 1u + (x - r->inputs));
+    memcpy(pkg + 4, x->in.data, x->in.data_size);
+    return size;
+}
+
+/* One look at every [input] at now_us, as the gateway's loop takes one: with
+ * a node, what its RPDOs and SDO writes stored (and its state); without, the
+ * timeout; then each package due, written as a line. */
+static void inputs_look(struct replay *r, uint64_t now_us)
+{
+    uint8_t pkg[URRT_RTDE_IN_PACKAGE_MAX];
+    r->inputs_us = now_us;
+    for (size_t i = 0; i < r->input_count; i++) {
+        struct replay_input *x = &r->inputs[i];
+        bool ready = inputs_ready(r, x);
+        size_t n;
+        if (r->node != NULL) {
+            urrt_plcin_rpdo rpdo = {r->node, (uint16_t)co_run_input_first_var(r->co_run, x->index),
+                                    (uint8_t)x->index};
+            urrt_plcin_look look;
+            urrt_plcin_node(&x->d, &rpdo, &x->st, &x->in, now_us, &look);
+        } else if (urrt_plcin_timed_out(&x->d, &x->st, now_us)) {
+            urrt_plcin_silent(&x->d, &x->st, &x->in);
+        }
+        if (!urrt_plcin_due(&x->d, &x->st, ready, (uint32_t)r->sessions, now_us, r->period_us)) {
+            continue;
+        }
+        n = input_package(r, x, pkg);
+        urrt_plcin_sent(&x->st, n > 0, (uint32_t)r->sessions, now_us);
+        if (n > 0) {
+            fprintf(r->inputs_out, "(%llu.%06llu) ", (unsigned long long)(now_us / 1000000u),
+                    (unsigned long long)(now_us % 1000000u));
+            for (size_t k = 0; k < n; k++) {
+                fprintf(r->inputs_out, "%02X", pkg[k]);
+            }
+            fputc('\n', r->inputs_out);
+            r->packages++;
+        }
+    }
+}
+
+/* The earliest of the [input]s' deadlines (lib's), never before the latest look. */
+static uint64_t inputs_deadline(const struct replay *r)
+{
+    uint64_t due = URRT_CANTX_NEVER;
+    for (size_t i = 0; i < r->input_count; i++) {
+        const struct replay_input *x = &r->inputs[i];
+        uint64_t d = urrt_plcin_deadline(&x->d, &x->st, inputs_ready(r, x), r->period_us);
+        due = d < due ? d : due;
+    }
+    return due != URRT_CANTX_NEVER && due < r->inputs_us ? r->inputs_us : due;
+}
+
+/* The node and the [input]s at each of their deadlines before until_us, in
+ * time order: heartbeats, EMCYs, TPDOs, timeouts and input packages, as a
+ * loop waking at each would have sent them. */
+static void catch_up(struct replay *r, uint64_t until_us)
 {
     for (;;) {
-        uint64_t due = urrt_co_deadline(r->node);
-        due = due < r->node_us ? r->node_us : due;
-        if (due >= until_us) {
+        uint64_t node_due = URRT_CANTX_NEVER, in_due = inputs_deadline(r);
+        if (r->node != NULL) {
+            node_due = urrt_co_deadline(r->node);
+            node_due = node_due < r->node_us ? r->node_us : node_due;
+        }
+        if (node_due >= until_us && in_due >= until_us) {
             return;
         }
-        urrt_co_run(r->node, due, emit, r);
-        if (due == r->node_us && urrt_co_deadline(r->node) <= due) {
-            return; /* nothing left at this instant that time would change */
+        if (node_due <= in_due) {
+            urrt_co_run(r->node, node_due, emit, r);
+            if (node_due == r->node_us && urrt_co_deadline(r->node) <= node_due) {
+                return; /* nothing left at this instant that time would change */
+            }
+            r->node_us = node_due;
+        } else {
+            uint64_t before = r->inputs_us;
+            inputs_look(r, in_due);
+            if (in_due == before && inputs_deadline(r) <= in_due) {
+                return; /* likewise */
+            }
         }
-        r->node_us = due;
     }
 }
 
@@ -109,16 +218,38 @@ static void rx_advance(struct replay *r)
     }
 }
 
+/* A received frame to the [input] of its id, when there is no node. */
+static void input_frame(struct replay *r, const urrt_can_frame *f, uint64_t at_us)
+{
+    uint64_t raws[URRT_PLCIN_MAX_SIGNALS];
+    for (size_t i = 0; i < r->input_count; i++) {
+        struct replay_input *x = &r->inputs[i];
+        if (x->d.id == f->id && ((x->d.flags & URRT_CANTX_EXTENDED) != 0) == f->extended &&
+            urrt_plcin_raws(&x->d, f->data, f->len, f->fd, raws)) {
+            (void)urrt_plcin_take(&x->d, &x->st, &x->in, raws, 0, at_us);
+        }
+    }
+}
+
 /* The frames received up to t_us, each at its own time, after what the node
- * would have sent before it. Frames before the first packet wait for the boot. */
+ * (and the [input]s) would have sent before it, then the [input]s looked
+ * at. A node's frames before the first packet wait for its boot. */
 static void rx_until(struct replay *r, uint64_t t_us)
 {
     while (r->has_next && r->next.t_us <= t_us) {
         uint64_t at = r->next.t_us < r->node_us ? r->node_us : r->next.t_us;
-        node_catch_up(r, at);
-        urrt_co_on_frame(r->node, r->next.frame.id, r->next.frame.extended ? URRT_CO_RX_EXTENDED : 0u,
-                         r->next.frame.data, r->next.frame.len, at, emit, r);
-        r->node_us = at;
+        at = at < r->inputs_us ? r->inputs_us : at;
+        catch_up(r, at);
+        if (r->node != NULL) {
+            urrt_co_on_frame(r->node, r->next.frame.id, r->next.frame.extended ? URRT_CO_RX_EXTENDED : 0u,
+                             r->next.frame.data, r->next.frame.len, at, emit, r);
+            r->node_us = at;
+        } else {
+            input_frame(r, &r->next.frame, at);
+        }
+        if (r->input_count > 0) {
+            inputs_look(r, at);
+        }
         r->rx_frames++;
         rx_advance(r);
     }
@@ -131,10 +262,15 @@ static void packet_at(struct replay *r, uint64_t t_us, const urrt_state *st, con
 {
     if (r->node == NULL) {
         /* What a gateway waking at each deadline would have sent until now. */
+        rx_until(r, t_us);
+        catch_up(r, t_us);
         urrt_cantx_catch_up(can_run_tx(r->run), t_us, emit, r);
         can_run_rtde(r->run, 0, values);
         urrt_cantx_on_packet(can_run_tx(r->run), 0, st, t_us);
         can_run_due(r->run, t_us, urrt_canlink_get_stats(r->link), emit, r);
+        if (r->input_count > 0) {
+            inputs_look(r, t_us);
+        }
         return;
     }
     if (!r->started) {
@@ -143,12 +279,15 @@ static void packet_at(struct replay *r, uint64_t t_us, const urrt_state *st, con
         urrt_co_start(r->node, t_us, emit, r);
     }
     rx_until(r, t_us);
-    node_catch_up(r, t_us);
+    catch_up(r, t_us);
     can_run_rtde(r->run, 0, values);
     urrt_cantx_on_packet(can_run_tx(r->run), 0, st, t_us);
     can_run_set_link(r->run, urrt_canlink_get_stats(r->link));
     urrt_co_run(r->node, t_us, emit, r);
     r->node_us = t_us;
+    if (r->input_count > 0) {
+        inputs_look(r, t_us);
+    }
 }
 
 /* One packet (values NULL: RealTime's) at its own controller time: what a
@@ -397,9 +536,14 @@ static int rtde_pump(struct replay *r, FILE *in, const char *path)
         urrt_log(URRT_LOG_ERR, "%s", why);
         return CLI_EXIT_RUNTIME;
     }
+    r->session = rtde_replay_session(rp);
     while ((k = rtde_replay_next(rp, &ev, why, sizeof why)) > 0) {
         if (k == RTDE_REPLAY_SESSION) {
             r->sessions++;
+            r->recipe_in = false;
+        } else if (k == URRT_RTDE_EV_RECIPE) {
+            r->recipe_in = true;
+            r->recipe_id = ev.recipe_id;
         } else if (k == URRT_RTDE_EV_DATA) {
             on_state(r, rtde_replay_state(rp), rtde_replay_values(rp));
         } else if (k == URRT_RTDE_EV_DROP || k == URRT_RTDE_EV_CONFIG) {
@@ -414,6 +558,7 @@ static int rtde_pump(struct replay *r, FILE *in, const char *path)
         urrt_log(URRT_LOG_WARNING, "%s ends inside a record (%zu bytes, the recorder stopped mid-write): replayed "
                  "up to it", path, rtde_replay_truncated(rp));
     }
+    r->session = NULL;
     rtde_replay_free(rp);
     return k < 0 ? CLI_EXIT_RUNTIME : CLI_EXIT_OK;
 }
@@ -423,8 +568,9 @@ static bool open_rx(struct replay *r, const char *rx_path)
     if (rx_path == NULL) {
         return true;
     }
-    if (r->node == NULL) {
-        urrt_log(URRT_LOG_ERR, "--replay-rx feeds a CANopen node: the configuration has no [canopen] section");
+    if (r->node == NULL && r->input_count == 0) {
+        urrt_log(URRT_LOG_ERR, "--replay-rx feeds a CANopen node, or the [input]s with --replay-inputs: the "
+                 "configuration has no [canopen] section, and no --replay-inputs FILE was given");
         return false;
     }
     if ((r->rx = fopen(rx_path, "r")) == NULL) {
@@ -445,17 +591,70 @@ static bool is_rtde_capture(FILE *f)
     return first == RTDE_CAPTURE_FIRST_BYTE;
 }
 
+/* The first robot's [input]s, for --replay-inputs path (NULL: none). */
+static bool open_inputs(struct replay *r, const struct can_map *map, const char *path)
+{
+    size_t n = 0;
+    if (path == NULL) {
+        return true;
+    }
+    for (size_t i = 0; i < map->input_count; i++) {
+        n += map->inputs[i].robot_index == 0;
+    }
+    if (n == 0) {
+        urrt_log(URRT_LOG_ERR, "--replay-inputs %s: the configuration has no [input NAME] of its first robot (the "
+                 "capture's): nothing would be written to it", path);
+        return false;
+    }
+    if ((r->inputs = calloc(n, sizeof *r->inputs)) == NULL) {
+        urrt_log(URRT_LOG_ERR, "--replay-inputs: out of memory");
+        return false;
+    }
+    for (size_t i = 0; i < map->input_count; i++) {
+        const struct can_map_frame *f = &map->inputs[i];
+        struct replay_input *x = &r->inputs[r->input_count];
+        if (f->robot_index != 0) {
+            continue;
+        }
+        r->input_count++;
+        x->index = i;
+        if ((x->vars = malloc(f->count * sizeof *x->vars)) == NULL) {
+            urrt_log(URRT_LOG_ERR, "--replay-inputs: out of memory");
+            return false;
+        }
+        can_in_desc(f, x->vars, &x->d);
+        urrt_plcin_init(&x->st);
+        (void)urrt_rtde_in_init(&x->in, f->regs, f->reg_count); /* can_map_finish checked the recipe */
+    }
+    r->period_us = (uint64_t)(1e6 / map->inputs_min_rate_hz);
+    if ((r->inputs_out = fopen(path, "w")) == NULL) {
+        urrt_log(URRT_LOG_ERR, "cannot write the input packages to %s: %s", path, strerror(errno));
+        return false;
+    }
+    return true;
+}
+
 static int close_all(struct replay *r, FILE *in, int rc)
 {
-    fclose(in);
+    if (in != NULL) {
+        fclose(in);
+    }
     if (r->rx != NULL) {
         fclose(r->rx);
     }
+    if (r->inputs_out != NULL && fclose(r->inputs_out) != 0 && rc == CLI_EXIT_OK) {
+        urrt_log(URRT_LOG_ERR, "writing the input packages failed: %s", strerror(errno));
+        rc = CLI_EXIT_RUNTIME;
+    }
+    for (size_t i = 0; i < r->input_count; i++) {
+        free(r->inputs[i].vars);
+    }
+    free(r->inputs);
     return rc;
 }
 
 int can_replay(const struct can_map *map, struct can_run *run, struct co_run *node, const char *capture_path,
-               const char *rx_path)
+               const char *rx_path, const char *inputs_path)
 {
     struct replay r;
     urrt_canlink_config cfg;
@@ -464,24 +663,30 @@ int can_replay(const struct can_map *map, struct can_run *run, struct co_run *no
     int rc;
     memset(&r, 0, sizeof r);
     r.run = run;
+    r.co_run = node;
     r.node = node != NULL ? co_run_node(node) : NULL;
     if (run == NULL) {
         urrt_log(URRT_LOG_ERR, "--replay needs a [can] section and [frame NAME]s in the configuration");
         return CLI_EXIT_USAGE;
     }
+    if (!open_inputs(&r, map, inputs_path)) {
+        return close_all(&r, NULL, r.inputs_out == NULL && r.inputs == NULL ? CLI_EXIT_USAGE : CLI_EXIT_RUNTIME);
+    }
     if (!open_rx(&r, rx_path)) {
-        return r.node == NULL ? CLI_EXIT_USAGE : CLI_EXIT_RUNTIME;
+        return close_all(&r, NULL, r.node == NULL && r.input_count == 0 ? CLI_EXIT_USAGE : CLI_EXIT_RUNTIME);
     }
     if ((in = fopen(capture_path, "rb")) == NULL) {
         urrt_log(URRT_LOG_ERR, "cannot open the capture %s: %s", capture_path, strerror(errno));
-        if (r.rx != NULL) {
-            fclose(r.rx);
-        }
-        return CLI_EXIT_RUNTIME;
+        return close_all(&r, NULL, CLI_EXIT_RUNTIME);
     }
     /* Refusals come before the link opens: a refused replay leaves an
      * earlier log as it was. */
     rtde = is_rtde_capture(in);
+    if (!rtde && r.input_count > 0) {
+        urrt_log(URRT_LOG_ERR, "--replay-inputs: %s is a RealTime capture, and input registers are written over "
+                 "RTDE: replay an RTDE capture (urrt-dump --rtde -w FILE)", capture_path);
+        return close_all(&r, in, CLI_EXIT_RUNTIME);
+    }
     if (rtde ? !rtde_check(map, in, capture_path) : !realtime_has_all(map, capture_path)) {
         return close_all(&r, in, CLI_EXIT_RUNTIME);
     }
@@ -493,15 +698,18 @@ int can_replay(const struct can_map *map, struct can_run *run, struct co_run *no
         return close_all(&r, in, CLI_EXIT_RUNTIME);
     }
     rc = rtde ? rtde_pump(&r, in, capture_path) : pump(&r, in, capture_path);
-    fclose(in);
     if (r.rx != NULL) {
         if (r.has_next) {
             urrt_log(URRT_LOG_WARNING, "%s: frames after the capture's last packet were not fed", r.rx_path);
         }
         urrt_log(URRT_LOG_NOTICE, "fed %llu received frames from %s (%llu lines not a classic frame, skipped)",
                  (unsigned long long)r.rx_frames, r.rx_path, (unsigned long long)r.rx_bad);
-        fclose(r.rx);
     }
+    if (r.input_count > 0) {
+        urrt_log(URRT_LOG_NOTICE, "wrote %llu input packages of %zu [input]%s to %s", (unsigned long long)r.packages,
+                 r.input_count, r.input_count == 1 ? "" : "s", inputs_path);
+    }
+    rc = close_all(&r, in, rc);
     urrt_canlink_free(r.link);
     if (rtde) {
         urrt_log(URRT_LOG_NOTICE, "replayed %s (RTDE): %llu data packages in %llu session%s (%llu ended on an error, "

@@ -23,8 +23,15 @@
  * received, candump -l lines ("(SEC.USEC) can0 605#4000100000000000")
  * timed on the capture's clock: each goes to urrt_co_on_frame at its time,
  * between the packets, as a firmware's CAN receive interrupt would hand it
- * over. Returns a CLI_EXIT_* status; reasons go to the log. */
+ * over (with no node, to the first robot's [input]s of their ids).
+ * inputs_path (NULL: none; an RTDE capture only) gets the input packages the
+ * gateway would write for the first robot's [input]s (lib/urrt_plcin's
+ * rules, looked at after each received frame, at each packet and at each of
+ * their deadlines), one line each, "(SEC.USEC) HEX", each session of the
+ * capture taken as accepting every input recipe once its output recipe is
+ * in, with ids after the output recipe's, in order. Returns a CLI_EXIT_*
+ * status; reasons go to the log. */
 int can_replay(const struct can_map *map, struct can_run *run, struct co_run *node, const char *capture_path,
-               const char *rx_path);
+               const char *rx_path, const char *inputs_path);
 
 #endif

@@ -365,11 +365,6 @@ uint32_t co_run_input_raw(const struct co_run *run, size_t input, size_t signal)
     return run->vars[run->first_var[input] + signal];
 }
 
-uint64_t co_run_input_var_written_us(const struct co_run *run, size_t input, size_t signal)
-{
-    return run->written_us[run->first_var[input] + signal];
-}
-
 uint64_t co_run_input_written_us(const struct co_run *run, size_t input)
 {
     uint64_t newest = URRT_CANTX_NEVER;

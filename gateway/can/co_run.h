@@ -68,8 +68,6 @@ uint32_t co_run_input_raw(const struct co_run *run, size_t input, size_t signal)
 /* When an RPDO or SDO write last stored one of [input] i's variables, on the
  * node's clock; URRT_CANTX_NEVER before the first. */
 uint64_t co_run_input_written_us(const struct co_run *run, size_t input);
-/* The same for signal k's variable alone. */
-uint64_t co_run_input_var_written_us(const struct co_run *run, size_t input, size_t signal);
 
 /* Whether a TPDO's mapping names the object (the EDS's PDOMapping). */
 bool co_run_mapped(const struct co_run *run, uint16_t index, uint8_t sub);

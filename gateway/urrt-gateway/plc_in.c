@@ -24,7 +24,6 @@ struct plc_group {
     gw_robot *robot;
     size_t recipe;            /* its input recipe's index in the robot's source */
     size_t input;             /* its index among the [input]s: with [canopen], RPDO input + 1 */
-    uint64_t written_seen;    /* with [canopen]: the node's newest write taken */
     uint64_t logged_us;       /* the last refused value or bad frame logged */
     plc_in_counts counts;
 };
@@ -115,11 +114,12 @@ static void plan(plc_in *in)
 
 /* ---- silence ----------------------------------------------------------------------- */
 
-static void fall_silent(struct plc_group *g, const char *why)
+/* The PLC fell silent (lib applied on_silence): counted and logged. */
+static void said_silent(struct plc_group *g, const char *why)
 {
     static const char *const does[] = {
         [URRT_PLCIN_STOP] = "nothing more is written (on_silence = stop): the robot program's "
-                                 "rtde_set_watchdog acts",
+                            "rtde_set_watchdog acts",
         [URRT_PLCIN_HOLD] = "their last values go on being written (on_silence = hold)",
         [URRT_PLCIN_VALUE] = "the on_silence value goes to them",
     };
@@ -128,8 +128,14 @@ static void fall_silent(struct plc_group *g, const char *why)
     names_of(g->f, names, sizeof names);
     urrt_log(URRT_LOG_WARNING, "[input %s]: the PLC is silent (%s): %s: %s", g->f->name, why, names,
              does[g->f->silence]);
+}
+
+/* The PLC is silent for a reason of the gateway's (a timeout, the CAN link). */
+static void fall_silent(struct plc_group *g, const char *why)
+{
     /* on_silence value: one every register takes (can_map_finish checked it). */
     urrt_plcin_silent(&g->desc, &g->st, recipe_of(g));
+    said_silent(g, why);
 }
 
 /* ---- receiving --------------------------------------------------------------------- */
@@ -150,28 +156,31 @@ static void log_limited(struct plc_group *g, uint64_t now_us, const char *fmt, .
     urrt_log(URRT_LOG_WARNING, "[input %s]: %s", g->f->name, text);
 }
 
-/* What the PLC wrote, at at_us: each register taken from raws (see
- * urrt_plcin_take), the package sent if a value changed. */
-static void take_values(plc_in *in, struct plc_group *g, const uint64_t *raws, uint64_t absent, uint64_t at_us)
+/* lib took what the PLC wrote: refusals counted and logged (at most every
+ * PLC_IN_LOG_US), its return said, the package sent if it is due. */
+static void took(plc_in *in, struct plc_group *g, size_t refused, bool was_silent, uint64_t now_us)
 {
-    urrt_rtde_in *recipe = recipe_of(g);
-    uint64_t now = urrt_port_monotonic_us();
-    bool was_silent = g->st.ever && !g->st.fresh;
-    size_t refused = 0;
-    if (recipe == NULL) {
-        return;
-    }
-    refused = urrt_plcin_take(&g->desc, &g->st, recipe, raws, absent, at_us < now ? at_us : now);
     if (refused > 0) {
         g->counts.refused += refused;
-        log_limited(g, now, "%zu value%s refused (outside min..max, or not one the register takes): nothing is "
+        log_limited(g, now_us, "%zu value%s refused (outside min..max, or not one the register takes): nothing is "
                     "written for %s until a good one comes (%" PRIu64 " refused so far)", refused,
                     refused == 1 ? "" : "s", refused == 1 ? "it" : "them", g->counts.refused);
     }
     if (was_silent) {
         urrt_log(URRT_LOG_NOTICE, "[input %s]: the PLC writes again", g->f->name);
     }
-    send_due(in, g, now);
+    send_due(in, g, now_us);
+}
+
+/* A frame's values, received at rx_us (see urrt_plcin_take). */
+static void take_values(plc_in *in, struct plc_group *g, const uint64_t *raws, uint64_t rx_us)
+{
+    urrt_rtde_in *recipe = recipe_of(g);
+    uint64_t now = urrt_port_monotonic_us();
+    bool was_silent = g->st.ever && !g->st.fresh;
+    if (recipe != NULL) {
+        took(in, g, urrt_plcin_take(&g->desc, &g->st, recipe, raws, 0, rx_us < now ? rx_us : now), was_silent, now);
+    }
 }
 
 static void take_frame(plc_in *in, struct plc_group *g, const urrt_can_frame *frame, uint64_t rx_us)
@@ -185,54 +194,39 @@ static void take_frame(plc_in *in, struct plc_group *g, const urrt_can_frame *fr
                     g->f->fd ? "CAN FD" : "classic", (unsigned)g->f->len, g->counts.bad_frames);
         return;
     }
-    take_values(in, g, raws, 0, rx_us);
+    take_values(in, g, raws, rx_us);
 }
 
 /* ---- through the CANopen node: its RPDOs and SDO writes ---------------------------- */
 
-/* The node's own reasons for [input] g to be silent (urrt_co_rpdo_status:
- * its NMT state, the manager's heartbeat), or NULL. */
-static const char *node_state(const plc_in *in, const struct plc_group *g, uint64_t now_us)
-{
-    switch (urrt_co_rpdo_status(co_run_node(in->node), g->input, now_us)) {
-    case URRT_CO_RPDO_NOT_OPERATIONAL: return "the CANopen node is not OPERATIONAL";
-    /* Before "heartbeat lost" in lib's order, which it would hide: a manager
-     * that switched the RPDO off has said its registers are not written. */
-    case URRT_CO_RPDO_NOT_VALID: return "the manager switched the RPDO off (0x1400+n sub 1, bit 31)";
-    case URRT_CO_RPDO_HEARTBEAT_LOST: return "the manager's heartbeat is lost (0x1016)";
-    default: return NULL;
-    }
-}
-
-/* [input] g through the node: what an RPDO or SDO write stored since the
- * last look, taken while the node may act on it (OPERATIONAL, the manager's
- * heartbeat there) and younger than timeout_ms (a manager may write by SDO
- * alone); silent on the node's reasons, or with no write for timeout_ms. */
+/* [input] g through the node: lib's look (urrt_plcin_node), its take
+ * counted and logged as a frame's, its silence said. */
 static void node_group(plc_in *in, struct plc_group *g, uint64_t now_us)
 {
-    uint64_t timeout_us = (uint64_t)g->f->timeout_ms * 1000u;
-    uint64_t written = co_run_input_written_us(in->node, g->input);
-    const char *why = node_state(in, g, now_us);
+    static const char *const why_text[] = {
+        [URRT_PLCIN_NOT_OPERATIONAL] = "the CANopen node is not OPERATIONAL",
+        [URRT_PLCIN_RPDO_OFF] = "the manager switched the RPDO off (0x1400+n sub 1, bit 31)",
+        [URRT_PLCIN_HEARTBEAT_LOST] = "the manager's heartbeat is lost (0x1016)",
+    };
+    urrt_plcin_rpdo rpdo = {co_run_node(in->node), (uint16_t)co_run_input_first_var(in->node, g->input),
+                            (uint8_t)g->input};
+    urrt_rtde_in *recipe = recipe_of(g);
+    bool was_silent = g->st.ever && !g->st.fresh;
+    urrt_plcin_look look;
     char buf[64];
-    if (why == NULL && written != URRT_CANTX_NEVER && written != g->written_seen && now_us - written <= timeout_us) {
-        uint64_t raws[URRT_CO_RPDO_MAX_MAPPED], absent = 0;
+    if (recipe == NULL) {
+        return;
+    }
+    urrt_plcin_node(&g->desc, &rpdo, &g->st, recipe, now_us, &look);
+    if (look.took) {
         g->counts.frames++;
-        for (size_t i = 0; i < g->f->count && i < sizeof raws / sizeof raws[0]; i++) {
-            /* A variable is as old as its own last write: one the node refused in
-             * this RPDO (out of its object's range) keeps an older one. */
-            uint64_t w = co_run_input_var_written_us(in->node, g->input, i);
-            raws[i] = co_run_input_raw(in->node, g->input, i);
-            absent |= (uint64_t)(w == URRT_CANTX_NEVER || now_us - w > timeout_us) << i;
-        }
-        take_values(in, g, raws, absent, written);
+        took(in, g, look.refused, was_silent, now_us);
     }
-    g->written_seen = written;
-    if (why == NULL && urrt_plcin_timed_out(&g->desc, &g->st, now_us)) {
+    if (look.why == URRT_PLCIN_NO_WRITE) {
         snprintf(buf, sizeof buf, "no RPDO%zu or SDO write for %u ms", g->input + 1u, (unsigned)g->f->timeout_ms);
-        why = buf;
-    }
-    if (g->st.fresh && why != NULL) {
-        fall_silent(g, why);
+        said_silent(g, buf);
+    } else if (look.why != URRT_PLCIN_STILL) {
+        said_silent(g, why_text[look.why]);
     }
 }
 
@@ -395,7 +389,6 @@ plc_in *plc_in_new(gateway *gw, const struct can_map *map, struct co_run *node)
         g->robot = &gw->robots[r];
         g->recipe = per_robot[r]++;
         g->input = i;
-        g->written_seen = URRT_CANTX_NEVER;
     }
     return in;
 }

@@ -71,7 +71,11 @@ static void usage(FILE *out)
         "                         CAN side needs is refused with the names\n"
         "      --replay-rx FILE   with --replay and [canopen]: the frames the node\n"
         "                         received (candump -l lines timed on the capture's\n"
-        "                         clock), fed to it between the packets\n"
+        "                         clock), fed to it between the packets; without\n"
+        "                         [canopen], to the [input]s (with --replay-inputs)\n"
+        "      --replay-inputs FILE  with --replay of an RTDE capture: the input\n"
+        "                         packages the gateway would write for the first\n"
+        "                         robot's [input]s, one line each, (SEC.USEC) HEX\n"
         "  -s, --summary          one line per robot each second on stdout\n"
         "                         (state, data age, reconnects, messages/s per channel)\n"
         "  -u, --lcm-url URL      publish on URL instead of [lcm] url\n"
@@ -273,6 +277,7 @@ typedef struct options {
     const char *url_override;
     const char *replay_path;
     const char *replay_rx_path;
+    const char *replay_inputs_path;
     const char *config_path;
     urrt_log_level level;
     bool level_given;
@@ -281,7 +286,7 @@ typedef struct options {
 /* CLI_EXIT_* to stop with, or -1 to go on. */
 static int parse_options(int argc, char **argv, options *o)
 {
-    enum { OPT_C_TABLES = 256, OPT_REPLAY, OPT_PRINT_KEYS, OPT_EDS, OPT_REPLAY_RX };
+    enum { OPT_C_TABLES = 256, OPT_REPLAY, OPT_PRINT_KEYS, OPT_EDS, OPT_REPLAY_RX, OPT_REPLAY_INPUTS };
     static const struct option longopts[] = {
         {"check-config", no_argument, NULL, 'c'},
         {"print-dbc", no_argument, NULL, 'd'},
@@ -290,6 +295,7 @@ static int parse_options(int argc, char **argv, options *o)
         {"print-eds", no_argument, NULL, OPT_EDS},
         {"replay", required_argument, NULL, OPT_REPLAY},
         {"replay-rx", required_argument, NULL, OPT_REPLAY_RX},
+        {"replay-inputs", required_argument, NULL, OPT_REPLAY_INPUTS},
         {"output", required_argument, NULL, 'o'},
         {"summary", no_argument, NULL, 's'},
         {"lcm-url", required_argument, NULL, 'u'},
@@ -309,6 +315,7 @@ static int parse_options(int argc, char **argv, options *o)
         case OPT_EDS: o->print_eds = true; break;
         case OPT_REPLAY: o->replay_path = optarg; break;
         case OPT_REPLAY_RX: o->replay_rx_path = optarg; break;
+        case OPT_REPLAY_INPUTS: o->replay_inputs_path = optarg; break;
         case OPT_PRINT_KEYS: gw_config_print_keys(stdout); return CLI_EXIT_OK;
         case 'o': o->output_path = optarg; break;
         case 's': o->summary = true; break;
@@ -341,8 +348,8 @@ static int parse_options(int argc, char **argv, options *o)
                         "separate jobs: give one\nTry 'urrt-gateway --help'.\n");
         return CLI_EXIT_USAGE;
     }
-    if (o->replay_rx_path != NULL && o->replay_path == NULL) {
-        fprintf(stderr, "urrt-gateway: --replay-rx goes with --replay\nTry 'urrt-gateway --help'.\n");
+    if ((o->replay_rx_path != NULL || o->replay_inputs_path != NULL) && o->replay_path == NULL) {
+        fprintf(stderr, "urrt-gateway: --replay-rx and --replay-inputs go with --replay\nTry 'urrt-gateway --help'.\n");
         return CLI_EXIT_USAGE;
     }
     if (o->output_path != NULL && !o->print_dbc && !o->print_c_tables && !o->print_eds) {
@@ -517,7 +524,7 @@ int main(int argc, char **argv)
     } else if (o.print_eds) {
         rc = write_output(&cfg, o.output_path, eds_writer, "EDS");
     } else if (o.replay_path != NULL) {
-        rc = can_replay(&cfg.can, cfg.can_run, cfg.co_run, o.replay_path, o.replay_rx_path);
+        rc = can_replay(&cfg.can, cfg.can_run, cfg.co_run, o.replay_path, o.replay_rx_path, o.replay_inputs_path);
     } else if (o.check_only) {
         print_plan(&cfg, cfg.lcm.url);
         rc = CLI_EXIT_OK;

@@ -22,13 +22,20 @@
 #                     the bytes tests/fw/rtde_controller.py plays as the controller of that capture
 #                     to the recipe the tables carry; its requests are checked too (V, v, O, S only,
 #                     the recipe's names); prints the rtde-plc image's footprint.
+#                     The PLC's answers (-DFW_INPUTS: lib/urrt_plcin over the node's RPDOs, lib/urrt_rtde_in's
+#                     input recipes): plc-inputs (tests/fw/plc-inputs.ini, two [input]s as RPDO1 and RPDO2)
+#                     fed tests/fw/make_rx_inputs.py's manager (RPDOs, refused values, silences, an SDO
+#                     write, NMT stop and start, an RPDO switched off and on): the input packages the
+#                     image sends its scripted controller must be, byte for byte and in order, those
+#                     urrt-gateway --replay --replay-inputs writes; its requests V, v, O, I, I, S, U...
 #   record-fw-master  make check-canopen, then that recording from its run (tests/fw/record_master.py)
 # The rules use target.mk's toolchain variables in recipes only (it is included after this file).
 
 FW := $(BUILD)/tests/fw
-FW_CONFIGS := canopen canopen-vm fd j1939 rtde-plc rtde-types
-FW_CANOPEN := canopen canopen-vm rtde-plc
-FW_RTDE := rtde-plc rtde-types
+FW_CONFIGS := canopen canopen-vm fd j1939 rtde-plc rtde-types plc-inputs
+FW_CANOPEN := canopen canopen-vm rtde-plc plc-inputs
+FW_RTDE := rtde-plc rtde-types plc-inputs
+FW_INPUTS := plc-inputs
 FW_LIB_OBJS = $(LIB_SRCS:lib/%.c=$(FW)/lib/%.o)
 
 CHECKS += check-fw-gateway
@@ -51,6 +58,9 @@ $(FW)/%/controller.bin: $(FW)/rtde-capture.bin $(FW)/%/tables.c tests/fw/rtde_co
 $(FW)/canopen-vm/rx.log: tests/fw/vm-master.log
 	@mkdir -p $(@D)
 	cp $< $@
+$(FW)/plc-inputs/rx.log: tests/fw/make_rx_inputs.py
+	@mkdir -p $(@D)
+	$(PYTHON) $< $@
 $(FW)/%/rx.log:
 	@mkdir -p $(@D)
 	: > $@
@@ -79,6 +89,8 @@ $(FW)/%/gateway.ini: docs/examples/%.ini
 $(FW)/canopen-vm/gateway.ini: tests/canopen/canopen.ini
 	$(fw_log_ini)
 $(FW)/rtde-types/gateway.ini: tests/fw/rtde-types.ini
+	$(fw_log_ini)
+$(FW)/plc-inputs/gateway.ini: tests/fw/plc-inputs.ini
 	$(fw_log_ini)
 
 $(FW)/%/tables.c: $(FW)/%/gateway.ini $(BUILD)/bin/urrt-gateway
@@ -109,7 +121,7 @@ $(FW)/%/fw_gateway.elf: tests/fw/fw_gateway.c tests/fw/fw_rx.h tests/target/cm.c
   tests/target/an386.ld $(FW)/%/tables.o $$(if $$(filter $$*,$$(FW_CANOPEN)),$(FW)/%/rx.o $(FW)/%/rx.log) \
   $$(FW_LIB_OBJS)
 	$(TGT_CM) $(TGT_M4) -Os $(TGT_FLAGS) -DURRT_TARGET_CORTEX_M $(if $(filter $*,$(FW_CANOPEN)),-DFW_CANOPEN) \
-	  $(if $(filter $*,$(FW_RTDE) rtde-port),-DFW_RTDE) \
+	  $(if $(filter $*,$(FW_RTDE) rtde-port),-DFW_RTDE) $(if $(filter $*,$(FW_INPUTS)),-DFW_INPUTS) \
 	  -Itests/fw tests/target/cm.c tests/fw/fw_gateway.c $(FW)/$*/tables.o \
 	  $(if $(filter $*,$(FW_CANOPEN)),$(FW)/$*/rx.o) $(FW_LIB_OBJS) -T tests/target/an386.ld $(TGT_LINK) -o $@
 

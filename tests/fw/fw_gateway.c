@@ -32,6 +32,14 @@
  * come through semihosting in the same chunks; each data package's state,
  * and its RTDE-only values through urrt_gateway_rtde_values, go to the CAN
  * core at the package's controller time.
+ *
+ * Built with -DFW_INPUTS too (a CANopen node whose RPDOs are [input]s): the
+ * PLC's answers. The session sets up one input recipe per [input]
+ * (lib/urrt_rtde_in.h, urrt_gateway_inputs[k].regs); after each frame to the
+ * node, at each package and at each of their deadlines, lib/urrt_plcin.h
+ * takes what the node's RPDOs and SDO writes stored and says when an input
+ * package is due, which goes to the TCP stack like a request ("rtde> HEX"),
+ * as `urrt-gateway --replay --replay-inputs` writes the same packages.
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -46,6 +54,9 @@
 #ifdef FW_RTDE
 #include "urrt_rtde.h"
 #endif
+#ifdef FW_INPUTS
+#include "urrt_plcin.h"
+#endif
 
 /* From the generated tables. */
 extern const urrt_cantx_tables urrt_gateway_tables;
@@ -59,6 +70,17 @@ extern const size_t urrt_gateway_rtde_var_count[];
 extern const double urrt_gateway_rtde_frequency[];
 extern const uint16_t urrt_gateway_rtde_port[];
 void urrt_gateway_rtde_values(size_t robot, const urrt_rtde_values *values);
+#endif
+#ifdef FW_INPUTS
+extern const urrt_plcin_desc urrt_gateway_inputs[];
+extern const size_t urrt_gateway_input_count;
+extern const uint64_t urrt_gateway_inputs_period_us;
+extern const uint16_t urrt_gateway_input_first_var[];
+#define FW_INPUTS_MAX 4 /* the node's RPDOs */
+static urrt_rtde_in inputs[FW_INPUTS_MAX];  /* URRT_RTDE_IN_RAM each */
+static urrt_plcin input_states[FW_INPUTS_MAX];
+static const uint32_t session_number = 1;   /* one TCP connection here; a board counts its connects */
+static uint32_t input_packages;
 #endif
 
 #define CHUNK 1460 /* one TCP segment on Ethernet */
@@ -130,22 +152,83 @@ static void values_to_tables(void)
 static urrt_co node;
 static uint64_t node_us; /* the node's latest run */
 static int booted;
+static uint64_t inputs_us; /* the inputs' latest look */
 
-/* A board wakes at every deadline (urrt_co_deadline) on its timer; here the
- * clock jumps from packet to packet, so run the node at each deadline first. */
+#ifdef FW_INPUTS
+static void tcp_send(const uint8_t *p, size_t n);
+
+/* Each input through the node at now_us (lib's look), then its package if due. */
+static void inputs_look(uint64_t now_us)
+{
+    static uint8_t pkg[URRT_RTDE_IN_PACKAGE_MAX];
+    size_t k;
+    inputs_us = now_us;
+    for (k = 0; k < urrt_gateway_input_count && k < FW_INPUTS_MAX; k++) {
+        const urrt_plcin_rpdo rpdo = {&node, urrt_gateway_input_first_var[k], (uint8_t)k};
+        urrt_plcin_look look;
+        int n;
+        urrt_plcin_node(&urrt_gateway_inputs[k], &rpdo, &input_states[k], &inputs[k], now_us, &look);
+        if (!urrt_plcin_due(&urrt_gateway_inputs[k], &input_states[k], urrt_rtde_in_ready(&session, &inputs[k]),
+                            session_number, now_us, urrt_gateway_inputs_period_us)) {
+            continue;
+        }
+        n = urrt_rtde_in_package(&session, &inputs[k], pkg, sizeof pkg);
+        urrt_plcin_sent(&input_states[k], n > 0, session_number, now_us);
+        if (n > 0) {
+            tcp_send(pkg, (size_t)n);
+            input_packages++;
+        }
+    }
+}
+
+/* The inputs' earliest deadline, never before the latest look. */
+static uint64_t inputs_deadline(void)
+{
+    uint64_t due = URRT_CANTX_NEVER;
+    size_t k;
+    for (k = 0; k < urrt_gateway_input_count && k < FW_INPUTS_MAX; k++) {
+        uint64_t d = urrt_plcin_deadline(&urrt_gateway_inputs[k], &input_states[k],
+                                         urrt_rtde_in_ready(&session, &inputs[k]), urrt_gateway_inputs_period_us);
+        due = d < due ? d : due;
+    }
+    return due != URRT_CANTX_NEVER && due < inputs_us ? inputs_us : due;
+}
+#else
+static void inputs_look(uint64_t now_us)
+{
+    (void)now_us;
+}
+
+static uint64_t inputs_deadline(void)
+{
+    return URRT_CANTX_NEVER;
+}
+#endif
+
+/* A board wakes at every deadline (urrt_co_deadline, and the inputs') on its
+ * timer; here the clock jumps from packet to packet, so run each due first,
+ * in time order. */
 static void node_catch_up(uint64_t until_us)
 {
     for (;;) {
-        uint64_t due = urrt_co_deadline(&node);
+        uint64_t due = urrt_co_deadline(&node), in_due = inputs_deadline();
         due = due < node_us ? node_us : due;
-        if (due >= until_us) {
+        if (due >= until_us && in_due >= until_us) {
             return;
         }
-        urrt_co_run(&node, due, can_transmit, NULL);
-        if (due == node_us && urrt_co_deadline(&node) <= due) {
-            return;
+        if (due <= in_due) {
+            urrt_co_run(&node, due, can_transmit, NULL);
+            if (due == node_us && urrt_co_deadline(&node) <= due) {
+                return;
+            }
+            node_us = due;
+        } else {
+            uint64_t before = inputs_us;
+            inputs_look(in_due);
+            if (in_due == before && inputs_deadline() <= in_due) {
+                return;
+            }
         }
-        node_us = due;
     }
 }
 
@@ -156,9 +239,15 @@ static void rx_until(uint64_t now_us)
     for (; next < fw_rx_count && fw_rx_frames[next].t_us <= now_us; next++) {
         const struct fw_rx_frame *f = &fw_rx_frames[next];
         uint64_t at = f->t_us < node_us ? node_us : f->t_us;
+#ifdef FW_INPUTS
+        at = at < inputs_us ? inputs_us : at;
+#endif
         node_catch_up(at);
         urrt_co_on_frame(&node, f->id, 0, f->data, f->len, at, can_transmit, NULL);
         node_us = at;
+#ifdef FW_INPUTS
+        inputs_look(at);
+#endif
     }
 }
 
@@ -175,6 +264,9 @@ static void packet_at(uint64_t now_us)
     urrt_cantx_on_packet(&tx, 0, &state, now_us);
     urrt_co_run(&node, now_us, can_transmit, NULL);
     node_us = now_us;
+#ifdef FW_INPUTS
+    inputs_look(now_us);
+#endif
 }
 #else
 static void packet_at(uint64_t now_us)
@@ -211,7 +303,11 @@ static void tcp_send(const uint8_t *p, size_t n)
 static void send_requests(void)
 {
     int n;
+#ifdef FW_INPUTS
+    while ((n = urrt_rtde_in_output(&session, inputs, urrt_gateway_input_count, request, sizeof request)) > 0) {
+#else
     while ((n = urrt_rtde_output(&session, request, sizeof request)) > 0) {
+#endif
         tcp_send(request, (size_t)n);
     }
 }
@@ -235,7 +331,12 @@ static int on_tcp_bytes(const uint8_t *p, size_t n)
     while (n > 0) {
         size_t used = 0;
         urrt_rtde_event ev;
+#ifdef FW_INPUTS
+        int k = urrt_rtde_in_feed(&session, inputs, urrt_gateway_input_count, p, n, &used, &ev, &state,
+                                  &rtde_values[rtde_decoding]);
+#else
         int k = urrt_rtde_feed(&session, p, n, &used, &ev, &state, &rtde_values[rtde_decoding]);
+#endif
         p += used;
         n -= used;
         if (k == URRT_RTDE_EV_DATA) {
@@ -324,6 +425,19 @@ int main(void)
         target_puts("fw_gateway: urrt_rtde_begin refuses the generated recipe (urrt_gateway_rtde_vars)\n");
         return 1;
     }
+#ifdef FW_INPUTS
+    /* One input recipe per [input] (its RPDO), set up in the handshake; nothing is
+     * written before the PLC writes. */
+    for (n = 0; n < urrt_gateway_input_count && n < FW_INPUTS_MAX; n++) {
+        if (urrt_rtde_in_init(&inputs[n], urrt_gateway_inputs[n].regs, urrt_gateway_inputs[n].reg_count) !=
+            URRT_OK) {
+            target_puts("fw_gateway: urrt_rtde_in_init refuses a generated input recipe (urrt_gateway_inputs)\n");
+            return 1;
+        }
+        urrt_plcin_init(&input_states[n]);
+    }
+    urrt_rtde_in_begin(inputs, urrt_gateway_input_count);
+#endif
     send_requests();
 #else
     urrt_framer_init(&framer);
@@ -336,6 +450,11 @@ int main(void)
 #ifdef FW_RTDE
     target_puts("fw_gateway: RTDE data packages: ");
     target_put_uint(rtde_packages);
+    target_puts("\n");
+#endif
+#ifdef FW_INPUTS
+    target_puts("fw_gateway: input packages: ");
+    target_put_uint(input_packages);
     target_puts("\n");
 #endif
     target_puts("fw_gateway: frames sent: ");

@@ -13,13 +13,21 @@ from the protocol (docs/rtde.md) and the capture format, apart from lib/.
       capture's reply gave it; each data package re-encoded for the client's
       recipe, every value's bytes sliced, byte for byte, from the capture's
       package by the capture's types. A name the capture lacks is refused.
+      With [input]s in TABLES.c (urrt_gateway_inputs), after the setup reply
+      one setup-inputs reply per input recipe, in order, accepting it with
+      the id after the output recipe's (+1, +2, ...; urrt-gateway --replay
+      --replay-inputs takes a capture's controller as doing the same), each
+      register's type as the protocol gives it.
 
   rtde_controller.py check FIRMWARE_OUT TABLES.c STREAM
       What the firmware sent ("rtde> HEX" lines, one whole request each) is
       exactly the handshake of a read-only client: V (protocol 2), v, O
       (TABLES.c's frequency, or for 0 the maximum of the controller version
       STREAM's v reply names: 125 Hz on CB3, 500 later; and, in order, its
-      recipe's names), S, and nothing else ever. Prints one line per check; exit status 1 on a failure.
+      recipe's names), S, and nothing else ever. With [input]s: V, v, O, one I
+      per input recipe naming its registers in order, S, then input data
+      packages only, each of an accepted recipe's id and size. Prints one
+      line per check; exit status 1 on a failure.
 
 Captures are read with tests/ref/rtde_capture.py, packages written with
 tests/ref/rtde_ref.py: both from the format and the protocol, not from lib/.
@@ -58,6 +66,21 @@ def recipe_of_tables(path):
     return re.findall(r"/\* (\S+) \*/", m.group(1)), float(f.group(1))
 
 
+def inputs_of_tables(path):
+    """Each input recipe of generated tables, in urrt_gateway_inputs' order: its register names."""
+    text = open(path).read()
+    table = re.search(r"urrt_gateway_inputs\[\d+\] = \{\n(.*?)\n\};", text, re.S)
+    if not table:
+        return []
+    recipes = []
+    for regs in re.findall(r"\{input_\w+_signals, input_\w+_vars, (input_\w+_regs),", table.group(1)):
+        m = re.search(regs + r"\[\d+\] = \{\n(.*?)\n\};", text, re.S)
+        if not m:
+            sys.exit("%s: no %s" % (path, regs))
+        recipes.append(re.findall(r"/\* (\S+) \*/", m.group(1)))
+    return recipes
+
+
 def first_session(records, path):
     start = [i for i, (k, _) in enumerate(records) if k == b"C"]
     if not start:
@@ -70,6 +93,7 @@ def first_session(records, path):
 
 def stream(capture, tables, out_path):
     names, _ = recipe_of_tables(tables)
+    inputs = inputs_of_tables(tables)
     session = first_session(read_records(capture), capture)
     protocol = 1
     sent = None  # the capture's setup request's names
@@ -96,6 +120,9 @@ def stream(capture, tables, out_path):
                 sys.exit("%s: the recipe lacks %s: record it with urrt-dump --rtde -w FILE -k %s"
                          % (capture, ", ".join(lacking), ",".join(lacking)))
             out.append(rtde_ref.package(b"O", rid + ",".join(types[n] for n in names).encode("ascii")))
+            first = body[0] + 1 if protocol == 2 else 1
+            for k, regs in enumerate(inputs):
+                out.append(rtde_ref.rep_setup_inputs(first + k, [rtde_ref.type_of(n) for n in regs]))
         elif ptype == b"U":
             at = 3 + (1 if protocol == 2 else 0)
             where = {}
@@ -123,6 +150,18 @@ def controller_major(stream_path):
     sys.exit("%s: no controller version reply" % stream_path)
 
 
+def recipe_id_of(stream_path):
+    """The output recipe's id in a stream's setup reply (protocol 2)."""
+    data = open(stream_path, "rb").read()
+    at = 0
+    while at + 3 <= len(data):
+        size = struct.unpack(">H", data[at:at + 2])[0]
+        if data[at + 2:at + 3] == b"O":
+            return data[at + 3]
+        at += max(size, 3)
+    sys.exit("%s: no setup reply" % stream_path)
+
+
 def check(fw_out, tables, stream_path):
     names, freq = recipe_of_tables(tables)
     if freq == 0:
@@ -138,8 +177,29 @@ def check(fw_out, tables, stream_path):
 
     whole = all(len(p) >= 3 and struct.unpack(">H", p[:2])[0] == len(p) for p in sent)
     verdict(whole, "each of the firmware's %d requests is one whole package" % len(sent))
+    inputs = inputs_of_tables(tables)
     kinds = "".join(chr(p[2]) for p in sent if len(p) >= 3)
-    verdict(kinds == "VvOS", "the firmware sent V, v, O, S and nothing else (sent: %s)" % (" ".join(kinds) or "none"))
+    handshake = "VvO" + "I" * len(inputs) + "S"
+    if inputs:
+        ok = re.fullmatch(handshake + "U*", kinds) is not None
+        verdict(ok, "the firmware sent V, v, O, I (one per input recipe), S, then input data packages and nothing "
+                "else (sent: %s%s)" % (" ".join(kinds[:len(handshake) + 3]) or "none",
+                                      " ..." if len(kinds) > len(handshake) + 3 else ""))
+        for k, regs in enumerate(inputs):
+            i = sent[3 + k][3:].decode("ascii", "replace").split(",") if len(sent) > 3 + k else []
+            verdict(i == regs, "its setup-inputs request %d names the generated input recipe, in order: %s%s"
+                    % (k + 1, ",".join(regs), "" if i == regs else " (sent: %s)" % ",".join(i)))
+        first = recipe_id_of(stream_path) + 1
+        sizes = {first + k: 4 + sum(type_size(rtde_ref.type_of(n)) for n in regs) for k, regs in enumerate(inputs)}
+        packages = sent[len(handshake):]
+        verdict(bool(packages) and all(len(p) >= 4 and sizes.get(p[3]) == len(p) for p in packages),
+                "its %d input data packages are each of an accepted recipe's id and size (%s)"
+                % (len(packages), ", ".join("id %d: %d bytes" % kv for kv in sorted(sizes.items()))))
+        if ok:  # the read-only client's checks on V, v, O, S
+            sent = sent[:3] + [sent[len(handshake) - 1]]
+            kinds = "VvOS"
+    else:
+        verdict(kinds == "VvOS", "the firmware sent V, v, O, S and nothing else (sent: %s)" % (" ".join(kinds) or "none"))
     if whole and kinds == "VvOS":
         verdict(struct.unpack(">H", sent[0][3:])[0] == 2, "it asked for protocol 2")
         o = sent[2][3:]

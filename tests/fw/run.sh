@@ -19,8 +19,10 @@ for name in "$@"; do
   capture=$fw/capture.bin; [ -f "$dir/capture.bin" ] && capture=$dir/capture.bin
   stream=$capture; [ -f "$dir/controller.bin" ] && { capture=$fw/rtde-capture.bin; stream=$dir/controller.bin; }
   rx=; [ -s "$dir/rx.log" ] && rx="--replay-rx $dir/rx.log"
+  # [input]s: the input packages the replay would write to the robot.
+  inputs=; grep -q '^const urrt_plcin_desc urrt_gateway_inputs' "$dir/tables.c" && inputs="--replay-inputs $dir/inputs.log"
   # shellcheck disable=SC2086
-  "$build/bin/urrt-gateway" --replay "$capture" $rx "$ini" 2> "$dir/replay.err" || {
+  "$build/bin/urrt-gateway" --replay "$capture" $rx $inputs "$ini" 2> "$dir/replay.err" || {
     echo "FAIL: $name: urrt-gateway --replay: $(cat "$dir/replay.err")"; failed=$((failed + 1)); continue; }
   qemu-system-arm -nographic -monitor none -serial none \
     -semihosting-config "enable=on,target=native,arg=$stream" \
@@ -77,6 +79,27 @@ for name in "$@"; do
     else
       echo "FAIL: $name: the replay's SDO answers are not the live node's (diff $dir/answers.live $dir/answers.replay):"
       diff "$dir/answers.live" "$dir/answers.replay" | head -n 5; failed=$((failed + 1))
+    fi
+  fi
+  # The PLC's answers: the input packages the image sent ("rtde> " lines of type 'U') are the
+  # replay's, byte for byte and in order; and that comparison refuses one digit changed.
+  if [ -n "$inputs" ]; then
+    sed -n 's/^rtde> \(....55.*\)$/\1/p' "$dir/firmware.out" > "$dir/inputs.firmware"
+    awk '{ print $2 }' "$dir/inputs.log" > "$dir/inputs.replay"
+    n=$(wc -l < "$dir/inputs.replay")
+    if [ "$n" -ge 50 ] && cmp -s "$dir/inputs.replay" "$dir/inputs.firmware"; then
+      echo "ok: $name: the image's $n input packages are the replay's, byte for byte and in order"
+      passed=$((passed + 1))
+    else
+      echo "FAIL: $name: the image's input packages are not the replay's $n (diff $dir/inputs.replay $dir/inputs.firmware):"
+      diff "$dir/inputs.replay" "$dir/inputs.firmware" | head -n 5; failed=$((failed + 1))
+    fi
+    awk -v k=$(((n + 1) / 2)) 'NR == k { c = substr($0, 9, 1); $0 = substr($0, 1, 8) (c == "0" ? "1" : "0") substr($0, 10) } 1' \
+      "$dir/inputs.firmware" > "$dir/inputs.changed"
+    if cmp -s "$dir/inputs.replay" "$dir/inputs.changed"; then
+      echo "FAIL: $name: the comparison accepts an input package with one digit changed"; failed=$((failed + 1))
+    else
+      echo "ok: $name: the comparison refuses an input package with one digit changed"; passed=$((passed + 1))
     fi
   fi
   # The comparison must be able to fail: one payload digit changed in the middle frame (in an

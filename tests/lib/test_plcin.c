@@ -8,7 +8,10 @@
  *     a value refused or absent leaving its register without one;
  *   - when a package is due: nothing before the first write, at once on a
  *     change or a new session, then every period while fresh; the deadline;
- *   - the timeout, and each on_silence policy: stop, hold, value.
+ *   - the timeout, and each on_silence policy: stop, hold, value;
+ *   - through a CANopen node (tests/lib/co_fixture.h's with RPDOs): an RPDO's
+ *     values taken, an SDO write alone, each variable as old as its own write,
+ *     and the node's reasons for silence (NMT stop, the RPDO switched off).
  * It runs on the host and, as NAME/plcin.elf, on the Cortex-M boards of
  * make check-lib-m4, where it paints the stack of each urrt_plcin function
  * (tests/target/stack_marks.h).
@@ -17,6 +20,7 @@
 #include <stdint.h>
 
 #include "check.h"
+#include "co_fixture.h"
 #include "urrt_plcin.h"
 #define STACK_MARKS_MAX 12
 #include "target/stack_marks.h"
@@ -145,7 +149,7 @@ static void test_raws(void)
 static void test_values(void)
 {
     urrt_plcin_desc d = desc(URRT_PLCIN_STOP, 0);
-    urrt_rtde_in in;
+    static urrt_rtde_in in; /* 896 bytes: not on the Cortex-M0's small stack */
     urrt_plcin p;
     uint64_t raws[5];
     setup(&in, &p);
@@ -187,7 +191,7 @@ static void test_values(void)
 static void test_schedule(void)
 {
     urrt_plcin_desc d = desc(URRT_PLCIN_STOP, 0);
-    urrt_rtde_in in;
+    static urrt_rtde_in in; /* 896 bytes: not on the Cortex-M0's small stack */
     urrt_plcin p;
     uint64_t raws[5];
     const uint64_t t = 1000000;
@@ -205,8 +209,8 @@ static void test_schedule(void)
     CHECK(due(&d, &p, true, 1, t + PERIOD_US, PERIOD_US), "again after the period");
     CHECK(due(&d, &p, true, 2, t + 1, PERIOD_US), "at once to a new session");
     CHECK(deadline(&d, &p, true, PERIOD_US) == t + PERIOD_US, "deadline: the period (before the timeout)");
-    CHECK(deadline(&d, &p, false, PERIOD_US) == t + TIMEOUT_MS * 1000u,
-          "deadline with no session ready: the timeout");
+    CHECK(deadline(&d, &p, false, PERIOD_US) == t + TIMEOUT_MS * 1000u + 1u,
+          "deadline with no session ready: the first instant past the timeout");
 
     (void)take(&d, &p, &in, raws, 0, t + 10);
     CHECK(!due(&d, &p, true, 1, t + 10, PERIOD_US), "the same values: not due within the period");
@@ -235,7 +239,7 @@ static void test_schedule(void)
 static void test_hold_and_value(void)
 {
     urrt_plcin_desc hold = desc(URRT_PLCIN_HOLD, 0), value = desc(URRT_PLCIN_VALUE, 0);
-    urrt_rtde_in in;
+    static urrt_rtde_in in; /* 896 bytes: not on the Cortex-M0's small stack */
     urrt_plcin p;
     uint64_t raws[5];
     const uint64_t t = 5000000;
@@ -263,6 +267,119 @@ static void test_hold_and_value(void)
     CHECK(!p.fresh, "silent twice: nothing more");
 }
 
+/* ---- through the node: co_fixture_rx_node, its RPDO1 (0x20A) mapping 0x2200 sub 1-3,
+ * the node's variables 2 (INTEGER16, -1000..1000), 3 (a BOOLEAN) and 4 (UNSIGNED32). */
+
+static urrt_co co;
+static urrt_cantx tx;
+static urrt_cantx_frame_state frame_states[2];
+static urrt_cantx_robot robots[1];
+static double values[8];
+static urrt_co_tpdo_state tpdo_states[2];
+static urrt_co_rpdo_state rpdo_states[2];
+static urrt_co_consumer consumer_states[2];
+static uint32_t node_vars[CO_FIXTURE_RX_VARS];
+static uint64_t written[CO_FIXTURE_RX_VARS];
+static urrt_co_rx_storage storage;
+
+static const urrt_can_signal node_signals[] = {
+    {.factor = 1, .offset = 0, .min = -1000, .max = 1000, .start = 0, .length = 16, .type = URRT_CAN_SIGNED},
+    {.factor = 1, .offset = 0, .min = 0, .max = 1, .start = 16, .length = 8, .type = URRT_CAN_UNSIGNED},
+    {.factor = 1, .offset = 0, .min = 0, .max = 4294967295.0, .start = 24, .length = 32, .type = URRT_CAN_UNSIGNED,
+     .flags = URRT_CAN_SIG_MASK(0)},
+};
+static const uint16_t node_vars_of[] = {URRT_RTDE_V_INPUT_INT_REGISTER + 24, URRT_RTDE_V_INPUT_BIT_REGISTER + 0,
+                                        URRT_RTDE_V_INPUT_BIT_REGISTERS0_TO_31};
+
+static void emit(void *ctx, const urrt_can_frame *f, uint64_t now_us)
+{
+    (void)ctx, (void)f, (void)now_us;
+}
+
+static void frame(uint32_t id, const uint8_t *data, unsigned len, uint64_t t)
+{
+    urrt_co_on_frame(&co, id, 0, data, len, t, emit, NULL);
+}
+
+static urrt_plcin_look look_at(const urrt_plcin_desc *d, urrt_plcin *p, urrt_rtde_in *in, uint64_t t)
+{
+    const urrt_plcin_rpdo rpdo = {&co, 2, 0};
+    urrt_plcin_look look;
+    MEASURED_VOID(urrt_plcin_node, (d, &rpdo, p, in, t, &look));
+    return look;
+}
+
+static void test_node(void)
+{
+    static const uint8_t start[2] = {0x01, NODE}, stop[2] = {0x02, NODE};
+    /* 1000 (0x2200 sub 1's HighLimit), 1, 0x0000000F; then 1001, which the node refuses, and 0x000000F0. */
+    static const uint8_t rpdo1[7] = {0xE8, 0x03, 0x01, 0x0F, 0x00, 0x00, 0x00};
+    static const uint8_t rpdo_1001[7] = {0xE9, 0x03, 0x01, 0xF0, 0x00, 0x00, 0x00};
+    static const uint8_t sdo_500[8] = {0x2B, 0x00, 0x22, 0x01, 0xF4, 0x01, 0, 0}; /* 0x2200 sub 1 = 500 */
+    static const uint8_t rpdo_off[8] = {0x23, 0x00, 0x14, 0x01, 0x0A, 0x02, 0x00, 0x80}; /* 0x1400 sub 1 |= bit 31 */
+    const uint16_t recipe[] = {URRT_RTDE_V_INPUT_INT_REGISTER + 24, URRT_RTDE_V_INPUT_BIT_REGISTER + 0,
+                               URRT_RTDE_V_INPUT_BIT_REGISTERS0_TO_31};
+    const urrt_plcin_desc d = {node_signals, node_vars_of, recipe, 3, 3, 7, 0, 0x20A, TIMEOUT_MS, URRT_PLCIN_STOP,
+                               0, 0};
+    urrt_co_desc desc;
+    static urrt_rtde_in in; /* 896 bytes: not on the Cortex-M0's small stack */
+    urrt_plcin p;
+    urrt_plcin_look look;
+    size_t bad = 0;
+    co_fixture_rx_desc(&desc);
+    desc.heartbeat_ms = 0;
+    storage.rpdos = rpdo_states;
+    storage.consumers = consumer_states;
+    storage.written_us = written;
+    CHECK_EQ_INT(urrt_cantx_init(&tx, &tables, frame_states, robots, values, 8, NULL, NULL), 0);
+    CHECK_EQ_INT(urrt_co_init_rx(&co, &desc, &tx, tpdo_states, node_vars, CO_FIXTURE_RX_VARS, &storage, &bad), 0);
+    (void)urrt_co_start(&co, 0, emit, NULL);
+    CHECK_EQ_INT(urrt_rtde_in_init(&in, recipe, 3), URRT_OK);
+    urrt_plcin_init(&p);
+
+    look = look_at(&d, &p, &in, 1000);
+    CHECK(!look.took && look.why == URRT_PLCIN_STILL && !p.fresh, "nothing written: nothing taken, nothing said");
+    frame(0x20A, rpdo1, 7, 2000);
+    look = look_at(&d, &p, &in, 2000);
+    CHECK(!look.took, "an RPDO in PRE-OPERATIONAL is not acted on");
+    frame(0x000, start, 2, 3000);
+    frame(0x20A, rpdo1, 7, 10000);
+    look = look_at(&d, &p, &in, 10000);
+    CHECK(look.took && look.refused == 0 && look.why == URRT_PLCIN_STILL && p.fresh, "RPDO1 in OPERATIONAL: taken");
+    CHECK(in.data[2] == 0x03 && in.data[3] == 0xE8 && in.data[4] == 1 && in.data[8] == 0x0F &&
+              urrt_rtde_in_complete(&in), "1000, 1, 0x0000000F");
+    look = look_at(&d, &p, &in, 20000);
+    CHECK(!look.took && p.fresh, "nothing new: nothing taken");
+    frame(0x20A, rpdo_1001, 7, 30000);
+    look = look_at(&d, &p, &in, 30000);
+    CHECK(look.took && in.data[3] == 0xE8 && in.data[8] == 0xF0 && urrt_rtde_in_complete(&in),
+          "1001 refused by the node: the register keeps 1000 (written 20 ms before), the mask is new");
+    look = look_at(&d, &p, &in, 30000 + TIMEOUT_MS * 1000u + 1u);
+    CHECK(look.why == URRT_PLCIN_NO_WRITE && !p.fresh && !urrt_rtde_in_complete(&in),
+          "no write for timeout_ms: silent, and stop forgets the values");
+
+    /* An SDO write alone, long after the RPDO: its variable taken, the others too old to be. */
+    frame(0x60A, sdo_500, 8, 700000);
+    look = look_at(&d, &p, &in, 700000);
+    CHECK(look.took && p.fresh, "an SDO write makes the input fresh");
+    CHECK(given(&in, 0) && in.data[2] == 0x01 && in.data[3] == 0xF4 && !given(&in, 1) && !given(&in, 2),
+          "500 taken; the variables the RPDO wrote 690 ms before are absent");
+
+    frame(0x20A, rpdo1, 7, 710000);
+    look = look_at(&d, &p, &in, 710000);
+    CHECK(look.took && urrt_rtde_in_complete(&in), "the RPDO again: every register");
+    frame(0x000, stop, 2, 720000);
+    look = look_at(&d, &p, &in, 720000);
+    CHECK(look.why == URRT_PLCIN_NOT_OPERATIONAL && !p.fresh, "NMT stop: silent, the node not OPERATIONAL");
+    frame(0x000, start, 2, 730000);
+    frame(0x20A, rpdo1, 7, 740000);
+    look = look_at(&d, &p, &in, 740000);
+    CHECK(look.took && p.fresh, "started again: taken");
+    frame(0x60A, rpdo_off, 8, 750000);
+    look = look_at(&d, &p, &in, 750000);
+    CHECK(look.why == URRT_PLCIN_RPDO_OFF && !p.fresh, "the RPDO switched off: silent");
+}
+
 int main(void)
 {
 #ifdef URRT_TARGET_CORTEX_M
@@ -272,8 +389,9 @@ int main(void)
     test_values();
     test_schedule();
     test_hold_and_value();
+    test_node();
     {
-        urrt_rtde_in in;
+        static urrt_rtde_in in;
         CHECK_EQ_INT(urrt_rtde_in_init(&in, regs, 4), URRT_OK);
         in.given[0] = 0x0F;
         MEASURED_VOID(urrt_rtde_in_unset, (&in, 2));

@@ -13,6 +13,12 @@
 #include "urrt.h"
 #include "urrt_can.h"
 #include "urrt_rtde.h"
+#ifdef __ARM_ARCH_7EM__ /* the Cortex-M4 images: the PLC's answer (the M0's RAM holds the rest) */
+#include "../lib/co_fixture.h"
+#include "urrt_plcin.h"
+#include "urrt_rtde_in.h"
+#define BENCH_PLCIN 1
+#endif
 
 /* Marks for the trace: the operation runs between their calls. */
 __attribute__((noinline)) void bench_begin(void)
@@ -394,6 +400,123 @@ static int bench_rtde(const tv_vector *v1116)
     return sink;
 }
 
+#ifdef BENCH_PLCIN
+/* ---- the PLC's answer: one RPDO to its input data package ------------------------
+ * tests/lib/co_fixture.h's node with RPDOs (RPDO1 0x20A: 0x2200 sub 1 INTEGER16,
+ * sub 2 a BOOLEAN, sub 3 UNSIGNED32, the node's variables 2, 3, 4), operational;
+ * an input recipe of three registers (an INT32 from the INTEGER16, a BOOL, the
+ * UINT32 bit-register word from the UNSIGNED32 as a mask) accepted in a streaming
+ * session; timed: the RPDO to the node (urrt_co_on_frame), lib's look
+ * (urrt_plcin_node: the take and the change), urrt_plcin_due and the package
+ * (urrt_rtde_in_package): what a firmware runs from the CAN receive interrupt's
+ * frame to the bytes for the TCP stack. */
+static urrt_co bench_node;
+static urrt_cantx bench_tx;
+static urrt_cantx_frame_state bench_frame_states[2];
+static urrt_cantx_robot bench_robots[1];
+static double bench_values[8];
+static urrt_co_tpdo_state bench_tpdo_states[2];
+static urrt_co_rpdo_state bench_rpdo_states[2];
+static urrt_co_consumer bench_consumer_states[2];
+static uint32_t bench_vars[CO_FIXTURE_RX_VARS];
+static uint64_t bench_written[CO_FIXTURE_RX_VARS];
+static urrt_co_rx_storage bench_storage;
+static urrt_rtde_in bench_in;
+static urrt_plcin bench_plcin;
+static uint8_t bench_package[URRT_RTDE_IN_PACKAGE_MAX];
+
+static const urrt_can_signal plcin_signals[3] = {
+    {1, 0, -1000, 1000, 0, 0, 16, URRT_CAN_INTEL, URRT_CAN_SIGNED, 0},
+    {1, 0, 0, 1, 0, 16, 8, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, 0},
+    {1, 0, 0, 4294967295.0, 0, 24, 32, URRT_CAN_INTEL, URRT_CAN_UNSIGNED, URRT_CAN_SIG_MASK(0)},
+};
+static const uint16_t plcin_regs[3] = {URRT_RTDE_V_INPUT_INT_REGISTER + 24, URRT_RTDE_V_INPUT_BIT_REGISTER + 0,
+                                       URRT_RTDE_V_INPUT_BIT_REGISTERS0_TO_31};
+static const urrt_plcin_desc plcin_desc = {plcin_signals, plcin_regs, plcin_regs, 3, 3, 7, 0, 0x20A, 100,
+                                           URRT_PLCIN_STOP, 0, 0};
+
+static void bench_emit(void *ctx, const urrt_can_frame *f, uint64_t now_us)
+{
+    (void)ctx, (void)f, (void)now_us;
+}
+
+/* The controller's reply to what the session asks (the bench's own): the event. */
+static int plcin_reply(uint8_t *pkg, uint8_t type, size_t n)
+{
+    urrt_rtde_event ev;
+    size_t used;
+    pkg[0] = (uint8_t)((n + 3u) >> 8);
+    pkg[1] = (uint8_t)(n + 3u);
+    pkg[2] = type;
+    while (urrt_rtde_in_output(&ram.r.rtde, &bench_in, 1, (uint8_t *)copy_words, sizeof copy_words) > 0) {
+    }
+    return urrt_rtde_in_feed(&ram.r.rtde, &bench_in, 1, pkg, n + 3u, &used, &ev, &st, &ram.r.vals);
+}
+
+static int bench_plcin_rpdo(void)
+{
+    static const uint8_t start[2] = {0x01, NODE};
+    static const uint8_t rpdo[7] = {0xE8, 0x03, 0x01, 0x0F, 0x00, 0x00, 0x00};
+    static const uint8_t version[16] = {0, 0, 0, 5, 0, 0, 0, 12, 0, 0, 0, 0, 0, 0, 0, 1};
+    static const char types[] = "\x02INT32,BOOL,UINT32";
+    const urrt_plcin_rpdo r = {&bench_node, 2, 0};
+    uint8_t *pkg = (uint8_t *)packet_words;
+    uint16_t ts = (uint16_t)URRT_RTDE_V_TIMESTAMP;
+    urrt_plcin_look look;
+    uint32_t ticks;
+    size_t bad, k;
+    int sink = 0, ok;
+    bench_storage.rpdos = bench_rpdo_states;
+    bench_storage.consumers = bench_consumer_states;
+    bench_storage.written_us = bench_written;
+    ok = urrt_cantx_init(&bench_tx, &tables, bench_frame_states, bench_robots, bench_values, 8, NULL, NULL) == 0;
+    ok = ok && urrt_co_init_rx(&bench_node, &co_fixture_rx_node, &bench_tx, bench_tpdo_states, bench_vars,
+                               CO_FIXTURE_RX_VARS, &bench_storage, &bad) == 0;
+    (void)urrt_co_start(&bench_node, 0, bench_emit, NULL);
+    urrt_co_on_frame(&bench_node, 0x000, 0, start, 2, 1000, bench_emit, NULL);
+    /* A session of one output (the timestamp) and the input recipe, streaming. */
+    urrt_rtde_init(&ram.r.rtde);
+    ok = ok && urrt_rtde_in_init(&bench_in, plcin_regs, 3) == URRT_OK;
+    ok = ok && urrt_rtde_begin(&ram.r.rtde, &ts, 1, 0.0) == URRT_OK;
+    urrt_rtde_in_begin(&bench_in, 1);
+    urrt_plcin_init(&bench_plcin);
+    pkg[3] = 1;
+    ok = ok && plcin_reply(pkg, 'V', 1) == URRT_RTDE_EV_PROTOCOL;
+    for (k = 0; k < 16; k++) {
+        pkg[3 + k] = version[k];
+    }
+    ok = ok && plcin_reply(pkg, 'v', 16) == URRT_RTDE_EV_CONTROLLER;
+    pkg[3] = 1;
+    for (k = 0; k < 6; k++) {
+        pkg[4 + k] = (uint8_t)"DOUBLE"[k];
+    }
+    ok = ok && plcin_reply(pkg, 'O', 7) == URRT_RTDE_EV_RECIPE;
+    for (k = 0; k + 1 < sizeof types; k++) {
+        pkg[3 + k] = (uint8_t)types[k];
+    }
+    ok = ok && plcin_reply(pkg, 'I', sizeof types - 1) == URRT_RTDE_EV_INPUTS;
+    pkg[3] = 1;
+    ok = ok && plcin_reply(pkg, 'S', 1) == URRT_RTDE_EV_STARTED && urrt_rtde_in_ready(&ram.r.rtde, &bench_in);
+    if (!ok) {
+        target_puts("bench: the node or the RTDE session with an input recipe did not start\n");
+        target_exit(2);
+    }
+    TIMED(ticks, {
+        urrt_co_on_frame(&bench_node, 0x20A, 0, rpdo, 7, 2000, bench_emit, NULL);
+        urrt_plcin_node(&plcin_desc, &r, &bench_plcin, &bench_in, 2000, &look);
+        if (urrt_plcin_due(&plcin_desc, &bench_plcin, true, 1, 2000, 100000)) {
+            sink += urrt_rtde_in_package(&ram.r.rtde, &bench_in, bench_package, sizeof bench_package);
+        }
+    });
+    if (sink != 13 || !look.took || bench_package[3] != 2 || bench_package[12] != 0x0F) {
+        target_puts("bench: the RPDO did not become its input data package\n");
+        target_exit(2);
+    }
+    report("plcin_rpdo_to_package", ticks);
+    return sink;
+}
+#endif
+
 int main(void)
 {
     int sink = 0;
@@ -407,6 +530,9 @@ int main(void)
     sink += bench_framer_decode(v1116);
     sink += bench_can_pack(v1116);
     sink += bench_rtde(v1116);
+#ifdef BENCH_PLCIN
+    sink += bench_plcin_rpdo();
+#endif
     target_puts("bench: sink ");
     target_put_uint((uint32_t)sink);
     target_puts("\n");

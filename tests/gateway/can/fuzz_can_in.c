@@ -19,7 +19,10 @@
  *     a DOUBLE finite) and, from a quantity, within each of its signals'
  *     min..max; a mask holds no bit its signals do not carry;
  *   - a register whose signal was absent holds no value;
- *   - the input is fresh after it, and its package due to a new session.
+ *   - the input is fresh after it, and its package due to a new session;
+ *   - lib's own look through the node (urrt_plcin_node) keeps the same
+ *     value rules, is fresh after a write it took, not after falling silent,
+ *     and holds nothing after falling silent with on_silence = stop.
  */
 #include <math.h>
 #include <stdio.h>
@@ -71,6 +74,8 @@ struct input {
     urrt_rtde_in in;
 };
 static struct input plain_in[8], canopen_in[URRT_CO_MAX_RPDOS];
+/* The same [input]s taken by lib's look through the node (urrt_plcin_node). */
+static struct input node_in[URRT_CO_MAX_RPDOS];
 
 static void die(const char *what)
 {
@@ -100,6 +105,10 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
     urrt_log_init("fuzz_can_in", URRT_LOG_ERR);
     load(&plain, plain_ini, "plain.ini", plain_in);
     load(&canopen, canopen_ini, "canopen.ini", canopen_in);
+    for (size_t i = 0; i < canopen.can.input_count; i++) {
+        node_in[i] = canopen_in[i];
+        node_in[i].d.vars = node_in[i].vars;
+    }
     if (canopen.co_run == NULL) {
         die("the CANopen twin has no node");
     }
@@ -230,6 +239,36 @@ static size_t plain_frame(const uint8_t *p, size_t n)
     return used;
 }
 
+/* [input] i through lib's look at the node, then the rules: every value held
+ * is one its register and signals take; a look that took is fresh after it
+ * unless it fell silent; one that fell silent is not fresh, and with
+ * on_silence = stop holds no value. */
+static void node_look(const struct can_map_frame *f, size_t i, uint64_t now)
+{
+    struct input *input = &node_in[i];
+    urrt_plcin_rpdo rpdo = {co_run_node(canopen.co_run), (uint16_t)co_run_input_first_var(canopen.co_run, i),
+                            (uint8_t)i};
+    urrt_plcin_look look;
+    urrt_plcin_node(&input->d, &rpdo, &input->st, &input->in, now, &look);
+    for (size_t k = 0; k < f->reg_count; k++) {
+        if (given(&input->in, k)) {
+            check_value(f, &input->in, k);
+        }
+    }
+    if (look.why != URRT_PLCIN_STILL) {
+        if (input->st.fresh) {
+            die("an input that fell silent is fresh");
+        }
+        for (size_t k = 0; f->silence == URRT_PLCIN_STOP && k < f->reg_count; k++) {
+            if (given(&input->in, k)) {
+                die("on_silence = stop, and a register still holds a value");
+            }
+        }
+    } else if (look.took && !input->st.fresh) {
+        die("a look that took a write left the input not fresh");
+    }
+}
+
 /* A frame to the CANopen node (NMT, an RPDO, an SDO request, anything), the
  * clock moved on, then each [input] taken from the node's variables with
  * the absent mask the fuzzer gives. */
@@ -257,6 +296,7 @@ static size_t node_frame(const uint8_t *p, size_t n, uint64_t *now)
             absent |= (uint64_t)((p[0] >> k & 1u) && (p[2] & 1u)) << k;
         }
         take_and_check(f, &canopen_in[i], raws, absent, *now);
+        node_look(f, i, *now);
     }
     return used;
 }
@@ -274,6 +314,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (size_t i = 0; i < canopen.can.input_count; i++) {
         urrt_rtde_in_forget(&canopen_in[i].in);
         urrt_plcin_init(&canopen_in[i].st);
+        urrt_rtde_in_forget(&node_in[i].in);
+        urrt_plcin_init(&node_in[i].st);
     }
     while (size > 1) {
         size_t used = (data[0] & 1u) == 0 ? plain_frame(data + 1, size - 1) : node_frame(data + 1, size - 1, &now);
