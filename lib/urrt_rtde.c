@@ -103,6 +103,26 @@ RTDE_STATIC_ASSERT(state_doubles_first, offsetof(urrt_state, present) == 8u * ST
 RTDE_STATIC_ASSERT(present_words, URRT_RTDE_PRESENT_WORDS * 32 >= URRT_RTDE_ONLY_COUNT &&
                                        URRT_RTDE_PRESENT_WORDS % 4 == 0);
 
+/* A function kept out of its caller, where GCC or clang would inline it
+ * (or GCC clone it with fewer arguments): the caller's usual path then
+ * does not pay for its registers. */
+#if defined(__GNUC__) && !defined(__clang__)
+#define RTDE_NOINLINE __attribute__((noinline, noclone))
+#elif defined(__GNUC__)
+#define RTDE_NOINLINE __attribute__((noinline))
+#else
+#define RTDE_NOINLINE
+#endif
+
+/* A function GCC and clang must inline, where their estimate would keep one
+ * copy called from two places and its caller would save registers for it;
+ * not when optimizing for size (-Os), which the copies would undo. */
+#if defined(__GNUC__) && !defined(__OPTIMIZE_SIZE__)
+#define RTDE_INLINE inline __attribute__((always_inline))
+#else
+#define RTDE_INLINE inline
+#endif
+
 /* ---- bytes ----------------------------------------------------------------- */
 
 typedef union rtde_bits {
@@ -919,32 +939,40 @@ size_t urrt_rtde_finish(urrt_rtde *s)
 
 /* ---- data packages ---------------------------------------------------------- */
 
-/* How an entry's elements are converted (urrt_rtde_entry.op). */
+/* How an entry's elements are converted (urrt_rtde_entry.op). The two usual
+ * conversions, doubles and 32-bit values, carry their entry's count in the
+ * op where it is at most RUN_MAX (OP_F64_1 + count - 1, OP_X32_1 + count - 1:
+ * a variable, or a short run): the decode reaches the code for exactly that
+ * many values by one switch over the op's low bits, which covers every value
+ * they can have (so no range test either). A longer run keeps OP_F64 or
+ * OP_X32 and is converted by a loop. compile_recipe sets them when the recipe
+ * is accepted. */
+#define RUN_MAX 8
 enum rtde_op {
-    OP_F64 = 0, /* a double into a double (urrt_state or urrt_rtde_values) */
-    OP_X32,     /* 32 bits into an int32_t or uint32_t of urrt_rtde_values */
-    OP_I32_F64, /* an int32 into a double of urrt_state */
-    OP_U32_F64, /* a uint32 into a double of urrt_state */
-    OP_U64_F64, /* a uint64 into a double of urrt_state */
-    OP_U64,     /* 64 bits into a uint64_t of urrt_rtde_values */
-    OP_U8,      /* a byte into urrt_rtde_values */
-    OP_BOOL     /* a byte into urrt_rtde_values as 0 or 1 */
+    OP_F64_1 = 0,          /* 1..RUN_MAX doubles into doubles */
+    OP_X32_1 = RUN_MAX,    /* 1..RUN_MAX 32-bit values into int32_t or uint32_t */
+    OP_F64 = 2 * RUN_MAX,  /* doubles into doubles (urrt_state or urrt_rtde_values) */
+    OP_X32,                /* 32 bits into int32_t or uint32_t of urrt_rtde_values */
+    OP_I32_F64,            /* an int32 into a double of urrt_state */
+    OP_U32_F64,            /* a uint32 into a double of urrt_state */
+    OP_U64_F64,            /* a uint64 into a double of urrt_state */
+    OP_U64,                /* 64 bits into a uint64_t of urrt_rtde_values */
+    OP_U8,                 /* a byte into urrt_rtde_values */
+    OP_BOOL                /* a byte into urrt_rtde_values as 0 or 1 */
 };
+#define SHORT_OPS (2 * RUN_MAX) /* the ops below it carry a count; a power of two */
+RTDE_STATIC_ASSERT(short_ops, (SHORT_OPS & (SHORT_OPS - 1)) == 0);
+RTDE_STATIC_ASSERT(ops_fit, OP_BOOL <= 0xFF);
 
 static int32_t to_int32(uint32_t u)
 {
     return u >= UINT32_C(0x80000000) ? -(int32_t)(~u) - 1 : (int32_t)u;
 }
 
-/* n doubles from the wire at p into d: eight at a time, then the last
- * ones (a variable's 1, 3 or 6 where it is not a run) by four, two and one,
- * without a loop or a jump table. */
-static inline void swap_doubles(double *d, const uint8_t *p, size_t n)
+/* n doubles from the wire at p into d, a run longer than RUN_MAX: eight at
+ * a time, then the last ones by four, two and one. */
+static RTDE_NOINLINE void swap_doubles(double *d, const uint8_t *p, size_t n)
 {
-    if (n == 1) { /* a DOUBLE: the usual case by itself */
-        d[0] = load_double(p);
-        return;
-    }
     for (; n >= 8; n -= 8, d += 8, p += 64) {
         d[0] = load_double(p);
         d[1] = load_double(p + 8);
@@ -976,12 +1004,8 @@ static inline void swap_doubles(double *d, const uint8_t *p, size_t n)
 
 /* The same for 32-bit values (an int32_t written through its unsigned type,
  * C99 6.5p7). */
-static inline void swap_words(uint32_t *d, const uint8_t *p, size_t n)
+static RTDE_NOINLINE void swap_words(uint32_t *d, const uint8_t *p, size_t n)
 {
-    if (n == 1) { /* an INT32 or UINT32: the usual case by itself */
-        d[0] = load_be32(p);
-        return;
-    }
     for (; n >= 4; n -= 4, d += 4, p += 16) {
         d[0] = load_be32(p);
         d[1] = load_be32(p + 4);
@@ -1001,7 +1025,7 @@ static inline void swap_words(uint32_t *d, const uint8_t *p, size_t n)
 
 /* One entry's values of the ops other than OP_F64 and OP_X32, once (p: its
  * first byte on the wire, d: its destination, n its elements). */
-static void decode_other(unsigned op, const uint8_t *p, unsigned char *d, size_t n)
+static RTDE_NOINLINE void decode_other(unsigned op, const uint8_t *p, unsigned char *d, size_t n)
 {
     size_t k;
     switch (op) {
@@ -1068,14 +1092,70 @@ static void copy_present(uint32_t *d, const uint32_t *p)
 #endif
 }
 
+/* The entries after the short ones (compile_recipe puts those first): long
+ * runs and the rarer conversions, each by a loop. Returns
+ * URRT_RTDE_EV_DATA, as decode_package, which ends in it. */
+static RTDE_NOINLINE int decode_long(const urrt_rtde *s, const uint8_t *pkg, urrt_state *st,
+                                     urrt_rtde_values *vals)
+{
+    const urrt_rtde_entry *e = s->recipe + s->short_entries, *end = s->recipe + s->entry_count;
+    for (; e != end; e++) {
+        const uint8_t *p = pkg + e->wire_offset;
+        unsigned char *d = (e->to_state ? (unsigned char *)st : (unsigned char *)vals) + e->dest_offset;
+        if (e->op == OP_F64) {
+            swap_doubles((double *)(void *)d, p, e->count);
+        } else if (e->op == OP_X32) {
+            swap_words((uint32_t *)(void *)d, p, e->count); /* an int32_t through its unsigned type */
+        } else {
+            decode_other(e->op, p, d, e->count);
+        }
+    }
+    return URRT_RTDE_EV_DATA;
+}
+
+/* The short entries from e to end, all into one struct (base), by one switch
+ * each, which enters the straight line below at their count (the cases fall
+ * through to the first value). It calls nothing, so that on x86-64 the loop
+ * fits in the registers a call may clobber and none is saved for it. */
+static RTDE_INLINE void decode_short(const urrt_rtde_entry *e, const urrt_rtde_entry *end, const uint8_t *pkg,
+                                unsigned char *base)
+{
+    for (; e != end; e++) {
+        const uint8_t *p = pkg + e->wire_offset;
+        double *dd = (double *)(void *)(base + e->dest_offset);
+        uint32_t *dw = (uint32_t *)(void *)(base + e->dest_offset); /* an int32_t as unsigned (C99 6.5p7) */
+        switch (e->op & (SHORT_OPS - 1u)) {
+        case OP_F64_1 + 7: dd[7] = load_double(p + 56); /* fall through */
+        case OP_F64_1 + 6: dd[6] = load_double(p + 48); /* fall through */
+        case OP_F64_1 + 5: dd[5] = load_double(p + 40); /* fall through */
+        case OP_F64_1 + 4: dd[4] = load_double(p + 32); /* fall through */
+        case OP_F64_1 + 3: dd[3] = load_double(p + 24); /* fall through */
+        case OP_F64_1 + 2: dd[2] = load_double(p + 16); /* fall through */
+        case OP_F64_1 + 1: dd[1] = load_double(p + 8); /* fall through */
+        case OP_F64_1: dd[0] = load_double(p); break;
+        case OP_X32_1 + 7: dw[7] = load_be32(p + 28); /* fall through */
+        case OP_X32_1 + 6: dw[6] = load_be32(p + 24); /* fall through */
+        case OP_X32_1 + 5: dw[5] = load_be32(p + 20); /* fall through */
+        case OP_X32_1 + 4: dw[4] = load_be32(p + 16); /* fall through */
+        case OP_X32_1 + 3: dw[3] = load_be32(p + 12); /* fall through */
+        case OP_X32_1 + 2: dw[2] = load_be32(p + 8); /* fall through */
+        case OP_X32_1 + 1: dw[1] = load_be32(p + 4); /* fall through */
+        default: dw[0] = load_be32(p); break; /* OP_X32_1: the cases cover every value */
+        }
+    }
+}
+
 /* The decode proper, of a package whose size (the recipe's), type and
  * recipe id are checked: the present bits whole, every time (nothing of
  * another recipe reads as present), then each value of the recipe, once;
- * nothing else. */
-static void decode_package(const urrt_rtde *s, const uint8_t *pkg, urrt_state *st, urrt_rtde_values *vals)
+ * nothing else. compile_recipe orders the entries: the short ones into
+ * urrt_state, the short ones into urrt_rtde_values (a loop each, with its
+ * struct's address: no choice per entry), then the rest, by decode_long.
+ * Returns URRT_RTDE_EV_DATA, the event it completes: the feed's usual read
+ * ends in it, and it in decode_long, by jumps where the compiler makes them. */
+static RTDE_INLINE int decode_in(const urrt_rtde *s, const uint8_t *pkg, urrt_state *st, urrt_rtde_values *vals)
 {
     const urrt_rtde_entry *e = s->recipe;
-    size_t k;
     if (st != 0) {
         st->present = s->state_present;
         st->length = s->data_size;
@@ -1086,27 +1166,19 @@ static void decode_package(const urrt_rtde *s, const uint8_t *pkg, urrt_state *s
     if (vals != 0) {
         copy_present(vals->present, s->values_present);
     }
-    /* the entries into urrt_state, then those into urrt_rtde_values; the
-     * two usual ops by a test each */
-#define RTDE_ENTRY(base)                                                                    \
-    do {                                                                                    \
-        const uint8_t *p = pkg + e->wire_offset;                                            \
-        unsigned char *d = (unsigned char *)(base) + e->dest_offset;                        \
-        if (e->op == OP_F64) {                                                              \
-            swap_doubles((double *)(void *)d, p, e->count);                                 \
-        } else if (e->op == OP_X32) {                                                       \
-            swap_words((uint32_t *)(void *)d, p, e->count);                                 \
-        } else {                                                                            \
-            decode_other(e->op, p, d, e->count);                                            \
-        }                                                                                   \
-    } while (0)
-    for (k = s->state_entries; k > 0; k--, e++) {
-        RTDE_ENTRY(st);
+    decode_short(e, e + s->state_entries, pkg, (unsigned char *)st);
+    decode_short(e + s->state_entries, e + s->short_entries, pkg, (unsigned char *)vals);
+    if (s->short_entries != s->entry_count) {
+        return decode_long(s, pkg, st, vals);
     }
-    for (k = (size_t)(s->entry_count - s->state_entries); k > 0; k--, e++) {
-        RTDE_ENTRY(vals);
-    }
-#undef RTDE_ENTRY
+    return URRT_RTDE_EV_DATA;
+}
+
+/* decode_in once, out of line, for urrt_rtde_decode and feed_bytes; the
+ * feed's usual read has a copy of its own. */
+static int decode_package(const urrt_rtde *s, const uint8_t *pkg, urrt_state *st, urrt_rtde_values *vals)
+{
+    return decode_in(s, pkg, st, vals);
 }
 
 /* Whether a data package of the recipe's size and type has its recipe id
@@ -1298,9 +1370,19 @@ static unsigned compile_pass(urrt_rtde *s, unsigned n, bool to_state)
     return n;
 }
 
-/* Compiles the accepted recipe into the entry table: the entries into
- * urrt_state first, then those into urrt_rtde_values (the decode walks each
- * part with its struct's address, no choice per entry); and the present
+/* *d = *e, field by field: a struct copy may be a call of memcpy (which
+ * lib/ must not need) where a target has no unaligned access (Cortex-M0). */
+static void copy_entry(urrt_rtde_entry *d, const urrt_rtde_entry *e)
+{
+    d->wire_offset = e->wire_offset;
+    d->dest_offset = e->dest_offset;
+    d->count = e->count;
+    d->op = e->op;
+    d->to_state = e->to_state;
+}
+
+/* Compiles the accepted recipe into the entry table (to_state says which
+ * struct each fills; the short entries first, see below) and the present
  * bits of its RTDE-only variables, which every decode writes whole. */
 static void compile_recipe(urrt_rtde *s)
 {
@@ -1311,6 +1393,25 @@ static void compile_recipe(urrt_rtde *s)
     }
     s->state_entries = (uint16_t)compile_pass(s, 0, true);
     s->entry_count = (uint16_t)compile_pass(s, s->state_entries, false);
+    /* The short entries (up to RUN_MAX doubles or 32-bit values) carry
+     * their count in the op and come first, those into urrt_state first
+     * (compile_pass put them first, and this keeps the short ones in
+     * order), then the rest: the decode converts the short ones without a
+     * loop, a struct at a time. Their order is free: each writes values of
+     * its own. */
+    s->short_entries = 0;
+    s->state_entries = 0;
+    for (i = 0; i < s->entry_count; i++) {
+        urrt_rtde_entry e;
+        copy_entry(&e, &s->recipe[i]);
+        if ((e.op == OP_F64 || e.op == OP_X32) && e.count <= RUN_MAX) {
+            e.op = (uint8_t)((e.op == OP_F64 ? OP_F64_1 : OP_X32_1) + e.count - 1);
+            copy_entry(&s->recipe[i], &s->recipe[s->short_entries]);
+            copy_entry(&s->recipe[s->short_entries], &e);
+            s->short_entries++;
+            s->state_entries = (uint16_t)(s->state_entries + e.to_state);
+        }
+    }
     /* A data package begins size, 'U', recipe id (protocol 2): the feed
      * compares those four bytes (three in protocol 1) at once. */
     store_be16(head, s->data_size);
@@ -1570,8 +1671,24 @@ static void clear_event(urrt_rtde_event *ev)
     ev->var = -1;
 }
 
-int urrt_rtde_feed(urrt_rtde *s, const uint8_t *data, size_t len, size_t *used, urrt_rtde_event *ev,
-                   urrt_state *st, urrt_rtde_values *vals)
+/* A data event: clear_event's fields, kind URRT_RTDE_EV_DATA. Where GCC
+ * copies a struct of this size inline (x86-64, AArch64: a few vector moves,
+ * never a memcpy call), as one copy of a constant event (fewer stores than
+ * its 13 fields); elsewhere field by field. */
+static void data_event_start(urrt_rtde_event *ev)
+{
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__aarch64__))
+    static const urrt_rtde_event data = {URRT_RTDE_EV_DATA, 0, 0, 0, 0, false, {0, 0, 0, 0}, 0, 0, 0, 0, 0, -1};
+    *ev = data;
+#else
+    clear_event(ev);
+    ev->kind = URRT_RTDE_EV_DATA;
+#endif
+}
+
+/* urrt_rtde_feed in general: every argument, phase and split. */
+static RTDE_NOINLINE int feed_bytes(urrt_rtde *s, const uint8_t *data, size_t len, size_t *used,
+                                    urrt_rtde_event *ev, urrt_state *st, urrt_rtde_values *vals)
 {
     size_t i = 0;
     if (used != 0) {
@@ -1586,10 +1703,9 @@ int urrt_rtde_feed(urrt_rtde *s, const uint8_t *data, size_t len, size_t *used, 
         return URRT_RTDE_E_ENDED;
     }
     if (s->have == 0 && len >= s->data_size && len >= 4 && (load_head(data) & s->head_mask) == s->head) {
-        /* The usual read first: one that starts with a whole data package
-         * of the recipe (its size, type and recipe id are its first four
-         * bytes, compared at once), decoded where it lies: what the loop
-         * below does, without it. */
+        /* The same read in the other phases (data before the S reply,
+         * around a pause): a whole data package of the recipe first,
+         * decoded where it lies, what the loop below does, without it. */
         int k;
         s->stats.packages++;
         k = data_event(s, data, ev, st, vals);
@@ -1664,4 +1780,30 @@ int urrt_rtde_feed(urrt_rtde *s, const uint8_t *data, size_t len, size_t *used, 
     *used = len;
     s->stats.bytes += len;
     return URRT_RTDE_EV_NONE;
+}
+
+int urrt_rtde_feed(urrt_rtde *s, const uint8_t *data, size_t len, size_t *used, urrt_rtde_event *ev,
+                   urrt_state *st, urrt_rtde_values *vals)
+{
+    /* The usual read, while the session streams: one that starts with a
+     * whole data package of the recipe (its size, type and recipe id are
+     * its first four bytes, compared at once; a recipe's package has at
+     * least four), with the structs its recipe needs: what feed_bytes does
+     * for it, its event and counts, then the decode where the package lies,
+     * which this ends in. Any other read goes to feed_bytes. Both are jumps
+     * where the compiler makes them (the call is the last thing done), so
+     * the usual read pays for none of feed_bytes's registers. */
+    if (s != 0 && used != 0 && ev != 0 && data != 0 && s->phase == PH_STREAMING && s->have == 0 &&
+        len >= s->data_size && (load_head(data) & s->head_mask) == s->head && (st != 0 || !s->has_state) &&
+        (vals != 0 || !s->has_values)) {
+        data_event_start(ev);
+        ev->first = !s->up;
+        s->up = 1;
+        s->stats.bytes += s->data_size;
+        *used = s->data_size;
+        s->stats.packages++;
+        s->stats.data++;
+        return decode_in(s, data, st, vals);
+    }
+    return feed_bytes(s, data, len, used, ev, st, vals);
 }

@@ -495,7 +495,9 @@ typedef struct urrt_rtde_stats {
  * the wire and in their struct, converted alike (target_q, target_qd, ...:
  * doubles; robot_mode, joint_mode, safety_mode: int32s into doubles;
  * robot_status_bits, safety_status_bits: 32 bits) are one entry, a run.
- * The entries into urrt_state come first, each part in wire order. */
+ * The short entries (up to 8 doubles or 32-bit values) come first, those
+ * into urrt_state before those into urrt_rtde_values, each in wire order;
+ * then the rest. */
 typedef struct urrt_rtde_entry {
     uint16_t wire_offset; /* from the package's first byte */
     uint16_t dest_offset; /* bytes into urrt_state or urrt_rtde_values */
@@ -512,11 +514,13 @@ typedef struct urrt_rtde {
     uint8_t not_found[URRT_RTDE_MAX_VARS / 8]; /* bit i: vars[i] was NOT_FOUND */
     uint16_t var_count;
     uint16_t entry_count;  /* entries of recipe[] in use */
-    uint16_t state_entries; /* of those, the first ones, into urrt_state */
+    uint16_t state_entries; /* of the short entries, the first ones, into urrt_state, internal */
     uint16_t data_size;    /* size of a data package of the accepted recipe, 0 before */
     uint32_t head, head_mask; /* a data package's first bytes, internal */
     uint16_t have;         /* bytes of buf filled */
     uint16_t need;         /* size of the package being received, 0 in its header */
+    uint16_t short_entries; /* of recipe[], the first ones, converted without a loop (the
+                             * rest: long runs, other conversions), internal */
     double frequency;      /* asked for; 0: the controller's maximum */
     uint64_t state_present; /* urrt_state present mask of the recipe */
     uint32_t controller[4];

@@ -14,13 +14,30 @@ painted mark must cover the static lib/ part, and the difference is libgcc's.
 
 Every function lib/*.h declares must have been measured.
 
+Tail calls: where gcc ends a function in a jump to another (a sibling call,
+`b`/`b.w` instead of `bl`), it pops the caller's frame before the jump, so
+the callee runs at the depth the caller was entered at: that edge adds the
+callee's worst path, not the caller's frame on top of it. The call graph
+does not say which calls are jumps; the objects do. Each .ci file's object
+(the .o beside it) is read with readelf -r: with -ffunction-sections every
+call into another function is a relocation in the caller's section
+(.rel.text.NAME), R_ARM_THM_CALL for a `bl`, R_ARM_THM_JUMP24, _JUMP19,
+_JUMP11 or _JUMP8 for a branch. An edge is a tail call only if every
+relocation from the caller to the callee is a branch; a caller that also
+calls it with `bl` keeps its frame on that edge.
+
 Usage: stack.py RUN_LOG FOOTPRINT_MD CI_FILE... (prints the table, then
 "N passed, N failed")"""
 import glob
+import os
 import re
+import subprocess
 import sys
 
 TOLERANCE = 8
+READELF = "arm-none-eabi-readelf"
+# Relocations of a Thumb branch (b, b.w, b<cond>, b<cond>.w): a jump that does not return here.
+BRANCHES = {"R_ARM_THM_JUMP24", "R_ARM_THM_JUMP19", "R_ARM_THM_JUMP11", "R_ARM_THM_JUMP8"}
 # Declared in lib/*.h but not built for Cortex-M.
 NOT_ON_CORTEX_M = {"urrt_x86_vector_bytes"}
 
@@ -35,31 +52,63 @@ def public_functions():
     return names - NOT_ON_CORTEX_M
 
 
+def bare(title):
+    """A call graph node's function name: a static one's title is FILE:NAME."""
+    return title.rsplit(":", 1)[-1]
+
+
+def relocations(obj):
+    """{(caller, callee): relocation types} of an object's calls between functions."""
+    out = subprocess.run([READELF, "-rW", obj], check=True, capture_output=True, text=True).stdout
+    kinds, caller = {}, None
+    for line in out.splitlines():
+        # a function's cold part (.text.unlikely.NAME) calls as the function
+        m = re.match(r"Relocation section '\.rela?\.text\.(?:unlikely\.|hot\.)?(\S+)'", line)
+        if m:
+            caller = m.group(1)
+            continue
+        if line.startswith("Relocation section"):
+            caller = None  # data (.rel.rodata...): addresses, not calls
+            continue
+        fields = line.split()
+        if caller is not None and len(fields) >= 5 and fields[2].startswith("R_ARM_"):
+            callee = re.sub(r"^\.text\.", "", fields[4])
+            if callee == caller + ".cold":
+                continue  # a jump into its own cold part, no call
+            kinds.setdefault((caller, callee), set()).add(fields[2])
+    return kinds
+
+
 def call_graph(paths):
+    """Frames by node title, and each node's callees as (title, tail call)."""
     frames, edges = {}, {}
     for path in paths:
+        kinds = relocations(os.path.splitext(path)[0] + ".o")
         for line in open(path):
             m = re.match(r'node: \{ title: "([^"]+)" label: "[^"]*\\n(\d+) bytes', line)
             if m:
                 frames[m.group(1)] = int(m.group(2))
             m = re.match(r'edge: \{ sourcename: "([^"]+)" targetname: "([^"]+)"', line)
             if m:
-                edges.setdefault(m.group(1), set()).add(m.group(2))
+                k = kinds.get((bare(m.group(1)), bare(m.group(2))), set())
+                edges.setdefault(m.group(1), set()).add((m.group(2), bool(k) and k <= BRANCHES))
     return frames, edges
 
 
 def worst(name, frames, edges, seen=()):
-    """(bytes, calls outside lib/) of the deepest path from name."""
+    """(bytes, calls outside lib/) of the deepest path from name: a callee
+    reached by a call below name's frame, one reached by a tail call at
+    name's own depth."""
     if name not in frames:
         return 0, {name}
     if name in seen:
         sys.exit("stack.py: recursion through %s" % name)
-    deepest, outside = 0, set()
-    for callee in edges.get(name, ()):
+    deepest, outside = frames[name], set()
+    for callee, tail in edges.get(name, ()):
         b, o = worst(callee, frames, edges, seen + (name,))
-        deepest = max(deepest, b)
+        deepest = max(deepest, b if tail else frames[name] + b)
         outside |= o
-    return frames[name] + deepest, outside
+    return deepest, outside
 
 
 def main():
