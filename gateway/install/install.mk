@@ -151,7 +151,11 @@ deb:
 	rm -rf $(DEB_WORK) $(DEB_DIR)
 	mkdir -p $(DEB_WORK)/urrt $(DEB_DIR)
 	tar -c --exclude-vcs --exclude='./build' --exclude='./build-*' --exclude='./$(BUILD)' . | tar -x -C $(DEB_WORK)/urrt
-	cd $(DEB_WORK)/urrt && DEB_BUILD_OPTIONS="parallel=$(DEB_JOBS) noddebs $(DEB_BUILD_OPTIONS)" \
+	@# The package builds with its own make settings (debian/rules): none of this make's may
+	@# reach it, or its `make clean` would remove a BUILD given here (an absolute one lies
+	@# outside the copy).
+	cd $(DEB_WORK)/urrt && env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL -u MAKEOVERRIDES -u BUILD \
+	  DEB_BUILD_OPTIONS="parallel=$(DEB_JOBS) noddebs $(DEB_BUILD_OPTIONS)" \
 	  dpkg-buildpackage -b -us -uc > ../build.log 2>&1 || { tail -n 30 ../build.log; exit 1; }
 	mv $(DEB_WORK)/*.deb $(DEB_WORK)/*.changes $(DEB_WORK)/*.buildinfo $(DEB_WORK)/build.log $(DEB_DIR)/
 	rm -rf $(DEB_WORK)
