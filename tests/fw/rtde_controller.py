@@ -139,27 +139,25 @@ def stream(capture, tables, out_path):
         f.write(b"".join(out))
 
 
-def controller_major(stream_path):
+def first_body(stream_path, kind):
+    """The payload of a stream's first package of type kind (bytes)."""
     data = open(stream_path, "rb").read()
     at = 0
     while at + 3 <= len(data):
         size = struct.unpack(">H", data[at:at + 2])[0]
-        if data[at + 2:at + 3] == b"v":
-            return struct.unpack(">I", data[at + 3:at + 7])[0]
+        if data[at + 2:at + 3] == kind:
+            return data[at + 3:at + size]
         at += max(size, 3)
-    sys.exit("%s: no controller version reply" % stream_path)
+    sys.exit("%s: no %s reply" % (stream_path, kind.decode()))
+
+
+def controller_major(stream_path):
+    return struct.unpack(">I", first_body(stream_path, b"v")[:4])[0]
 
 
 def recipe_id_of(stream_path):
     """The output recipe's id in a stream's setup reply (protocol 2)."""
-    data = open(stream_path, "rb").read()
-    at = 0
-    while at + 3 <= len(data):
-        size = struct.unpack(">H", data[at:at + 2])[0]
-        if data[at + 2:at + 3] == b"O":
-            return data[at + 3]
-        at += max(size, 3)
-    sys.exit("%s: no setup reply" % stream_path)
+    return first_body(stream_path, b"O")[0]
 
 
 def check(fw_out, tables, stream_path):
