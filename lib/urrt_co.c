@@ -101,7 +101,7 @@ uint32_t urrt_co_type_size(uint8_t type)
 
 static bool type_signed(uint8_t type)
 {
-    return type == URRT_CO_INTEGER8 || type == URRT_CO_INTEGER16 || type == URRT_CO_INTEGER32;
+    return urrt_co_type_signed(type);
 }
 
 static uint32_t size_mask(uint32_t bytes)
@@ -109,21 +109,10 @@ static uint32_t size_mask(uint32_t bytes)
     return bytes >= 4u ? UINT32_MAX : (UINT32_C(1) << (8u * bytes)) - 1u;
 }
 
-/* An order-keeping unsigned key for a value of the type: signed values with
- * their sign bit flipped compare as unsigned ones (no implementation-defined
- * conversion to int32_t). */
+/* urrt_co_order_key for a value of the type (urrt_co_internal.h). */
 static uint32_t order_key(uint32_t raw, uint8_t type)
 {
-    uint32_t bytes = type_size(type);
-    uint32_t sign = UINT32_C(1) << (8u * bytes - 1u);
-    if (!type_signed(type)) {
-        return raw;
-    }
-    raw &= size_mask(bytes);
-    if ((raw & sign) != 0u) {
-        raw |= ~size_mask(bytes);
-    }
-    return raw ^ UINT32_C(0x80000000);
+    return urrt_co_order_key(raw, type_signed(type), type_size(type));
 }
 
 static uint64_t min64(uint64_t a, uint64_t b)

@@ -229,6 +229,7 @@ typedef struct urrt_co_tpdo {
 #define URRT_CO_MAX_RPDOS 4u            /* RPDO1..4: CiA 301's pre-defined connection set */
 #define URRT_CO_RPDO_MAX_MAPPED 8u      /* entries of 8 bits or more in a classic frame */
 #define URRT_CO_MAX_CONSUMERS 4u        /* 0x1016's entries at most */
+#define URRT_CO_UNRESOLVED 0xFFFFu      /* urrt_co_rpdo_state.mapped: no object resolved */
 
 typedef struct urrt_co_rpdo {
     const uint32_t *mapping;     /* 0x1600+n sub 1..: index << 16 | sub << 8 | bits (read-only) */
@@ -289,9 +290,16 @@ typedef struct urrt_co_tpdo_state {
 /* Run-time values of RPDO n (0x1400+n) and what it received. */
 typedef struct urrt_co_rpdo_state {
     uint64_t received_us;     /* the latest one processed (its length right) */
+    /* Its mapping resolved, so that a frame scans no dictionary: entry i's
+     * object, its place in desc->objects (URRT_CO_UNRESOLVED: a dummy, or an
+     * object past the first 65535, found by a scan), and the bytes the
+     * mapping covers. Set where a mapping takes effect (urrt_co_init_rx, a
+     * reset, the RPDO made valid). 16 bits, not pointers: 16 bytes an RPDO. */
+    uint16_t mapped[URRT_CO_RPDO_MAX_MAPPED];
     uint32_t cob_id;          /* sub 1 */
     uint16_t event_ms;        /* sub 5 */
     uint8_t type;             /* sub 2 */
+    uint8_t bytes;            /* the mapping's length: a shorter RPDO is not processed */
     uint8_t data[8];          /* types 0..240: the latest one, acted on at the next SYNC */
     bool pending;             /* data waits for the SYNC */
     bool received;            /* one was processed since the node entered OPERATIONAL or sub 1 changed */

@@ -74,6 +74,21 @@ uint32_t urrt_co_cob_check(uint32_t old, uint32_t value, uint32_t also_allowed);
 uint32_t urrt_co_type_size(uint8_t type);
 /* A value outside low..high of the type: URRT_CO_ABORT_TOO_LOW or _TOO_HIGH; else 0. */
 uint32_t urrt_co_range_check(uint32_t value, uint8_t type, uint32_t low, uint32_t high);
+/* An order-keeping unsigned key for a value of `bytes` bytes (1, 2, 4): a
+ * signed value's bits (those of its size; higher ones ignored) with its
+ * sign bit flipped compare as unsigned ones do (no implementation-defined
+ * conversion to int32_t): shifted up to bit 31, flipped there, shifted back
+ * down. An unsigned value is its own key. Keys are compared only with keys
+ * of the same type. Inline: the RPDO path checks each value it receives. */
+static inline uint32_t urrt_co_order_key(uint32_t raw, bool is_signed, uint32_t bytes)
+{
+    uint32_t shift = 32u - 8u * bytes; /* 24, 16, 0 */
+    return is_signed ? ((raw << shift) ^ UINT32_C(0x80000000)) >> shift : raw;
+}
+static inline bool urrt_co_type_signed(uint8_t type)
+{
+    return type == URRT_CO_INTEGER8 || type == URRT_CO_INTEGER16 || type == URRT_CO_INTEGER32;
+}
 /* The EMCY of a condition of the receiving side that started (or ended:
  * the reset naming the code), as the node's are sent: emcy is the code, and
  * in bits 16..23 its manufacturer byte 5 (the 0x1016 entry or RPDO). */

@@ -212,6 +212,23 @@ uint32_t urrt_co_rpdo_cob_default(const urrt_co *co, size_t n)
     return rpdo_cob(co->desc, n);
 }
 
+/* RPDO n's mapping to its objects and its length, once, so that no frame
+ * scans the dictionary (urrt_co_init_rx saw every entry name one). Where a
+ * mapping takes effect: init, a reset, the RPDO made valid. The mapping is
+ * the description's (0x1600+n is read-only), but CiA 301 lets a manager
+ * change one only while its RPDO is not valid, so that making the RPDO valid
+ * is the one place a writable 0x1600+n would need its mapping resolved again. */
+static void rpdo_resolve(const urrt_co_desc *d, size_t n, urrt_co_rpdo_state *t)
+{
+    const urrt_co_rpdo *p = &d->rpdos[n];
+    size_t i;
+    for (i = 0; i < URRT_CO_RPDO_MAX_MAPPED; i++) {
+        size_t k = i < p->mapping_count && !dummy_entry(p->mapping[i]) ? object_of(d, p->mapping[i]) : NONE;
+        t->mapped[i] = (uint16_t)(k < URRT_CO_UNRESOLVED ? k : URRT_CO_UNRESOLVED);
+    }
+    t->bytes = (uint8_t)rpdo_bytes(p);
+}
+
 /* RPDO n starts over: nothing received, kept or wrong (a new COB-ID, a reset). */
 static void rpdo_forget(urrt_co_rpdo_state *t)
 {
@@ -239,6 +256,7 @@ static void rx_defaults(urrt_co *co, bool boot, bool whole_node)
         uint32_t cob = rpdo_cob(d, i);
         changed = changed || (boot && rpdo_rx_id(t->cob_id) != rpdo_rx_id(cob));
         t->cob_id = cob;
+        rpdo_resolve(d, i, t);
         t->type = d->rpdos[i].transmission_type;
         t->event_ms = d->rpdos[i].event_ms;
         rpdo_forget(t);
@@ -317,7 +335,9 @@ static void rx_refresh(urrt_co *co, uint64_t now_us)
     uint32_t active = rx_conditions(co, now_us);
     uint32_t started = active & ~(uint32_t)co->rx_storage->active;
     unsigned i, k;
-    for (i = 0; i < URRT_CO_RX_CONDITIONS; i++) {
+    /* Up to the highest condition that started only: most calls (each RPDO
+     * received) start none. */
+    for (i = 0; i < URRT_CO_RX_CONDITIONS && started >> i != 0u; i++) {
         if ((started >> i & 1u) == 0u) {
             continue;
         }
@@ -409,24 +429,31 @@ static void rpdo_act(urrt_co *co, size_t n, const uint8_t *data, uint64_t now_us
 {
     const urrt_co_desc *d = co->desc;
     const urrt_co_rpdo *p = &d->rpdos[n];
+    const urrt_co_rpdo_state *t = &co->rx_storage->rpdos[n];
+    uint64_t *written = co->rx_storage->written_us;
     uint32_t at = 0;
     bool wrote = false;
     size_t i;
     for (i = 0; i < p->mapping_count; i++) {
-        uint32_t bytes = (p->mapping[i] & 0xFFu) / 8u;
-        if (!dummy_entry(p->mapping[i])) {
-            const urrt_co_object *o = &d->objects[object_of(d, p->mapping[i])]; /* urrt_co_init saw it */
-            uint32_t value = 0;
-            uint32_t k;
-            for (k = 0; k < bytes; k++) {
-                value |= (uint32_t)data[at + k] << (8u * k);
-            }
-            if (urrt_co_range_check(value, o->type, o->min, o->max) != 0u) {
-                co->values_refused++;
+        uint32_t entry = p->mapping[i];
+        uint32_t bytes = (entry & 0xFFu) / 8u; /* 1, 2 or 4, its object's size: urrt_co_init_rx saw it */
+        size_t k = t->mapped[i]; /* resolved once (rpdo_resolve) */
+        if (k != URRT_CO_UNRESOLVED || !dummy_entry(entry)) {
+            /* Past the first 65535 objects: a scan (urrt_co_init_rx saw the object exists). */
+            const urrt_co_object *o = &d->objects[k != URRT_CO_UNRESOLVED ? k : object_of(d, entry)];
+            const uint8_t *b = data + at;
+            uint32_t value = bytes == 1u   ? b[0]
+                             : bytes == 2u ? (uint32_t)b[0] | (uint32_t)b[1] << 8
+                                           : (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 |
+                                                 (uint32_t)b[3] << 24; /* little-endian (CiA 301) */
+            bool sign = urrt_co_type_signed(o->type);
+            uint32_t key = urrt_co_order_key(value, sign, bytes);
+            if (key < urrt_co_order_key(o->min, sign, bytes) || key > urrt_co_order_key(o->max, sign, bytes)) {
+                co->values_refused++; /* urrt_co_range_check's refusal, inline */
             } else {
                 co->vars[o->item] = value;
-                if (co->rx_storage->written_us != NULL) {
-                    co->rx_storage->written_us[o->item] = now_us;
+                if (written != NULL) {
+                    written[o->item] = now_us;
                 }
                 wrote = true;
             }
@@ -442,7 +469,7 @@ static void rpdo_received(urrt_co *co, size_t n, const uint8_t *data, size_t len
 {
     urrt_co_rpdo_state *t = &co->rx_storage->rpdos[n];
     size_t i;
-    t->short_seen = len < rpdo_bytes(&co->desc->rpdos[n]);
+    t->short_seen = len < t->bytes;
     if (!t->short_seen) {
         t->received_us = now_us;
         t->received = true;
@@ -562,6 +589,9 @@ static uint32_t write_rpdo(urrt_co *co, size_t n, uint8_t sub, uint32_t value, u
         if (rpdo_rx_id(t->cob_id) != rpdo_rx_id(value)) {
             co->rx_changes++;
             rpdo_forget(t);
+        }
+        if (!cob_valid(t->cob_id) && cob_valid(value)) {
+            rpdo_resolve(co->desc, n, t); /* switched on: where a mapping takes effect */
         }
         t->cob_id = value;
         break;

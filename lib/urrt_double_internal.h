@@ -42,32 +42,39 @@ static inline bool urrt_double_bits_of_int(int64_t v, uint64_t *bits)
 
 /* A double's bits as an integer, if it is one exactly and its magnitude is
  * below 2^40 (past every integer register's range); false otherwise. -0.0
- * is 0. */
+ * is 0. Worked on the two 32-bit halves: a 32-bit core (a range check per
+ * value received, urrt_plcin.c) would otherwise shift 64-bit words by
+ * variable amounts, several instructions each. */
 static inline bool urrt_int_of_double_bits(uint64_t bits, int64_t *v)
 {
-    unsigned exponent = (unsigned)(bits >> 52) & 0x7FFu;
-    uint64_t m = bits & ((UINT64_C(1) << 52) - 1u);
-    int shift;
-    if (exponent == 0) {
+    uint32_t hi = (uint32_t)(bits >> 32), lo = (uint32_t)bits;
+    unsigned exponent = (unsigned)(hi >> 20) & 0x7FFu;
+    uint32_t top = (hi & 0xFFFFFu) | 0x100000u; /* the mantissa's upper 21 bits, its implicit 1 */
+    uint64_t m;
+    unsigned s;
+    if (exponent < 1023u) {
         *v = 0;
-        return m == 0; /* a zero, or a denormal (no integer) */
+        return exponent == 0u && (hi & 0xFFFFFu) == 0u && lo == 0u; /* a zero; else below 1 (or a denormal) */
     }
-    if (exponent == 0x7FFu) {
-        return false; /* infinite, NaN */
+    if (exponent > 1062u) {
+        return false; /* 2^40 or more, infinite, NaN */
     }
-    shift = (int)exponent - 1075; /* value = (m | 2^52) * 2^shift */
-    m |= UINT64_C(1) << 52;
-    if (shift >= -52 + 40) {
-        return false; /* 2^40 or more */
+    /* value = mantissa (53 bits) >> s, s = 1075 - exponent = 13..52: no fraction
+     * when the s bits shifted out are zero */
+    if (exponent <= 1043u) {
+        s = 1043u - exponent; /* the whole value in top (below 2^21): lo all fraction */
+        if (lo != 0u || (top & ((UINT32_C(1) << s) - 1u)) != 0u) {
+            return false;
+        }
+        m = top >> s;
+    } else {
+        s = 1075u - exponent; /* 13..31 */
+        if ((lo & ((UINT32_C(1) << s) - 1u)) != 0u) {
+            return false;
+        }
+        m = (uint64_t)top << (32u - s) | lo >> s;
     }
-    if (shift < -52) {
-        return false; /* below 1 in magnitude, not zero */
-    }
-    if ((m & ((UINT64_C(1) << (unsigned)-shift) - 1u)) != 0) {
-        return false; /* a fraction (shift is -52..-13 here) */
-    }
-    m >>= (unsigned)-shift;
-    *v = (bits >> 63) != 0 ? -(int64_t)m : (int64_t)m;
+    *v = (hi >> 31) != 0u ? -(int64_t)m : (int64_t)m;
     return true;
 }
 

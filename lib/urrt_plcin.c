@@ -63,6 +63,14 @@ static bool identity_value(const urrt_can_signal *sig, uint64_t raw, int64_t *v)
         sig->length > 64u || (sig->type != URRT_CAN_UNSIGNED && sig->type != URRT_CAN_SIGNED)) {
         return false;
     }
+    if (sig->length <= 32u) {
+        /* The usual signal, in 32-bit arithmetic: (r ^ sign) - sign sign-extends
+         * a signed one without a conversion the standard leaves open. */
+        uint32_t r = (uint32_t)raw & (UINT32_MAX >> (32u - sig->length));
+        uint32_t sign32 = UINT32_C(1) << (sig->length - 1u);
+        *v = sig->type == URRT_CAN_SIGNED ? (int64_t)(r ^ sign32) - (int64_t)sign32 : (int64_t)r;
+        return true;
+    }
     if (sig->length < 64u) {
         raw &= (UINT64_C(1) << sig->length) - 1u;
         sign = UINT64_C(1) << (sig->length - 1u);
@@ -90,13 +98,75 @@ static bool within(const urrt_can_signal *sig, int64_t v)
     return above && below;
 }
 
+/* Bit i of absent (none past 63), from one 32-bit half: a 64-bit shift by
+ * a variable amount is several instructions on a 32-bit core. */
+static bool absent_bit(uint64_t absent, size_t i)
+{
+    uint32_t half = i < 32u ? (uint32_t)absent : (uint32_t)(absent >> 32);
+    return i < 64u && (half >> (i % 32u) & 1u) != 0u;
+}
+
+/* A bit-mask signal's bits in the register's word: its raw shifted up by
+ * its first bit; in 32-bit arithmetic when they end by bit 31 (a bit
+ * register word, the usual case), as 64-bit shifts by a variable amount
+ * are several instructions each on a 32-bit core. */
+static uint64_t mask_bits(const urrt_can_signal *sig, uint64_t raw)
+{
+    unsigned first = URRT_CAN_SIG_MASK_FIRST(sig->flags);
+    uint64_t bits;
+    if (sig->length >= 1u && first + sig->length <= 32u) {
+        return (uint64_t)(((uint32_t)raw & (UINT32_MAX >> (32u - sig->length))) << first);
+    }
+    bits = sig->length >= 64u ? raw : raw & ((UINT64_C(1) << sig->length) - 1u);
+    return first < 64u ? bits << first : 0u;
+}
+
 static enum take none(urrt_rtde_in *in, size_t k, enum take why)
 {
     urrt_rtde_in_unset(in, k);
     return why;
 }
 
-/* Register k (d->regs[k]) from the signals that write it. */
+static enum take set_int(urrt_rtde_in *in, size_t k, int64_t v)
+{
+    return urrt_rtde_in_set_int(in, k, v) == URRT_OK ? TAKEN : REFUSED;
+}
+
+/* A bit mask's word: the bit-register words are UINT32, so that a mask past
+ * bit 31 is refused there. */
+static enum take set_mask(urrt_rtde_in *in, size_t k, uint64_t word)
+{
+    return set_int(in, k, word > (uint64_t)INT64_MAX ? -1 : (int64_t)word);
+}
+
+/* Register k (d->regs[k]) from signal i alone: an input in register order
+ * (in_register_order), the usual one. take_register's rules for a
+ * register one signal writes, without its gathering over the signals. */
+static enum take take_one(const urrt_plcin_desc *d, urrt_rtde_in *in, size_t k, size_t i, const uint64_t *raws,
+                          uint64_t absent)
+{
+    const urrt_can_signal *sig = &d->signals[i];
+    int64_t whole;
+    double value;
+    if (absent_bit(absent, i)) {
+        return none(in, k, ABSENT);
+    }
+    if ((sig->flags & URRT_CAN_SIG_BITMASK) != 0) {
+        return set_mask(in, k, mask_bits(sig, raws[i]));
+    }
+    if (identity_value(sig, raws[i], &whole)) {
+        return within(sig, whole) ? set_int(in, k, whole) : none(in, k, REFUSED);
+    }
+    value = urrt_can_from_raw(sig, raws[i]);
+    if (!(value >= sig->min) || !(value <= sig->max)) {
+        return none(in, k, REFUSED);
+    }
+    return urrt_rtde_in_set_double(in, k, value) == URRT_OK ? TAKEN : REFUSED;
+}
+
+/* Register k (d->regs[k]) from the signals that write it: bit masks' bits
+ * or-ed into one word, any other value through its signal's scaling and
+ * limits. */
 static enum take take_register(const urrt_plcin_desc *d, urrt_rtde_in *in, size_t k, const uint64_t *raws,
                                uint64_t absent)
 {
@@ -110,14 +180,12 @@ static enum take take_register(const urrt_plcin_desc *d, urrt_rtde_in *in, size_
         if (d->vars[i] != d->regs[k]) {
             continue;
         }
-        if (i < 64u && (absent >> i & 1u) != 0) {
+        if (absent_bit(absent, i)) {
             return none(in, k, ABSENT);
         }
         if ((sig->flags & URRT_CAN_SIG_BITMASK) != 0) {
-            uint64_t bits = sig->length >= 64u ? raws[i] : raws[i] & ((UINT64_C(1) << sig->length) - 1u);
-            unsigned first = URRT_CAN_SIG_MASK_FIRST(sig->flags);
             mask = true;
-            word |= first < 64u ? bits << first : 0u;
+            word |= mask_bits(sig, raws[i]);
             continue;
         }
         if (identity_value(sig, raws[i], &whole)) {
@@ -133,12 +201,10 @@ static enum take take_register(const urrt_plcin_desc *d, urrt_rtde_in *in, size_
         }
     }
     if (integer) {
-        return urrt_rtde_in_set_int(in, k, whole) == URRT_OK ? TAKEN : REFUSED;
+        return set_int(in, k, whole);
     }
     if (mask) {
-        /* The bit-register words are UINT32: a mask past bit 31 is refused there. */
-        return urrt_rtde_in_set_int(in, k, word > (uint64_t)INT64_MAX ? -1 : (int64_t)word) == URRT_OK ? TAKEN
-                                                                                                       : REFUSED;
+        return set_mask(in, k, word);
     }
     return urrt_rtde_in_set_double(in, k, value) == URRT_OK ? TAKEN : REFUSED;
 }
@@ -148,24 +214,50 @@ static bool given(const urrt_rtde_in *in, size_t k)
     return ((unsigned)in->given[k / 8u] >> (k % 8u) & 1u) != 0;
 }
 
-/* Register k from raws: whether its value changed, came or went. */
-static bool take_changed(const urrt_plcin_desc *d, urrt_rtde_in *in, size_t k, const uint64_t *raws,
-                         uint64_t absent, size_t *refused)
+/* Register k's packed bytes (at most 8: a DOUBLE's) as one number, to see
+ * a change. */
+static uint64_t packed(const urrt_rtde_in *in, size_t k)
 {
     size_t at = in->offset[k];
     size_t end = k + 1u < in->count ? in->offset[k + 1u] : in->data_size;
-    uint8_t before[8];
-    bool had = given(in, k);
-    bool same = true;
+    uint64_t bytes = 0;
     size_t b;
-    for (b = 0; b < end - at && b < sizeof before; b++) {
-        before[b] = in->data[at + b];
+    for (b = at; b < end && b < at + 8u; b++) {
+        bytes = bytes << 8 | in->data[b];
     }
-    *refused += take_register(d, in, k, raws, absent) == REFUSED;
-    for (b = 0; b < end - at && b < sizeof before; b++) {
-        same = same && before[b] == in->data[at + b];
+    return bytes;
+}
+
+/* Register k from raws (from signal k alone when ordered): whether its
+ * value changed, came or went. */
+static bool take_changed(const urrt_plcin_desc *d, urrt_rtde_in *in, size_t k, bool ordered, const uint64_t *raws,
+                         uint64_t absent, size_t *refused)
+{
+    bool had = given(in, k);
+    uint64_t before = had ? packed(in, k) : 0u; /* a register without a value: any value is news */
+    enum take took = ordered ? take_one(d, in, k, k, raws, absent) : take_register(d, in, k, raws, absent);
+    *refused += took == REFUSED;
+    if (!given(in, k)) {
+        return had;
     }
-    return had != given(in, k) || (given(in, k) && !same);
+    return !had || packed(in, k) != before;
+}
+
+/* Signal i writes register i, and no other signal writes it (the registers
+ * are distinct): the usual input, one signal per register in recipe order,
+ * taken in one pass over the signals instead of one per register. */
+static bool in_register_order(const urrt_plcin_desc *d)
+{
+    size_t i;
+    if (d->signal_count != d->reg_count) {
+        return false;
+    }
+    for (i = 0; i < d->reg_count; i++) {
+        if (d->vars[i] != d->regs[i]) {
+            return false;
+        }
+    }
+    return true;
 }
 
 size_t urrt_plcin_take(const urrt_plcin_desc *d, urrt_plcin *p, urrt_rtde_in *in, const uint64_t *raws,
@@ -173,12 +265,14 @@ size_t urrt_plcin_take(const urrt_plcin_desc *d, urrt_plcin *p, urrt_rtde_in *in
 {
     size_t refused = 0;
     bool changed = false;
+    bool ordered;
     size_t k;
     if (d == 0 || p == 0 || in == 0 || raws == 0 || d->reg_count != in->count) {
         return 0;
     }
+    ordered = in_register_order(d);
     for (k = 0; k < d->reg_count; k++) {
-        changed = take_changed(d, in, k, raws, absent, &refused) || changed;
+        changed = take_changed(d, in, k, ordered, raws, absent, &refused) || changed;
     }
     /* A package is news when a value changed, came or went, or the PLC was silent. */
     p->changed = p->changed || changed || !p->fresh;
@@ -277,6 +371,7 @@ void urrt_plcin_node(const urrt_plcin_desc *d, const urrt_plcin_rpdo *r, urrt_pl
                      uint64_t now_us, urrt_plcin_look *look)
 {
     uint64_t timeout_us, newest = URRT_CANTX_NEVER;
+    uint32_t absent = 0;
     const uint64_t *written;
     urrt_plcin_why why;
     size_t i;
@@ -293,18 +388,23 @@ void urrt_plcin_node(const urrt_plcin_desc *d, const urrt_plcin_rpdo *r, urrt_pl
     }
     timeout_us = (uint64_t)d->timeout_ms * 1000u;
     written = r->co->rx_storage->written_us + r->first_var;
+    /* One pass: the newest write, and the variables never written or too old
+     * (absent: at most 8 of them, bits of a 32-bit word). */
     for (i = 0; i < d->signal_count; i++) {
         uint64_t w = written[i];
-        newest = w == URRT_CANTX_NEVER ? newest : newest == URRT_CANTX_NEVER || w > newest ? w : newest;
+        if (w == URRT_CANTX_NEVER) {
+            absent |= UINT32_C(1) << i;
+            continue;
+        }
+        newest = newest == URRT_CANTX_NEVER || w > newest ? w : newest;
+        absent |= (uint32_t)(since(now_us, w) > timeout_us) << i;
     }
     why = node_why(r, now_us);
     if (why == URRT_PLCIN_STILL && newest != URRT_CANTX_NEVER && newest != p->seen_us &&
         since(now_us, newest) <= timeout_us) {
         uint64_t raws[URRT_CO_RPDO_MAX_MAPPED];
-        uint64_t absent = 0;
         for (i = 0; i < d->signal_count; i++) {
             raws[i] = r->co->vars[r->first_var + i];
-            absent |= (uint64_t)(written[i] == URRT_CANTX_NEVER || since(now_us, written[i]) > timeout_us) << i;
         }
         look->refused = urrt_plcin_take(d, p, in, raws, absent, newest);
         look->took = true;

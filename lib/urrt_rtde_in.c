@@ -472,16 +472,20 @@ void urrt_rtde_in_unset(urrt_rtde_in *in, size_t i)
 
 bool urrt_rtde_in_complete(const urrt_rtde_in *in)
 {
+    unsigned rest;
     size_t i;
     if (in == 0 || !usable(in)) {
         return false;
     }
-    for (i = 0; i < in->count; i++) {
-        if (((unsigned)in->given[i / 8u] >> (i % 8u) & 1u) == 0) {
+    /* A byte of given bits at a time (each package asks), then the last one's
+     * bits below count. */
+    for (i = 0; i < in->count / 8u; i++) {
+        if (in->given[i] != 0xFFu) {
             return false;
         }
     }
-    return true;
+    rest = (1u << (in->count % 8u)) - 1u;
+    return rest == 0u || ((unsigned)in->given[i] & rest) == rest;
 }
 
 bool urrt_rtde_in_ready(const urrt_rtde *s, const urrt_rtde_in *in)
@@ -493,7 +497,8 @@ bool urrt_rtde_in_ready(const urrt_rtde *s, const urrt_rtde_in *in)
 
 int urrt_rtde_in_package(const urrt_rtde *s, urrt_rtde_in *in, uint8_t *out, size_t cap)
 {
-    size_t size, i;
+    const uint8_t *from;
+    size_t size, i, n;
     if (s == 0 || in == 0 || out == 0 || !usable(in)) {
         return URRT_E_ARG;
     }
@@ -511,8 +516,12 @@ int urrt_rtde_in_package(const urrt_rtde *s, urrt_rtde_in *in, uint8_t *out, siz
     out[1] = (uint8_t)size;
     out[2] = URRT_RTDE_TYPE_DATA;
     out[3] = in->id;
-    for (i = 0; i < in->data_size; i++) {
-        out[4 + i] = in->data[i];
+    /* The count and the source held in locals: out may alias in for all the
+     * compiler knows, which would reload both at every byte. */
+    from = in->data;
+    n = in->data_size;
+    for (i = 0; i < n; i++) {
+        out[4 + i] = from[i];
     }
     in->stats.packages++;
     return (int)size;

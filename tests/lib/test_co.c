@@ -1702,6 +1702,117 @@ static void test_rpdo_status(void)
     EQ(urrt_co_rpdo_status(&co, 1, 240000), URRT_CO_RPDO_FRESH);
 }
 
+/* Each RPDO's mapping is resolved to its objects where a mapping takes
+ * effect (urrt_co_init_rx, a reset, the RPDO made valid), not per frame: the
+ * resolution in urrt_co_rpdo_state, a stale one scribbled over while the
+ * RPDO is off, made again when the manager switches it on (0x1400+n sub 1,
+ * bit 31), and at a reset; the RPDOs then write, check and skip as their
+ * mappings say. */
+static void expect_resolved(int line)
+{
+    /* RPDO1: 0x2200 sub 1, 2, 3 (rx_objects[4..6]), 7 bytes; RPDO2: sub 4, a dummy, sub 1, 4 bytes. */
+    const urrt_co_rpdo_state *r1 = &rpdo_states[0], *r2 = &rpdo_states[1];
+    CHECK(r1->mapped[0] == 4 && r1->mapped[1] == 5 && r1->mapped[2] == 6 && r1->mapped[3] == URRT_CO_UNRESOLVED &&
+              r1->bytes == 7,
+          "line %d: RPDO1's mapping not resolved", line);
+    CHECK(r2->mapped[0] == 7 && r2->mapped[1] == URRT_CO_UNRESOLVED && r2->mapped[2] == 4 && r2->bytes == 4,
+          "line %d: RPDO2's mapping not resolved", line);
+}
+
+/* What a stale resolution would hold: the wrong objects (a read-only one,
+ * the wrong slot), no length. */
+static void scribble(urrt_co_rpdo_state *t)
+{
+    size_t i;
+    for (i = 0; i < URRT_CO_RPDO_MAX_MAPPED; i++) {
+        t->mapped[i] = 8;
+    }
+    t->bytes = 0;
+}
+
+static void test_rpdo_mapping_resolved(void)
+{
+    rx_node();
+    expect_resolved(__LINE__); /* at urrt_co_init_rx */
+    nmt(0x01, NODE, 1000);
+    RX0(2000, 0x20A, 0xF4, 0x01, 0x01, 0x78, 0x56, 0x34, 0x12);
+    EQ(rx_vars[2], 500);
+    EQ(rx_vars[3], 1);
+    EQ(rx_vars[4], 0x12345678);
+    /* RPDO1 switched off: not received, its resolution scribbled over. */
+    SDO(3000, 0x23, 0x00, 0x14, 0x01, 0x0A, 0x02, 0x00, 0x80);
+    ANSWER(0x60, 0x00, 0x14, 0x01, 0, 0, 0, 0);
+    scribble(&rpdo_states[0]);
+    RX0(4000, 0x20A, 0x01, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00);
+    EQ(rx_vars[2], 500);
+    EQ(rx_vars[6], 5); /* 0x2201, read-only, untouched */
+    /* Switched on again: resolved again, before any frame. */
+    SDO(5000, 0x23, 0x00, 0x14, 0x01, 0x0A, 0x02, 0x00, 0x00);
+    ANSWER(0x60, 0x00, 0x14, 0x01, 0, 0, 0, 0);
+    expect_resolved(__LINE__);
+    RX0(6000, 0x20A, 0x18, 0xFC, 0x00, 0x01, 0x00, 0x00, 0x00);
+    EQ(rx_vars[2], 0xFC18); /* -1000 */
+    EQ(rx_vars[3], 0);
+    EQ(rx_vars[4], 1);
+    EQ(rx_vars[6], 5);
+    EQ(written[2], 6000);
+    EQ(written[6], URRT_CANTX_NEVER);
+    /* Its objects' ranges, not another's: 1001 and a BOOLEAN 2 refused. */
+    EQ(co.values_refused, 0);
+    RX0(7000, 0x20A, 0xE9, 0x03, 0x02, 0x07, 0x00, 0x00, 0x00);
+    EQ(rx_vars[2], 0xFC18);
+    EQ(rx_vars[3], 0);
+    EQ(rx_vars[4], 7);
+    EQ(co.values_refused, 2);
+    /* Its length: one byte short is not processed (an EMCY follows from the run). */
+    RX0(8000, 0x20A, 0x05, 0x00, 0x01, 0x09, 0x00, 0x00);
+    EQ(rx_vars[4], 7);
+    EQ(run(8000), 1);
+    EXPECT(0, 0x08A, 0x10, 0x82, 0x11, 0x00, 0x00, 0x01, 0x00, 0x00);
+    /* Switched off and on with a new id in the off write (python-canopen's
+     * way): resolved, received on the new id only. */
+    SDO(9000, 0x23, 0x00, 0x14, 0x01, 0x0B, 0x02, 0x00, 0x80);
+    ANSWER(0x60, 0x00, 0x14, 0x01, 0, 0, 0, 0);
+    scribble(&rpdo_states[0]);
+    SDO(9000, 0x23, 0x00, 0x14, 0x01, 0x0B, 0x02, 0x00, 0x00);
+    ANSWER(0x60, 0x00, 0x14, 0x01, 0, 0, 0, 0);
+    expect_resolved(__LINE__);
+    RX0(10000, 0x20A, 0x03, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00);
+    EQ(rx_vars[2], 0xFC18);
+    RX0(10000, 0x20B, 0x03, 0x00, 0x01, 0x0A, 0x00, 0x00, 0x00);
+    EQ(rx_vars[2], 3);
+    EQ(rx_vars[3], 1);
+    EQ(rx_vars[4], 10);
+    /* A write that leaves it valid (its type) resolves nothing again, and needs not. */
+    SDO(11000, 0x2F, 0x00, 0x14, 0x02, 0xFE, 0, 0, 0);
+    ANSWER(0x60, 0x00, 0x14, 0x02, 0, 0, 0, 0);
+    expect_resolved(__LINE__);
+    /* Reset communication: both resolved again with the defaults. */
+    scribble(&rpdo_states[0]);
+    scribble(&rpdo_states[1]);
+    nmt(0x82, NODE, 12000);
+    expect_resolved(__LINE__);
+    nmt(0x01, NODE, 13000);
+    RX0(14000, 0x30A, 0x9C, 0xAA, 0x10, 0x00); /* RPDO2, type 0: at the next SYNC; the dummy byte skipped */
+    EQ(rx(0x080, NULL, 0, 15000), 0);
+    EQ(rx_vars[5], 0x9C);
+    EQ(rx_vars[2], 0x10);
+    RX0(16000, 0x20A, 0x04, 0x00, 0x00, 0x0B, 0x00, 0x00, 0x00); /* RPDO1 back on 0x20A */
+    EQ(rx_vars[2], 4);
+    EQ(rx_vars[4], 11);
+    /* An object it could not resolve (one past the description's first 65535,
+     * as none here is): found by a scan at each frame, the same values. */
+    rpdo_states[0].mapped[0] = rpdo_states[0].mapped[2] = URRT_CO_UNRESOLVED;
+    RX0(17000, 0x20A, 0x18, 0xFC, 0x01, 0x0C, 0x00, 0x00, 0x00);
+    EQ(rx_vars[2], 0xFC18);
+    EQ(rx_vars[3], 1);
+    EQ(rx_vars[4], 12);
+    RX0(18000, 0x20A, 0x17, 0xFC, 0x00, 0x0D, 0x00, 0x00, 0x00); /* -1001: its own range still */
+    EQ(rx_vars[2], 0xFC18);
+    EQ(rx_vars[4], 13);
+    EQ(co.values_refused, 3);
+}
+
 /* ---- robustness ----------------------------------------------------------------------- */
 
 static bool state_known(void)
@@ -1898,6 +2009,7 @@ int main(void)
     test_consumer_heartbeat();
     test_consumer_write();
     test_rpdo_status();
+    test_rpdo_mapping_resolved();
     test_rx_robustness();
     return check_report();
 }

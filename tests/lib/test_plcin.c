@@ -236,6 +236,78 @@ static void test_schedule(void)
     CHECK(p.fresh && due(&d, &p, true, 1, t + 20000000, PERIOD_US), "the PLC writes again: due at once");
 }
 
+/* An input whose signals write its registers one each, in recipe order (the
+ * usual input, and any RPDO's: register k taken from signal k alone), and the
+ * same signals in another order (taken by a pass over all of them for each
+ * register): the same bytes, refusals, absences and changes, worked out by
+ * hand. A 40-bit identity signal (past 32 bits), a lone mask, a scaled value. */
+static const urrt_can_signal in_order[4] = {
+    /* big: 40 bits, signed, factor 1, -1000000..1000000 */
+    {.factor = 1, .offset = 0, .min = -1000000, .max = 1000000, .start = 0, .length = 40, .type = URRT_CAN_SIGNED},
+    /* start */
+    {.factor = 1, .offset = 0, .min = 0, .max = 1, .start = 40, .length = 1, .type = URRT_CAN_UNSIGNED},
+    /* mask: 8 bits, the word's bits 8-15 */
+    {.factor = 1, .offset = 0, .min = 0, .max = 255, .start = 48, .length = 8, .type = URRT_CAN_UNSIGNED,
+     .flags = URRT_CAN_SIG_MASK(8)},
+    /* speed: as signals[4] */
+    {.factor = 0.01, .offset = 0.5, .min = -100, .max = 200, .start = 0, .length = 16, .type = URRT_CAN_SIGNED},
+};
+static const urrt_can_signal out_of_order[4] = {in_order[3], in_order[2], in_order[1], in_order[0]};
+static const uint16_t out_of_order_vars[4] = {
+    URRT_RTDE_V_INPUT_DOUBLE_REGISTER + 30, URRT_RTDE_V_INPUT_BIT_REGISTERS32_TO_63,
+    URRT_RTDE_V_INPUT_BIT_REGISTER + 0, URRT_RTDE_V_INPUT_INT_REGISTER + 24,
+};
+
+static void test_register_order(void)
+{
+    static urrt_rtde_in in; /* 896 bytes: not on the Cortex-M0's small stack */
+    /* -10 (40 bits: 0xFFFFFFFFF6); 1; 0xA5 << 8; 100.5 */
+    static const uint8_t want[17] = {0xFF, 0xFF, 0xFF, 0xF6, 0x01, 0x00, 0x00, 0xA5, 0x00,
+                                     0x40, 0x59, 0x20, 0x00, 0x00, 0x00, 0x00, 0x00};
+    urrt_plcin_desc d = desc(URRT_PLCIN_STOP, 0);
+    urrt_plcin p;
+    unsigned pass;
+    d.signal_count = 4;
+    for (pass = 0; pass < 2; pass++) {
+        /* raws in signal order: big, start, mask, speed; or reversed */
+        uint64_t r[4] = {UINT64_C(0xFFFFFFFFF6), 1, 0xA5, 10000};
+        uint64_t raws[4];
+        unsigned big = pass == 0 ? 0 : 3, start = pass == 0 ? 1 : 2, mask = pass == 0 ? 2 : 1,
+                 speed = pass == 0 ? 3 : 0;
+        d.signals = pass == 0 ? in_order : out_of_order;
+        d.vars = pass == 0 ? regs : out_of_order_vars;
+        for (unsigned i = 0; i < 4; i++) {
+            raws[pass == 0 ? i : 3 - i] = r[i];
+        }
+        setup(&in, &p);
+        CHECK_EQ_INT(take(&d, &p, &in, raws, 0, 1000), 0);
+        CHECK(same(in.data, want, 17) && urrt_rtde_in_complete(&in), "pass %u: the four registers", pass);
+        CHECK(p.changed, "pass %u: the first values are news", pass);
+        sent(&p, true, 1, 1000);
+        CHECK_EQ_INT(take(&d, &p, &in, raws, 0, 2000), 0);
+        CHECK(!p.changed, "pass %u: the same values again: no change", pass);
+        raws[mask] = 0xA4; /* one bit of the mask */
+        CHECK_EQ_INT(take(&d, &p, &in, raws, 0, 3000), 0);
+        CHECK(p.changed && in.data[7] == 0xA4, "pass %u: one bit changed: news", pass);
+        sent(&p, true, 1, 3000);
+        raws[big] = 1000001;                    /* past max */
+        raws[speed] = (uint64_t)(uint16_t)-30000; /* below min */
+        CHECK_EQ_INT(take(&d, &p, &in, raws, 0, 4000), 2);
+        CHECK(!given(&in, 0) && given(&in, 1) && given(&in, 2) && !given(&in, 3) && p.changed,
+              "pass %u: the refused ones hold no value, and that is news", pass);
+        sent(&p, true, 1, 4000);
+        raws[big] = UINT64_C(0x8000000000); /* -2^39: below min */
+        CHECK_EQ_INT(take(&d, &p, &in, raws, 0, 5000), 2);
+        CHECK(!p.changed, "pass %u: refused again: no change", pass);
+        raws[big] = 1000000;
+        raws[speed] = 10000;
+        CHECK_EQ_INT(take(&d, &p, &in, raws, UINT64_C(1) << start, 6000), 0); /* start absent: not counted */
+        CHECK(given(&in, 0) && !given(&in, 1) && given(&in, 3), "pass %u: an absent signal's register: none", pass);
+        CHECK(in.data[0] == 0x00 && in.data[1] == 0x0F && in.data[2] == 0x42 && in.data[3] == 0x40,
+              "pass %u: 1000000 = 0x000F4240", pass);
+    }
+}
+
 static void test_hold_and_value(void)
 {
     urrt_plcin_desc hold = desc(URRT_PLCIN_HOLD, 0), value = desc(URRT_PLCIN_VALUE, 0);
@@ -388,6 +460,7 @@ int main(void)
     test_raws();
     test_values();
     test_schedule();
+    test_register_order();
     test_hold_and_value();
     test_node();
     {
