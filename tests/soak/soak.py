@@ -1058,7 +1058,7 @@ def main():
     rt = subprocess.run(["chrt", "-f", "1", "true"], capture_output=True).returncode == 0
     args.sim_rt = ["--rt-priority", str(RT_PRIORITY)] if rt else []
     args.checker_rt = ["chrt", "-f", str(RT_PRIORITY)] if rt else []
-    print("soak: simulator and checker %s" % ("under SCHED_FIFO %d" % RT_PRIORITY if rt else
+    print("soak: simulators and checkers %s" % ("under SCHED_FIFO %d" % RT_PRIORITY if rt else
           "at normal priority (no CAP_SYS_NICE): their own delays count as the gateway's"))
     signal.signal(signal.SIGTERM, on_signal)
     signal.signal(signal.SIGHUP, on_signal)

@@ -318,8 +318,10 @@ class Sim:
             self.proc = None
 
 
-def config_frames(port, t0):
-    return """[robot armf]
+def robot_can(name, port, can_extra):
+    """Both gateways' robot (RTDE through its proxy, the VM's wide bounds), no LCM
+    messages, and [can] on vcan0."""
+    return """[robot {name}]
 host = 127.0.0.1
 port = {port}
 source = rtde
@@ -338,10 +340,14 @@ gateway_rate = off
 
 [can]
 interface = vcan0
-heartbeat_id = 0x7F0
+{can_extra}
 stale_after_ms = {bound}
 inputs_min_rate = {rate} Hz
+""".format(name=name, port=port, hz=RTDE_HZ, silence=SILENCE, can_extra=can_extra, bound=BOUND_MS, rate=MIN_RATE_HZ)
 
+
+def config_frames(port, t0):
+    return robot_can("armf", port, "heartbeat_id = 0x7F0") + """
 [input plc_frames]
 id = 0x{fin:X}
 timeout_ms = {timeout}
@@ -355,33 +361,11 @@ period_ms = 40
 signal = time @0|32 intel unsigned factor=0.001 offset={t0} name=time_ms
 signal = {reg} @32|24 intel unsigned name=echo
 validity_bit = 63
-""".format(port=port, hz=RTDE_HZ, silence=SILENCE, bound=BOUND_MS, rate=MIN_RATE_HZ, fin=FRAME_IN,
-           timeout=TIMEOUT_MS, reg=REG_A, clock=CLOCK_A, t0=t0)
+""".format(fin=FRAME_IN, timeout=TIMEOUT_MS, reg=REG_A, clock=CLOCK_A, t0=t0)
 
 
 def config_canopen(port, t0):
-    return """[robot armc]
-host = 127.0.0.1
-port = {port}
-source = rtde
-rtde_frequency = {hz} Hz
-silence_timeout = {silence}
-backoff_initial = 50 ms
-backoff_max = 500 ms
-
-[lcm]
-url = udpm://239.255.76.67:7667?ttl=0
-state_rate = off
-joints_rate = off
-tool_rate = off
-status_rate = off
-gateway_rate = off
-
-[can]
-interface = vcan0
-stale_after_ms = {bound}
-inputs_min_rate = {rate} Hz
-
+    return robot_can("armc", port, "") + """
 [canopen]
 node_id = {node}
 heartbeat_ms = 100
@@ -398,8 +382,7 @@ stale_policy = invalid
 signal = time @0|32 intel unsigned factor=0.001 offset={t0} name=time_ms
 signal = {reg} @32|16 intel unsigned name=echo
 validity_bit = 56
-""".format(port=port, hz=RTDE_HZ, silence=SILENCE, bound=BOUND_MS, rate=MIN_RATE_HZ, node=NODE,
-           timeout=TIMEOUT_MS, reg=REG_B, t0=t0)
+""".format(node=NODE, timeout=TIMEOUT_MS, reg=REG_B, t0=t0)
 
 
 def proc_sample(pid):
