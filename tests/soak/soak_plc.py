@@ -188,30 +188,22 @@ class Proxy(threading.Thread):
             return
         with self.lock:
             self.conns.append(conn)
-        a, b = b"", b""
+        # Each direction: (from, to, bytes of an unfinished package, what records a package).
+        ways = [[client, up, b"", conn.from_gateway], [up, client, b"", conn.from_controller]]
         try:
             while True:
                 r, _, _ = select.select([client, up], [], [], 1.0)
                 t = time.time()
-                if client in r:
-                    data = client.recv(65536)
+                for way in (w for w in ways if w[0] in r):
+                    data = way[0].recv(65536)
                     if not data:
-                        break
-                    up.sendall(data)
-                    pk, a = packages(a + data)
+                        raise EOFError
+                    way[1].sendall(data)
+                    pk, way[2] = packages(way[2] + data)
                     with self.lock:
                         for k, p in pk:
-                            conn.from_gateway(k, p, t)
-                if up in r:
-                    data = up.recv(65536)
-                    if not data:
-                        break
-                    client.sendall(data)
-                    pk, b = packages(b + data)
-                    with self.lock:
-                        for k, p in pk:
-                            conn.from_controller(k, p, t)
-        except OSError:
+                            way[3](k, p, t)
+        except (OSError, EOFError):     # either side closed or reset
             pass
         conn.closed = time.time()
         client.close()
